@@ -1,0 +1,23 @@
+# Two commands for a new user: `make demo` and `make test` (both set up .venv on first use).
+VENV := .venv
+STAMP := $(VENV)/.installed
+PYTEST_ARGS ?=
+
+.PHONY: demo test lint setup clean
+
+$(STAMP): pyproject.toml tools/setup_venv.sh
+	bash tools/setup_venv.sh
+
+setup: $(STAMP)
+
+demo: $(STAMP)
+	$(VENV)/bin/wheelrail run
+
+test: $(STAMP)
+	$(VENV)/bin/python -m pytest -q $(PYTEST_ARGS)
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .
+
+clean:
+	rm -rf $(VENV) out .pytest_cache

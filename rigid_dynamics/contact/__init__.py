@@ -1,0 +1,1 @@
+"""rigid_dynamics/contact."""

@@ -1,0 +1,82 @@
+"""One interface and one registry for the contact models.
+
+Every model solves one patch::
+
+    model.solve(geometry, creepage, material, normal_force_N=None, options=None) -> ContactResult
+
+``normal_force_N=None`` means approach control (``geometry.approach_m`` is imposed); a number
+means force control. ``options`` is a mapping of model-specific settings (grid size, ...);
+an unknown option raises ``ValueError`` naming it.
+
+Models are registered by name as ``"module:Class"`` strings and imported only when asked
+for, so asking for ``hertz`` never imports the BEM, and nothing of FEniCSx is imported unless
+``fea`` is used. (``fea`` lives in the top-level ``fea`` package, above rigid_dynamics; the
+registry names it but never imports it on its own.)
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Mapping
+from typing import Protocol, runtime_checkable
+
+from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
+from rigid_dynamics.materials import Material
+
+
+@runtime_checkable
+class ContactModel(Protocol):
+    """What every contact model provides."""
+
+    name: str
+    description: str
+
+    def solve(
+        self,
+        geometry: ContactGeometry,
+        creepage: Creepage,
+        material: Material,
+        *,
+        normal_force_N: float | None = None,
+        options: Mapping | None = None,
+    ) -> ContactResult: ...
+
+
+MODELS: dict[str, tuple[str, str]] = {
+    "hertz": ("rigid_dynamics.contact.models:HertzModel", "Hertz normal contact only; creep forces 0"),
+    "linear": ("rigid_dynamics.contact.models:LinearModel", "Hertz + Kalker's linear theory (full adhesion)"),
+    "vermeulen-johnson": (
+        "rigid_dynamics.contact.models:VermeulenJohnsonModel",
+        "Hertz + Vermeulen-Johnson saturation (no spin)",
+    ),
+    "fastsim": ("rigid_dynamics.contact.models:FastsimModel", "Hertz + Kalker's FASTSIM (simplified theory)"),
+    "bem": ("rigid_dynamics.contact.bem.model:BemModel", "boundary elements: CONTACT-style NORM + TANG"),
+    "fea": ("fea.model:FeaModel", "finite elements (FEniCSx): normal contact, subsurface stresses"),
+    "auto": ("rigid_dynamics.contact.models:AutoModel", "cheapest model meeting the tolerance for the patch"),
+}
+"""name -> ("module:Class", one-line description)."""
+
+
+def model_names() -> list[str]:
+    """Registered model names, in order of rising cost."""
+    return list(MODELS)
+
+
+def get_model(name: str | ContactModel, **kwargs) -> ContactModel:
+    """Return an instance of the model registered as ``name`` (or ``name`` itself if it is a model).
+
+    Raises:
+        ValueError: unknown name (the message lists the choices).
+        ImportError: the model's optional dependencies are missing (the message names them).
+    """
+    if not isinstance(name, str):
+        if isinstance(name, ContactModel):
+            return name
+        raise ValueError(f"contact model = {name!r}: expected a name or a ContactModel")
+    try:
+        target, _ = MODELS[name]
+    except KeyError:
+        raise ValueError(f"contact model = {name!r}: expected one of {', '.join(MODELS)}") from None
+    module_name, class_name = target.split(":")
+    module = importlib.import_module(module_name)
+    return getattr(module, class_name)(**kwargs)

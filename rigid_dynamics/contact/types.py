@@ -1,0 +1,206 @@
+"""Data passed between contact search, contact models and the wheelset.
+
+Frames and signs (used by every contact model):
+
+* The *contact frame* of a patch has x along the rolling direction, y lateral in the
+  tangent plane and z the common normal pointing from the rail into the wheel.
+  (``ContactGeometry.frame`` holds its axes as columns in the main track frame.)
+* The undeformed distance between the bodies near the patch is
+  ``h(x, y) = A x^2 + B y^2 - approach`` for an elliptic (Hertzian) patch, A, B in 1/m;
+  in general it is sampled on a grid (:class:`UndeformedDistance`).
+* Creep forces and the spin moment act **on the wheel**, in the contact frame, and oppose
+  the wheel's creepage (seed eq 50-52, Kalker 1990): positive longitudinal creepage gives a
+  negative longitudinal force.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Creepage:
+    """Rigid creepages of the wheel over the rail, in the contact frame.
+
+    Attributes:
+        longitudinal: xi = (v_wheel,x - v_rail,x)/V, dimensionless.
+        lateral: eta, dimensionless.
+        spin_1_per_m: phi = omega_z / V, 1/m.
+        rolling_speed_m_per_s: V, magnitude of the rolling velocity, m/s (> 0).
+    """
+
+    longitudinal: float = 0.0
+    lateral: float = 0.0
+    spin_1_per_m: float = 0.0
+    rolling_speed_m_per_s: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("longitudinal", "lateral", "spin_1_per_m", "rolling_speed_m_per_s"):
+            value = getattr(self, name)
+            if not math.isfinite(value):
+                raise ValueError(f"{name} = {value!r}: expected a finite number")
+        if self.rolling_speed_m_per_s <= 0:
+            raise ValueError(f"rolling_speed_m_per_s = {self.rolling_speed_m_per_s!r}: expected > 0")
+
+
+@dataclass(frozen=True, eq=False)
+class UndeformedDistance:
+    """Undeformed distance between wheel and rail on a regular grid of the contact plane.
+
+    ``distance_m[j, i]`` is the gap at ``(x_m[i], y_m[j])`` with the bodies at their rigid
+    approach, i.e. ``h(x, y) - approach`` in the notation of the module docstring: negative
+    where the undeformed surfaces overlap. x along rolling, y lateral (contact frame), m.
+    Points where the local surfaces are not defined (off the profile) hold +inf.
+    """
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    distance_m: np.ndarray
+
+    def __post_init__(self) -> None:
+        nx, ny = len(self.x_m), len(self.y_m)
+        if self.distance_m.shape != (ny, nx):
+            raise ValueError(f"distance_m has shape {self.distance_m.shape}: expected (len(y_m), len(x_m)) = {(ny, nx)}")
+
+    def evaluate(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+        """Bilinear interpolation of the gap at arbitrary points (+inf outside the grid)."""
+        from scipy.interpolate import RegularGridInterpolator
+
+        interp = RegularGridInterpolator(
+            (self.y_m, self.x_m), self.distance_m, bounds_error=False, fill_value=np.inf
+        )
+        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        return interp(np.stack([y_m.ravel(), x_m.ravel()], axis=-1)).reshape(x_m.shape)
+
+
+@dataclass(frozen=True, eq=False)
+class ContactGeometry:
+    """Geometry of one contact patch, as the contact search or a quadric case gives it.
+
+    Attributes:
+        curvature_long_1_per_m: A, relative curvature term along x (h = A x^2 + B y^2 - q), 1/m.
+            A = 1/(2 R_long) for relative radius of curvature R_long.
+        curvature_lat_1_per_m: B, the same along y, 1/m.
+        approach_m: q, rigid approach (interpenetration) of the undeformed bodies, m; > 0 in contact.
+        side: "left", "right" or "" (a single patch of a quadric case).
+        point_m: contact point in the main track frame (x, y, z), m.
+        frame: 3x3 matrix, columns = contact-frame axes (x rolling, y lateral, z normal from rail
+            into wheel) in the main track frame.
+        contact_angle_rad: angle of the normal to the track's vertical, positive when the normal
+            tilts towards the track centre... for a flange contact on either side it is large and
+            positive. 0 for quadric cases.
+        contact_point_rail_m: (y, z) of the contact point in rail-profile coordinates, m.
+        contact_point_wheel_m: (y, z) of the contact point in wheel-profile coordinates, m.
+        rolling_radius_m: wheel radius at the contact point, m (nan for quadric cases).
+        ellipse_angle_rad: angle from the rolling direction (x) to the principal direction of A, rad.
+        undeformed: sampled gap field for non-Hertzian solvers, or None (then the quadric form holds).
+        is_elliptic: whether the local gap is well described by the quadric form (Hertz valid).
+    """
+
+    curvature_long_1_per_m: float
+    curvature_lat_1_per_m: float
+    approach_m: float = 0.0
+    side: str = ""
+    point_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    frame: np.ndarray = field(default_factory=lambda: np.eye(3))
+    contact_angle_rad: float = 0.0
+    contact_point_rail_m: tuple[float, float] = (math.nan, math.nan)
+    contact_point_wheel_m: tuple[float, float] = (math.nan, math.nan)
+    rolling_radius_m: float = math.nan
+    ellipse_angle_rad: float = 0.0
+    undeformed: UndeformedDistance | None = None
+    is_elliptic: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("curvature_long_1_per_m", "curvature_lat_1_per_m", "approach_m"):
+            value = getattr(self, name)
+            if not math.isfinite(value):
+                raise ValueError(f"{name} = {value!r}: expected a finite number")
+        if self.curvature_long_1_per_m <= 0 or self.curvature_lat_1_per_m <= 0:
+            raise ValueError(
+                f"relative curvatures A = {self.curvature_long_1_per_m!r}, B = {self.curvature_lat_1_per_m!r} 1/m: "
+                "expected both > 0 (the bodies must be locally convex against each other)"
+            )
+
+    @classmethod
+    def quadric(cls, radius_long_m: float, radius_lat_m: float, approach_m: float = 0.0) -> ContactGeometry:
+        """Patch of two quadric bodies with relative radii of curvature R_long (along x), R_lat (along y)."""
+        for name, value in (("radius_long_m", radius_long_m), ("radius_lat_m", radius_lat_m)):
+            if not math.isfinite(value) or value <= 0:
+                raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+        return cls(0.5 / radius_long_m, 0.5 / radius_lat_m, approach_m)
+
+    def gap_m(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+        """Undeformed gap h(x, y) - q at points of the contact plane (sampled field if present), m."""
+        if self.undeformed is not None:
+            return self.undeformed.evaluate(x_m, y_m)
+        return self.curvature_long_1_per_m * np.square(x_m) + self.curvature_lat_1_per_m * np.square(y_m) - self.approach_m
+
+
+@dataclass(frozen=True, eq=False)
+class ContactFields:
+    """Surface fields of a solved patch on a regular grid of the contact plane (contact frame).
+
+    ``pressure_Pa[j, i]`` etc. at ``(x_m[i], y_m[j])``. Tractions act on the wheel.
+    ``slip_m_per_s`` holds the magnitude of the local slip velocity (0 in adhesion);
+    ``in_contact`` and ``in_slip`` are boolean masks. Fields a model does not produce are None.
+    """
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    pressure_Pa: np.ndarray
+    traction_long_Pa: np.ndarray | None = None
+    traction_lat_Pa: np.ndarray | None = None
+    slip_m_per_s: np.ndarray | None = None
+    in_contact: np.ndarray | None = None
+    in_slip: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class ContactResult:
+    """Solution of one contact patch by one model.
+
+    Forces act on the wheel, in the contact frame (x rolling, y lateral, z normal).
+    Quantities a model does not compute are None (e.g. creep forces of ``hertz``, semi-axes
+    of a non-elliptic patch). When ``success`` is False, ``status`` and ``message`` say why and
+    the numbers are the last iterate, not a solution.
+
+    Attributes:
+        method: registered model name.
+        success: True when the solver converged.
+        status: "ok", "not-converged", "no-contact", "invalid-input", ...
+        message: human-readable explanation.
+        normal_force_N, creep_force_long_N, creep_force_lat_N: N.
+        spin_moment_Nm: moment about the normal, N m.
+        max_pressure_Pa: Pa.
+        semi_axis_long_m, semi_axis_lat_m: semi-axes along x and y of an elliptic patch, m.
+        contact_area_m2: m^2.
+        approach_m: rigid approach q, m.
+        creepage: the creepages solved for.
+        fields: optional surface fields.
+        iterations, residual, wall_time_s: solver diagnostics.
+        extra: further model-specific diagnostics (JSON-serialisable values).
+    """
+
+    method: str
+    success: bool
+    status: str
+    message: str
+    normal_force_N: float
+    creep_force_long_N: float | None = None
+    creep_force_lat_N: float | None = None
+    spin_moment_Nm: float | None = None
+    max_pressure_Pa: float | None = None
+    semi_axis_long_m: float | None = None
+    semi_axis_lat_m: float | None = None
+    contact_area_m2: float | None = None
+    approach_m: float | None = None
+    creepage: Creepage | None = None
+    fields: ContactFields | None = None
+    iterations: int = 0
+    residual: float = 0.0
+    wall_time_s: float = 0.0
+    extra: dict = field(default_factory=dict)
