@@ -63,15 +63,15 @@ class UndeformedDistance:
     def __post_init__(self) -> None:
         nx, ny = len(self.x_m), len(self.y_m)
         if self.distance_m.shape != (ny, nx):
-            raise ValueError(f"distance_m has shape {self.distance_m.shape}: expected (len(y_m), len(x_m)) = {(ny, nx)}")
+            raise ValueError(
+                f"distance_m has shape {self.distance_m.shape}: expected (len(y_m), len(x_m)) = {(ny, nx)}"
+            )
 
     def evaluate(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
         """Bilinear interpolation of the gap at arbitrary points (+inf outside the grid)."""
         from scipy.interpolate import RegularGridInterpolator
 
-        interp = RegularGridInterpolator(
-            (self.y_m, self.x_m), self.distance_m, bounds_error=False, fill_value=np.inf
-        )
+        interp = RegularGridInterpolator((self.y_m, self.x_m), self.distance_m, bounds_error=False, fill_value=np.inf)
         x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
         return interp(np.stack([y_m.ravel(), x_m.ravel()], axis=-1)).reshape(x_m.shape)
 
@@ -137,7 +137,9 @@ class ContactGeometry:
         """Undeformed gap h(x, y) - q at points of the contact plane (sampled field if present), m."""
         if self.undeformed is not None:
             return self.undeformed.evaluate(x_m, y_m)
-        return self.curvature_long_1_per_m * np.square(x_m) + self.curvature_lat_1_per_m * np.square(y_m) - self.approach_m
+        return (
+            self.curvature_long_1_per_m * np.square(x_m) + self.curvature_lat_1_per_m * np.square(y_m) - self.approach_m
+        )
 
 
 @dataclass(frozen=True, eq=False)
