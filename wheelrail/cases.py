@@ -1,0 +1,275 @@
+"""Contact-case files (``wheelrail contact CASE.toml``): reading, validation, solving, JSON.
+
+A case file has the tables
+
+* ``[material]``: ``shear_modulus_Pa`` or ``young_modulus_Pa``, ``poisson_ratio``, ``friction_coefficient``;
+* ``[geometry]``: ``kind = "quadric"`` with ``radius_long_m``, ``radius_lat_m`` (relative radii of
+  curvature, h = x^2/(2 R_long) + y^2/(2 R_lat)); or ``kind = "wheelset"`` with ``wheel_profile``,
+  ``rail_profile``, ``lateral_shift_m``, ``yaw_rad``, ``gauge_m``, ``gauge_height_m``,
+  ``flange_back_distance_m``, ``nominal_radius_m``, ``rail_inclination_rad``;
+* ``[loading]``: ``normal_force_N`` (quadric) or ``wheel_load_N`` (wheelset), or ``approach_m``;
+* ``[kinematics]``: ``creepage_long``, ``creepage_lat``, ``spin_creepage_1_per_m``,
+  ``rolling_speed_m_per_s`` (quadric); a wheelset case takes only ``rolling_speed_m_per_s`` and
+  derives the creepages from its yaw and geometry;
+* ``[solver]``: options of the contact model (passed through; the model rejects unknown ones).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
+from rigid_dynamics.materials import Material
+from wheelrail.config import ConfigError, check_keys, get_number, get_table, read_toml
+
+TOP_LEVEL_TABLES = {"name", "description", "material", "geometry", "loading", "kinematics", "solver"}
+QUADRIC_GEOMETRY_KEYS = {"kind", "radius_long_m", "radius_lat_m"}
+WHEELSET_GEOMETRY_KEYS = {
+    "kind",
+    "wheel_profile",
+    "rail_profile",
+    "lateral_shift_m",
+    "yaw_rad",
+    "gauge_m",
+    "gauge_height_m",
+    "flange_back_distance_m",
+    "nominal_radius_m",
+    "rail_inclination_rad",
+}
+QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
+
+
+@dataclass(frozen=True, eq=False)
+class ContactCase:
+    """A validated contact case.
+
+    Attributes:
+        kind: "quadric" or "wheelset".
+        material: elastic constants and friction.
+        geometry: the single patch of a quadric case (None for a wheelset case).
+        creepage: creepages of a quadric case (None for a wheelset case).
+        normal_force_N: imposed normal force (quadric), or None for approach control.
+        wheelset: the ``WheelsetCase`` of a wheelset case (None for a quadric case).
+        solver_options: options passed to the contact model.
+        name: case name (file stem unless given).
+    """
+
+    kind: str
+    material: Material
+    geometry: ContactGeometry | None = None
+    creepage: Creepage | None = None
+    normal_force_N: float | None = None
+    wheelset: Any = None
+    solver_options: dict = field(default_factory=dict)
+    name: str = ""
+
+
+def read_material(table: dict, prefix: str = "material") -> Material:
+    """[material] -> Material. Exactly one of shear_modulus_Pa and young_modulus_Pa."""
+    check_keys(table, {"shear_modulus_Pa", "young_modulus_Pa", "poisson_ratio", "friction_coefficient"}, prefix)
+    has_g, has_e = "shear_modulus_Pa" in table, "young_modulus_Pa" in table
+    if has_g == has_e:
+        raise ConfigError(
+            f"table [{prefix}]: expected exactly one of 'shear_modulus_Pa' and 'young_modulus_Pa'"
+            f" (found {'both' if has_g else 'neither'})"
+        )
+    nu = get_number(table, "poisson_ratio", prefix)
+    if not -1.0 < nu < 0.5:
+        raise ConfigError(f"key '{prefix}.poisson_ratio' = {nu!r}: expected a value in (-1, 0.5)")
+    mu = get_number(table, "friction_coefficient", prefix)
+    if mu < 0:
+        raise ConfigError(f"key '{prefix}.friction_coefficient' = {mu!r}: expected a number >= 0")
+    if has_g:
+        return Material(get_number(table, "shear_modulus_Pa", prefix, positive=True), nu, mu)
+    return Material.from_young(get_number(table, "young_modulus_Pa", prefix, positive=True), nu, mu)
+
+
+def _read_loading(table: dict, force_key: str) -> tuple[float | None, float | None]:
+    check_keys(table, {force_key, "approach_m"}, "loading")
+    if (force_key in table) == ("approach_m" in table):
+        raise ConfigError(f"table [loading]: expected exactly one of {force_key!r} and 'approach_m'")
+    if force_key in table:
+        return get_number(table, force_key, "loading", positive=True), None
+    return None, get_number(table, "approach_m", "loading")
+
+
+def _read_solver(table: dict) -> dict:
+    for key, value in table.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ConfigError(f"key 'solver.{key}' = {value!r}: expected a finite number")
+    return dict(table)
+
+
+def parse_case(doc: dict, name: str = "") -> ContactCase:
+    """Validate a parsed case document into a ContactCase (ConfigError on any problem)."""
+    check_keys(doc, TOP_LEVEL_TABLES, "")
+    material = read_material(get_table(doc, "material"))
+    geometry_table = get_table(doc, "geometry")
+    kinematics = get_table(doc, "kinematics", required=False)
+    solver = _read_solver(get_table(doc, "solver", required=False))
+    name = str(doc.get("name", name))
+    kind = geometry_table.get("kind")
+    if kind == "quadric":
+        check_keys(geometry_table, QUADRIC_GEOMETRY_KEYS, "geometry")
+        radius_long = get_number(geometry_table, "radius_long_m", "geometry", positive=True)
+        radius_lat = get_number(geometry_table, "radius_lat_m", "geometry", positive=True)
+        force, approach = _read_loading(get_table(doc, "loading"), "normal_force_N")
+        check_keys(kinematics, QUADRIC_KINEMATICS_KEYS, "kinematics")
+        creepage = Creepage(
+            get_number(kinematics, "creepage_long", "kinematics", default=0.0),
+            get_number(kinematics, "creepage_lat", "kinematics", default=0.0),
+            get_number(kinematics, "spin_creepage_1_per_m", "kinematics", default=0.0),
+            get_number(kinematics, "rolling_speed_m_per_s", "kinematics", positive=True, default=1.0),
+        )
+        geometry = ContactGeometry.quadric(radius_long, radius_lat, approach if approach is not None else 0.0)
+        return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
+    if kind == "wheelset":
+        check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
+        check_keys(kinematics, {"rolling_speed_m_per_s"}, "kinematics")
+        force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
+        wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics)
+        return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
+    raise ConfigError(f"key 'geometry.kind' = {kind!r}: expected 'quadric' or 'wheelset'")
+
+
+def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: dict):
+    from rigid_dynamics.contact.wheelset_case import WheelsetCase
+    from rigid_dynamics.geometry import load_profile
+    from wheelrail.config import build_dataclass
+
+    table = {k: v for k, v in geometry.items() if k != "kind"}
+    if wheel_load_N is not None:
+        table["wheel_load_N"] = wheel_load_N
+    if approach_m is not None:
+        table["approach_m"] = approach_m
+    if "rolling_speed_m_per_s" in kinematics:
+        table["rolling_speed_m_per_s"] = kinematics["rolling_speed_m_per_s"]
+    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail")):
+        if key not in table:
+            raise ConfigError(f"missing key 'geometry.{key}': expected a built-in profile name or a file path")
+        value = table[key]
+        if not isinstance(value, str):
+            raise ConfigError(f"key 'geometry.{key}' = {value!r}: expected a built-in profile name or a file path")
+        try:
+            load_profile(value, kind)
+        except ValueError as exc:
+            raise ConfigError(f"key 'geometry.{key}' = {value!r}: {exc}") from None
+    return build_dataclass(WheelsetCase, table, "geometry")
+
+
+def load_case(path: str | Path) -> ContactCase:
+    """Read and validate a case file (an embedded case name is accepted too)."""
+    path = resolve_case_path(path)
+    return parse_case(read_toml(path, "case file"), name=Path(path).stem)
+
+
+CASES_DIR = Path(__file__).parent / "cases"
+
+
+def embedded_cases() -> dict[str, Path]:
+    """Embedded contact cases: name -> path."""
+    return {p.stem: p for p in sorted(CASES_DIR.glob("*.toml"))}
+
+
+def resolve_case_path(path: str | Path) -> Path:
+    """A file path, or the path of an embedded case of that name."""
+    candidate = Path(path)
+    if candidate.exists() or candidate.suffix:
+        return candidate
+    cases = embedded_cases()
+    if str(path) in cases:
+        return cases[str(path)]
+    raise ConfigError(
+        f"case {str(path)!r}: no such file and no embedded case of that name (embedded: {', '.join(cases)})"
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class CaseSolution:
+    """What one contact-case run produced: per patch (side, geometry, creepage, result)."""
+
+    method: str
+    success: bool
+    message: str
+    wall_time_s: float
+    patches: list = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
+
+
+def solve_case(case: ContactCase, method: str) -> CaseSolution:
+    """Solve a validated case with the contact model ``method``."""
+    from rigid_dynamics.contact.registry import get_model
+
+    start = time.perf_counter()
+    if case.kind == "quadric":
+        model = get_model(method)
+        result = model.solve(
+            case.geometry, case.creepage, case.material, normal_force_N=case.normal_force_N, options=case.solver_options
+        )
+        return CaseSolution(
+            method,
+            result.success,
+            result.message,
+            time.perf_counter() - start,
+            [("single", case.geometry, case.creepage, result)],
+        )
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options)
+    patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
+    extra = {
+        k: v
+        for k, v in ((f.name, getattr(solution, f.name)) for f in dataclasses.fields(solution))
+        if isinstance(v, (int, float, str, bool)) and k not in ("success", "message", "status", "wall_time_s")
+    }
+    return CaseSolution(method, solution.success, solution.message, time.perf_counter() - start, patches, extra)
+
+
+def _number(value) -> float | None:
+    if value is None:
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def patch_record(side: str, geometry: ContactGeometry, creepage: Creepage | None, result: ContactResult) -> dict:
+    """The JSON record of one patch (the contract of ``wheelrail contact --json``)."""
+    rail_point = geometry.contact_point_rail_m
+    rail_point = [float(v) for v in rail_point] if all(math.isfinite(v) for v in rail_point) else None
+    creepage = creepage or result.creepage
+    return {
+        "side": side,
+        "success": bool(result.success),
+        "status": result.status,
+        "normal_force_N": _number(result.normal_force_N),
+        "creep_force_long_N": _number(result.creep_force_long_N),
+        "creep_force_lat_N": _number(result.creep_force_lat_N),
+        "spin_moment_Nm": _number(result.spin_moment_Nm),
+        "max_pressure_Pa": _number(result.max_pressure_Pa),
+        "semi_axis_long_m": _number(result.semi_axis_long_m),
+        "semi_axis_lat_m": _number(result.semi_axis_lat_m),
+        "contact_area_m2": _number(result.contact_area_m2),
+        "approach_m": _number(result.approach_m),
+        "contact_angle_rad": _number(geometry.contact_angle_rad),
+        "contact_point_rail_m": rail_point,
+        "creepage_long": _number(creepage.longitudinal) if creepage else None,
+        "creepage_lat": _number(creepage.lateral) if creepage else None,
+        "spin_creepage_1_per_m": _number(creepage.spin_1_per_m) if creepage else None,
+    }
+
+
+def solution_record(solution: CaseSolution) -> dict:
+    """The JSON object printed by ``wheelrail contact --json``."""
+    return {
+        "method": solution.method,
+        "success": bool(solution.success),
+        "message": solution.message,
+        "wall_time_s": solution.wall_time_s,
+        "patches": [patch_record(*p) for p in solution.patches],
+        **({"case": solution.extra} if solution.extra else {}),
+    }

@@ -1,0 +1,187 @@
+"""Turn TOML tables into the frozen dataclasses of rigid_dynamics, with messages that name the key.
+
+The mapping is generic: a TOML table fills a dataclass field by field. Accepted field types are
+float, int, str, bool, tuples of those, ``X | None`` and nested frozen dataclasses (a sub-table).
+Every problem becomes one :class:`ConfigError` naming the dotted key, the value and what was
+expected; validation errors raised by a dataclass's ``__post_init__`` are re-raised with the
+key path of the table they came from.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import types
+import typing
+from pathlib import Path
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """A scene or case file is invalid. The message names the key, the value and what was expected."""
+
+
+def read_toml(path: str | Path, what: str = "file") -> dict:
+    """Read a TOML file, turning I/O and syntax errors into ConfigError."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"{what} {str(path)!r}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{what} {str(path)!r}: cannot be read ({exc})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{what} {str(path)!r}: not valid TOML ({exc})") from None
+
+
+def _key(prefix: str, name: str) -> str:
+    return f"{prefix}.{name}" if prefix else name
+
+
+def _type_name(tp: Any) -> str:
+    if tp is float:
+        return "a finite number"
+    if tp is int:
+        return "an integer"
+    if tp is str:
+        return "a string"
+    if tp is bool:
+        return "true or false"
+    if dataclasses.is_dataclass(tp):
+        return f"a table ({tp.__name__})"
+    origin = typing.get_origin(tp)
+    if origin is tuple:
+        args = typing.get_args(tp)
+        inner = args[0] if args else Any
+        return f"a list of {_type_name(inner).removeprefix('a ').removeprefix('an ')}s"
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join("nothing (omit the key)" if a is type(None) else _type_name(a) for a in typing.get_args(tp))
+    if origin is typing.Literal:
+        return "one of " + ", ".join(repr(a) for a in typing.get_args(tp))
+    return str(tp)
+
+
+def convert_value(value: Any, tp: Any, key: str) -> Any:
+    """Check and convert one TOML value to the annotated type ``tp``; ConfigError names ``key``."""
+    origin = typing.get_origin(tp)
+    if tp is Any:
+        return value
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(tp)
+        errors = []
+        for arg in args:
+            if arg is type(None):
+                continue
+            try:
+                return convert_value(value, arg, key)
+            except ConfigError as exc:
+                errors.append(exc)
+        if len(errors) == 1:
+            raise errors[0]
+        raise ConfigError(f"key {key!r} = {value!r}: expected {_type_name(tp)}")
+    if origin is typing.Literal:
+        if value not in typing.get_args(tp):
+            raise ConfigError(f"key {key!r} = {value!r}: expected {_type_name(tp)}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"key {key!r} = {value!r}: expected a finite number")
+        if not math.isfinite(value):
+            raise ConfigError(f"key {key!r} = {value!r}: expected a finite number")
+        return float(value)
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"key {key!r} = {value!r}: expected an integer")
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"key {key!r} = {value!r}: expected a string")
+        return value
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"key {key!r} = {value!r}: expected true or false")
+        return value
+    if origin is tuple:
+        if not isinstance(value, list):
+            raise ConfigError(f"key {key!r} = {value!r}: expected {_type_name(tp)}")
+        args = typing.get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(convert_value(v, args[0], f"{key}[{i}]") for i, v in enumerate(value))
+        if len(args) != len(value):
+            raise ConfigError(f"key {key!r} = {value!r}: expected a list of {len(args)} values")
+        return tuple(convert_value(v, a, f"{key}[{i}]") for i, (v, a) in enumerate(zip(value, args, strict=True)))
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise ConfigError(f"key {key!r} = {value!r}: expected {_type_name(tp)}")
+        return build_dataclass(tp, value, key)
+    raise ConfigError(f"key {key!r}: unsupported field type {tp!r} (a wheelrail bug)")
+
+
+def build_dataclass(cls: type, table: dict, prefix: str = "") -> Any:
+    """Build the frozen dataclass ``cls`` from a TOML table, checking every key.
+
+    Raises:
+        ConfigError: unknown key, missing key, wrong type, non-finite number, or a validation
+            error of the dataclass itself (re-raised with the key path).
+    """
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    unknown = sorted(set(table) - set(fields))
+    if unknown:
+        where = f"in table [{prefix}]" if prefix else "at the top level"
+        raise ConfigError(
+            f"unknown key {_key(prefix, unknown[0])!r} {where}: expected one of {', '.join(sorted(fields))}"
+        )
+    kwargs = {}
+    for name, f in fields.items():
+        key = _key(prefix, name)
+        if name not in table:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise ConfigError(f"missing key {key!r}: expected {_type_name(hints[name])}")
+            continue
+        kwargs[name] = convert_value(table[name], hints[name], key)
+    try:
+        return cls(**kwargs)
+    except ConfigError:
+        raise
+    except (ValueError, TypeError) as exc:
+        where = f"[{prefix}] " if prefix else ""
+        raise ConfigError(f"{where}{exc}") from None
+
+
+def check_keys(table: dict, allowed: set[str] | dict, prefix: str) -> None:
+    """Raise ConfigError for a key of ``table`` not in ``allowed``."""
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        where = f"in table [{prefix}]" if prefix else "at the top level"
+        raise ConfigError(
+            f"unknown key {_key(prefix, unknown[0])!r} {where}: expected one of {', '.join(sorted(allowed))}"
+        )
+
+
+def get_table(doc: dict, name: str, required: bool = True) -> dict:
+    """Sub-table ``name`` of ``doc`` ({} if absent and not required)."""
+    if name not in doc:
+        if required:
+            raise ConfigError(f"missing table [{name}]")
+        return {}
+    value = doc[name]
+    if not isinstance(value, dict):
+        raise ConfigError(f"key {name!r} = {value!r}: expected a table [{name}]")
+    return value
+
+
+def get_number(table: dict, name: str, prefix: str, *, positive: bool = False, default: float | None = None) -> float:
+    """A finite number from ``table`` (ConfigError naming ``prefix.name`` otherwise)."""
+    key = _key(prefix, name)
+    if name not in table:
+        if default is not None:
+            return default
+        raise ConfigError(f"missing key {key!r}: expected a finite number")
+    value = convert_value(table[name], float, key)
+    if positive and value <= 0:
+        raise ConfigError(f"key {key!r} = {value!r}: expected a number > 0")
+    return value
