@@ -1,0 +1,451 @@
+"""3-D wheel-rail contact search on real geometry (seed eq 5-11) with every patch's local geometry (eq 12-33).
+
+For a wheelset pose (centre x_t, yaw psi, roll theta, spin angle phi) and one side, a grid of wheel points
+(alpha, y_d) is mapped to the main frame (eq 7-8: x_w = C_D x_d + x_t) with the wheel's outward unit normal
+n_w (eq 9; pointing out of the wheel, towards the rail). Eq 10-11 then ask for the distance h along the normal
+to the rail surface z = N(x, y):
+
+    f(h) = (x_w + h n_w)_z - N((x_w + h n_w)_x, (x_w + h n_w)_y) = 0,
+
+solved for all grid points at once by Newton's method (f'(h) = n_z - N_x n_x - N_y n_y). h > 0 is a gap,
+h < 0 an interpenetration (the rail's material is at z > N, the main z axis points down).
+
+Every local minimum of h(alpha, y_d) on the grid below ``candidate_gap_m`` is refined by a damped Newton
+iteration on (alpha, y_d) (gradient and Hessian of h by central differences of the vectorised distance
+function, all candidates at once). Minima that end in the same interpenetration region (h < 0 along the
+segment joining them) are merged, so tread and flange contact give two patches and one patch is never counted
+twice. At each patch:
+
+* normal n = -n_w (from the rail into the wheel), contact frame e_x = rolling direction (main x projected on the
+  contact plane, eq 39-43), e_y = n x e_x, e_z = n;
+* relative curvature D = (K_w - K_r)/2 (eq 33) from the wheel's and the rail's curvature tensors (curvature.py)
+  in (e_x, e_y), split into A, B and the ellipse angle;
+* approach q = -h_min (> 0 in contact); contact point = midpoint of the wheel point and its rail point;
+* contact angle: angle of n from the track's upward vertical, positive when n tilts towards the track centre
+  (large and positive at a flange contact on either side);
+* the undeformed distance sampled on a grid of the contact plane (gap along n between the two surfaces, minus
+  nothing: it is h(x, y) - q, negative where the undeformed bodies overlap) and the Hertz-validity test
+  ``is_elliptic`` (see :func:`ellipticity_error`).
+
+Surfaces are duck-typed (rigid_dynamics.geometry provides them): the wheel's ``evaluate(alpha, y_d)`` returns R
+and its first and second partial derivatives (R, R_a, R_y, R_aa, R_ay, R_yy) in the wheelset frame; the rail's
+``evaluate(x, y)`` returns (N, N_x, N_y, N_xx, N_xy, N_yy) in the main frame.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigid_dynamics.contact.curvature import curvature_tensor, principal_relative_curvature, relative_curvature
+from rigid_dynamics.contact.types import ContactGeometry, UndeformedDistance
+from rigid_dynamics.kinematics import wheelset_rotation
+
+SIDES = ("left", "right")
+
+DEFAULT_OPTIONS: dict = {
+    "alpha_half_range_rad": 0.10,  # grid of alpha around the lowest point
+    "alpha_points": 11,
+    "lateral_step_m": 1.0e-3,  # grid step along the axle
+    "candidate_gap_m": 2.0e-3,  # grid minima above this gap are not refined
+    "newton_iterations": 8,  # distance (eq 11)
+    "refine_iterations": 12,
+    "refine_tolerance_m": 1.0e-9,
+    "field": True,  # sample the undeformed distance
+    "field_points": 31,  # per direction
+    "field_scale": 1.6,  # half-size = field_scale x the rigid-overlap semi-axis sqrt(q/A), sqrt(q/B)
+    "field_min_half_size_m": 1.0e-3,
+    "ellipticity_tolerance": 0.15,
+    "rolling_direction": (1.0, 0.0, 0.0),  # eq 39: main x
+}
+
+
+@dataclass(frozen=True)
+class WheelsetPose:
+    """Position and orientation of the wheelset.
+
+    Attributes:
+        x_m, y_m, z_m: centre x_t in the main frame (z down; z ~ -r0 on the rails), m.
+        yaw_rad: psi. roll_rad: theta. spin_rad: phi (eq 1), rad.
+    """
+
+    x_m: float = 0.0
+    y_m: float = 0.0
+    z_m: float = 0.0
+    yaw_rad: float = 0.0
+    roll_rad: float = 0.0
+    spin_rad: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("x_m", "y_m", "z_m", "yaw_rad", "roll_rad", "spin_rad"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f"{name} = {value!r}: expected a finite number")
+
+    @property
+    def centre_m(self) -> np.ndarray:
+        return np.array([self.x_m, self.y_m, self.z_m])
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """C_D (eq 1)."""
+        return wheelset_rotation(self.yaw_rad, self.roll_rad, self.spin_rad)
+
+
+@dataclass(frozen=True, eq=False)
+class ContactCandidates:
+    """All refined local minima of h on one side (including those not in contact).
+
+    Attributes:
+        alpha_rad, lateral_m: wheel parameters (alpha, y_d) of each minimum, shape (k,).
+        gap_m: h at each minimum (negative: interpenetration), shape (k,).
+        converged: whether the refinement converged, shape (k,).
+    """
+
+    alpha_rad: np.ndarray
+    lateral_m: np.ndarray
+    gap_m: np.ndarray
+    converged: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class SideSearch:
+    """Contact search result of one side.
+
+    Attributes:
+        side: "left" or "right".
+        success, status, message: status "ok", "no-contact" (every minimum has a gap: no patch) or
+            "not-converged" (a refinement did not converge; its patch is still returned).
+        patches: one :class:`ContactGeometry` per interpenetration region, deepest first.
+        candidates: all refined minima.
+        min_gap_m: smallest h found (negative when in contact), m.
+        wheel_parameters: (alpha, y_d) of each patch, shape (n_patches, 2).
+        wall_time_s: s.
+    """
+
+    side: str
+    success: bool
+    status: str
+    message: str
+    patches: list[ContactGeometry]
+    candidates: ContactCandidates
+    min_gap_m: float
+    wheel_parameters: np.ndarray
+    wall_time_s: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+
+def _merge_options(options: Mapping | None) -> dict:
+    merged = dict(DEFAULT_OPTIONS)
+    for key, value in (options or {}).items():
+        if key not in DEFAULT_OPTIONS:
+            raise ValueError(f"contact search option {key!r}: expected one of {', '.join(DEFAULT_OPTIONS)}")
+        merged[key] = value
+    return merged
+
+
+class _SideGeometry:
+    """Wheel and rail surfaces of one side at one pose: vectorised point / normal / distance evaluation."""
+
+    def __init__(self, wheel, rail, pose: WheelsetPose, side: str, lateral_range_m, rail_lateral_range_m):
+        self.wheel, self.rail, self.side = wheel, rail, side
+        self.rot = pose.rotation
+        self.centre = pose.centre_m
+        self.pose = pose
+        self.y_range = lateral_range_m
+        self.rail_range = rail_lateral_range_m
+
+    def wheel_point(self, alpha, y, second: bool = False):
+        """Wheel points (main frame), outward unit normal, and optionally tangents and second derivatives."""
+        r, r_a, r_y, r_aa, r_ay, r_yy = self.wheel.evaluate(alpha, y)
+        ca, sa = np.cos(alpha), np.sin(alpha)
+        zero = np.zeros_like(r)
+        x_d = np.stack([r * ca, y + zero, r * sa], -1)
+        t_a = np.stack([r_a * ca - r * sa, zero, r_a * sa + r * ca], -1)  # eq 9
+        t_y = np.stack([r_y * ca, zero + 1.0, r_y * sa], -1)
+        rot_t = self.rot.T
+        point = x_d @ rot_t + self.centre  # eq 8
+        t_a, t_y = t_a @ rot_t, t_y @ rot_t
+        normal = np.cross(t_y, t_a)  # outward (towards the rail) for a wheel below its axle
+        normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+        if not second:
+            return point, normal, x_d
+        x_aa = np.stack([r_aa * ca - 2 * r_a * sa - r * ca, zero, r_aa * sa + 2 * r_a * ca - r * sa], -1) @ rot_t
+        x_ay = np.stack([r_ay * ca - r_y * sa, zero, r_ay * sa + r_y * ca], -1) @ rot_t
+        x_yy = np.stack([r_yy * ca, zero, r_yy * sa], -1) @ rot_t
+        return point, normal, x_d, (t_a, t_y, x_aa, x_ay, x_yy), r
+
+    def distance(self, alpha, y, iterations: int):
+        """h along the outward wheel normal to the rail (eq 10-11); +inf where the normal misses the rail."""
+        point, normal, _ = self.wheel_point(alpha, y)
+        h = self._distance_along(point, normal, iterations)
+        inside = (y >= self.y_range[0]) & (y <= self.y_range[1])
+        return np.where(inside, h, np.inf), point, normal
+
+    def _distance_along(self, point, direction, iterations: int):
+        n_x, n_y, n_z = direction[..., 0], direction[..., 1], direction[..., 2]
+        h = np.zeros(point.shape[:-1])
+        y_lo, y_hi = self.rail_range
+        for _ in range(iterations):
+            px, py, pz = point[..., 0] + h * n_x, point[..., 1] + h * n_y, point[..., 2] + h * n_z
+            big_n, n_dx, n_dy = self.rail.evaluate(px, np.clip(py, y_lo, y_hi))[:3]
+            f = pz - big_n
+            slope = n_z - n_dx * n_x - n_dy * n_y
+            h = h - f / np.where(np.abs(slope) > 1e-3, slope, np.copysign(1e-3, slope))
+        py = point[..., 1] + h * n_y
+        on_rail = (py >= y_lo) & (py <= y_hi) & np.isfinite(h)
+        return np.where(on_rail, h, np.inf)
+
+
+def _grid_minima(values: np.ndarray) -> np.ndarray:
+    """Indices (i, j) of local minima of a 2-D array (<= all 8 neighbours, < at least the lower-index ones)."""
+    padded = np.pad(values, 1, constant_values=np.inf)
+    core = padded[1:-1, 1:-1]
+    is_min = np.isfinite(core)
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di == 0 and dj == 0:
+                continue
+            neighbour = padded[1 + di : padded.shape[0] - 1 + di, 1 + dj : padded.shape[1] - 1 + dj]
+            # strict on one half of the neighbourhood so a flat pair yields one minimum
+            if (di, dj) < (0, 0):
+                is_min &= core < neighbour
+            else:
+                is_min &= core <= neighbour
+    return np.argwhere(is_min)
+
+
+def _refine(geo: _SideGeometry, alpha, y, opts, radius_guess):
+    """Damped Newton on h(alpha, y) for all candidates at once; FD gradient and Hessian in arc length."""
+    step = 1.0e-5  # m, FD step along both parameters
+    da = step / radius_guess
+    converged = np.zeros(alpha.shape, bool)
+    offsets = np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], float)
+    for _ in range(opts["refine_iterations"]):
+        aa = alpha[:, None] + offsets[None, :, 0] * da
+        yy = y[:, None] + offsets[None, :, 1] * step
+        h = geo.distance(aa, yy, opts["newton_iterations"])[0]
+        g = np.stack([(h[:, 1] - h[:, 2]) / (2 * step), (h[:, 3] - h[:, 4]) / (2 * step)], -1)
+        haa = (h[:, 1] - 2 * h[:, 0] + h[:, 2]) / step**2
+        hyy = (h[:, 3] - 2 * h[:, 0] + h[:, 4]) / step**2
+        hay = (h[:, 5] - h[:, 6] - h[:, 7] + h[:, 8]) / (4 * step**2)
+        det = haa * hyy - hay**2
+        ok = (haa > 0) & (det > 0) & np.all(np.isfinite(h), axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            s_a = np.where(ok, -(hyy * g[:, 0] - hay * g[:, 1]) / det, -g[:, 0] * 1e-3)
+            s_y = np.where(ok, -(haa * g[:, 1] - hay * g[:, 0]) / det, -g[:, 1] * 1e-3)
+        s_a, s_y = np.nan_to_num(s_a), np.nan_to_num(s_y)
+        norm = np.hypot(s_a, s_y)
+        limit = 3.0e-3
+        scale = np.where(norm > limit, limit / np.maximum(norm, 1e-300), 1.0)
+        s_a, s_y = s_a * scale, s_y * scale
+        alpha = alpha + np.where(converged, 0.0, s_a / radius_guess)
+        y = np.clip(y + np.where(converged, 0.0, s_y), geo.y_range[0], geo.y_range[1])
+        converged |= ok & (norm < opts["refine_tolerance_m"])
+        if np.all(converged):
+            break
+    return alpha, y, converged
+
+
+def ellipticity_error(undeformed: UndeformedDistance, a_1_per_m, b_1_per_m, angle_rad, approach_m) -> float:
+    """How far the sampled gap departs from the quadric of the patch's curvatures, relative to the approach.
+
+    The quadric gap is g_q(x, y) = A x'^2 + B y'^2 - q (x', y' rotated by the ellipse angle). Over the points
+    where either the sampled or the quadric gap is below +q (the rigid-overlap region and a margin of the same
+    depth), the error is max |g - g_q| / q. A Hertzian patch has an error of the order of the cubic terms of
+    the surfaces (a few %); a patch at the flange root or the gauge corner, where the curvature changes across
+    the patch, is well above 0.15 (the default tolerance of ``is_elliptic``).
+    """
+    x, y = np.meshgrid(undeformed.x_m, undeformed.y_m)
+    c, s = math.cos(angle_rad), math.sin(angle_rad)
+    xr, yr = c * x + s * y, -s * x + c * y
+    quadric = a_1_per_m * xr**2 + b_1_per_m * yr**2 - approach_m
+    g = undeformed.distance_m
+    region = (np.minimum(g, quadric) < approach_m) & np.isfinite(g)
+    if approach_m <= 0 or not np.any(region):
+        return math.inf
+    return float(np.max(np.abs(g[region] - quadric[region])) / approach_m)
+
+
+def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, half_x, half_y, npts, iterations):
+    """Gap along n between the wheel and the rail surfaces on a grid of the contact plane (vectorised)."""
+    xs = np.linspace(-half_x, half_x, npts)
+    ys = np.linspace(-half_y, half_y, npts)
+    gx, gy = np.meshgrid(xs, ys)
+    e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
+    base = centre + gx[..., None] * e_x + gy[..., None] * e_y
+    # Rail: p = base + t n on z = N(x, y)  (n points from the rail into the wheel).
+    t_rail = geo._distance_along(base, n, iterations)
+    # Wheel: x_w(alpha, y) = base + s n, Newton on (alpha, y, s) from the patch parameters.
+    radius = geo.wheel.evaluate(np.array([alpha0]), np.array([y0]))[0][0]
+    alpha = np.full(gx.shape, alpha0) + gx / radius
+    lat = np.full(gx.shape, y0) + gy * np.dot(e_y, geo.rot[:, 1])
+    s = np.zeros(gx.shape)
+    for _ in range(iterations):
+        point, _, _, (t_a, t_y, *_), _ = geo.wheel_point(alpha, lat, second=True)
+        residual = point - base - s[..., None] * n
+        jac = np.stack([t_a, t_y, np.broadcast_to(-n, t_a.shape)], -1)
+        delta = np.linalg.solve(jac, -residual[..., None])[..., 0]
+        alpha, lat, s = alpha + delta[..., 0], lat + delta[..., 1], s + delta[..., 2]
+    inside = (lat >= geo.y_range[0]) & (lat <= geo.y_range[1])
+    gap = np.where(inside, s - t_rail, np.inf)
+    return UndeformedDistance(x_m=xs, y_m=ys, distance_m=gap)
+
+
+def search_side(
+    wheel, rail, pose: WheelsetPose, side: str, *, wheel_lateral_range_m, rail_lateral_range_m, options=None
+) -> SideSearch:
+    """Find every contact patch between one wheel and its rail (eq 5-11) and its local geometry (eq 12-33).
+
+    Args:
+        wheel: wheel surface of this side, ``evaluate(alpha, y_d) -> (R, R_a, R_y, R_aa, R_ay, R_yy)`` (eq 5, 7),
+            y_d along the axle from the wheelset centre, m.
+        rail: rail surface of this side, ``evaluate(x, y) -> (N, N_x, N_y, N_xx, N_xy, N_yy)`` (eq 6), main frame.
+        pose: wheelset pose.
+        side: "left" or "right" (only used for the sign of the contact angle and the patch label).
+        wheel_lateral_range_m: (y_min, y_max) of y_d where the wheel surface is defined, m.
+        rail_lateral_range_m: (y_min, y_max) of the main-frame y where the rail surface is defined, m.
+        options: see ``DEFAULT_OPTIONS``.
+
+    Returns:
+        :class:`SideSearch`. Patches carry A, B in the rolling-direction frame, the approach, and (option
+        ``field``) the sampled undeformed distance; ``contact_point_rail_m``/``contact_point_wheel_m`` are left
+        nan here (the caller that knows the profile placement fills them).
+
+    Raises:
+        ValueError: unknown side or option.
+    """
+    started = time.perf_counter()
+    if side not in SIDES:
+        raise ValueError(f"side = {side!r}: expected one of {', '.join(SIDES)}")
+    opts = _merge_options(options)
+    geo = _SideGeometry(wheel, rail, pose, side, tuple(wheel_lateral_range_m), tuple(rail_lateral_range_m))
+
+    # Grid around the lowest point alpha = pi/2 - phi (spin angle, see kinematics: R_y(-phi)).
+    alpha_mid = 0.5 * np.pi - pose.spin_rad
+    half = opts["alpha_half_range_rad"]
+    alphas = alpha_mid + np.linspace(-half, half, opts["alpha_points"])
+    y_lo, y_hi = geo.y_range
+    n_y = max(int(round((y_hi - y_lo) / opts["lateral_step_m"])) + 1, 3)
+    ys = np.linspace(y_lo, y_hi, n_y)
+    grid_a, grid_y = np.meshgrid(alphas, ys, indexing="ij")
+    h_grid = geo.distance(grid_a, grid_y, opts["newton_iterations"])[0]
+    minima = _grid_minima(h_grid)
+    minima = minima[h_grid[minima[:, 0], minima[:, 1]] < opts["candidate_gap_m"]]
+    if len(minima) == 0:
+        min_gap = float(np.min(h_grid)) if np.any(np.isfinite(h_grid)) else math.inf
+        empty = ContactCandidates(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, bool))
+        return SideSearch(
+            side, True, "no-contact", f"no wheel-rail gap below {opts['candidate_gap_m']} m on the {side} side",
+            [], empty, min_gap, np.zeros((0, 2)), time.perf_counter() - started,
+        )  # fmt: skip
+    radius_guess = float(np.median(wheel.evaluate(np.array([alpha_mid]), np.array([0.5 * (y_lo + y_hi)]))[0]))
+    alpha_c, y_c, converged = _refine(geo, alphas[minima[:, 0]], ys[minima[:, 1]], opts, radius_guess)
+    h_c = geo.distance(alpha_c, y_c, opts["newton_iterations"])[0]
+
+    # Deduplicate: same point, or the same interpenetration region (h < 0 along the joining segment).
+    order = np.argsort(h_c)
+    kept: list[int] = []
+    for k in order:
+        if not np.isfinite(h_c[k]):
+            continue
+        duplicate = False
+        for j in kept:
+            if abs(y_c[k] - y_c[j]) < 1e-6 and abs(alpha_c[k] - alpha_c[j]) * radius_guess < 1e-6:
+                duplicate = True
+                break
+            if h_c[k] < 0:
+                t = np.linspace(0, 1, 25)
+                seg = geo.distance(alpha_c[j] + t * (alpha_c[k] - alpha_c[j]), y_c[j] + t * (y_c[k] - y_c[j]), 6)[0]
+                if np.all(seg < 0):
+                    duplicate = True
+                    break
+        if not duplicate:
+            kept.append(k)
+    kept_arr = np.array(kept, int)
+    candidates = ContactCandidates(alpha_c[kept_arr], y_c[kept_arr], h_c[kept_arr], converged[kept_arr])
+    in_contact = kept_arr[h_c[kept_arr] < 0]
+    patches = [_patch(geo, alpha_c[k], y_c[k], opts) for k in in_contact]
+    min_gap = float(np.min(h_c[kept_arr])) if len(kept_arr) else math.inf
+    all_converged = bool(np.all(converged[in_contact]))
+    if not patches:
+        status, message = "no-contact", f"smallest gap on the {side} side is {min_gap:.3e} m"
+    elif all_converged:
+        status, message = "ok", f"{len(patches)} patch(es) on the {side} side"
+    else:
+        status, message = "not-converged", "a contact-point refinement did not converge"
+    return SideSearch(
+        side=side,
+        success=status != "not-converged",
+        status=status,
+        message=message,
+        patches=patches,
+        candidates=candidates,
+        min_gap_m=min_gap,
+        wheel_parameters=np.stack([alpha_c[in_contact], y_c[in_contact]], -1),
+        wall_time_s=time.perf_counter() - started,
+    )
+
+
+def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts) -> ContactGeometry:
+    a_arr, y_arr = np.array([alpha0]), np.array([y0])
+    point, n_out, _, (t_a, t_y, x_aa, x_ay, x_yy), radius = geo.wheel_point(a_arr, y_arr, second=True)
+    h = geo._distance_along(point, n_out, opts["newton_iterations"])[0]
+    point, n_out = point[0], n_out[0]
+    rail_point = point + h * n_out
+    n = -n_out
+    rolling = np.asarray(opts["rolling_direction"], float)
+    e_x = rolling - np.dot(rolling, n) * n
+    e_x /= np.linalg.norm(e_x)
+    e_y = np.cross(n, e_x)
+    frame = np.stack([e_x, e_y, n], -1)
+    k_w = curvature_tensor(t_a[0], t_y[0], x_aa[0], x_ay[0], x_yy[0], n, e_x, e_y)
+    _, n_dx, n_dy, n_xx, n_xy, n_yy = (
+        v[0] for v in geo.rail.evaluate(np.array([rail_point[0]]), np.array([rail_point[1]]))
+    )
+    k_r = curvature_tensor(
+        np.array([1.0, 0.0, n_dx]),
+        np.array([0.0, 1.0, n_dy]),
+        np.array([0.0, 0.0, n_xx]),
+        np.array([0.0, 0.0, n_xy]),
+        np.array([0.0, 0.0, n_yy]),
+        n,
+        e_x,
+        e_y,
+    )
+    a_rel, b_rel, angle = principal_relative_curvature(relative_curvature(k_w, k_r))
+    a_rel, b_rel, angle = float(a_rel), float(b_rel), float(angle)
+    approach = float(-h)
+    lateral_tilt = -n[1] if geo.side == "right" else n[1]
+    contact_angle = math.atan2(lateral_tilt, -n[2])
+    convex = a_rel > 0 and b_rel > 0
+    a_use, b_use = max(a_rel, 1e-6), max(b_rel, 1e-6)
+    undeformed = None
+    elliptic = convex
+    if opts["field"]:
+        half_x = max(opts["field_scale"] * math.sqrt(max(approach, 0) / a_use), opts["field_min_half_size_m"])
+        half_y = max(opts["field_scale"] * math.sqrt(max(approach, 0) / b_use), opts["field_min_half_size_m"])
+        half_x, half_y = min(half_x, 0.05), min(half_y, 0.03)
+        centre = 0.5 * (point + rail_point)
+        undeformed = _sample_field(
+            geo, alpha0, y0, centre, frame, half_x, half_y, opts["field_points"], opts["newton_iterations"]
+        )
+        error = ellipticity_error(undeformed, a_use, b_use, angle, approach)
+        elliptic = convex and error <= opts["ellipticity_tolerance"]
+    return ContactGeometry(
+        curvature_long_1_per_m=a_use,
+        curvature_lat_1_per_m=b_use,
+        approach_m=approach,
+        side=geo.side,
+        point_m=0.5 * (point + rail_point),
+        frame=frame,
+        contact_angle_rad=contact_angle,
+        rolling_radius_m=float(radius[0]),
+        ellipse_angle_rad=angle,
+        undeformed=undeformed,
+        is_elliptic=bool(elliptic),
+    )

@@ -1,0 +1,159 @@
+"""3-D contact search (eq 5-11, 12-33) on analytic surfaces with closed-form contact.
+
+Exact reference for a crowned wheel on a crowned rail (no yaw, no roll): in the cross-section x = 0 the wheel's
+crown is a circle (centre c_w, radius rho) and the rail's crown a circle (centre c_r, radius Rr); the
+approach is q = rho + Rr - |c_w - c_r|, the normal is along c_r -> c_w, and the relative curvatures are
+A = cos(gamma)/(2 R_c) (the wheel's circumferential curvature at a point of rolling radius R_c whose normal is
+tilted by gamma from the radial direction; the cylindrical rail is straight along x) and
+B = (1/rho + 1/Rr)/2.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from rigid_dynamics.contact.search import WheelsetPose, ellipticity_error, search_side
+
+
+class CrownWheel:
+    """R(alpha, y) = r0 - rho + sqrt(rho^2 - (y - y_c)^2): torus-shaped tread (crown radius rho) about y_c."""
+
+    def __init__(self, r0, rho, y_c):
+        self.r0, self.rho, self.y_c = r0, rho, y_c
+
+    def evaluate(self, alpha, y):
+        alpha, y = np.broadcast_arrays(np.asarray(alpha, float), np.asarray(y, float))
+        u = y - self.y_c
+        root = np.sqrt(np.maximum(self.rho**2 - u**2, 1e-12))
+        zero = np.zeros_like(u)
+        return (self.r0 - self.rho + root, zero, -u / root, zero, zero, -(self.rho**2) / root**3)
+
+
+class TwoBumpWheel:
+    """R = r0 + sum_k d_k exp(-(y - y_k)^2 / w_k^2): two separate 'tread' and 'flange' bumps."""
+
+    def __init__(self, r0, bumps):
+        self.r0, self.bumps = r0, bumps
+
+    def evaluate(self, alpha, y):
+        alpha, y = np.broadcast_arrays(np.asarray(alpha, float), np.asarray(y, float))
+        r, r_y, r_yy = np.full_like(y, self.r0), np.zeros_like(y), np.zeros_like(y)
+        for depth, centre, width in self.bumps:
+            u = (y - centre) / width
+            e = depth * np.exp(-(u**2))
+            r += e
+            r_y += e * (-2 * u / width)
+            r_yy += e * (4 * u**2 - 2) / width**2
+        zero = np.zeros_like(y)
+        return (r, zero, r_y, zero, zero, r_yy)
+
+
+class CrownRail:
+    """N(x, y) = Rr - sqrt(Rr^2 - (y - y_r)^2) (+ 0 for a flat rail when Rr is inf)."""
+
+    def __init__(self, radius, y_r):
+        self.radius, self.y_r = radius, y_r
+
+    def evaluate(self, x, y):
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        zero = np.zeros_like(y)
+        if not math.isfinite(self.radius):
+            return (zero, zero, zero, zero, zero, zero)
+        u = y - self.y_r
+        root = np.sqrt(np.maximum(self.radius**2 - u**2, 1e-12))
+        return (self.radius - root, zero, u / root, zero, zero, self.radius**2 / root**3)
+
+
+def crown_case(shift, sink):
+    r0, rho, y_w, rr, y_r = 0.46, 0.3, 0.75, 0.3, 0.752
+    wheel, rail = CrownWheel(r0, rho, y_w), CrownRail(rr, y_r)
+    pose = WheelsetPose(y_m=shift, z_m=-r0 + sink)
+    # Exact: circles in the (y, z) plane.
+    c_w = np.array([y_w + shift, -r0 + sink + r0 - rho])
+    c_r = np.array([y_r, rr])
+    dist = np.linalg.norm(c_r - c_w)
+    approach = rho + rr - dist
+    direction = (c_w - c_r) / dist  # rail -> wheel in (y, z)
+    gamma = math.atan2(-direction[0], -direction[1])  # right side: tilt towards -y positive
+    return wheel, rail, pose, approach, direction, gamma, (r0, rho, rr, c_w)
+
+
+@pytest.mark.parametrize(("shift", "sink"), [(0.0, 1e-4), (0.006, 5e-5), (-0.01, 2e-4)])
+def test_crowned_wheel_on_crowned_rail_matches_circle_geometry(shift, sink):
+    wheel, rail, pose, approach, direction, gamma, (r0, rho, rr, c_w) = crown_case(shift, sink)
+    got = search_side(wheel, rail, pose, "right", wheel_lateral_range_m=(0.70, 0.80), rail_lateral_range_m=(0.72, 0.78))
+    assert got.status == "ok" and len(got.patches) == 1
+    patch = got.patches[0]
+    assert patch.approach_m == pytest.approx(approach, rel=1e-7)
+    np.testing.assert_allclose(patch.frame[1:, 2], direction, atol=1e-8)
+    assert patch.contact_angle_rad == pytest.approx(gamma, abs=1e-8)
+    # Rolling radius: distance from the axle to the wheel's contact point on the crown circle.
+    contact_on_wheel = c_w - rho * direction
+    radius = contact_on_wheel[1] - pose.z_m
+    assert patch.rolling_radius_m == pytest.approx(radius, rel=1e-9)
+    assert patch.curvature_long_1_per_m == pytest.approx(math.cos(gamma) / (2 * radius), rel=1e-6)
+    assert patch.curvature_lat_1_per_m == pytest.approx(0.5 * (1 / rho + 1 / rr), rel=1e-6)
+    assert patch.ellipse_angle_rad == pytest.approx(0.0, abs=1e-8)
+    assert patch.is_elliptic
+    # Sampled gap at the centre equals -q, and it is a quadric of the patch's curvatures to a few %.
+    field = patch.undeformed
+    assert field.evaluate(0.0, 0.0) == pytest.approx(-approach, rel=1e-3)
+    error = ellipticity_error(field, patch.curvature_long_1_per_m, patch.curvature_lat_1_per_m, 0.0, approach)
+    assert error < 0.05
+
+
+def test_gap_only_gives_no_contact_and_min_gap():
+    wheel, rail, pose, approach, *_ = crown_case(0.0, -3e-4)
+    got = search_side(wheel, rail, pose, "right", wheel_lateral_range_m=(0.70, 0.80), rail_lateral_range_m=(0.72, 0.78))
+    assert got.status == "no-contact" and got.patches == []
+    assert got.min_gap_m == pytest.approx(-approach, rel=1e-6)
+
+
+def dense_patches(wheel, rail, pose, y_range, rail_range, step=2e-4):
+    """Brute force: h on a dense grid (no Newton refinement of minima), connected regions with h < 0."""
+    from scipy import ndimage
+
+    from rigid_dynamics.contact.search import _SideGeometry
+
+    geo = _SideGeometry(wheel, rail, pose, "right", y_range, rail_range)
+    alphas = np.pi / 2 + np.linspace(-0.06, 0.06, 121)
+    ys = np.arange(y_range[0], y_range[1], step)
+    a, y = np.meshgrid(alphas, ys, indexing="ij")
+    h = geo.distance(a, y, 12)[0]
+    labels, count = ndimage.label(h < 0)
+    out = []
+    for k in range(1, count + 1):
+        idx = np.argmin(np.where(labels == k, h, np.inf))
+        out.append((y.flat[idx], -h.flat[idx]))
+    return out
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.02])
+def test_two_point_contact_matches_brute_force_scan(yaw):
+    """A wheel with a 'tread' and a 'flange' bump on a flat rail: both patches, as the dense scan finds them."""
+    wheel = TwoBumpWheel(0.46, [(8e-5, 0.76, 0.01), (1.2e-4, 0.72, 0.004)])
+    rail = CrownRail(math.inf, 0.75)
+    pose = WheelsetPose(z_m=-0.46 - 2e-5, yaw_rad=yaw)
+    y_range, rail_range = (0.70, 0.80), (0.65, 0.85)
+    got = search_side(wheel, rail, pose, "right", wheel_lateral_range_m=y_range, rail_lateral_range_m=rail_range)
+    brute = dense_patches(wheel, rail, pose, y_range, rail_range)
+    assert len(brute) == 2 and len(got.patches) == 2
+    found = sorted((p.point_m[1], p.approach_m) for p in got.patches)
+    for (y_b, q_b), (y_s, q_s) in zip(sorted(brute), found, strict=True):
+        assert abs(y_b * math.cos(yaw) - y_s) < 2e-3 or abs(y_b - y_s) < 2e-3
+        assert q_s >= q_b - 1e-9  # refined minimum is at least as deep as the grid's
+        assert q_s == pytest.approx(q_b, rel=0.05)
+
+
+def test_bad_side_and_option():
+    wheel, rail, pose, *_ = crown_case(0.0, 1e-4)
+    with pytest.raises(ValueError, match="side = 'middle'"):
+        search_side(wheel, rail, pose, "middle", wheel_lateral_range_m=(0.7, 0.8), rail_lateral_range_m=(0.7, 0.8))
+    with pytest.raises(ValueError, match="option 'grid'"):
+        search_side(
+            wheel, rail, pose, "right", wheel_lateral_range_m=(0.7, 0.8), rail_lateral_range_m=(0.7, 0.8),
+            options={"grid": 3},
+        )  # fmt: skip
+    with pytest.raises(ValueError, match="yaw_rad = nan"):
+        WheelsetPose(yaw_rad=float("nan"))
