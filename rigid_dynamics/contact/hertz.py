@@ -1,0 +1,318 @@
+"""Hertz's theory of elliptic normal contact, vectorised over many patches (seed eq 32-38).
+
+Undeformed distance near the initial contact point (contact frame, x rolling, y lateral)::
+
+    h(x, y) = A x^2 + B y^2 - q            (seed eq 32; A, B > 0 in 1/m, q the approach in m)
+
+For two quasi-identical elastic half-spaces (shear modulus G, Poisson's ratio nu, combined
+modulus E* = G/(1 - nu), Johnson 1985 eq 4.22) the contact area is an ellipse with semi-axes
+a_major along the direction of the *smaller* relative curvature and b_minor = a_major sqrt(p),
+and the pressure is p(x, y) = p0 sqrt(1 - x^2/a_x^2 - y^2/b_y^2). With the complete elliptic
+integrals of parameter m = 1 - p (Kalker 1990 notation, m = e^2 = 1 - (b_minor/a_major)^2)::
+
+    D(m) = (K - E)/m,   B(m) = (E - p K)/m,   C(m) = (D - B)/m                (Kalker 1990)
+    curvature ratio   r = max(A, B)/min(A, B) = B(m) / (p D(m))              (axial function)
+    min(A, B) = 3 N D / (2 pi E* a_major^3)      max(A, B) = 3 N B / (2 pi E* a_major b_minor^2)
+    q = 3 N K / (2 pi E* a_major)               p0 = 3 N / (2 pi a_major b_minor)
+
+The seed's axial function (eq 34) cos t = m (D - C)/E with cos t = |A - B|/(A + B) is the same
+relation written for (r - 1)/(r + 1); eq 35 gives k_e = p (or 1/p), eq 36 the force from the
+approach and eq 37-38 the semi-axes (Johnson 1985 sec. 4.2; Kalker 1990 sec. 1.4).
+REFERENCES.md records that eq 34-38 were checked against the classical formulae.
+
+Inverting the axial function: r(p) is solved for s = ln p by a bracketed (safeguarded) Newton
+iteration, vectorised over patches. The upper end of the bracket, s <= -ln r, holds because
+D(m) >= B(m) (1/Delta grows with sin t), so r(p) <= 1/p; the lower end
+``-ln r - ln(2 (1 + ln(16 r)))`` is conservative and is checked (and widened) before iterating.
+To keep full precision for every ratio from 1 (A = B) to beyond 1e4 (b/a ~ 4e-3):
+
+* for m < 0.1 the functions D, B, C are summed from their power series (no cancellation in
+  K - E when A ~ B),
+* otherwise K comes from ``scipy.special.ellipkm1(p)`` (accurate as p -> 0, slender ellipses)
+  and E from ``scipy.special.ellipe(m)``.
+
+The residual is evaluated to ~1e-15 relative, so the converged semi-axes carry that accuracy
+(the tests compare with an independent quadrature of Hertz's potential integrals to 1e-8).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import ellipe, ellipkm1
+
+_SERIES_LIMIT = 0.1
+_N_SERIES = 24
+
+
+def _central_binomials(n: int) -> np.ndarray:
+    """c_k = (2k)! / (4^k (k!)^2), k = 0..n-1 (so that int_0^{pi/2} sin^{2k} = pi/2 c_k)."""
+    c = np.empty(n)
+    c[0] = 1.0
+    for k in range(1, n):
+        c[k] = c[k - 1] * (2 * k - 1) / (2 * k)
+    return c
+
+
+_C = _central_binomials(_N_SERIES + 2)
+# D(m) = pi/2 sum c_n c_{n+1} m^n ; B(m) = pi/2 sum c_n (c_n - c_{n+1}) m^n ;
+# C(m) = pi/2 sum_{n>=1} c_n (2 c_{n+1} - c_n) m^(n-1)   (expanding (1 - m sin^2)^(-1/2) term by term)
+_D_SERIES = 0.5 * math.pi * _C[:_N_SERIES] * _C[1 : _N_SERIES + 1]
+_B_SERIES = 0.5 * math.pi * _C[:_N_SERIES] * (_C[:_N_SERIES] - _C[1 : _N_SERIES + 1])
+_C_SERIES = 0.5 * math.pi * _C[1 : _N_SERIES + 1] * (2.0 * _C[2 : _N_SERIES + 2] - _C[1 : _N_SERIES + 1])
+
+
+def _horner(coefficients: np.ndarray, m: np.ndarray) -> np.ndarray:
+    out = np.full_like(m, coefficients[-1])
+    for c in coefficients[-2::-1]:
+        out = out * m + c
+    return out
+
+
+def elliptic_kdbc(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Complete elliptic integrals K, D, B, C of parameter m = 1 - p, to full precision.
+
+    Args:
+        p: complementary parameter p = 1 - m in (0, 1], array.
+
+    Returns:
+        (K, D, B, C) with K = int dt/Delta, D = int sin^2/Delta, B = int cos^2/Delta,
+        C = int sin^2 cos^2/Delta^3 over t in [0, pi/2], Delta = sqrt(1 - m sin^2 t) (Kalker 1990).
+    """
+    p = np.asarray(p, dtype=float)
+    m = 1.0 - p
+    k = ellipkm1(p)
+    small = m < _SERIES_LIMIT
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e = ellipe(m)
+        d = np.where(small, 0.0, (k - e) / m)
+        b = np.where(small, 0.0, (e - p * k) / m)
+        c = np.where(small, 0.0, (d - b) / m)
+    if np.any(small):
+        ms = m[small]
+        d[small] = _horner(_D_SERIES, ms)
+        b[small] = _horner(_B_SERIES, ms)
+        c[small] = _horner(_C_SERIES, ms)
+    return k, d, b, c
+
+
+def ellipse_shape_from_curvature_ratio(
+    curvature_ratio: np.ndarray, *, rtol: float = 1e-14, max_iterations: int = 60
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Invert the axial function: p = (b_minor/a_major)^2 from r = max(A, B)/min(A, B) >= 1.
+
+    Solves ``ln B(m) - ln p - ln D(m) = ln r`` for s = ln p (m = 1 - p) by Newton's method
+    safeguarded by bisection inside a bracket that always contains the root; vectorised.
+    Derivative: d(ln r)/ds = -(p C/(2B) + 1/2 + C/(2D)) (from dD/dm = (D - C)/(2p), dB/dm = C/2).
+
+    Args:
+        curvature_ratio: r >= 1, array (any shape).
+        rtol: stop when the Newton step in s, or the bracket, is below rtol (1 + |s|) (the residual
+            itself is only known to a few 1e-15, so smaller values cannot be met everywhere).
+        max_iterations: iteration cap; patches not converged by then are flagged.
+
+    Returns:
+        (p, iterations, converged): p in (0, 1]; iterations used (scalar array); bool mask.
+    """
+    r = np.asarray(curvature_ratio, dtype=float)
+    shape = r.shape
+    r = r.ravel()
+    log_r = np.log(r)
+    hi = -log_r
+    lo = -log_r - np.log(2.0 * (1.0 + np.log(16.0 * r)))
+    # initial guess: small-eccentricity slope ln r ~ 3 m / 4 ~ -3 s / 4, clipped into the bracket
+    s = np.clip(-4.0 / 3.0 * log_r, lo, hi)
+    converged = r == 1.0
+    s[converged] = 0.0
+    # make sure the lower end really brackets the root (g(lo) >= 0)
+    for _ in range(8):
+        p_lo = np.exp(lo)
+        _, d_lo, b_lo, _ = elliptic_kdbc(p_lo)
+        g_lo = np.log(b_lo) - lo - np.log(d_lo) - log_r
+        bad = (g_lo < 0) & ~converged
+        if not np.any(bad):
+            break
+        lo[bad] -= 2.0
+    iterations = 0
+    active = ~converged
+    while np.any(active) and iterations < max_iterations:
+        iterations += 1
+        sa = s[active]
+        p = np.exp(sa)
+        _, d, b, c = elliptic_kdbc(p)
+        g = np.log(b) - sa - np.log(d) - log_r[active]
+        dg = -(p * c / (2.0 * b) + 0.5 + c / (2.0 * d))
+        lo_a, hi_a = lo[active], hi[active]
+        # g decreases with s: g > 0 means the root is above s
+        lo_a = np.where(g > 0, sa, lo_a)
+        hi_a = np.where(g <= 0, sa, hi_a)
+        step = -g / dg
+        s_new = sa + step
+        outside = ~((s_new >= lo_a) & (s_new <= hi_a))
+        s_new = np.where(outside, 0.5 * (lo_a + hi_a), s_new)
+        s_new = np.where(g == 0, sa, s_new)
+        tol = rtol * (1.0 + np.abs(sa))
+        done = (np.abs(s_new - sa) <= tol) | (g == 0) | (hi_a - lo_a <= tol)
+        lo[active], hi[active], s[active] = lo_a, hi_a, s_new
+        idx = np.flatnonzero(active)
+        converged[idx[done]] = True
+        active[idx[done]] = False
+    return np.exp(s).reshape(shape), np.asarray(iterations), converged.reshape(shape)
+
+
+@dataclass(frozen=True, eq=False)
+class HertzBatch:
+    """Hertz solutions for a batch of patches (arrays of one common shape).
+
+    Attributes:
+        semi_axis_long_m: a, semi-axis along x (rolling), m.
+        semi_axis_lat_m: b, semi-axis along y (lateral), m.
+        approach_m: q, rigid approach, m.
+        normal_force_N: N, N.
+        max_pressure_Pa: p0 = 3 N / (2 pi a b), Pa.
+        ellipse_parameter: m = 1 - (b_minor/a_major)^2 (Kalker's m^2 in the seed, eq 34-35).
+        major_axis_along_x: True where the major axis lies along x (A <= B).
+        converged: the axial-function inversion converged (always True in practice).
+        iterations: Newton iterations used for the batch.
+    """
+
+    semi_axis_long_m: np.ndarray
+    semi_axis_lat_m: np.ndarray
+    approach_m: np.ndarray
+    normal_force_N: np.ndarray
+    max_pressure_Pa: np.ndarray
+    ellipse_parameter: np.ndarray
+    major_axis_along_x: np.ndarray
+    converged: np.ndarray
+    iterations: int
+
+    @property
+    def contact_area_m2(self) -> np.ndarray:
+        """Contact area pi a b, m^2."""
+        return math.pi * self.semi_axis_long_m * self.semi_axis_lat_m
+
+    @property
+    def ellipse_angle_rad(self) -> np.ndarray:
+        """Angle from x to the major axis: 0 (major along x) or pi/2 (major along y), rad."""
+        return np.where(self.major_axis_along_x, 0.0, 0.5 * math.pi)
+
+
+def _check_material(shear_modulus_Pa: float, poisson_ratio: float) -> None:
+    if not (np.all(np.isfinite(shear_modulus_Pa)) and np.all(np.asarray(shear_modulus_Pa) > 0)):
+        raise ValueError(f"shear_modulus_Pa = {shear_modulus_Pa!r}: expected a finite number > 0")
+    nu = np.asarray(poisson_ratio)
+    if not (np.all(np.isfinite(nu)) and np.all((nu > -1.0) & (nu < 0.5))):
+        raise ValueError(f"poisson_ratio = {poisson_ratio!r}: expected a value in (-1, 0.5)")
+
+
+def hertz_solve_batch(
+    curvature_long_1_per_m: np.ndarray,
+    curvature_lat_1_per_m: np.ndarray,
+    *,
+    normal_force_N: np.ndarray | None = None,
+    approach_m: np.ndarray | None = None,
+    shear_modulus_Pa: float,
+    poisson_ratio: float,
+) -> HertzBatch:
+    """Solve Hertz's problem for many patches at once (force or approach control).
+
+    Exactly one of ``normal_force_N`` and ``approach_m`` must be given. Patches with a
+    non-positive force or approach get zero semi-axes, force, pressure and approach (no contact).
+
+    Args:
+        curvature_long_1_per_m: A in h = A x^2 + B y^2 - q, 1/m, > 0 (array or scalar).
+        curvature_lat_1_per_m: B, 1/m, > 0.
+        normal_force_N: N, N (force control).
+        approach_m: q, m (approach control).
+        shear_modulus_Pa: G, Pa (both bodies).
+        poisson_ratio: nu (both bodies).
+
+    Returns:
+        :class:`HertzBatch` with arrays of the broadcast input shape.
+
+    Raises:
+        ValueError: non-finite or non-positive curvatures, bad material, or not exactly one of
+            normal_force_N / approach_m.
+    """
+    if (normal_force_N is None) == (approach_m is None):
+        raise ValueError("hertz_solve_batch: expected exactly one of normal_force_N or approach_m")
+    _check_material(shear_modulus_Pa, poisson_ratio)
+    load = np.asarray(normal_force_N if approach_m is None else approach_m, dtype=float)
+    A, B, load = np.broadcast_arrays(
+        np.asarray(curvature_long_1_per_m, dtype=float), np.asarray(curvature_lat_1_per_m, dtype=float), load
+    )
+    if not (np.all(np.isfinite(A)) and np.all(A > 0)):
+        raise ValueError(f"curvature_long_1_per_m = {curvature_long_1_per_m!r}: expected finite values > 0")
+    if not (np.all(np.isfinite(B)) and np.all(B > 0)):
+        raise ValueError(f"curvature_lat_1_per_m = {curvature_lat_1_per_m!r}: expected finite values > 0")
+    if not np.all(np.isfinite(load)):
+        name = "normal_force_N" if approach_m is None else "approach_m"
+        raise ValueError(f"{name} = {load!r}: expected finite values")
+
+    e_star = shear_modulus_Pa / (1.0 - poisson_ratio)
+    a_min = np.minimum(A, B)
+    ratio = np.maximum(A, B) / a_min
+    p, iterations, converged = ellipse_shape_from_curvature_ratio(ratio)
+    k, d, _, _ = elliptic_kdbc(p.ravel())
+    k, d = k.reshape(p.shape), d.reshape(p.shape)
+    in_contact = load > 0
+    positive = np.where(in_contact, load, 1.0)
+    if approach_m is None:
+        force = positive
+        major = np.cbrt(3.0 * force * d / (2.0 * math.pi * e_star * a_min))
+        approach = 3.0 * force * k / (2.0 * math.pi * e_star * major)
+    else:
+        approach = positive
+        major = np.sqrt(approach * d / (k * a_min))
+        force = 2.0 * math.pi * major * e_star * approach / (3.0 * k)
+    minor = major * np.sqrt(p)
+    along_x = A <= B
+    a = np.where(along_x, major, minor)
+    b = np.where(along_x, minor, major)
+    p0 = 3.0 * force / (2.0 * math.pi * major * minor)
+    zero = np.zeros_like(a)
+    return HertzBatch(
+        semi_axis_long_m=np.where(in_contact, a, zero),
+        semi_axis_lat_m=np.where(in_contact, b, zero),
+        approach_m=np.where(in_contact, approach, zero),
+        normal_force_N=np.where(in_contact, force, zero),
+        max_pressure_Pa=np.where(in_contact, p0, zero),
+        ellipse_parameter=1.0 - p,
+        major_axis_along_x=along_x,
+        converged=converged,
+        iterations=int(iterations),
+    )
+
+
+def hertz_force_from_approach(
+    curvature_long_1_per_m, curvature_lat_1_per_m, approach_m, *, shear_modulus_Pa: float, poisson_ratio: float
+) -> np.ndarray:
+    """N(q): normal force for a given approach (seed eq 36), N; 0 where q <= 0."""
+    return hertz_solve_batch(
+        curvature_long_1_per_m,
+        curvature_lat_1_per_m,
+        approach_m=approach_m,
+        shear_modulus_Pa=shear_modulus_Pa,
+        poisson_ratio=poisson_ratio,
+    ).normal_force_N
+
+
+def hertz_approach_from_force(
+    curvature_long_1_per_m, curvature_lat_1_per_m, normal_force_N, *, shear_modulus_Pa: float, poisson_ratio: float
+) -> np.ndarray:
+    """q(N): approach for a given normal force (inverse of seed eq 36), m; 0 where N <= 0."""
+    return hertz_solve_batch(
+        curvature_long_1_per_m,
+        curvature_lat_1_per_m,
+        normal_force_N=normal_force_N,
+        shear_modulus_Pa=shear_modulus_Pa,
+        poisson_ratio=poisson_ratio,
+    ).approach_m
+
+
+def hertz_pressure_Pa(x_m, y_m, semi_axis_long_m: float, semi_axis_lat_m: float, max_pressure_Pa: float) -> np.ndarray:
+    """Hertz pressure p0 sqrt(1 - x^2/a^2 - y^2/b^2) inside the ellipse, 0 outside, Pa."""
+    rho = 1.0 - np.square(x_m / semi_axis_long_m) - np.square(y_m / semi_axis_lat_m)
+    return max_pressure_Pa * np.sqrt(np.clip(rho, 0.0, None))
