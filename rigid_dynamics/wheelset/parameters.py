@@ -1,0 +1,368 @@
+"""Parameters of a wheelset dynamics run, as frozen dataclasses with SI units in the field names.
+
+Every field is a plain type (float, int, str, bool) or a nested frozen dataclass, so a TOML scene
+maps onto :class:`DynamicsScene` table by table, field by field. Invalid values raise ``ValueError``
+naming the field, its value and what was expected.
+
+Frames (fixed by the project): main (track) frame x along the track in the direction of travel,
+y lateral to the right, z vertically downward; gravity is +g e_z; the left rail is at y < 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+from rigid_dynamics.materials import STEEL, Material
+
+CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
+"""Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
+
+INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4")
+"""scipy.integrate.solve_ivp methods plus the fixed-step classical Runge-Kutta method ``RK4``."""
+
+IRREGULARITY_SIDES = ("both", "left", "right")
+
+
+def _check_finite(obj, *, positive=(), nonnegative=()) -> None:
+    """Check that all float/int fields are finite, and the named ones > 0 or >= 0."""
+    for f in fields(obj):
+        value = getattr(obj, f.name)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            continue
+        if not math.isfinite(value):
+            raise ValueError(f"{f.name} = {value!r}: expected a finite number")
+    for name in positive:
+        value = getattr(obj, name)
+        if not value > 0:
+            raise ValueError(f"{name} = {value!r}: expected a number > 0")
+    for name in nonnegative:
+        value = getattr(obj, name)
+        if not value >= 0:
+            raise ValueError(f"{name} = {value!r}: expected a number >= 0")
+
+
+@dataclass(frozen=True)
+class WheelsetParameters:
+    """Rigid wheelset: mass, inertia and the nominal wheel/contact geometry.
+
+    Defaults: the wheelset of the Manchester benchmark vehicle (S. Iwnicki, "Manchester benchmarks
+    for rail vehicle simulation", Vehicle System Dynamics 30 (1998) 295-313): m = 1813 kg,
+    I_xx = I_zz = 1120 kg m^2, I_yy = 112 kg m^2, wheel radius 0.46 m, half distance between the
+    nominal contact points 0.75 m.
+
+    Attributes:
+        mass_kg: m, wheelset mass, kg.
+        transverse_inertia_kg_m2: J_t, moment of inertia about any axis through the centre of mass
+            perpendicular to the axle (roll and yaw), kg m^2.
+        axle_inertia_kg_m2: J_a, moment of inertia about the axle, kg m^2.
+        nominal_radius_m: r0, rolling radius at the nominal contact point (tape circle), m.
+        contact_half_distance_m: e0, half the lateral distance between the nominal contact points, m.
+        suspension_half_spacing_m: b_s, lateral distance from the centre to the primary suspension
+            attachment on each side (springs act at y_d = +-b_s on the axle), m.
+    """
+
+    mass_kg: float = 1813.0
+    transverse_inertia_kg_m2: float = 1120.0
+    axle_inertia_kg_m2: float = 112.0
+    nominal_radius_m: float = 0.46
+    contact_half_distance_m: float = 0.75
+    suspension_half_spacing_m: float = 1.0
+
+    def __post_init__(self) -> None:
+        _check_finite(self, positive=[f.name for f in fields(self)])
+
+
+@dataclass(frozen=True)
+class SuspensionParameters:
+    """Primary suspension between the axle and a frame moving at constant speed along the track.
+
+    Per side, three linear springs and dampers act between the axle point y_d = +-b_s (wheelset
+    frame) and the frame point above it (main-frame directions x, y, z), plus a torsional yaw
+    spring/damper about z per side. The frame moves at the scene speed along x and stays at y = 0
+    and at the nominal centre height. The force on the wheelset of side s is
+    F = -k (x_axle - x_frame) - c (v_axle - v_frame), per direction.
+
+    Attributes:
+        longitudinal_stiffness_N_per_m, lateral_stiffness_N_per_m, vertical_stiffness_N_per_m: k per side, N/m.
+        longitudinal_damping_N_s_per_m, lateral_damping_N_s_per_m, vertical_damping_N_s_per_m: c per side, N s/m.
+        yaw_stiffness_N_m_per_rad: torsional yaw stiffness per side, N m/rad.
+        yaw_damping_N_m_s_per_rad: torsional yaw damping per side, N m s/rad.
+    """
+
+    longitudinal_stiffness_N_per_m: float = 0.0
+    lateral_stiffness_N_per_m: float = 0.0
+    vertical_stiffness_N_per_m: float = 0.0
+    longitudinal_damping_N_s_per_m: float = 0.0
+    lateral_damping_N_s_per_m: float = 0.0
+    vertical_damping_N_s_per_m: float = 0.0
+    yaw_stiffness_N_m_per_rad: float = 0.0
+    yaw_damping_N_m_s_per_rad: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_finite(self, nonnegative=[f.name for f in fields(self)])
+
+    @property
+    def is_damped(self) -> bool:
+        """True when any damper is present."""
+        return any(getattr(self, f.name) > 0 for f in fields(self) if "damping" in f.name)
+
+
+@dataclass(frozen=True)
+class LoadParameters:
+    """Constant exterior loads on the wheelset (eq 63-64).
+
+    Attributes:
+        axle_load_N: vertical force of the vehicle on the axle (without the wheelset's own weight),
+            acting downward (+z) at the centre, N.
+        traction_torque_N_m: torque about the axle driving forward rolling (> 0 traction, < 0 braking), N m.
+    """
+
+    axle_load_N: float = 160.0e3
+    traction_torque_N_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_finite(self, nonnegative=["axle_load_N"])
+
+
+@dataclass(frozen=True)
+class TrackGeometry:
+    """Wheel and rail profiles and their placement.
+
+    ``wheel_profile`` = "conical" with ``rail_profile`` = "circular" selects the analytic conical
+    provider (exactly linear rolling-radius difference, see providers.ConicalProvider); other names
+    are built-in profiles or profile files read by rigid_dynamics.geometry.
+
+    Attributes:
+        wheel_profile: wheel profile name or file ("conical", "S1002", path).
+        rail_profile: rail profile name or file ("circular", "UIC60", path).
+        conicity: lambda, cone slope of the conical wheel (dimensionless, tan of the cone angle).
+        rail_head_radius_m: transverse radius of the circular rail head, m.
+        rail_inclination_rad: cant of the rails towards the track centre, rad (1:40 -> 0.025).
+        gauge_m: track gauge, m.
+        gauge_height_m: depth below the rail top where the gauge is measured, m.
+        flange_back_distance_m: distance between the flange backs of the wheelset, m.
+        flange_contact_angle_rad: patches with a contact angle above this are flange contacts, rad.
+    """
+
+    wheel_profile: str = "conical"
+    rail_profile: str = "circular"
+    conicity: float = 0.05
+    rail_head_radius_m: float = 0.3
+    rail_inclination_rad: float = 0.0
+    gauge_m: float = 1.435
+    gauge_height_m: float = 0.014
+    flange_back_distance_m: float = 1.360
+    flange_contact_angle_rad: float = 0.5
+
+    def __post_init__(self) -> None:
+        _check_finite(
+            self,
+            positive=["rail_head_radius_m", "gauge_m", "flange_back_distance_m", "flange_contact_angle_rad"],
+            nonnegative=["gauge_height_m"],
+        )
+        for name in ("wheel_profile", "rail_profile"):
+            if not isinstance(getattr(self, name), str) or not getattr(self, name):
+                raise ValueError(f"{name} = {getattr(self, name)!r}: expected a profile name or file path")
+        if not 0 <= self.conicity < 1:
+            raise ValueError(f"conicity = {self.conicity!r}: expected a value in [0, 1)")
+        if abs(self.rail_inclination_rad) > 0.2:
+            raise ValueError(f"rail_inclination_rad = {self.rail_inclination_rad!r}: expected |value| <= 0.2")
+
+    @property
+    def is_conical(self) -> bool:
+        """True for the analytic conical wheel on circular rail heads."""
+        return self.wheel_profile.lower() == "conical" and self.rail_profile.lower() == "circular"
+
+
+@dataclass(frozen=True)
+class Irregularities:
+    """Shape irregularities of the wheels (eq 5: R_irr) and rails (eq 6: N_irr). Zero amplitude = none.
+
+    Attributes:
+        polygon_order: n, number of harmonics round the wheel (out-of-roundness order); 0 = none.
+        polygon_amplitude_m: amplitude of R_irr = A cos(n alpha + phase), m.
+        polygon_phase_rad: phase, rad.
+        flat_length_m: L, length of the (rounded) wheel flat along the circumference, m; 0 = none.
+        flat_depth_m: d, depth of the flat, m; 0 means the depth of a fresh flat of chord L,
+            d = L^2 / (16 r0).
+        flat_angle_rad: wheel angle alpha_d of the flat centre, rad (the wheel's lowest point is
+            at alpha_d = pi/2 - phi, so with phi(0) = 0 the value pi/2 + r0-arc puts it ahead).
+        corrugation_wavelength_m: wavelength of sinusoidal rail corrugation, m; 0 = none.
+        corrugation_amplitude_m: amplitude of N_irr = -A cos(2 pi x / wavelength), m.
+        side: which wheels/rails carry the irregularities: "both", "left" or "right".
+    """
+
+    polygon_order: int = 0
+    polygon_amplitude_m: float = 0.0
+    polygon_phase_rad: float = 0.0
+    flat_length_m: float = 0.0
+    flat_depth_m: float = 0.0
+    flat_angle_rad: float = 0.0
+    corrugation_wavelength_m: float = 0.0
+    corrugation_amplitude_m: float = 0.0
+    side: str = "both"
+
+    def __post_init__(self) -> None:
+        _check_finite(
+            self,
+            nonnegative=[
+                "polygon_order",
+                "polygon_amplitude_m",
+                "flat_length_m",
+                "flat_depth_m",
+                "corrugation_wavelength_m",
+                "corrugation_amplitude_m",
+            ],
+        )
+        if isinstance(self.polygon_order, bool) or not isinstance(self.polygon_order, int):
+            raise ValueError(f"polygon_order = {self.polygon_order!r}: expected an integer >= 0")
+        if self.side not in IRREGULARITY_SIDES:
+            raise ValueError(f"side = {self.side!r}: expected one of {', '.join(IRREGULARITY_SIDES)}")
+        if self.corrugation_amplitude_m > 0 and self.corrugation_wavelength_m <= 0:
+            raise ValueError(
+                f"corrugation_wavelength_m = {self.corrugation_wavelength_m!r}: expected > 0 with corrugation"
+            )
+
+    @property
+    def any(self) -> bool:
+        """True when any irregularity is present."""
+        return (
+            (self.polygon_order > 0 and self.polygon_amplitude_m > 0)
+            or self.flat_length_m > 0
+            or self.corrugation_amplitude_m > 0
+        )
+
+
+@dataclass(frozen=True)
+class IntegratorSettings:
+    """Time integration, output and safety limits.
+
+    Attributes:
+        method: one of RK45, DOP853, Radau, BDF, LSODA (scipy.integrate) or RK4 (fixed step).
+        relative_tolerance, absolute_tolerance: error tolerances of the adaptive methods.
+        fixed_step_s: step of RK4, s.
+        max_step_s: largest step of the adaptive methods, s.
+        output_step_s: spacing of the output samples, s (RK4: rounded to a multiple of the step).
+        max_rhs_evaluations: the run stops with status "budget-exceeded" after this many evaluations.
+        max_wall_time_s: the run stops with status "budget-exceeded" after this wall time, s.
+        max_force_factor: a normal force above this multiple of the static wheel load is a force
+            anomaly (status "force-anomaly").
+        max_lateral_displacement_m: |y| beyond this ends the run (status "derailed"), m.
+        stop_at_wheel_lift: end the run (status "wheel-lift") when a wheel loses contact.
+    """
+
+    method: str = "RK45"
+    relative_tolerance: float = 1e-6
+    absolute_tolerance: float = 1e-9
+    fixed_step_s: float = 1e-4
+    max_step_s: float = 2e-3
+    output_step_s: float = 1e-3
+    max_rhs_evaluations: int = 2_000_000
+    max_wall_time_s: float = 600.0
+    max_force_factor: float = 50.0
+    max_lateral_displacement_m: float = 0.05
+    stop_at_wheel_lift: bool = False
+
+    def __post_init__(self) -> None:
+        _check_finite(
+            self,
+            positive=[
+                "relative_tolerance",
+                "absolute_tolerance",
+                "fixed_step_s",
+                "max_step_s",
+                "output_step_s",
+                "max_rhs_evaluations",
+                "max_wall_time_s",
+                "max_force_factor",
+                "max_lateral_displacement_m",
+            ],
+        )
+        if self.method not in INTEGRATORS:
+            raise ValueError(f"method = {self.method!r}: expected one of {', '.join(INTEGRATORS)}")
+
+
+@dataclass(frozen=True)
+class InitialConditions:
+    """Initial state; vertical position and roll are set to static equilibrium by simulate().
+
+    Attributes:
+        lateral_displacement_m: y(0), m.
+        yaw_rad: psi(0), rad.
+        lateral_velocity_m_per_s: y'(0), m/s.
+        yaw_rate_rad_per_s: psi'(0), rad/s.
+        longitudinal_creepage: initial slip of the spin, phi'(0) = (1 - xi0) V / r0 (dimensionless).
+    """
+
+    lateral_displacement_m: float = 0.0
+    yaw_rad: float = 0.0
+    lateral_velocity_m_per_s: float = 0.0
+    yaw_rate_rad_per_s: float = 0.0
+    longitudinal_creepage: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_finite(self)
+        if abs(self.yaw_rad) > 0.2:
+            raise ValueError(f"yaw_rad = {self.yaw_rad!r}: expected |value| <= 0.2")
+
+
+@dataclass(frozen=True)
+class DynamicsScene:
+    """Everything a wheelset dynamics run needs.
+
+    Attributes:
+        name: scene name. description: one line for listings.
+        wheelset, suspension, loads, track, irregularities, integrator, initial: nested parameters.
+        material: elastic constants and friction of the wheel-rail pair.
+        speed_m_per_s: V, forward speed of the suspension frame and initial speed of the wheelset, m/s.
+        duration_s: simulated time, s.
+        contact_model: registered contact model name (rigid_dynamics.contact.registry), or "auto".
+        contact_provider: "auto" (conical analytic for conical wheels, tables for ideal geometry,
+            3-D search with irregularities), "conical", "tables" or "search".
+        contact_tolerance: relative force tolerance handed to the "auto" contact model.
+    """
+
+    name: str = "scene"
+    description: str = ""
+    wheelset: WheelsetParameters = field(default_factory=WheelsetParameters)
+    suspension: SuspensionParameters = field(default_factory=SuspensionParameters)
+    loads: LoadParameters = field(default_factory=LoadParameters)
+    track: TrackGeometry = field(default_factory=TrackGeometry)
+    irregularities: Irregularities = field(default_factory=Irregularities)
+    material: Material = STEEL
+    speed_m_per_s: float = 20.0
+    duration_s: float = 1.0
+    contact_model: str = "linear"
+    contact_provider: str = "auto"
+    contact_tolerance: float = 0.05
+    integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
+    initial: InitialConditions = field(default_factory=InitialConditions)
+
+    def __post_init__(self) -> None:
+        _check_finite(self, positive=["speed_m_per_s", "duration_s", "contact_tolerance"])
+        if self.contact_provider not in CONTACT_PROVIDERS:
+            raise ValueError(
+                f"contact_provider = {self.contact_provider!r}: expected one of {', '.join(CONTACT_PROVIDERS)}"
+            )
+        if not isinstance(self.contact_model, str) or not self.contact_model:
+            raise ValueError(f"contact_model = {self.contact_model!r}: expected a registered model name")
+        for name, cls in (
+            ("wheelset", WheelsetParameters),
+            ("suspension", SuspensionParameters),
+            ("loads", LoadParameters),
+            ("track", TrackGeometry),
+            ("irregularities", Irregularities),
+            ("material", Material),
+            ("integrator", IntegratorSettings),
+            ("initial", InitialConditions),
+        ):
+            if not isinstance(getattr(self, name), cls):
+                raise ValueError(f"{name} = {getattr(self, name)!r}: expected a {cls.__name__}")
+
+    @property
+    def static_wheel_load_N(self) -> float:
+        """Vertical load per wheel at rest, (m g + axle load)/2, N."""
+        from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
+
+        return 0.5 * (self.wheelset.mass_kg * STANDARD_GRAVITY_M_PER_S2 + self.loads.axle_load_N)

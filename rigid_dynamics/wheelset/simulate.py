@@ -1,0 +1,600 @@
+"""Running a wheelset scene: provider and model selection, integration, events, results.
+
+``simulate(scene, progress=None) -> SimulationResult``. The adaptive methods are scipy's
+``OdeSolver`` classes (RK45, DOP853, Radau, BDF, LSODA) stepped one step at a time, so that the run
+can be watched: output samples are taken from each step's dense output at the fixed output times,
+and after every step the state is checked. ``RK4`` is the classical fourth-order Runge-Kutta method
+with a fixed step (Butcher 1987 tableau: c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)).
+
+Safety (a run never hangs and never writes NaN silently): the run ends with a status
+(``SimulationResult.status``) and the time and state where it happened when
+
+* ``"blow-up"``: the state or its derivative is not finite;
+* ``"force-anomaly"``: a normal force exceeds ``max_force_factor`` times the static wheel load;
+* ``"derailed"``: |y| exceeds ``max_lateral_displacement_m``;
+* ``"contact-failed"``: a contact model failed or the creepages became undefined (rolling speed 0);
+* ``"solver-failed"``: the adaptive solver could not continue (step size too small);
+* ``"budget-exceeded"``: more than ``max_rhs_evaluations`` evaluations or ``max_wall_time_s``;
+* ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
+* ``"invalid-initial-state"``: no static equilibrium was found for the initial state;
+
+and ``"ok"`` when it reaches the end. Events (wheel lift, contact restored, flange contact onset)
+are detected on the output samples, so their times are known to one output step.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rigid_dynamics.wheelset.equations import (
+    MAX_SLOTS,
+    PATCH_FIELDS,
+    STATE_NAMES,
+    ContactFailure,
+    WheelsetModel,
+)
+from rigid_dynamics.wheelset.parameters import DynamicsScene
+from rigid_dynamics.wheelset.providers import SIDES, ConicalProvider, TableProvider
+
+ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+STATUSES = (
+    "ok",
+    "wheel-lift",
+    "blow-up",
+    "force-anomaly",
+    "derailed",
+    "contact-failed",
+    "solver-failed",
+    "budget-exceeded",
+    "invalid-initial-state",
+)
+
+
+class _Stop(Exception):
+    def __init__(self, status: str, message: str, t: float | None = None, state=None):
+        super().__init__(message)
+        self.status, self.message, self.t, self.state = status, message, t, state
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult:
+    """Outcome of a wheelset run (time series on the output grid, diagnostics, status).
+
+    Attributes:
+        status: one of STATUSES (module docstring). success: status == "ok".
+        message: what happened, in words.
+        t: output times, s, shape (n,).
+        states: the 12 states (STATE_NAMES) at the output times, shape (n, 12).
+        patches: PATCH_FIELDS -> array (n, 2 sides [left, right], 2 slots [tread, flange/second]);
+            NaN where a candidate does not exist or is not in contact (normal_force_N is 0 there).
+        contact_force_N: sum of the contact forces on each wheel, main frame, shape (n, 2, 3).
+        kinetic_energy_J, potential_energy_J: T and V_g = -m g z at the output times, (n,).
+        work_contact_J, work_exterior_J: work done on the wheelset since t = 0 by contact forces and
+            by exterior forces (suspension, axle load, torque), (n,).
+        events: tuples (kind, side, time_s): "wheel-lift", "contact-restored", "flange-contact".
+        rhs_evaluations, steps: counters. wall_time_s: wall time of the integration, s.
+        failure_time_s, failure_state: where the run ended abnormally (None when it did not).
+        provider, contact_model, method: what was used.
+        scene: the scene that ran.
+    """
+
+    status: str
+    message: str
+    t: np.ndarray
+    states: np.ndarray
+    patches: dict
+    contact_force_N: np.ndarray
+    kinetic_energy_J: np.ndarray
+    potential_energy_J: np.ndarray
+    work_contact_J: np.ndarray
+    work_exterior_J: np.ndarray
+    events: tuple = ()
+    rhs_evaluations: int = 0
+    steps: int = 0
+    wall_time_s: float = 0.0
+    failure_time_s: float | None = None
+    failure_state: np.ndarray | None = None
+    provider: str = ""
+    contact_model: str = ""
+    method: str = ""
+    scene: DynamicsScene | None = field(default=None, repr=False)
+
+    @property
+    def success(self) -> bool:
+        """True when the run reached its end time without trouble."""
+        return self.status == "ok"
+
+    @property
+    def simulated_time_s(self) -> float:
+        """Last output time, s."""
+        return float(self.t[-1]) if len(self.t) else 0.0
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated seconds per wall-clock second."""
+        return self.simulated_time_s / self.wall_time_s if self.wall_time_s > 0 else math.inf
+
+    @property
+    def wheel_normal_force_N(self) -> np.ndarray:
+        """Total normal force per wheel, (n, 2), N."""
+        return np.nansum(self.patches["normal_force_N"], axis=2)
+
+    @property
+    def energy_residual_J(self) -> np.ndarray:
+        """(T + V_g)(t) - (T + V_g)(0) - W_contact(t) - W_exterior(t), J (0 for exact integration)."""
+        energy = self.kinetic_energy_J + self.potential_energy_J
+        return energy - energy[0] - self.work_contact_J - self.work_exterior_J
+
+    def summary(self) -> dict:
+        """JSON-serialisable summary (NaN -> None); keys listed in the issue and a few diagnostics."""
+        forces = self.wheel_normal_force_N
+        lateral = self.states[:, 1] if len(self.t) else np.zeros(0)
+        wavelength = dominant_wavelength_m(self.states[:, 0], lateral) if len(self.t) > 4 else math.nan
+        residual = self.energy_residual_J
+        scale = max(float(np.max(np.abs(self.kinetic_energy_J))) if len(self.t) else 0.0, 1.0)
+
+        def num(value):
+            value = float(value)
+            return value if math.isfinite(value) else None
+
+        return {
+            "status": self.status,
+            "message": self.message,
+            "success": self.success,
+            "simulated_time_s": num(self.simulated_time_s),
+            "wall_time_s": num(self.wall_time_s),
+            "real_time_factor": num(self.real_time_factor),
+            "peak_normal_force_N": {
+                side: num(np.max(forces[:, i])) if len(self.t) else None for i, side in enumerate(SIDES)
+            },
+            "max_abs_lateral_displacement_m": num(np.max(np.abs(lateral))) if len(self.t) else None,
+            "dominant_lateral_wavelength_m": num(wavelength),
+            "distance_travelled_m": num(self.states[-1, 0] - self.states[0, 0]) if len(self.t) else None,
+            "energy_balance_relative": num(np.max(np.abs(residual)) / scale) if len(self.t) else None,
+            "events": [{"kind": k, "side": s, "time_s": num(t)} for k, s, t in self.events],
+            "rhs_evaluations": int(self.rhs_evaluations),
+            "steps": int(self.steps),
+            "failure_time_s": None if self.failure_time_s is None else num(self.failure_time_s),
+            "failure_state": None if self.failure_state is None else [num(v) for v in self.failure_state],
+            "provider": self.provider,
+            "contact_model": self.contact_model,
+            "method": self.method,
+        }
+
+
+def dominant_wavelength_m(distance_m, lateral_m) -> float:
+    """Dominant wavelength of y(x): twice the mean spacing of the zero crossings of y - mean(y).
+
+    Crossings are located by linear interpolation in the travelled distance x. Falls back to the
+    peak of the FFT of y resampled on a uniform x grid when there are fewer than 3 crossings
+    (then the resolution is the record length). NaN when neither gives an answer.
+
+    Args:
+        distance_m: x, travelled distance (monotonic), m.
+        lateral_m: y, lateral displacement, m.
+    """
+    x = np.asarray(distance_m, float)
+    y = np.asarray(lateral_m, float)
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    if len(x) < 5 or np.ptp(x) <= 0 or np.ptp(y) <= 0:
+        return math.nan
+    y = y - np.mean(y)
+    sign = np.signbit(y)
+    idx = np.flatnonzero(sign[1:] != sign[:-1])
+    if len(idx) >= 3:
+        x0, x1, y0, y1 = x[idx], x[idx + 1], y[idx], y[idx + 1]
+        crossings = x0 - y0 * (x1 - x0) / (y1 - y0)
+        return float(2.0 * np.mean(np.diff(crossings)))
+    grid = np.linspace(x[0], x[-1], max(len(x), 64))
+    yy = np.interp(grid, x, y)
+    spectrum = np.abs(np.fft.rfft(yy))
+    k = int(np.argmax(spectrum[1:])) + 1
+    if spectrum[k] <= 0:
+        return math.nan
+    return float((grid[-1] - grid[0]) * len(grid) / (len(grid) - 1) / k)
+
+
+# ------------------------------------------------------------------------------------------------
+def build_provider(scene: DynamicsScene):
+    """The contact-geometry provider of a scene (``contact_provider``, "auto" rules in DynamicsScene).
+
+    Raises:
+        ValueError: the provider cannot serve the scene (the message says why).
+    """
+    choice = scene.contact_provider
+    track, irr = scene.track, scene.irregularities
+    if choice == "auto":
+        if track.is_conical:
+            choice = "conical"
+        elif irr.any:
+            choice = "search"
+        else:
+            choice = "tables"
+    if choice == "conical":
+        if not track.is_conical:
+            raise ValueError(
+                f"contact_provider = 'conical': needs wheel_profile = 'conical' and rail_profile = 'circular', "
+                f"got {track.wheel_profile!r} and {track.rail_profile!r}"
+            )
+        return ConicalProvider(scene.wheelset, track, irr)
+    if choice == "tables":
+        if track.is_conical:
+            section = ConicalProvider(scene.wheelset, track)
+        else:
+            from rigid_dynamics.wheelset.profiles import ProfileSectionProvider
+
+            section = ProfileSectionProvider(scene.wheelset, track)
+        return TableProvider(section, scene.wheelset.nominal_radius_m, irregularities=irr)
+    if choice == "search":
+        from rigid_dynamics.wheelset.profiles import SearchProvider
+
+        return SearchProvider(scene.wheelset, track, irr)
+    raise ValueError(f"contact_provider = {choice!r}: unknown")  # pragma: no cover (validated by the scene)
+
+
+def build_contact_model(scene: DynamicsScene):
+    """The contact model of a scene by its registered name (registry.get_model)."""
+    from rigid_dynamics.contact.registry import get_model
+
+    return get_model(scene.contact_model)
+
+
+def initial_state(scene: DynamicsScene) -> np.ndarray:
+    """The 12-state at t = 0 before the static equilibrium of z and theta (see InitialConditions)."""
+    ic = scene.initial
+    r0 = scene.wheelset.nominal_radius_m
+    v = scene.speed_m_per_s
+    state = np.zeros(12)
+    state[1] = ic.lateral_displacement_m
+    state[2] = -r0 + 1e-4
+    state[3] = ic.yaw_rad
+    state[6] = v
+    state[7] = ic.lateral_velocity_m_per_s
+    state[9] = ic.yaw_rate_rad_per_s
+    state[11] = (1.0 - ic.longitudinal_creepage) * v / r0
+    return state
+
+
+class _Recorder:
+    """Collects output samples and detects events and anomalies on them."""
+
+    def __init__(self, model: WheelsetModel, scene: DynamicsScene):
+        self.model = model
+        self.scene = scene
+        self.t: list[float] = []
+        self.states: list[np.ndarray] = []
+        self.patches = {name: [] for name in PATCH_FIELDS}
+        self.forces: list[np.ndarray] = []
+        self.kinetic: list[float] = []
+        self.potential: list[float] = []
+        self.work_contact: list[float] = []
+        self.work_exterior: list[float] = []
+        self.events: list[tuple] = []
+        self.in_contact = None
+        self.flange = None
+        self.limit_force = scene.integrator.max_force_factor * scene.static_wheel_load_N
+        self.limit_y = scene.integrator.max_lateral_displacement_m
+        self.flange_angle = scene.track.flange_contact_angle_rad
+
+    def record(self, t: float, full_state: np.ndarray) -> None:
+        state = full_state[:12]
+        if not np.all(np.isfinite(full_state)):
+            raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, state)
+        contact = self.model.contact(state)
+        table = {name: np.full((2, MAX_SLOTS), np.nan) for name in PATCH_FIELDS}
+        for k in range(len(contact.side)):
+            side, slot = int(contact.side[k]), int(contact.slot[k])
+            if slot >= MAX_SLOTS:
+                continue
+            for name in PATCH_FIELDS:
+                table[name][side, slot] = contact.values[name][k]
+        forces = np.zeros((2, 3))
+        np.add.at(forces, contact.side, contact.force_N)
+        normal = np.nansum(table["normal_force_N"], axis=1)
+        if not (np.all(np.isfinite(forces)) and np.all(np.isfinite(normal))):
+            raise _Stop("blow-up", f"non-finite contact force at t = {t:.6g} s", t, state)
+        if np.max(normal) > self.limit_force:
+            raise _Stop(
+                "force-anomaly",
+                f"normal force {np.max(normal):.4g} N exceeds {self.limit_force:.4g} N "
+                f"(max_force_factor x static wheel load) at t = {t:.6g} s",
+                t,
+                state,
+            )
+        if abs(state[1]) > self.limit_y:
+            raise _Stop(
+                "derailed", f"|y| = {abs(state[1]):.4g} m exceeds {self.limit_y:.4g} m at t = {t:.6g} s", t, state
+            )
+        touching = normal > 0
+        flange = np.array(
+            [
+                bool(np.any((table["contact_angle_rad"][i] > self.flange_angle) & (table["normal_force_N"][i] > 0)))
+                for i in range(2)
+            ]
+        )
+        if self.in_contact is not None:
+            for i, side in enumerate(SIDES):
+                if self.in_contact[i] and not touching[i]:
+                    self.events.append(("wheel-lift", side, t))
+                elif touching[i] and not self.in_contact[i]:
+                    self.events.append(("contact-restored", side, t))
+                if flange[i] and not self.flange[i]:
+                    self.events.append(("flange-contact", side, t))
+        self.in_contact, self.flange = touching, flange
+        self.t.append(t)
+        self.states.append(state.copy())
+        for name in PATCH_FIELDS:
+            self.patches[name].append(table[name])
+        self.forces.append(forces)
+        self.kinetic.append(self.model.kinetic_energy_J(state))
+        self.potential.append(self.model.potential_energy_J(state))
+        self.work_contact.append(float(full_state[12]))
+        self.work_exterior.append(float(full_state[13]))
+        if self.scene.integrator.stop_at_wheel_lift and not np.all(touching):
+            side = SIDES[int(np.argmin(touching))]
+            raise _Stop("wheel-lift", f"the {side} wheel lost contact at t = {t:.6g} s", t, state)
+
+    def arrays(self):
+        n = len(self.t)
+        patches = {name: (np.array(v) if n else np.zeros((0, 2, MAX_SLOTS))) for name, v in self.patches.items()}
+        return (
+            np.array(self.t),
+            np.array(self.states) if n else np.zeros((0, 12)),
+            patches,
+            np.array(self.forces) if n else np.zeros((0, 2, 3)),
+            np.array(self.kinetic),
+            np.array(self.potential),
+            np.array(self.work_contact),
+            np.array(self.work_exterior),
+        )
+
+
+def simulate(
+    scene: DynamicsScene,
+    progress: Callable[[float], None] | None = None,
+    *,
+    provider=None,
+    contact_model=None,
+) -> SimulationResult:
+    """Run a scene and return its :class:`SimulationResult` (never raises for numerical trouble).
+
+    Args:
+        scene: the scene.
+        progress: optional callable(fraction in [0, 1]) called as the run advances (about 100 times).
+        provider: optional provider instance overriding the scene's ``contact_provider`` (e.g. a
+            prebuilt TableProvider reused across runs).
+        contact_model: optional model instance or registered name overriding ``scene.contact_model``.
+
+    Raises:
+        ValueError: the scene cannot be set up (unknown model, provider that cannot serve it).
+    """
+    from rigid_dynamics.contact.registry import get_model
+
+    provider = provider if provider is not None else build_provider(scene)
+    model_obj = get_model(contact_model if contact_model is not None else scene.contact_model)
+    model = WheelsetModel(scene, provider, model_obj)
+    settings = scene.integrator
+    duration = scene.duration_s
+    start = time.perf_counter()
+    recorder = _Recorder(model, scene)
+    status, message, fail_t, fail_state = "ok", "", None, None
+    steps = 0
+
+    state0, ok, why = model.static_state(initial_state(scene))
+    model.frame_x0 = float(state0[0])
+    model.rhs_evaluations = 0
+    full0 = np.concatenate([state0, [0.0, 0.0]])
+    last_fraction = [-1.0]
+
+    def report(t):
+        if progress is not None:
+            fraction = min(1.0, t / duration)
+            if fraction - last_fraction[0] >= 0.01 or fraction >= 1.0 and last_fraction[0] < 1.0:
+                last_fraction[0] = fraction
+                progress(fraction)
+
+    def fun(t, y):
+        if model.rhs_evaluations >= settings.max_rhs_evaluations:
+            raise _Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
+        if time.perf_counter() - start > settings.max_wall_time_s:
+            raise _Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
+        if not np.all(np.isfinite(y)):
+            raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, y[:12])
+        try:
+            d = model.derivative(t, y)
+        except ContactFailure as exc:
+            raise _Stop("contact-failed", f"{exc} (t = {t:.6g} s)", t, y[:12]) from None
+        if not np.all(np.isfinite(d)):
+            raise _Stop("blow-up", f"non-finite state derivative at t = {t:.6g} s", t, y[:12])
+        return d
+
+    n_out = int(math.floor(duration / settings.output_step_s + 1e-9))
+    out_times = settings.output_step_s * np.arange(n_out + 1)
+    if out_times[-1] < duration - 1e-12:
+        out_times = np.append(out_times, duration)
+
+    try:
+        if not ok:
+            raise _Stop("invalid-initial-state", f"no static equilibrium of z and roll found: {why}", 0.0, state0)
+        recorder.record(0.0, full0)
+        next_out = 1
+        if settings.method == "RK4":
+            steps = _run_rk4(fun, full0, duration, settings, out_times, recorder, report)
+        else:
+            steps = _run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
+        message = f"reached t = {duration:g} s"
+        del next_out
+    except _Stop as stop:
+        status, message, fail_t, fail_state = stop.status, stop.message, stop.t, stop.state
+        steps = steps or getattr(stop, "steps", 0)
+    except ContactFailure as exc:
+        status, message = "contact-failed", str(exc)
+    wall = time.perf_counter() - start
+    t, states, patches, forces, kin, pot, wc, we = recorder.arrays()
+    return SimulationResult(
+        status=status,
+        message=message,
+        t=t,
+        states=states,
+        patches=patches,
+        contact_force_N=forces,
+        kinetic_energy_J=kin,
+        potential_energy_J=pot,
+        work_contact_J=wc,
+        work_exterior_J=we,
+        events=tuple(recorder.events),
+        rhs_evaluations=model.rhs_evaluations,
+        steps=steps,
+        wall_time_s=wall,
+        failure_time_s=None if fail_t is None else float(fail_t),
+        failure_state=None if fail_state is None else np.array(fail_state[:12], float),
+        provider=getattr(provider, "name", type(provider).__name__),
+        contact_model=getattr(model_obj, "name", type(model_obj).__name__),
+        method=settings.method,
+        scene=scene,
+    )
+
+
+def _tolerances(settings, scene):
+    """Absolute tolerances per state: positions/angles atol, rates 10 atol x speed scale, work 1e-6 m g r0."""
+    atol = np.full(14, settings.absolute_tolerance)
+    atol[6:12] = settings.absolute_tolerance * 100.0
+    atol[5] = settings.absolute_tolerance * 100.0
+    atol[11] = settings.absolute_tolerance * 1e3
+    atol[12:] = 1e-3
+    return atol
+
+
+def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
+    from scipy import integrate
+
+    cls = getattr(integrate, settings.method)
+    solver = cls(
+        fun,
+        0.0,
+        y0,
+        duration,
+        rtol=settings.relative_tolerance,
+        atol=_tolerances(settings, scene),
+        max_step=settings.max_step_s,
+    )
+    steps = 0
+    next_out = 1
+    while solver.status == "running":
+        t_before = solver.t
+        try:
+            message = solver.step()
+        except _Stop as stop:
+            stop.steps = steps
+            raise
+        steps += 1
+        if solver.status == "failed":
+            exc = _Stop("solver-failed", f"{settings.method}: {message} (t = {t_before:.6g} s)", t_before, solver.y)
+            exc.steps = steps
+            raise exc
+        if not np.all(np.isfinite(solver.y)):
+            exc = _Stop("blow-up", f"non-finite state at t = {solver.t:.6g} s", solver.t, solver.y)
+            exc.steps = steps
+            raise exc
+        if next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
+            dense = solver.dense_output()
+            while next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
+                t_out = out_times[next_out]
+                try:
+                    recorder.record(t_out, dense(t_out) if t_out < solver.t else solver.y)
+                except _Stop as stop:
+                    stop.steps = steps
+                    raise
+                next_out += 1
+        report(solver.t)
+    return steps
+
+
+def _run_rk4(fun, y0, duration, settings, out_times, recorder, report) -> int:
+    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
+    h = duration / n_steps
+    y = y0.copy()
+    t = 0.0
+    next_out = 1
+    for i in range(n_steps):
+        try:
+            k1 = fun(t, y)
+            k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
+            k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
+            k4 = fun(t + h, y + h * k3)
+        except _Stop as stop:
+            stop.steps = i
+            raise
+        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        t_new = (i + 1) * h
+        while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
+            t_out = out_times[next_out]
+            # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
+            s = (t_out - t) / h
+            if abs(s - 1.0) < 1e-9:
+                y_out = y_new
+            else:
+                h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+                h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+                y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
+            try:
+                recorder.record(t_out, y_out)
+            except _Stop as stop:
+                stop.steps = i + 1
+                raise
+            next_out += 1
+        y, t = y_new, t_new
+        report(t)
+    return n_steps
+
+
+def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
+    """Write the time series of a result to an NPZ file, atomically (temporary name, then os.replace).
+
+    Arrays: ``t`` (n,), ``states`` (n, 12) with ``state_names``, ``patch_<field>`` (n, 2, 2) for every
+    PATCH_FIELDS entry (sides left/right, slots tread/flange), ``contact_force_N`` (n, 2, 3),
+    ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
+    ``status``/``message`` as strings. NaN marks candidates without contact, never a failed number:
+    a failed run stops at its last good sample and says so in ``status``.
+
+    Returns:
+        The path written (suffix .npz added when missing).
+    """
+    path = Path(path)
+    if path.suffix != ".npz":
+        path = path.with_suffix(".npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = {
+        "t": result.t,
+        "states": result.states,
+        "state_names": np.array(STATE_NAMES),
+        "contact_force_N": result.contact_force_N,
+        "kinetic_energy_J": result.kinetic_energy_J,
+        "potential_energy_J": result.potential_energy_J,
+        "work_contact_J": result.work_contact_J,
+        "work_exterior_J": result.work_exterior_J,
+        "status": np.array(result.status),
+        "message": np.array(result.message),
+        "sides": np.array(SIDES),
+    }
+    for name, values in result.patches.items():
+        arrays[f"patch_{name}"] = values
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".npz.tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            np.savez_compressed(handle, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
