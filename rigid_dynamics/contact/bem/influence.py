@@ -1,0 +1,351 @@
+"""Half-space influence coefficients for uniform tractions on rectangles, and their FFT convolution.
+
+Two elastic half-spaces touch in the plane z = 0 of the contact frame (x rolling, y lateral,
+z from the rail into the wheel). Body 1 is the wheel (material at z > 0), body 2 the rail.
+The traction ``(t_x, t_y, p)`` acts on the wheel (``p`` > 0 presses the bodies apart), minus it
+on the rail. The *displacement difference* ``u = u(wheel) - u(rail)`` at the surface is::
+
+    u_i(x) = sum_j  integral  A_ij(x - x') t_j(x') dx'          (Kalker 1990, sec. 1.6 and 5.2)
+
+with, for r = |x - x'|, (X, Y) = x - x' and the combined constants of the pair
+(Kalker 1990, eq 1.6.9)::
+
+    1/G = (1/G1 + 1/G2)/2,  nu/G = (nu1/G1 + nu2/G2)/2,  K = (G/4) [(1 - 2 nu1)/G1 - (1 - 2 nu2)/G2]
+
+    A_zz = (1 - nu)/(pi G r)                    (Boussinesq; both bodies)
+    A_xx = [(1 - nu)/r + nu X^2/r^3]/(pi G)     (Cerruti)
+    A_yy = [(1 - nu)/r + nu Y^2/r^3]/(pi G)
+    A_xy = A_yx = nu X Y/(pi G r^3)
+    A_zx = K X/(pi G r^2),  A_xz = -A_zx         (normal displacement from t_x and vice versa)
+    A_zy = K Y/(pi G r^2),  A_yz = -A_zy
+
+These follow from the single-body surface displacements of a point force on a half-space
+(Johnson 1985, eq 3.19 and 3.77; the sign of the Cerruti normal displacement fixed by Betti's
+reciprocity with the Boussinesq radial displacement u_r = -(1 - 2 nu) P/(4 pi G r)).
+Quasi-identical bodies have K = 0: the normal and tangential problems decouple.
+
+The coefficient of a *uniform* traction on the rectangle |x'| <= dx/2, |y'| <= dy/2 is the
+double integral of the kernel. With a primitive F (d^2 F/dX dY = kernel) it is::
+
+    C(x, y) = F(x + dx/2, y + dy/2) - F(x - dx/2, y + dy/2) - F(x + dx/2, y - dy/2) + F(x - dx/2, y - dy/2)
+
+    1/r     : F = X asinh(Y/|X|) + Y asinh(X/|Y|)      (Love 1929, uniform pressure on a rectangle)
+    X^2/r^3 : F = Y asinh(X/|Y|)
+    Y^2/r^3 : F = X asinh(Y/|X|)
+    XY/r^3  : F = -r
+    X/r^2   : F = X atan(Y/X) + Y ln r
+    Y/r^2   : F = Y atan(X/Y) + X ln r
+
+A 2-D (plane strain, long strip along y) variant uses line elements of width dx with the line-load
+kernels A_zz = A_xx = -2 (1 - nu) ln|X|/(pi G), A_yy = -2 ln|X|/(pi G), A_xy = 0 (Johnson 1985, eq
+2.19 and 2.24 for both bodies; valid up to a constant, which force control absorbs).
+
+Symbols: G shear modulus (Pa), nu Poisson's ratio, K difference parameter (-), dx, dy element
+sizes (m). Displacements per unit traction: m/Pa.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.fft
+
+KERNELS = ("zz", "xx", "yy", "xy", "zx", "zy", "xz", "yz")
+"""Names of the influence kernels A_ij: first index displacement, second traction component."""
+
+
+def combined_elastic_constants(
+    shear_modulus_1_Pa: float, poisson_ratio_1: float, shear_modulus_2_Pa: float, poisson_ratio_2: float
+) -> tuple[float, float, float]:
+    """Combined constants (G, nu, K) of two bodies (Kalker 1990, eq 1.6.9).
+
+    Returns:
+        G (Pa) with 1/G = (1/G1 + 1/G2)/2; nu with nu/G = (nu1/G1 + nu2/G2)/2; the difference
+        parameter K = (G/4) [(1 - 2 nu1)/G1 - (1 - 2 nu2)/G2] (0 for quasi-identical bodies).
+    """
+    for name, value in (("shear_modulus_1_Pa", shear_modulus_1_Pa), ("shear_modulus_2_Pa", shear_modulus_2_Pa)):
+        if not math.isfinite(value) or value <= 0:
+            raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+    for name, value in (("poisson_ratio_1", poisson_ratio_1), ("poisson_ratio_2", poisson_ratio_2)):
+        if not -1.0 < value < 0.5:
+            raise ValueError(f"{name} = {value!r}: expected a value in (-1, 0.5)")
+    g = 2.0 / (1.0 / shear_modulus_1_Pa + 1.0 / shear_modulus_2_Pa)
+    nu = 0.5 * g * (poisson_ratio_1 / shear_modulus_1_Pa + poisson_ratio_2 / shear_modulus_2_Pa)
+    k = (
+        0.25
+        * g
+        * ((1.0 - 2.0 * poisson_ratio_1) / shear_modulus_1_Pa - (1.0 - 2.0 * poisson_ratio_2) / shear_modulus_2_Pa)
+    )
+    return g, nu, k
+
+
+def point_load_kernels(
+    x_m: np.ndarray, y_m: np.ndarray, shear_modulus_Pa: float, poisson_ratio: float, difference_parameter: float = 0.0
+) -> dict[str, np.ndarray]:
+    """Displacement difference per unit point force, A_ij(X, Y) of the module docstring, m/N.
+
+    Boussinesq (normal) and Cerruti (tangential) surface solutions of both bodies combined.
+    ``x_m``, ``y_m``: offsets observation - load point (not both zero), m.
+    """
+    x, y = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    r = np.hypot(x, y)
+    c = 1.0 / (math.pi * shear_modulus_Pa)
+    nu, k = poisson_ratio, difference_parameter
+    out = {
+        "zz": c * (1.0 - nu) / r,
+        "xx": c * ((1.0 - nu) / r + nu * x * x / r**3),
+        "yy": c * ((1.0 - nu) / r + nu * y * y / r**3),
+        "xy": c * nu * x * y / r**3,
+        "zx": c * k * x / r**2,
+        "zy": c * k * y / r**2,
+    }
+    out["xz"] = -out["zx"]
+    out["yz"] = -out["zy"]
+    return out
+
+
+def _x_asinh_y_over_x(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """X asinh(Y/|X|), continuous with value 0 at X = 0."""
+    ax = np.abs(x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        val = x * np.arcsinh(y / ax)
+    return np.where(ax > 0, val, 0.0)
+
+
+def _primitives(x: np.ndarray, y: np.ndarray) -> dict[str, np.ndarray]:
+    """Primitives F of the kernel shapes (module docstring), at corner offsets (X, Y)."""
+    r = np.hypot(x, y)
+    xa = _x_asinh_y_over_x(x, y)
+    ya = _x_asinh_y_over_x(y, x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_r = np.where(r > 0, np.log(np.where(r > 0, r, 1.0)), 0.0)
+        x_atan = np.where(x != 0, x * np.arctan(y / np.where(x != 0, x, 1.0)), 0.0)
+        y_atan = np.where(y != 0, y * np.arctan(x / np.where(y != 0, y, 1.0)), 0.0)
+    return {
+        "inv_r": xa + ya,
+        "xx_r3": ya,
+        "yy_r3": xa,
+        "xy_r3": -r,
+        "x_r2": x_atan + y * log_r,
+        "y_r2": y_atan + x * log_r,
+    }
+
+
+def rectangle_influence(
+    x_m: np.ndarray,
+    y_m: np.ndarray,
+    dx_m: float,
+    dy_m: float,
+    shear_modulus_Pa: float,
+    poisson_ratio: float,
+    difference_parameter: float = 0.0,
+) -> dict[str, np.ndarray]:
+    """Displacement difference at (x, y) from unit uniform traction on the rectangle |x'| <= dx/2, |y'| <= dy/2.
+
+    Love (1929) for the normal load, the Cerruti counterparts for the tangential loads
+    (primitives in the module docstring). Returns a dict kernel name -> array of the broadcast
+    shape of ``x_m``, ``y_m``, in m/Pa (displacement per unit traction).
+    """
+    x, y = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    hx, hy = 0.5 * dx_m, 0.5 * dy_m
+    acc: dict[str, np.ndarray] = {}
+    for sx, sy, sign in ((1, 1, 1.0), (-1, 1, -1.0), (1, -1, -1.0), (-1, -1, 1.0)):
+        prim = _primitives(x + sx * hx, y + sy * hy)
+        for key, val in prim.items():
+            acc[key] = acc.get(key, 0.0) + sign * val
+    c = 1.0 / (math.pi * shear_modulus_Pa)
+    nu, k = poisson_ratio, difference_parameter
+    out = {
+        "zz": c * (1.0 - nu) * acc["inv_r"],
+        "xx": c * ((1.0 - nu) * acc["inv_r"] + nu * acc["xx_r3"]),
+        "yy": c * ((1.0 - nu) * acc["inv_r"] + nu * acc["yy_r3"]),
+        "xy": c * nu * acc["xy_r3"],
+        "zx": c * k * acc["x_r2"],
+        "zy": c * k * acc["y_r2"],
+    }
+    out["xz"] = -out["zx"]
+    out["yz"] = -out["zy"]
+    return out
+
+
+def strip_influence(
+    x_m: np.ndarray, dx_m: float, shear_modulus_Pa: float, poisson_ratio: float
+) -> dict[str, np.ndarray]:
+    """2-D (plane strain) influence of unit uniform traction on the strip |x'| <= dx/2, -inf < y' < inf.
+
+    Kernel -2 (1 - nu) ln|X|/(pi G) (normal and in-plane tangential), -2 ln|X|/(pi G) (antiplane);
+    the integral uses the primitive X ln|X| - X. Defined up to an additive constant. m/Pa.
+    """
+    x = np.asarray(x_m, float)
+
+    def prim(s: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(s != 0, s * np.log(np.abs(np.where(s != 0, s, 1.0))), 0.0) - s
+
+    integral = prim(x + 0.5 * dx_m) - prim(x - 0.5 * dx_m)
+    c = -2.0 / (math.pi * shear_modulus_Pa)
+    zero = np.zeros_like(integral)
+    return {
+        "zz": c * (1.0 - poisson_ratio) * integral,
+        "xx": c * (1.0 - poisson_ratio) * integral,
+        "yy": c * integral,
+        "xy": zero,
+        "zx": zero,
+        "zy": zero,
+        "xz": zero,
+        "yz": zero,
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class InfluenceGrid:
+    """Influence coefficients of a regular nx x ny grid of rectangular elements, applied by FFT.
+
+    Element (i, j) has its centre at (x0 + i dx, y0 + j dy); arrays are indexed ``[j, i]``
+    (y rows, x columns) as in :class:`~rigid_dynamics.contact.types.ContactFields`.
+
+    Two operators per kernel (A_ij of the module docstring):
+
+    * static: ``u[I] = sum_K C(I - K) t[K]`` (displacement difference, m), used by NORM and by the
+      shift problem;
+    * rolling: ``sum_K (C(I - K) - C(I - K + e_x)) t[K] / dx``, the upwind difference
+      ``(u(x_I) - u(x_I + dx))/dx = -du/dx`` of steady rolling with the leading edge at +x
+      (Kalker 1990, sec. 5.2: the previous position of a particle is dx ahead).
+
+    The convolution is a zero-padded FFT (period >= 2n - 1 along each axis, so no wrap-around),
+    O(N log N) time and O(N) memory; no dense N x N matrix is formed.
+
+    Attributes:
+        nx, ny: number of elements along x and y.
+        dx_m, dy_m: element size, m (dy_m is ignored in the 2-D mode).
+        shear_modulus_Pa, poisson_ratio, difference_parameter: combined constants G, nu, K.
+        plane: 2-D (plane strain) mode with ny = 1 line elements (forces per unit length).
+    """
+
+    nx: int
+    ny: int
+    dx_m: float
+    dy_m: float
+    shear_modulus_Pa: float
+    poisson_ratio: float
+    difference_parameter: float = 0.0
+    plane: bool = False
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        for name in ("nx", "ny"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"{name} = {value!r}: expected an integer >= 1")
+        for name in ("dx_m", "dy_m", "shear_modulus_Pa"):
+            value = getattr(self, name)
+            if not math.isfinite(value) or value <= 0:
+                raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+        if not -1.0 < self.poisson_ratio < 0.5:
+            raise ValueError(f"poisson_ratio = {self.poisson_ratio!r}: expected a value in (-1, 0.5)")
+        if not math.isfinite(self.difference_parameter) or abs(self.difference_parameter) >= 0.5:
+            raise ValueError(f"difference_parameter = {self.difference_parameter!r}: expected |K| < 0.5")
+        if self.plane and self.ny != 1:
+            raise ValueError(f"ny = {self.ny!r}: the 2-D (plane) mode expects ny = 1")
+        if self.plane and self.difference_parameter != 0.0:
+            raise ValueError(f"difference_parameter = {self.difference_parameter!r}: expected 0 in the 2-D mode")
+        nx, ny = int(self.nx), int(self.ny)
+        di = np.arange(-(nx - 1), nx + 1)  # one extra offset for the rolling difference
+        dj = np.arange(-(ny - 1), ny)
+        xx, yy = np.meshgrid(di * self.dx_m, dj * self.dy_m)
+        if self.plane:
+            ext = strip_influence(xx, self.dx_m, self.shear_modulus_Pa, self.poisson_ratio)
+        else:
+            ext = rectangle_influence(
+                xx, yy, self.dx_m, self.dy_m, self.shear_modulus_Pa, self.poisson_ratio, self.difference_parameter
+            )
+        static = {k: v[:, : 2 * nx - 1] for k, v in ext.items()}
+        rolling = {k: (v[:, : 2 * nx - 1] - v[:, 1:]) / self.dx_m for k, v in ext.items()}
+        shape = (
+            scipy.fft.next_fast_len(2 * ny - 1, real=True) if ny > 1 else 1,
+            scipy.fft.next_fast_len(2 * nx - 1, real=True),
+        )
+        self._cache["shape"] = shape
+        self._cache["static"] = static
+        self._cache["rolling"] = rolling
+        self._cache["fft"] = {}
+
+    # --- kernels -----------------------------------------------------------------------------------
+    def kernel(self, name: str, rolling: bool = False) -> np.ndarray:
+        """Coefficients on offsets, shape (2 ny - 1, 2 nx - 1), entry [dj + ny - 1, di + nx - 1], m/Pa or 1/Pa."""
+        if name not in KERNELS:
+            raise ValueError(f"kernel = {name!r}: expected one of {', '.join(KERNELS)}")
+        return self._cache["rolling" if rolling else "static"][name]
+
+    def self_coefficient(self, name: str, rolling: bool = False) -> float:
+        """Coefficient of an element on itself (offset 0)."""
+        return float(self.kernel(name, rolling)[self.ny - 1, self.nx - 1])
+
+    def window(self, name: str, rolling: bool, half_x: int, half_y: int) -> np.ndarray:
+        """Coefficients for offsets |di| <= half_x, |dj| <= half_y, shape (2 half_y + 1, 2 half_x + 1), zero-filled."""
+        out = np.zeros((2 * half_y + 1, 2 * half_x + 1))
+        k = self.kernel(name, rolling)
+        for a in range(-half_y, half_y + 1):
+            for b in range(-half_x, half_x + 1):
+                if abs(a) < self.ny and abs(b) < self.nx:
+                    out[a + half_y, b + half_x] = k[a + self.ny - 1, b + self.nx - 1]
+        return out
+
+    def _kernel_fft(self, name: str, rolling: bool) -> np.ndarray:
+        key = (name, rolling)
+        cache = self._cache["fft"]
+        if key not in cache:
+            ly, lx = self._cache["shape"]
+            pad = np.zeros((ly, lx))
+            k = self.kernel(name, rolling)
+            jj = np.arange(-(self.ny - 1), self.ny) % ly
+            ii = np.arange(-(self.nx - 1), self.nx) % lx
+            pad[np.ix_(jj, ii)] = k
+            cache[key] = scipy.fft.rfft2(pad)
+        return cache[key]
+
+    # --- operators ---------------------------------------------------------------------------------
+    def _forward(self, field_values: np.ndarray) -> np.ndarray:
+        return scipy.fft.rfft2(np.asarray(field_values, float), s=self._cache["shape"])
+
+    def _backward(self, spectrum: np.ndarray) -> np.ndarray:
+        return scipy.fft.irfft2(spectrum, s=self._cache["shape"])[: self.ny, : self.nx]
+
+    def apply(self, name: str, field_values: np.ndarray, rolling: bool = False) -> np.ndarray:
+        """Convolution ``sum_K C_name(I - K) t[K]`` of one kernel with a (ny, nx) field."""
+        return self._backward(self._kernel_fft(name, rolling) * self._forward(field_values))
+
+    def normal(self, pressure_Pa: np.ndarray, traction_x_Pa=None, traction_y_Pa=None) -> np.ndarray:
+        """Normal displacement difference u_z (m) from the pressure (and, if K != 0, the tractions)."""
+        spec = self._kernel_fft("zz", False) * self._forward(pressure_Pa)
+        if self.difference_parameter != 0.0:
+            if traction_x_Pa is not None:
+                spec = spec + self._kernel_fft("zx", False) * self._forward(traction_x_Pa)
+            if traction_y_Pa is not None:
+                spec = spec + self._kernel_fft("zy", False) * self._forward(traction_y_Pa)
+        return self._backward(spec)
+
+    def tangential(
+        self, traction_x_Pa: np.ndarray, traction_y_Pa: np.ndarray, rolling: bool = False, pressure_Pa=None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Tangential displacement differences (u_x, u_y) (static, m) or their rolling differences (-du/dx, -)."""
+        fx = self._forward(traction_x_Pa)
+        fy = self._forward(traction_y_Pa)
+        kxy = self._kernel_fft("xy", rolling)
+        sx = self._kernel_fft("xx", rolling) * fx + kxy * fy
+        sy = kxy * fx + self._kernel_fft("yy", rolling) * fy
+        if self.difference_parameter != 0.0 and pressure_Pa is not None:
+            fz = self._forward(pressure_Pa)
+            sx = sx + self._kernel_fft("xz", rolling) * fz
+            sy = sy + self._kernel_fft("yz", rolling) * fz
+        return self._backward(sx), self._backward(sy)
+
+    def dense(self, name: str, rolling: bool = False) -> np.ndarray:
+        """Dense N x N matrix of one kernel (N = nx ny, row-major over [j, i]); only for grids up to 64 x 64."""
+        if self.nx * self.ny > 64 * 64:
+            raise ValueError(f"grid {self.nx} x {self.ny}: a dense influence matrix is only built up to 64 x 64")
+        k = self.kernel(name, rolling)
+        j, i = np.divmod(np.arange(self.nx * self.ny), self.nx)
+        return k[(j[:, None] - j[None, :]) + self.ny - 1, (i[:, None] - i[None, :]) + self.nx - 1]

@@ -1,0 +1,321 @@
+"""The boundary-element contact model ``bem``: NORM + TANG on a grid over the potential contact area.
+
+Steps (Kalker 1990, ch. 5; the approach of his program CONTACT):
+
+1. Potential contact area: a rectangle in the contact plane. For an elliptic (quadric) geometry
+   it is the Hertz ellipse's bounding box [-m a, m a] x [-m b, m b] (a, b from Hertz for the given
+   force or approach, m the margin). For a sampled undeformed distance h it is the bounding box of
+   {h <= h_min + (-h_min) m^2/2} (approach control) or {h <= h_min + delta_H m^2/2} (force control,
+   delta_H the Hertz approach of the quadric part for that force); for a Hertzian h both give the
+   Hertz contact enlarged by m (the rigid overlap region is sqrt(2) times the contact).
+2. NORM (:func:`~.norm.solve_norm`) for the pressure; TANG (:func:`~.tang.solve_tang`) for the
+   tractions of steady rolling with rigid slip w = (xi - phi y, eta + phi x) and Coulomb friction.
+   For different materials (option ``difference_parameter`` K != 0) both are alternated until the
+   normal force settles (Panagiotopoulos' process, Kalker 1990 sec. 5.4).
+3. Forces on the wheel in the contact frame: F_x = dA sum t_x, F_y = dA sum t_y,
+   F_N = dA sum p, spin moment M_z = dA sum (x t_y - y t_x), N and N m.
+
+Hertz sizing (Johnson 1985, sec. 4.2; seed eq 34-37): with a along the direction of the smaller
+relative curvature, e^2 = 1 - (b/a)^2, K(e), E(e) complete elliptic integrals of modulus e, E*
+the combined modulus G/(1 - nu)::
+
+    A_small = p0 b (K - E)/(E* a^2 e^2),  A_large = p0 b ((a/b)^2 E - K)/(E* a^2 e^2),
+    approach = p0 b K/E*,  F_N = 2 pi a b p0/3.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.norm import solve_norm
+from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
+from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
+from rigid_dynamics.materials import Material
+
+DEFAULT_OPTIONS: dict = {
+    "nx": 40,
+    "ny": 40,
+    "margin": 1.15,
+    "tolerance": 1e-8,
+    "max_iterations": 500,
+    "difference_parameter": 0.0,
+}
+"""Options of :class:`BemModel` and their defaults: grid (nx, ny elements), margin m of the potential
+area, tolerance, iteration limit (NORM CG iterations and TANG Newton steps each), Kalker's K."""
+
+
+def hertz_ellipse(
+    curvature_long_1_per_m: float,
+    curvature_lat_1_per_m: float,
+    combined_modulus_Pa: float,
+    *,
+    normal_force_N: float | None = None,
+    approach_m: float | None = None,
+) -> tuple[float, float, float, float, float]:
+    """Hertz contact ellipse for h = A x^2 + B y^2 (module docstring formulas).
+
+    Give exactly one of ``normal_force_N`` (> 0) and ``approach_m`` (> 0).
+
+    Returns:
+        (a_x, b_y, p0, F_N, approach): semi-axes along x and y (m), maximum pressure (Pa),
+        normal force (N), approach (m).
+    """
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipk
+
+    if (normal_force_N is None) == (approach_m is None):
+        raise ValueError("hertz_ellipse: expected exactly one of normal_force_N and approach_m")
+    a_c, b_c = curvature_long_1_per_m, curvature_lat_1_per_m
+    small, large = min(a_c, b_c), max(a_c, b_c)
+    if small <= 0:
+        raise ValueError(f"curvatures A = {a_c!r}, B = {b_c!r} 1/m: expected both > 0")
+    ratio = large / small
+    if ratio - 1.0 < 1e-9:
+        radius = 0.5 / small
+        if normal_force_N is not None:
+            a = (3.0 * normal_force_N * radius / (4.0 * combined_modulus_Pa)) ** (1.0 / 3.0)
+        else:
+            a = math.sqrt(approach_m * radius)
+        force = 4.0 * combined_modulus_Pa * a**3 / (3.0 * radius)
+        p0 = 3.0 * force / (2.0 * math.pi * a * a)
+        return a, a, p0, force, a * a / radius
+
+    def mismatch(e2: float) -> float:
+        k, e = ellipk(e2), ellipe(e2)
+        return (e / (1.0 - e2) - k) / (k - e) - ratio
+
+    e2 = brentq(mismatch, 1e-12, 1.0 - 1e-15, xtol=1e-15, rtol=1e-14)
+    k, e = float(ellipk(e2)), float(ellipe(e2))
+    if normal_force_N is not None:
+        a = (3.0 * normal_force_N * (k - e) / (2.0 * math.pi * combined_modulus_Pa * small * e2)) ** (1.0 / 3.0)
+        b = a * math.sqrt(1.0 - e2)
+        p0 = 3.0 * normal_force_N / (2.0 * math.pi * a * b)
+    else:
+        a = math.sqrt(approach_m * (k - e) / (k * e2 * small))
+        b = a * math.sqrt(1.0 - e2)
+        p0 = approach_m * combined_modulus_Pa / (b * k)
+    force = 2.0 * math.pi * a * b * p0 / 3.0
+    approach = p0 * b * k / combined_modulus_Pa
+    if a_c <= b_c:
+        return a, b, p0, force, approach
+    return b, a, p0, force, approach
+
+
+def _options(options: Mapping | None) -> dict:
+    opts = dict(DEFAULT_OPTIONS)
+    if options is None:
+        return opts
+    unknown = sorted(set(options) - set(DEFAULT_OPTIONS))
+    if unknown:
+        raise ValueError(f"unknown bem option(s) {', '.join(unknown)}: expected any of {', '.join(DEFAULT_OPTIONS)}")
+    opts.update(options)
+    for name in ("nx", "ny", "max_iterations"):
+        value = opts[name]
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+            raise ValueError(f"option {name} = {value!r}: expected an integer >= 1")
+    value = opts["tolerance"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ValueError(f"option tolerance = {value!r}: expected a finite number > 0")
+    value = opts["margin"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 1:
+        raise ValueError(f"option margin = {value!r}: expected a finite number >= 1")
+    k = opts["difference_parameter"]
+    if not isinstance(k, (int, float)) or not math.isfinite(k) or abs(k) >= 0.5:
+        raise ValueError(f"option difference_parameter = {k!r}: expected a number with |K| < 0.5")
+    return opts
+
+
+class BemModel:
+    """Boundary-element NORM + TANG (Kalker's exact theory discretised; the CONTACT approach)."""
+
+    name = "bem"
+    description = "boundary elements: CONTACT-style NORM + TANG"
+
+    def solve(
+        self,
+        geometry: ContactGeometry,
+        creepage: Creepage,
+        material: Material,
+        *,
+        normal_force_N: float | None = None,
+        options: Mapping | None = None,
+    ) -> ContactResult:
+        """Solve one patch (see the module docstring); forces on the wheel in the contact frame.
+
+        Args:
+            geometry: patch geometry; ``geometry.undeformed`` (if set) is used as h, else the quadric.
+            creepage: xi, eta, phi and the rolling speed V (slip velocities are V times the slip).
+            material: G, nu, mu of the (quasi-identical) pair.
+            normal_force_N: None = approach control with ``geometry.approach_m``; else F_N > 0, N.
+            options: see :data:`DEFAULT_OPTIONS`; unknown keys raise ValueError.
+
+        Returns:
+            ContactResult with fields on the grid; semi-axes (extents of the contact along x, y)
+            only for an elliptic geometry without a sampled field; ``success`` False with status
+            "not-converged" when NORM or TANG did not converge.
+        """
+        start = time.perf_counter()
+        opts = _options(options)
+        if normal_force_N is not None and (not math.isfinite(normal_force_N) or normal_force_N <= 0):
+            raise ValueError(f"normal_force_N = {normal_force_N!r}: expected None or a finite number > 0")
+        g_mod, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
+        e_star = g_mod / (1.0 - nu)
+        curv = (geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m)
+        margin = float(opts["margin"])
+        nx, ny = int(opts["nx"]), int(opts["ny"])
+
+        def no_contact(message: str) -> ContactResult:
+            return ContactResult(
+                method=self.name,
+                success=True,
+                status="no-contact",
+                message=message,
+                normal_force_N=0.0,
+                creep_force_long_N=0.0,
+                creep_force_lat_N=0.0,
+                spin_moment_Nm=0.0,
+                max_pressure_Pa=0.0,
+                contact_area_m2=0.0,
+                approach_m=geometry.approach_m,
+                creepage=creepage,
+                wall_time_s=time.perf_counter() - start,
+            )
+
+        # 1. potential contact area
+        if geometry.undeformed is None:
+            if normal_force_N is None:
+                if geometry.approach_m <= 0:
+                    return no_contact(f"approach {geometry.approach_m!r} m <= 0: the bodies do not touch")
+                ax, by, *_ = hertz_ellipse(*curv, e_star, approach_m=geometry.approach_m)
+            else:
+                ax, by, *_ = hertz_ellipse(*curv, e_star, normal_force_N=normal_force_N)
+            x_lim = (-margin * ax, margin * ax)
+            y_lim = (-margin * by, margin * by)
+        else:
+            und = geometry.undeformed
+            d = np.asarray(und.distance_m, float)
+            finite = np.isfinite(d)
+            if not finite.any():
+                return no_contact("the sampled undeformed distance has no finite value")
+            d_min = float(d[finite].min())
+            if normal_force_N is None:
+                if d_min >= 0:
+                    return no_contact(f"minimum undeformed distance {d_min!r} m >= 0: the bodies do not touch")
+                depth = -d_min
+            else:
+                *_, depth = hertz_ellipse(*curv, e_star, normal_force_N=normal_force_N)
+            region = finite & (d <= d_min + 0.5 * depth * margin**2)
+            jj, ii = np.nonzero(region)
+            xs, ys = np.asarray(und.x_m), np.asarray(und.y_m)
+            hx = 0.5 * (np.abs(np.diff(xs)).min() if xs.size > 1 else 0.0)
+            hy = 0.5 * (np.abs(np.diff(ys)).min() if ys.size > 1 else 0.0)
+            x_lim = (float(xs[ii].min()) - hx, float(xs[ii].max()) + hx)
+            y_lim = (float(ys[jj].min()) - hy, float(ys[jj].max()) + hy)
+            if x_lim[1] <= x_lim[0] or y_lim[1] <= y_lim[0]:
+                return no_contact("the sampled undeformed distance gives an empty potential contact area")
+        dx = (x_lim[1] - x_lim[0]) / nx
+        dy = (y_lim[1] - y_lim[0]) / ny
+        x = x_lim[0] + dx * (np.arange(nx) + 0.5)
+        y = y_lim[0] + dy * (np.arange(ny) + 0.5)
+        xx, yy = np.meshgrid(x, y)
+        h = np.asarray(geometry.gap_m(xx, yy), float)
+        k_diff = float(opts["difference_parameter"])
+        influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
+
+        # 2. NORM and TANG (alternated for K != 0)
+        tol, max_it = float(opts["tolerance"]), int(opts["max_iterations"])
+        wx, wy = rigid_slip(x, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
+        tractions = None
+        norm = tang = None
+        outer = 1 if k_diff == 0.0 else 20
+        previous = math.inf
+        for _ in range(outer):
+            norm = solve_norm(
+                influence,
+                h,
+                normal_force_N=normal_force_N,
+                tolerance=tol,
+                max_iterations=max_it,
+                tractions_Pa=tractions,
+                initial_pressure_Pa=None if norm is None else norm.pressure_Pa,
+            )
+            tang = solve_tang(influence, norm.pressure_Pa, mu, wx, wy, tolerance=tol, max_iterations=max_it)
+            tractions = (tang.traction_x_Pa, tang.traction_y_Pa)
+            if abs(norm.normal_force_N - previous) <= tol * max(norm.normal_force_N, 1e-300):
+                break
+            previous = norm.normal_force_N
+        p = norm.pressure_Pa
+        contact = p > 0
+        if not contact.any():
+            return no_contact("NORM found no element in contact")
+        area = dx * dy
+        tx, ty = tang.traction_x_Pa, tang.traction_y_Pa
+        fx, fy = float(tx.sum() * area), float(ty.sum() * area)
+        mz = float((xx * ty - yy * tx).sum() * area)
+        slip_speed = creepage.rolling_speed_m_per_s * np.hypot(tang.slip_x, tang.slip_y)
+        fields = ContactFields(
+            x_m=x,
+            y_m=y,
+            pressure_Pa=p,
+            traction_long_Pa=tx,
+            traction_lat_Pa=ty,
+            slip_m_per_s=slip_speed,
+            in_contact=contact,
+            in_slip=tang.in_slip & contact,
+        )
+        semi_long = semi_lat = None
+        if geometry.undeformed is None and geometry.is_elliptic:
+            jj, ii = np.nonzero(contact)
+            semi_long = float(0.5 * (x[ii].max() - x[ii].min() + dx))
+            semi_lat = float(0.5 * (y[jj].max() - y[jj].min() + dy))
+        success = bool(norm.converged and tang.converged)
+        if success:
+            status, message = "ok", "NORM and TANG converged"
+        else:
+            status = "not-converged"
+            parts = []
+            if not norm.converged:
+                parts.append(f"NORM did not converge in {norm.iterations} iterations (residual {norm.residual:.3g})")
+            if not tang.converged:
+                parts.append(f"TANG did not converge in {tang.iterations} iterations (residual {tang.residual:.3g})")
+            message = "; ".join(parts)
+        edge = contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any()
+        return ContactResult(
+            method=self.name,
+            success=success,
+            status=status,
+            message=message,
+            normal_force_N=float(p.sum() * area),
+            creep_force_long_N=fx,
+            creep_force_lat_N=fy,
+            spin_moment_Nm=mz,
+            max_pressure_Pa=float(p.max()),
+            semi_axis_long_m=semi_long,
+            semi_axis_lat_m=semi_lat,
+            contact_area_m2=float(contact.sum() * area),
+            approach_m=float(geometry.approach_m + norm.approach_shift_m),
+            creepage=creepage,
+            fields=fields,
+            iterations=int(norm.iterations + tang.iterations),
+            residual=float(max(norm.residual, tang.residual)),
+            wall_time_s=time.perf_counter() - start,
+            extra={
+                "nx": nx,
+                "ny": ny,
+                "dx_m": float(dx),
+                "dy_m": float(dy),
+                "potential_area_m": [float(x_lim[0]), float(x_lim[1]), float(y_lim[0]), float(y_lim[1])],
+                "norm_iterations": int(norm.iterations),
+                "norm_residual": float(norm.residual),
+                "tang_iterations": int(tang.iterations),
+                "tang_linear_iterations": int(tang.linear_iterations),
+                "tang_residual": float(tang.residual),
+                "slip_elements": int((tang.in_slip & contact).sum()),
+                "contact_touches_potential_area_edge": bool(edge),
+            },
+        )
