@@ -1,1 +1,73 @@
-"""rigid_dynamics/geometry."""
+"""Wheel and rail geometry: profiles, readers, placement on wheelset and track, surfaces (seed eq 5-10).
+
+Conventions (project-wide): main frame x along the track, y to the right, z DOWN; profiles in
+(y_p towards the field side, z_p down), wheel origin at the tape circle, rail z_p = 0 at the top.
+
+Public API (stable):
+
+Profiles (profile.py)
+    Profile(y_m, z_m, kind, name="profile", source="", outline_y_m=(), outline_z_m=())
+        frozen, validated point set; .curve(smoothing_wavelength_m=0.002) -> ProfileCurve
+    ProfileCurve(profile, smoothing_wavelength_m=0.002)
+        .z(y_m, derivative=0|1|2), .evaluate(y_m) -> (z, dz, d2z), .y_min_m, .y_max_m, .kind
+    CircularArcCurve(radius_m, half_width_m, kind, centre_y_m=0, apex_z_m=0)  closed-form circle
+    find_self_intersection(y, z) -> (i, j) | None
+
+Readers (readers.py)
+    read_profile(path, kind=None) -> Profile      (.prw/.prr SIMPACK, .whl/.ban MiniProf, .csv/.txt)
+    load_profile(name_or_path, kind=None) -> Profile   (built-in name or file)
+    builtin_profiles() -> dict[name, description]
+    write_profile_csv(path, profile) -> Path
+
+Placement and surfaces (placement.py)
+    WheelsetGeometry(wheel_profile, flange_back_distance_m=1.360, nominal_radius_m=0.46,
+                     tape_circle_to_flange_back_m=0.070, smoothing_wavelength_m=0.002)
+        .wheel_surface(side, irregularities=()) -> WheelSurface; .wheel_radius(side, y_d_m)
+        .tape_circle_offset_m
+    TrackGeometry(rail_profile, gauge_m=1.435, gauge_height_m=0.014, rail_inclination_rad=atan(1/40),
+                  profile_is_canted=False, smoothing_wavelength_m=0.002)
+        .rail_surface(side, irregularities=(), deflection=None) -> RailSurface; .rail_height(side, y_m)
+        .rail_offset_m, .measured_gauge_m()
+    WheelSurface.evaluate(angle_rad, y_d_m) -> WheelSurfaceValues(R, R_a, R_y, R_aa, R_ay, R_yy)
+        .ideal_radius(y_d_m) -> (R_id, dR/dy, d2R/dy2), .y_range_m, .to_profile_coordinates(y_d, R)
+    RailSurface.evaluate(x_m, y_m) -> RailSurfaceValues(N, N_x, N_y, N_xx, N_xy, N_yy)
+        .ideal_height(y_m) -> (N_id, dN/dy, d2N/dy2), .y_range_m, .to_profile_coordinates(y, z)
+    side is "left" or "right". Values are NaN outside y_range_m.
+"""
+
+from .placement import (
+    SIDES,
+    RailSurface,
+    RailSurfaceValues,
+    TrackGeometry,
+    WheelsetGeometry,
+    WheelSurface,
+    WheelSurfaceValues,
+)
+from .profile import (
+    DEFAULT_SMOOTHING_WAVELENGTH_M,
+    CircularArcCurve,
+    Profile,
+    ProfileCurve,
+    find_self_intersection,
+)
+from .readers import builtin_profiles, load_profile, read_profile, write_profile_csv
+
+__all__ = [
+    "DEFAULT_SMOOTHING_WAVELENGTH_M",
+    "SIDES",
+    "CircularArcCurve",
+    "Profile",
+    "ProfileCurve",
+    "RailSurface",
+    "RailSurfaceValues",
+    "TrackGeometry",
+    "WheelSurface",
+    "WheelSurfaceValues",
+    "WheelsetGeometry",
+    "builtin_profiles",
+    "find_self_intersection",
+    "load_profile",
+    "read_profile",
+    "write_profile_csv",
+]
