@@ -46,6 +46,7 @@ from rigid_dynamics.contact.types import ContactGeometry, UndeformedDistance
 from rigid_dynamics.kinematics import wheelset_rotation
 
 SIDES = ("left", "right")
+_FAR_M = 0.05  # |h| beyond this is not a contact candidate (another branch of the rail surface, or far away)
 
 DEFAULT_OPTIONS: dict = {
     "alpha_half_range_rad": 0.10,  # grid of alpha around the lowest point
@@ -61,6 +62,7 @@ DEFAULT_OPTIONS: dict = {
     "field_min_half_size_m": 1.0e-3,
     "ellipticity_tolerance": 0.15,
     "rolling_direction": (1.0, 0.0, 0.0),  # eq 39: main x
+    "profile_only": False,  # fast path for ideal geometry: alpha fixed at the lowest point, search in y_d only
 }
 
 
@@ -148,6 +150,91 @@ def _merge_options(options: Mapping | None) -> dict:
     return merged
 
 
+class _LateralTable:
+    """Cubic Hermite table of a function of y alone: value and slope exact at the nodes, curvature linear.
+
+    Error of the value O(dy^4 |f^(4)|), of the slope O(dy^3); used only to locate minima (the patch's
+    geometry is then evaluated on the exact surface).
+    """
+
+    def __init__(self, func, lower, upper, spacing):
+        n = max(int(math.ceil((upper - lower) / spacing)) + 1, 4)
+        y = np.linspace(lower, upper, n)
+        value, slope, curvature = (np.asarray(v, float) for v in func(y))
+        self.lower, self.upper, self.step, self.n = float(lower), float(upper), (upper - lower) / (n - 1), n
+        self.value, self.slope, self.curvature = value, slope * self.step, curvature
+
+    def as_tuple(self):
+        """(lower, step, values, slopes x step, curvatures) for the compiled kernels."""
+        return (self.lower, self.step, self.value, self.slope, self.curvature)
+
+    def __call__(self, y):
+        u = (np.asarray(y, float) - self.lower) / self.step
+        i = np.clip(np.floor(np.nan_to_num(u)), 0, self.n - 2).astype(np.intp)
+        t = u - i
+        v0, v1, m0, m1 = self.value[i], self.value[i + 1], self.slope[i], self.slope[i + 1]
+        t2 = t * t
+        value = v0 + t * (m0 + t * (3 * (v1 - v0) - 2 * m0 - m1 + t * (2 * (v0 - v1) + m0 + m1)))
+        slope = (m0 + t * (6 * (v1 - v0) - 4 * m0 - 2 * m1) + t2 * (6 * (v0 - v1) + 3 * m0 + 3 * m1)) / self.step
+        curvature = self.curvature[i] * (1 - t) + self.curvature[i + 1] * t
+        outside = ~((u >= 0) & (u <= self.n - 1))
+        if np.any(outside):
+            value, slope, curvature = (np.where(outside, np.nan, a) for a in (value, slope, curvature))
+        return value, slope, curvature
+
+
+class TabulatedWheel:
+    """Fast stand-in for an ideal wheel surface (no irregularities): R(y_d) from a fine Hermite table.
+
+    ``exact`` is the surface it was built from; the contact search uses the table to find the minima and the
+    exact surface for each patch's geometry.
+    """
+
+    def __init__(self, surface, spacing_m: float = 2.0e-5):
+        self.exact = surface
+        self.y_range_m = tuple(float(v) for v in surface.y_range_m)
+        self._table = _LateralTable(surface.ideal_radius, *self.y_range_m, spacing_m)
+        self.table_tuple = self._table.as_tuple()
+
+    def evaluate(self, angle_rad, y_d_m):
+        angle_rad, y_d_m = np.broadcast_arrays(np.asarray(angle_rad, float), np.asarray(y_d_m, float))
+        r, r_y, r_yy = self._table(y_d_m)
+        zero = np.zeros_like(r)
+        return (r, zero, r_y, zero, zero, r_yy)
+
+
+class TabulatedRail:
+    """Fast stand-in for an ideal rail surface (no irregularities, no deflection): N(y) from a Hermite table."""
+
+    def __init__(self, surface, spacing_m: float = 2.0e-5):
+        self.exact = surface
+        self.y_range_m = tuple(float(v) for v in surface.y_range_m)
+        self._table = _LateralTable(surface.ideal_height, *self.y_range_m, spacing_m)
+        self.table_tuple = self._table.as_tuple()
+
+    def evaluate(self, x_m, y_m):
+        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        n, n_y, n_yy = self._table(y_m)
+        zero = np.zeros_like(n)
+        return (n, zero, n_y, zero, zero, n_yy)
+
+
+def fast_surfaces(wheel, rail):
+    """Tabulated stand-ins for surfaces without irregularities (``ideal_radius``/``ideal_height`` methods).
+
+    A surface with irregularities, a rail deflection or without those methods is returned unchanged.
+    """
+    if getattr(wheel, "irregularities", None) == () and hasattr(wheel, "ideal_radius"):
+        wheel = TabulatedWheel(wheel)
+    if (
+        getattr(rail, "irregularities", None) == ()
+        and getattr(rail, "deflection", 0) is None
+        and hasattr(rail, "ideal_height")
+    ):
+        rail = TabulatedRail(rail)
+    return wheel, rail
+
+
 class _SideGeometry:
     """Wheel and rail surfaces of one side at one pose: vectorised point / normal / distance evaluation."""
 
@@ -180,7 +267,7 @@ class _SideGeometry:
         return point, normal, x_d, (t_a, t_y, x_aa, x_ay, x_yy), r
 
     def distance(self, alpha, y, iterations: int):
-        """h along the outward wheel normal to the rail (eq 10-11); +inf where the normal misses the rail."""
+        """Distance h along the outward wheel normal to the rail (eq 10-11); +inf where the normal misses the rail."""
         point, normal, _ = self.wheel_point(alpha, y)
         h = self._distance_along(point, normal, iterations)
         inside = (y >= self.y_range[0]) & (y <= self.y_range[1])
@@ -195,9 +282,12 @@ class _SideGeometry:
             big_n, n_dx, n_dy = self.rail.evaluate(px, np.clip(py, y_lo, y_hi))[:3]
             f = pz - big_n
             slope = n_z - n_dx * n_x - n_dy * n_y
-            h = h - f / np.where(np.abs(slope) > 1e-3, slope, np.copysign(1e-3, slope))
+            step = f / np.where(np.abs(slope) > 1e-3, slope, np.copysign(1e-3, slope))
+            h = h - step
+            if not np.any(np.abs(step) > 1e-13):  # converged everywhere (nan: off the rail, handled below)
+                break
         py = point[..., 1] + h * n_y
-        on_rail = (py >= y_lo) & (py <= y_hi) & np.isfinite(h)
+        on_rail = (py >= y_lo) & (py <= y_hi) & np.isfinite(h) & (np.abs(h) <= _FAR_M)
         return np.where(on_rail, h, np.inf)
 
 
@@ -229,10 +319,13 @@ def _refine(geo: _SideGeometry, alpha, y, opts, radius_guess):
         aa = alpha[:, None] + offsets[None, :, 0] * da
         yy = y[:, None] + offsets[None, :, 1] * step
         h = geo.distance(aa, yy, opts["newton_iterations"])[0]
+        h = np.where(np.isfinite(h), h, 1.0)  # off the surfaces: a large gap, so the step leads back
         g = np.stack([(h[:, 1] - h[:, 2]) / (2 * step), (h[:, 3] - h[:, 4]) / (2 * step)], -1)
         haa = (h[:, 1] - 2 * h[:, 0] + h[:, 2]) / step**2
         hyy = (h[:, 3] - 2 * h[:, 0] + h[:, 4]) / step**2
         hay = (h[:, 5] - h[:, 6] - h[:, 7] + h[:, 8]) / (4 * step**2)
+        if opts["profile_only"]:
+            haa, hay, g[:, 0] = np.ones_like(haa), np.zeros_like(hay), 0.0
         det = haa * hyy - hay**2
         ok = (haa > 0) & (det > 0) & np.all(np.isfinite(h), axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -313,8 +406,8 @@ def search_side(
 
     Returns:
         :class:`SideSearch`. Patches carry A, B in the rolling-direction frame, the approach, and (option
-        ``field``) the sampled undeformed distance; ``contact_point_rail_m``/``contact_point_wheel_m`` are left
-        nan here (the caller that knows the profile placement fills them).
+        ``field``) the sampled undeformed distance; ``contact_point_rail_m``/``contact_point_wheel_m`` are filled
+        when the surfaces have ``to_profile_coordinates`` (rigid_dynamics.geometry's do), else nan.
 
     Raises:
         ValueError: unknown side or option.
@@ -324,16 +417,48 @@ def search_side(
         raise ValueError(f"side = {side!r}: expected one of {', '.join(SIDES)}")
     opts = _merge_options(options)
     geo = _SideGeometry(wheel, rail, pose, side, tuple(wheel_lateral_range_m), tuple(rail_lateral_range_m))
+    exact_wheel, exact_rail = getattr(wheel, "exact", wheel), getattr(rail, "exact", rail)
+    if exact_wheel is wheel and exact_rail is rail:
+        geo_exact = geo
+    else:
+        geo_exact = _SideGeometry(exact_wheel, exact_rail, pose, side, geo.y_range, geo.rail_range)
 
     # Grid around the lowest point alpha = pi/2 - phi (spin angle, see kinematics: R_y(-phi)).
     alpha_mid = 0.5 * np.pi - pose.spin_rad
     half = opts["alpha_half_range_rad"]
-    alphas = alpha_mid + np.linspace(-half, half, opts["alpha_points"])
+    if opts["profile_only"]:
+        alphas = np.array([alpha_mid])
+    else:
+        alphas = alpha_mid + np.linspace(-half, half, opts["alpha_points"])
     y_lo, y_hi = geo.y_range
     n_y = max(int(round((y_hi - y_lo) / opts["lateral_step_m"])) + 1, 3)
     ys = np.linspace(y_lo, y_hi, n_y)
-    grid_a, grid_y = np.meshgrid(alphas, ys, indexing="ij")
-    h_grid = geo.distance(grid_a, grid_y, opts["newton_iterations"])[0]
+    iters = opts["newton_iterations"]
+    radius_guess = float(np.median(wheel.evaluate(np.array([alpha_mid]), np.array([0.5 * (y_lo + y_hi)]))[0]))
+    compiled = isinstance(wheel, TabulatedWheel) and isinstance(rail, TabulatedRail)
+    if compiled:
+        from rigid_dynamics.contact import _search_kernels as kern
+
+        args = (
+            geo.rot,
+            geo.centre,
+            wheel.table_tuple,
+            rail.table_tuple,
+            np.array(geo.y_range),
+            np.array(geo.rail_range),
+        )
+
+        def points(a, y, n_iter=iters):
+            return kern.distance_points(np.ascontiguousarray(a, float), np.ascontiguousarray(y, float), *args, n_iter)
+
+        h_grid = kern.distance_grid(alphas, ys, *args, iters)
+    else:
+
+        def points(a, y, n_iter=iters):
+            return geo.distance(np.asarray(a, float), np.asarray(y, float), n_iter)[0]
+
+        grid_a, grid_y = np.meshgrid(alphas, ys, indexing="ij")
+        h_grid = points(grid_a, grid_y)
     minima = _grid_minima(h_grid)
     minima = minima[h_grid[minima[:, 0], minima[:, 1]] < opts["candidate_gap_m"]]
     if len(minima) == 0:
@@ -343,9 +468,15 @@ def search_side(
             side, True, "no-contact", f"no wheel-rail gap below {opts['candidate_gap_m']} m on the {side} side",
             [], empty, min_gap, np.zeros((0, 2)), time.perf_counter() - started,
         )  # fmt: skip
-    radius_guess = float(np.median(wheel.evaluate(np.array([alpha_mid]), np.array([0.5 * (y_lo + y_hi)]))[0]))
-    alpha_c, y_c, converged = _refine(geo, alphas[minima[:, 0]], ys[minima[:, 1]], opts, radius_guess)
-    h_c = geo.distance(alpha_c, y_c, opts["newton_iterations"])[0]
+    start_a, start_y = alphas[minima[:, 0]], ys[minima[:, 1]]
+    if compiled:
+        alpha_c, y_c, h_c, converged = kern.refine(
+            start_a, start_y, *args, iters, radius_guess, opts["refine_iterations"], opts["refine_tolerance_m"],
+            bool(opts["profile_only"]),
+        )  # fmt: skip
+    else:
+        alpha_c, y_c, converged = _refine(geo, start_a, start_y, opts, radius_guess)
+        h_c = points(alpha_c, y_c)
 
     # Deduplicate: same point, or the same interpenetration region (h < 0 along the joining segment).
     order = np.argsort(h_c)
@@ -360,7 +491,7 @@ def search_side(
                 break
             if h_c[k] < 0:
                 t = np.linspace(0, 1, 25)
-                seg = geo.distance(alpha_c[j] + t * (alpha_c[k] - alpha_c[j]), y_c[j] + t * (y_c[k] - y_c[j]), 6)[0]
+                seg = points(alpha_c[j] + t * (alpha_c[k] - alpha_c[j]), y_c[j] + t * (y_c[k] - y_c[j]))
                 if np.all(seg < 0):
                     duplicate = True
                     break
@@ -369,7 +500,7 @@ def search_side(
     kept_arr = np.array(kept, int)
     candidates = ContactCandidates(alpha_c[kept_arr], y_c[kept_arr], h_c[kept_arr], converged[kept_arr])
     in_contact = kept_arr[h_c[kept_arr] < 0]
-    patches = [_patch(geo, alpha_c[k], y_c[k], opts) for k in in_contact]
+    patches = [_patch(geo_exact, alpha_c[k], y_c[k], opts, float(h_c[k])) for k in in_contact]
     min_gap = float(np.min(h_c[kept_arr])) if len(kept_arr) else math.inf
     all_converged = bool(np.all(converged[in_contact]))
     if not patches:
@@ -391,10 +522,10 @@ def search_side(
     )
 
 
-def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts) -> ContactGeometry:
+def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts, h: float) -> ContactGeometry:
+    """Geometry of the patch at the refined minimum (alpha0, y0) with distance h (from the search)."""
     a_arr, y_arr = np.array([alpha0]), np.array([y0])
     point, n_out, _, (t_a, t_y, x_aa, x_ay, x_yy), radius = geo.wheel_point(a_arr, y_arr, second=True)
-    h = geo._distance_along(point, n_out, opts["newton_iterations"])[0]
     point, n_out = point[0], n_out[0]
     rail_point = point + h * n_out
     n = -n_out
@@ -436,6 +567,14 @@ def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts) -> ContactGeometr
         )
         error = ellipticity_error(undeformed, a_use, b_use, angle, approach)
         elliptic = convex and error <= opts["ellipticity_tolerance"]
+    rail_profile_point = (math.nan, math.nan)
+    wheel_profile_point = (math.nan, math.nan)
+    if hasattr(geo.rail, "to_profile_coordinates"):
+        yp, zp = geo.rail.to_profile_coordinates(rail_point[1], rail_point[2])
+        rail_profile_point = (float(yp), float(zp))
+    if hasattr(geo.wheel, "to_profile_coordinates"):
+        yp, zp = geo.wheel.to_profile_coordinates(y0, radius[0])
+        wheel_profile_point = (float(yp), float(zp))
     return ContactGeometry(
         curvature_long_1_per_m=a_use,
         curvature_lat_1_per_m=b_use,
@@ -445,6 +584,8 @@ def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts) -> ContactGeometr
         frame=frame,
         contact_angle_rad=contact_angle,
         rolling_radius_m=float(radius[0]),
+        contact_point_rail_m=rail_profile_point,
+        contact_point_wheel_m=wheel_profile_point,
         ellipse_angle_rad=angle,
         undeformed=undeformed,
         is_elliptic=bool(elliptic),

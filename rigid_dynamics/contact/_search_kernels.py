@@ -1,0 +1,145 @@
+"""Compiled (numba) kernels of the contact search for ideal surfaces given as lateral Hermite tables.
+
+Same mathematics as search.py (eq 7-11): wheel point x_w = C_D x_d + x_t with x_d = [R cos a, y, R sin a],
+outward normal n_w = t_y x t_a / |.|, distance h along n_w to the rail z = N(y) by Newton's method, and a
+damped Newton minimisation of h(a, y) with central-difference derivatives. Tables: (lower, step, values,
+slopes * step, curvatures) as built by search._LateralTable; R depends on y_d only, N on y only.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_FAR = 0.05  # |h| beyond this (m) is not a contact candidate (another branch of the rail, or far away)
+
+
+@njit(cache=True)
+def _table(y, lower, step, value, slope, curvature):
+    u = (y - lower) / step
+    n = value.shape[0]
+    if not (u >= 0.0 and u <= n - 1):
+        return math.nan, math.nan, math.nan
+    i = int(math.floor(u))
+    if i > n - 2:
+        i = n - 2
+    t = u - i
+    v0, v1, m0, m1 = value[i], value[i + 1], slope[i], slope[i + 1]
+    val = v0 + t * (m0 + t * (3.0 * (v1 - v0) - 2.0 * m0 - m1 + t * (2.0 * (v0 - v1) + m0 + m1)))
+    der = (m0 + t * (6.0 * (v1 - v0) - 4.0 * m0 - 2.0 * m1) + t * t * (6.0 * (v0 - v1) + 3.0 * m0 + 3.0 * m1)) / step
+    cur = curvature[i] * (1.0 - t) + curvature[i + 1] * t
+    return val, der, cur
+
+
+@njit(cache=True)
+def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations):
+    """h(alpha, y) for one wheel point; +inf outside the surfaces or beyond _FAR."""
+    if y < y_range[0] or y > y_range[1]:
+        return math.inf
+    r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
+    if not math.isfinite(r):
+        return math.inf
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    xd0, xd1, xd2 = r * ca, y, r * sa
+    ta0, ta2 = -r * sa, r * ca  # R_a = 0 for an ideal wheel
+    ty0, ty1, ty2 = r_y * ca, 1.0, r_y * sa
+    p0 = rot[0, 0] * xd0 + rot[0, 1] * xd1 + rot[0, 2] * xd2 + centre[0]
+    p1 = rot[1, 0] * xd0 + rot[1, 1] * xd1 + rot[1, 2] * xd2 + centre[1]
+    p2 = rot[2, 0] * xd0 + rot[2, 1] * xd1 + rot[2, 2] * xd2 + centre[2]
+    a0 = rot[0, 0] * ta0 + rot[0, 2] * ta2
+    a1 = rot[1, 0] * ta0 + rot[1, 2] * ta2
+    a2 = rot[2, 0] * ta0 + rot[2, 2] * ta2
+    b0 = rot[0, 0] * ty0 + rot[0, 1] * ty1 + rot[0, 2] * ty2
+    b1 = rot[1, 0] * ty0 + rot[1, 1] * ty1 + rot[1, 2] * ty2
+    b2 = rot[2, 0] * ty0 + rot[2, 1] * ty1 + rot[2, 2] * ty2
+    n0 = b1 * a2 - b2 * a1  # t_y x t_a: outward
+    n1 = b2 * a0 - b0 * a2
+    n2 = b0 * a1 - b1 * a0
+    norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    n0, n1, n2 = n0 / norm, n1 / norm, n2 / norm
+    h = 0.0
+    for _ in range(iterations):
+        py = p1 + h * n1
+        if py < rail_range[0]:
+            py = rail_range[0]
+        elif py > rail_range[1]:
+            py = rail_range[1]
+        big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
+        f = p2 + h * n2 - big_n
+        slope = n2 - n_y * n1
+        if abs(slope) < 1e-3:
+            slope = math.copysign(1e-3, slope)
+        step = f / slope
+        h -= step
+        if abs(step) < 1e-13:
+            break
+    py = p1 + h * n1
+    if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
+        return math.inf
+    return h
+
+
+@njit(cache=True)
+def distance_grid(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations):
+    """H on the grid alphas x ys, shape (len(alphas), len(ys))."""
+    out = np.empty((alphas.shape[0], ys.shape[0]))
+    for i in range(alphas.shape[0]):
+        for j in range(ys.shape[0]):
+            out[i, j] = _distance(alphas[i], ys[j], rot, centre, wheel, rail, y_range, rail_range, iterations)
+    return out
+
+
+@njit(cache=True)
+def distance_points(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations):
+    """H at the points (alphas[k], ys[k])."""
+    out = np.empty(alphas.shape[0])
+    for k in range(alphas.shape[0]):
+        out[k] = _distance(alphas[k], ys[k], rot, centre, wheel, rail, y_range, rail_range, iterations)
+    return out
+
+
+@njit(cache=True)
+def refine(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations, radius, max_iter, tol, fixed_alpha):
+    """Damped Newton on h(alpha, y) from each start; returns (alpha, y, h, converged)."""
+    k_max = alphas.shape[0]
+    out_a, out_y, out_h = alphas.copy(), ys.copy(), np.empty(k_max)
+    converged = np.zeros(k_max, dtype=np.bool_)
+    d = 1.0e-5  # m, difference step in arc length
+    da = d / radius
+    hs = np.empty(9)
+    oa = (0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 1.0, -1.0, -1.0)
+    oy = (0.0, 0.0, 0.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0)
+    for k in range(k_max):
+        a, y = out_a[k], out_y[k]
+        for _ in range(max_iter):
+            for s in range(9):
+                v = _distance(a + oa[s] * da, y + oy[s] * d, rot, centre, wheel, rail, y_range, rail_range, iterations)
+                hs[s] = v if math.isfinite(v) else 1.0
+            g_a = (hs[1] - hs[2]) / (2 * d)
+            g_y = (hs[3] - hs[4]) / (2 * d)
+            h_aa = (hs[1] - 2 * hs[0] + hs[2]) / (d * d)
+            h_yy = (hs[3] - 2 * hs[0] + hs[4]) / (d * d)
+            h_ay = (hs[5] - hs[6] - hs[7] + hs[8]) / (4 * d * d)
+            if fixed_alpha:
+                g_a, h_aa, h_ay = 0.0, 1.0, 0.0
+            det = h_aa * h_yy - h_ay * h_ay
+            if h_aa > 0 and det > 0:
+                s_a = -(h_yy * g_a - h_ay * g_y) / det
+                s_y = -(h_aa * g_y - h_ay * g_a) / det
+                ok = True
+            else:
+                s_a, s_y, ok = -g_a * 1e-3, -g_y * 1e-3, False
+            norm = math.sqrt(s_a * s_a + s_y * s_y)
+            if norm > 3.0e-3:
+                s_a *= 3.0e-3 / norm
+                s_y *= 3.0e-3 / norm
+            a += s_a / radius
+            y = min(max(y + s_y, y_range[0]), y_range[1])
+            if ok and norm < tol:
+                converged[k] = True
+                break
+        out_a[k], out_y[k] = a, y
+        out_h[k] = _distance(a, y, rot, centre, wheel, rail, y_range, rail_range, iterations)
+    return out_a, out_y, out_h, converged
