@@ -1,0 +1,387 @@
+"""Kalker's FASTSIM: the simplified theory of rolling contact on an elliptic patch.
+
+Simplified theory (Kalker 1982, *Vehicle System Dynamics* 11, 1-13; Kalker 1990 ch. 3): the
+elastic displacement difference is proportional to the local traction, u = L p (L in m/Pa). In
+steady rolling a wheel particle enters the patch at the leading edge x = a(y) with zero traction
+and travels towards x = -a(y); the slip (per rolling speed V) is s = w - du/dx with the rigid slip
+w = (xi - phi y, eta + phi x). Where the traction stays below the traction bound
+g = mu p_n(x, y) the particle adheres (s = 0, so p grows by -w dx / L); where it would exceed it,
+it slides with p = -g s/|s| (Coulomb). Tractions act on the wheel and oppose the creepage.
+
+Flexibilities (m/Pa; Kalker 1982) from the linear-theory coefficients C_ij (kalker.py), chosen so
+that each creepage alone reproduces Kalker's linear theory as creepage -> 0::
+
+    L1 = 8 a / (3 C11 G),   L2 = 8 a / (3 C22 G),   L3 = pi a sqrt(a/b) / (4 C23 G)
+
+Variants (option ``flexibility``):
+
+* ``"single"`` (Kalker 1982): one L = (L1 |xi| + L2 |eta| + L3 |phi| sqrt(ab)) / sqrt(xi^2 + eta^2 + ab phi^2).
+* ``"three"``: xi, eta, phi are divided by their own L1, L2, L3 (exact linear slopes for every
+  combination of creepages), blended towards one combined flexibility as the creepage grows, as
+  proposed by Vollebregt & Voltr (VSD 61, 2023, 309-317) and implemented in the open-source
+  CONTACT program (eve70a/CONTACT, ``src/m_hertz.f90``, ``simpflex``):
+  L_c = (xi^2 + eta^2 + (c phi)^2) / (xi^2/L1 + eta^2/L2 + (c phi)^2/L3), c = 3 pi a / 32,
+  weight w = min(1, f/3), f = |(xi, eta, phi)| / |(xi_c, eta_c, phi_c)| with the characteristic
+  creepages xi_c = mu N/(G ab C11), eta_c = mu N/(G ab C22), phi_c = mu N/(G (ab)^1.5 C23);
+  L_i <- (1 - w) L_i + w L_c.
+* ``"three-unblended"``: L1, L2, L3 without blending.
+
+Traction bound (option ``traction_bound``): ``"elliptic"`` g = mu p0 sqrt(1 - x^2/a^2 - y^2/b^2)
+with the Hertz p0 = 3 N / (2 pi a b); ``"parabolic"`` g = mu (2 N/(pi a b)) (1 - x^2/a^2 - y^2/b^2)
+(Kalker's FASTSIM choice, same total N).
+
+Discretisation (Kalker's strip layout): ny strips of width 2b/ny at y_j (midpoints); each strip is
+divided into nx equal elements of length dx_j = 2 a(y_j)/nx, a(y) = a sqrt(1 - y^2/b^2). The
+traction is computed at element midpoints x_k = a(y_j) - (k + 1/2) dx_j, integrating w exactly
+(midpoint value of a linear function) from the previous point; forces are midpoint sums. The hot
+loop is compiled with numba (cache=True) and allocates nothing per strip.
+
+Signs: Fx, Fy, Mz on the wheel, contact frame; Mz = sum (x p_y - y p_x) dA.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+from rigid_dynamics.contact.types import ContactFields
+
+TRACTION_BOUNDS = ("elliptic", "parabolic")
+FLEXIBILITIES = ("single", "three", "three-unblended")
+
+
+@njit(cache=True)
+def _fastsim_one(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, px_out, py_out, sx_out, sy_out, store):
+    """FASTSIM for one patch. Returns (Fx, Fy, Mz, slip_area_fraction); fills the strip fields if store."""
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    n_slip = 0
+    if fn <= 0.0 or a <= 0.0 or b <= 0.0:
+        return fx, fy, mz, 0.0
+    dy = 2.0 * b / ny
+    if parabolic:
+        g0 = mu * 2.0 * fn / (math.pi * a * b)
+    else:
+        g0 = mu * 3.0 * fn / (2.0 * math.pi * a * b)
+    cx = xi / l1
+    cy = eta / l2
+    cs = phi / l3
+    for j in range(ny):
+        y = -b + (j + 0.5) * dy
+        ay = a * math.sqrt(max(0.0, 1.0 - (y / b) ** 2))
+        dx = 2.0 * ay / nx
+        wx = cx - cs * y  # xi/L1 - phi y / L3 (constant along the strip)
+        px = 0.0
+        py = 0.0
+        x_prev = ay
+        for k in range(nx):
+            x = ay - (k + 0.5) * dx
+            d = x_prev - x
+            xm = 0.5 * (x + x_prev)
+            wy = cy + cs * xm
+            tx = px - wx * d
+            ty = py - wy * d
+            rho = 1.0 - (x / a) ** 2 - (y / b) ** 2
+            if rho < 0.0:
+                rho = 0.0
+            if parabolic:
+                g = g0 * rho
+            else:
+                g = g0 * math.sqrt(rho)
+            tn = math.sqrt(tx * tx + ty * ty)
+            if tn > g:
+                s = g / tn
+                px = tx * s
+                py = ty * s
+                n_slip += 1
+                slipping = True
+            else:
+                px = tx
+                py = ty
+                slipping = False
+            if store:
+                px_out[j, k] = px
+                py_out[j, k] = py
+                if slipping:
+                    # s = L (p - p_trial) / d per component (L1, L2 for x, y)
+                    sx_out[j, k] = l1 * (px - tx) / d
+                    sy_out[j, k] = l2 * (py - ty) / d
+                else:
+                    sx_out[j, k] = 0.0
+                    sy_out[j, k] = 0.0
+            area = dx * dy
+            fx += px * area
+            fy += py * area
+            mz += (x * py - y * px) * area
+            x_prev = x
+    return fx, fy, mz, n_slip / (nx * ny)
+
+
+@njit(cache=True)
+def _fastsim_many(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, out):
+    dummy = np.zeros((1, 1))
+    for i in range(a.shape[0]):
+        r = _fastsim_one(
+            a[i], b[i], mu[i], fn[i], xi[i], eta[i], phi[i], l1[i], l2[i], l3[i], nx, ny, parabolic,
+            dummy, dummy, dummy, dummy, False,
+        )  # fmt: skip
+        out[i, 0] = r[0]
+        out[i, 1] = r[1]
+        out[i, 2] = r[2]
+        out[i, 3] = r[3]
+
+
+def kalker_flexibilities(a, b, shear_modulus_Pa, coefficients: CreepCoefficients):
+    """(L1, L2, L3) in m/Pa (Kalker 1982): L1 = 8a/(3 C11 G), L2 = 8a/(3 C22 G), L3 = pi a sqrt(a/b)/(4 C23 G)."""
+    l1 = 8.0 * a / (3.0 * coefficients.c11 * shear_modulus_Pa)
+    l2 = 8.0 * a / (3.0 * coefficients.c22 * shear_modulus_Pa)
+    l3 = math.pi * a * np.sqrt(a / b) / (4.0 * coefficients.c23 * shear_modulus_Pa)
+    return l1, l2, l3
+
+
+def effective_flexibilities(
+    a, b, normal_force_N, xi, eta, phi, *, shear_modulus_Pa, friction_coefficient, coefficients, flexibility
+):
+    """Flexibilities (L1, L2, L3) actually used for each patch by the chosen variant (module docstring)."""
+    if flexibility not in FLEXIBILITIES:
+        raise ValueError(f"flexibility = {flexibility!r}: expected one of {', '.join(FLEXIBILITIES)}")
+    l1, l2, l3 = kalker_flexibilities(a, b, shear_modulus_Pa, coefficients)
+    if flexibility == "three-unblended":
+        return l1, l2, l3
+    ab = a * b
+    if flexibility == "single":
+        num = l1 * np.abs(xi) + l2 * np.abs(eta) + l3 * np.abs(phi) * np.sqrt(ab)
+        den = np.sqrt(xi**2 + eta**2 + ab * phi**2)
+        single = np.where(den > 0, num / np.where(den > 0, den, 1.0), l1)
+        return single, single, single
+    # "three": blending of Vollebregt & Voltr (2023)
+    c = 3.0 * math.pi * a / 32.0
+    cp2 = (c * phi) ** 2
+    num = xi**2 + eta**2 + cp2
+    den = xi**2 / l1 + eta**2 / l2 + cp2 / l3
+    l_comb = np.where(den > 0, num / np.where(den > 0, den, 1.0), l1)
+    force = friction_coefficient * normal_force_N
+    g = shear_modulus_Pa
+    ch2 = (
+        (force / (g * ab * coefficients.c11)) ** 2
+        + (force / (g * ab * coefficients.c22)) ** 2
+        + (force / (g * ab**1.5 * coefficients.c23)) ** 2
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f_crp = np.where(ch2 > 0, np.sqrt((xi**2 + eta**2 + phi**2) / ch2), np.inf)
+    w = np.clip(f_crp / 3.0, 0.0, 1.0)
+    return (1 - w) * l1 + w * l_comb, (1 - w) * l2 + w * l_comb, (1 - w) * l3 + w * l_comb
+
+
+@dataclass(frozen=True, eq=False)
+class FastsimBatch:
+    """FASTSIM results for a batch of patches (arrays of one shape).
+
+    Attributes:
+        creep_force_long_N, creep_force_lat_N: Fx, Fy on the wheel, N.
+        spin_moment_Nm: Mz on the wheel, N m.
+        slip_fraction: fraction of the grid elements in slip (0 = full adhesion).
+    """
+
+    creep_force_long_N: np.ndarray
+    creep_force_lat_N: np.ndarray
+    spin_moment_Nm: np.ndarray
+    slip_fraction: np.ndarray
+
+
+def _prepare(
+    a,
+    b,
+    fn,
+    xi,
+    eta,
+    phi,
+    shear_modulus_Pa,
+    poisson_ratio,
+    friction_coefficient,
+    nx,
+    ny,
+    traction_bound,
+    flexibility,
+    coefficients,
+):
+    if traction_bound not in TRACTION_BOUNDS:
+        raise ValueError(f"traction_bound = {traction_bound!r}: expected one of {', '.join(TRACTION_BOUNDS)}")
+    if flexibility not in FLEXIBILITIES:
+        raise ValueError(f"flexibility = {flexibility!r}: expected one of {', '.join(FLEXIBILITIES)}")
+    for name, n in (("nx", nx), ("ny", ny)):
+        if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 1:
+            raise ValueError(f"{name} = {n!r}: expected an integer >= 1")
+    if not (math.isfinite(shear_modulus_Pa) and shear_modulus_Pa > 0):
+        raise ValueError(f"shear_modulus_Pa = {shear_modulus_Pa!r}: expected a finite number > 0")
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, fn, xi, eta, phi, friction_coefficient)))
+    shape = arrays[0].shape
+    a, b, fn, xi, eta, phi, mu = (np.ascontiguousarray(v.ravel()) for v in arrays)
+    if not (np.all(np.isfinite(a)) and np.all(a > 0) and np.all(np.isfinite(b)) and np.all(b > 0)):
+        raise ValueError("semi_axis_long_m, semi_axis_lat_m: expected finite values > 0")
+    if not (np.all(np.isfinite(mu)) and np.all(mu >= 0)):
+        raise ValueError(f"friction_coefficient = {friction_coefficient!r}: expected finite values >= 0")
+    for name, v in (("normal_force_N", fn), ("longitudinal", xi), ("lateral", eta), ("spin_1_per_m", phi)):
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{name}: expected finite values")
+    coef = coefficients if coefficients is not None else kalker_coefficients(a / b, poisson_ratio)
+    if coefficients is not None:
+        coef = CreepCoefficients(
+            *(np.broadcast_to(np.asarray(c, float), shape).ravel() for c in (coef.c11, coef.c22, coef.c23, coef.c33))
+        )
+    l1, l2, l3 = effective_flexibilities(
+        a,
+        b,
+        fn,
+        xi,
+        eta,
+        phi,
+        shear_modulus_Pa=shear_modulus_Pa,
+        friction_coefficient=mu,
+        coefficients=coef,
+        flexibility=flexibility,
+    )
+    l1, l2, l3 = (np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float) for v in (l1, l2, l3))
+    return shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3
+
+
+def fastsim_batch(
+    semi_axis_long_m,
+    semi_axis_lat_m,
+    normal_force_N,
+    longitudinal,
+    lateral,
+    spin_1_per_m,
+    *,
+    shear_modulus_Pa: float,
+    poisson_ratio: float,
+    friction_coefficient,
+    nx: int = 20,
+    ny: int = 20,
+    traction_bound: str = "elliptic",
+    flexibility: str = "three",
+    coefficients: CreepCoefficients | None = None,
+) -> FastsimBatch:
+    """FASTSIM creep forces and spin moment for many elliptic patches (compiled loop over patches).
+
+    Args:
+        semi_axis_long_m: a (along rolling x), m; arrays broadcast together.
+        semi_axis_lat_m: b, m.
+        normal_force_N: N, N (patches with N <= 0 give zero forces).
+        longitudinal: xi; lateral: eta; spin_1_per_m: phi (1/m).
+        shear_modulus_Pa: G; poisson_ratio: nu (C_ij); friction_coefficient: mu (scalar or array).
+        nx, ny: elements per strip and number of strips.
+        traction_bound: "elliptic" or "parabolic".
+        flexibility: "single", "three" or "three-unblended".
+        coefficients: precomputed C_ij (else from Kalker's table).
+
+    Returns:
+        :class:`FastsimBatch`.
+
+    Raises:
+        ValueError: bad option or input (the message names it).
+    """
+    shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3 = _prepare(
+        semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m,
+        shear_modulus_Pa, poisson_ratio, friction_coefficient, nx, ny, traction_bound, flexibility, coefficients,
+    )  # fmt: skip
+    out = np.empty((a.size, 4))
+    _fastsim_many(a, b, mu, fn, xi, eta, phi, l1, l2, l3, int(nx), int(ny), traction_bound == "parabolic", out)
+    return FastsimBatch(*(out[:, i].reshape(shape) for i in range(4)))
+
+
+def fastsim_fields(
+    semi_axis_long_m: float,
+    semi_axis_lat_m: float,
+    normal_force_N: float,
+    longitudinal: float,
+    lateral: float,
+    spin_1_per_m: float,
+    *,
+    shear_modulus_Pa: float,
+    poisson_ratio: float,
+    friction_coefficient: float,
+    rolling_speed_m_per_s: float = 1.0,
+    nx: int = 20,
+    ny: int = 20,
+    traction_bound: str = "elliptic",
+    flexibility: str = "three",
+) -> tuple[tuple[float, float, float, float], ContactFields]:
+    """FASTSIM for one patch with surface fields.
+
+    The traction is computed on Kalker's strip grid (nx elements per strip) and resampled by
+    linear interpolation along each strip onto a regular grid x_i = -a + (i + 1/2) 2a/nx (same
+    strips y_j), with zero traction at the leading edge and projected onto the traction bound
+    (interpolation between points on a concave bound can overshoot it); the slip flag and slip speed
+    (V |s|, m/s) are taken from the nearest strip element. The forces returned are those of the
+    strip grid (the resampled fields integrate to them only to O(dx)).
+
+    Returns:
+        ((Fx, Fy, Mz, slip_fraction), ContactFields) with fields[j, i] at (x_m[i], y_m[j]).
+    """
+    shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3 = _prepare(
+        semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m,
+        shear_modulus_Pa, poisson_ratio, friction_coefficient, nx, ny, traction_bound, flexibility, None,
+    )  # fmt: skip
+    if a.size != 1:
+        raise ValueError("fastsim_fields: expected scalar inputs (one patch)")
+    px = np.zeros((ny, nx))
+    py = np.zeros((ny, nx))
+    sx = np.zeros((ny, nx))
+    sy = np.zeros((ny, nx))
+    res = _fastsim_one(
+        a[0], b[0], mu[0], fn[0], xi[0], eta[0], phi[0], l1[0], l2[0], l3[0], int(nx), int(ny),
+        traction_bound == "parabolic", px, py, sx, sy, True,
+    )  # fmt: skip
+    a0, b0 = a[0], b[0]
+    x_m = -a0 + (np.arange(nx) + 0.5) * 2.0 * a0 / nx
+    y_m = -b0 + (np.arange(ny) + 0.5) * 2.0 * b0 / ny
+    tx = np.zeros((ny, nx))
+    ty = np.zeros((ny, nx))
+    slip = np.zeros((ny, nx))
+    in_slip = np.zeros((ny, nx), dtype=bool)
+    rho = 1.0 - (x_m[None, :] / a0) ** 2 - (y_m[:, None] / b0) ** 2
+    in_contact = rho > 0
+    if fn[0] > 0:
+        p0 = 3.0 * fn[0] / (2.0 * math.pi * a0 * b0)
+        pressure = p0 * np.sqrt(np.clip(rho, 0.0, None))
+    else:
+        pressure = np.zeros((ny, nx))
+        in_contact[:] = False
+    for j in range(ny):
+        ay = a0 * math.sqrt(max(0.0, 1.0 - (y_m[j] / b0) ** 2))
+        if ay <= 0:
+            continue
+        dx = 2.0 * ay / nx
+        xs = ay - (np.arange(nx) + 0.5) * dx  # descending
+        xk = np.concatenate([[ay], xs])[::-1]  # ascending incl. the leading edge
+        inside = np.abs(x_m) < ay
+        tx[j, inside] = np.interp(x_m[inside], xk, np.concatenate([[0.0], px[j]])[::-1])
+        ty[j, inside] = np.interp(x_m[inside], xk, np.concatenate([[0.0], py[j]])[::-1])
+        nearest = np.clip(np.rint((ay - x_m[inside]) / dx - 0.5).astype(int), 0, nx - 1)
+        speed = rolling_speed_m_per_s * np.hypot(sx[j, nearest], sy[j, nearest])
+        slip[j, inside] = speed
+        in_slip[j, inside] = speed > 0
+    # linear interpolation of a traction that sits on a concave bound can overshoot it: project back
+    bound = mu[0] * pressure
+    t_abs = np.hypot(tx, ty)
+    over = t_abs > bound
+    scale = np.where(over, bound / np.where(over, t_abs, 1.0), 1.0)
+    tx *= scale
+    ty *= scale
+    fields = ContactFields(
+        x_m=x_m,
+        y_m=y_m,
+        pressure_Pa=pressure,
+        traction_long_Pa=tx,
+        traction_lat_Pa=ty,
+        slip_m_per_s=slip,
+        in_contact=in_contact,
+        in_slip=in_slip & in_contact,
+    )
+    return (float(res[0]), float(res[1]), float(res[2]), float(res[3])), fields

@@ -1,0 +1,60 @@
+"""Kalker's linear theory of rolling contact (full adhesion), seed eq 50-52, vectorised.
+
+Forces and spin moment on the wheel, contact frame (x rolling, y lateral, z normal rail -> wheel)::
+
+    Fx = -G a b C11 xi                                   (eq 50)
+    Fy = -G a b C22 eta - G (ab)^1.5 C23 phi             (eq 51)
+    Mz =  G (ab)^1.5 C23 eta - G (ab)^2 C33 phi          (eq 52 with C32 = -C23, REFERENCES.md)
+
+Symbols: a, b semi-axes along x and y (m); G shear modulus (Pa); xi, eta longitudinal and
+lateral creepage (-); phi spin creepage (1/m); C_ij from :mod:`rigid_dynamics.contact.kalker`.
+Positive lateral creepage and positive spin both give a negative lateral force (the same signs
+as the open-source CONTACT program). Valid for small creepages only: no saturation at mu N.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+
+
+def linear_creep_forces(
+    semi_axis_long_m,
+    semi_axis_lat_m,
+    longitudinal,
+    lateral,
+    spin_1_per_m,
+    *,
+    shear_modulus_Pa: float,
+    poisson_ratio: float,
+    coefficients: CreepCoefficients | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Creep forces Fx, Fy (N) and spin moment Mz (N m) of the linear theory for many patches.
+
+    Args:
+        semi_axis_long_m: a, m (> 0), array or scalar.
+        semi_axis_lat_m: b, m (> 0).
+        longitudinal: xi, longitudinal creepage.
+        lateral: eta, lateral creepage.
+        spin_1_per_m: phi, spin creepage, 1/m.
+        shear_modulus_Pa: G, Pa.
+        poisson_ratio: nu (selects the C_ij).
+        coefficients: precomputed C_ij for these patches (else interpolated from Kalker's table).
+
+    Returns:
+        (Fx, Fy, Mz) arrays of the broadcast shape (on the wheel, contact frame).
+    """
+    a, b, xi, eta, phi = np.broadcast_arrays(
+        *(np.asarray(v, dtype=float) for v in (semi_axis_long_m, semi_axis_lat_m, longitudinal, lateral, spin_1_per_m))
+    )
+    if not (np.all(a > 0) and np.all(b > 0)):
+        raise ValueError("semi-axes: expected semi_axis_long_m > 0 and semi_axis_lat_m > 0")
+    c = coefficients if coefficients is not None else kalker_coefficients(a / b, poisson_ratio)
+    ab = a * b
+    g_ab = shear_modulus_Pa * ab
+    g_ab15 = g_ab * np.sqrt(ab)
+    fx = -g_ab * c.c11 * xi
+    fy = -g_ab * c.c22 * eta - g_ab15 * c.c23 * phi
+    mz = g_ab15 * c.c23 * eta - g_ab * ab * c.c33 * phi
+    return fx, fy, mz

@@ -1,0 +1,374 @@
+"""The analytic contact models of the registry: hertz, linear, vermeulen-johnson, fastsim, auto.
+
+Each class implements :class:`rigid_dynamics.contact.registry.ContactModel`::
+
+    solve(geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult
+
+Normal problem (all models): Hertz (:mod:`.hertz`, seed eq 32-38) for h = A x^2 + B y^2 - q with
+A = ``geometry.curvature_long_1_per_m``, B = ``geometry.curvature_lat_1_per_m``. Force control
+uses ``normal_force_N``; approach control uses ``geometry.approach_m`` (q <= 0: no contact,
+``success=True``, ``status="no-contact"``, all forces 0). The ellipse is assumed aligned with the
+rolling direction (semi-axis a along x); a non-zero ``geometry.ellipse_angle_rad`` is reported in
+``extra["ellipse_angle_rad"]`` and the message but not otherwise used.
+
+Tangential problem: ``hertz`` none (creep forces 0.0); ``linear`` Kalker's linear theory
+(:mod:`.linear`, eq 50-52); ``vermeulen-johnson`` (:mod:`.vermeulen_johnson`, eq 53-58 with the
+cube; no spin moment: None); ``fastsim`` (:mod:`.fastsim`). Forces act on the wheel, contact frame.
+
+``auto`` picks the cheapest model whose expected relative error in the creep force is below the
+option ``tolerance`` (default 0.05):
+
+1. non-elliptic geometry (``geometry.is_elliptic`` False: sampled, two-point or flange patches)
+   -> ``bem`` (imported lazily; if it cannot be imported the result has ``success=False``,
+   ``status="unavailable"``);
+2. elliptic, with the linear-theory force T_lin and w' = T_lin/(3 mu N) (eq 55): the linear theory
+   differs from the saturating law by 1 - T_bar/T = w' - w'^2/3 (eq 56 with the cube), so
+   ``linear`` when w' < tolerance;
+3. otherwise ``vermeulen-johnson`` when the spin's share of the creep force is small, measured by
+   s = G (ab)^1.5 C23 |phi| / max(|T_lin|, mu N) (the spin's linear lateral force against the
+   force level of the patch): Vermeulen-Johnson treats spin only through that linear term, so its
+   error is bounded by this share; ``vermeulen-johnson`` when s < tolerance, else ``fastsim``.
+   (Calibration: for the CONTACT large-spin case, s = 1.0 and VJ's lateral force is 12 % off the
+   exact value while FASTSIM's is 2.5 % off; see benchmarks/results/analytic.md.)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+
+from rigid_dynamics.contact.fastsim import FLEXIBILITIES, TRACTION_BOUNDS, fastsim_fields
+from rigid_dynamics.contact.hertz import HertzBatch, hertz_solve_batch
+from rigid_dynamics.contact.kalker import kalker_coefficients
+from rigid_dynamics.contact.linear import linear_creep_forces
+from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
+from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+from rigid_dynamics.materials import Material
+
+
+def _options(options: Mapping | None, defaults: Mapping, model: str) -> dict:
+    merged = dict(defaults)
+    if options:
+        unknown = sorted(set(options) - set(defaults))
+        if unknown:
+            allowed = ", ".join(sorted(defaults)) if defaults else "none"
+            raise ValueError(f"{model}: unknown option(s) {', '.join(map(repr, unknown))}; allowed: {allowed}")
+        merged.update(options)
+    return merged
+
+
+def _hertz(
+    geometry: ContactGeometry, material: Material, normal_force_N: float | None
+) -> tuple[HertzBatch | None, str]:
+    """Hertz patch, or (None, reason) when there is no contact."""
+    if normal_force_N is not None:
+        if not math.isfinite(normal_force_N):
+            raise ValueError(f"normal_force_N = {normal_force_N!r}: expected a finite number")
+        if normal_force_N <= 0:
+            return None, f"normal force {normal_force_N:g} N <= 0: no contact"
+        load = {"normal_force_N": normal_force_N}
+    else:
+        if geometry.approach_m <= 0:
+            return None, f"approach {geometry.approach_m:g} m <= 0: no contact"
+        load = {"approach_m": geometry.approach_m}
+    sol = hertz_solve_batch(
+        geometry.curvature_long_1_per_m,
+        geometry.curvature_lat_1_per_m,
+        shear_modulus_Pa=material.shear_modulus_Pa,
+        poisson_ratio=material.poisson_ratio,
+        **load,
+    )
+    return sol, ""
+
+
+def _base_result(name, geometry, creepage, hertz: HertzBatch | None, reason: str, start: float, **kw) -> ContactResult:
+    extra = {"ellipse_angle_rad": float(geometry.ellipse_angle_rad)}
+    note = ""
+    if abs(math.sin(2.0 * geometry.ellipse_angle_rad)) > 1e-9:
+        note = " (ellipse_angle_rad != 0: the ellipse is treated as aligned with the rolling direction)"
+    if hertz is None:
+        return ContactResult(
+            method=name,
+            success=True,
+            status="no-contact",
+            message=reason,
+            normal_force_N=0.0,
+            creep_force_long_N=0.0,
+            creep_force_lat_N=0.0,
+            spin_moment_Nm=0.0,
+            max_pressure_Pa=0.0,
+            semi_axis_long_m=0.0,
+            semi_axis_lat_m=0.0,
+            contact_area_m2=0.0,
+            approach_m=max(geometry.approach_m, 0.0) if reason.startswith("approach") else 0.0,
+            creepage=creepage,
+            wall_time_s=time.perf_counter() - start,
+            extra=extra,
+        )
+    a = float(hertz.semi_axis_long_m)
+    b = float(hertz.semi_axis_lat_m)
+    converged = bool(hertz.converged)
+    fields = {
+        "method": name,
+        "success": converged,
+        "status": "ok" if converged else "not-converged",
+        "message": ("solved" if converged else "Hertz axial-function inversion did not converge") + note,
+        "normal_force_N": float(hertz.normal_force_N),
+        "max_pressure_Pa": float(hertz.max_pressure_Pa),
+        "semi_axis_long_m": a,
+        "semi_axis_lat_m": b,
+        "contact_area_m2": math.pi * a * b,
+        "approach_m": float(hertz.approach_m),
+        "creepage": creepage,
+        "iterations": int(hertz.iterations),
+        "extra": extra,
+    }
+    fields.update(kw)
+    fields["wall_time_s"] = time.perf_counter() - start
+    return ContactResult(**fields)
+
+
+class HertzModel:
+    """Hertz normal contact only (seed eq 32-38); creep forces and spin moment 0.0."""
+
+    name = "hertz"
+    description = "Hertz normal contact only; creep forces 0"
+    defaults: dict = {}
+
+    def solve(
+        self,
+        geometry: ContactGeometry,
+        creepage: Creepage,
+        material: Material,
+        *,
+        normal_force_N: float | None = None,
+        options: Mapping | None = None,
+    ) -> ContactResult:
+        start = time.perf_counter()
+        _options(options, self.defaults, self.name)
+        hertz, reason = _hertz(geometry, material, normal_force_N)
+        return _base_result(
+            self.name,
+            geometry,
+            creepage,
+            hertz,
+            reason,
+            start,
+            creep_force_long_N=0.0,
+            creep_force_lat_N=0.0,
+            spin_moment_Nm=0.0,
+        )
+
+
+class LinearModel:
+    """Hertz + Kalker's linear theory (full adhesion; seed eq 50-52)."""
+
+    name = "linear"
+    description = "Hertz + Kalker's linear theory (full adhesion)"
+    defaults: dict = {}
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+        start = time.perf_counter()
+        _options(options, self.defaults, self.name)
+        hertz, reason = _hertz(geometry, material, normal_force_N)
+        if hertz is None:
+            return _base_result(self.name, geometry, creepage, None, reason, start)
+        fx, fy, mz = linear_creep_forces(
+            hertz.semi_axis_long_m,
+            hertz.semi_axis_lat_m,
+            creepage.longitudinal,
+            creepage.lateral,
+            creepage.spin_1_per_m,
+            shear_modulus_Pa=material.shear_modulus_Pa,
+            poisson_ratio=material.poisson_ratio,
+        )
+        return _base_result(
+            self.name,
+            geometry,
+            creepage,
+            hertz,
+            reason,
+            start,
+            creep_force_long_N=float(fx),
+            creep_force_lat_N=float(fy),
+            spin_moment_Nm=float(mz),
+        )
+
+
+class VermeulenJohnsonModel:
+    """Hertz + linear theory saturated by Vermeulen-Johnson's cubic law (seed eq 53-58, cube)."""
+
+    name = "vermeulen-johnson"
+    description = "Hertz + Vermeulen-Johnson saturation (no spin)"
+    defaults: dict = {}
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+        start = time.perf_counter()
+        _options(options, self.defaults, self.name)
+        hertz, reason = _hertz(geometry, material, normal_force_N)
+        if hertz is None:
+            return _base_result(self.name, geometry, creepage, None, reason, start)
+        tx, ty, _ = linear_creep_forces(
+            hertz.semi_axis_long_m,
+            hertz.semi_axis_lat_m,
+            creepage.longitudinal,
+            creepage.lateral,
+            creepage.spin_1_per_m,
+            shear_modulus_Pa=material.shear_modulus_Pa,
+            poisson_ratio=material.poisson_ratio,
+        )
+        fx, fy = vermeulen_johnson_saturation(tx, ty, hertz.normal_force_N, material.friction_coefficient)
+        return _base_result(
+            self.name,
+            geometry,
+            creepage,
+            hertz,
+            reason,
+            start,
+            creep_force_long_N=float(fx),
+            creep_force_lat_N=float(fy),
+            spin_moment_Nm=None,
+        )
+
+
+class FastsimModel:
+    """Hertz + Kalker's FASTSIM (simplified theory), with traction and slip fields.
+
+    Options: ``nx``, ``ny`` (elements per strip, strips; default 20 x 20), ``traction_bound``
+    ("elliptic" | "parabolic"), ``flexibility`` ("single" | "three" | "three-unblended"),
+    ``fields`` (bool, return :class:`~rigid_dynamics.contact.types.ContactFields`).
+    """
+
+    name = "fastsim"
+    description = "Hertz + Kalker's FASTSIM (simplified theory)"
+    defaults: dict = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three", "fields": True}
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+        start = time.perf_counter()
+        opts = _options(options, self.defaults, self.name)
+        if opts["traction_bound"] not in TRACTION_BOUNDS:
+            raise ValueError(
+                f"fastsim: traction_bound = {opts['traction_bound']!r}; allowed: {', '.join(TRACTION_BOUNDS)}"
+            )
+        if opts["flexibility"] not in FLEXIBILITIES:
+            raise ValueError(f"fastsim: flexibility = {opts['flexibility']!r}; allowed: {', '.join(FLEXIBILITIES)}")
+        hertz, reason = _hertz(geometry, material, normal_force_N)
+        if hertz is None:
+            return _base_result(self.name, geometry, creepage, None, reason, start)
+        (fx, fy, mz, slip_fraction), fields = fastsim_fields(
+            float(hertz.semi_axis_long_m),
+            float(hertz.semi_axis_lat_m),
+            float(hertz.normal_force_N),
+            creepage.longitudinal,
+            creepage.lateral,
+            creepage.spin_1_per_m,
+            shear_modulus_Pa=material.shear_modulus_Pa,
+            poisson_ratio=material.poisson_ratio,
+            friction_coefficient=material.friction_coefficient,
+            rolling_speed_m_per_s=creepage.rolling_speed_m_per_s,
+            nx=opts["nx"],
+            ny=opts["ny"],
+            traction_bound=opts["traction_bound"],
+            flexibility=opts["flexibility"],
+        )
+        result = _base_result(
+            self.name,
+            geometry,
+            creepage,
+            hertz,
+            reason,
+            start,
+            creep_force_long_N=fx,
+            creep_force_lat_N=fy,
+            spin_moment_Nm=mz,
+            fields=fields if opts["fields"] else None,
+        )
+        result.extra.update(
+            {
+                "slip_fraction": slip_fraction,
+                "nx": int(opts["nx"]),
+                "ny": int(opts["ny"]),
+                "traction_bound": opts["traction_bound"],
+                "flexibility": opts["flexibility"],
+            }
+        )
+        return result
+
+
+def auto_choice(
+    geometry: ContactGeometry, creepage: Creepage, material: Material, hertz: HertzBatch, tolerance: float
+) -> tuple[str, str]:
+    """(model name, reason) by the criterion of the module docstring (elliptic patches)."""
+    a, b = float(hertz.semi_axis_long_m), float(hertz.semi_axis_lat_m)
+    coef = kalker_coefficients(a / b, material.poisson_ratio)
+    tx, ty, _ = linear_creep_forces(
+        a,
+        b,
+        creepage.longitudinal,
+        creepage.lateral,
+        creepage.spin_1_per_m,
+        shear_modulus_Pa=material.shear_modulus_Pa,
+        poisson_ratio=material.poisson_ratio,
+        coefficients=coef,
+    )
+    t_lin = math.hypot(float(tx), float(ty))
+    mu_n = material.friction_coefficient * float(hertz.normal_force_N)
+    w = t_lin / (3.0 * mu_n) if mu_n > 0 else math.inf
+    if w < tolerance:
+        return "linear", f"w' = T_lin/(3 mu N) = {w:.3g} < tolerance {tolerance:g}"
+    spin_force = material.shear_modulus_Pa * (a * b) ** 1.5 * float(coef.c23) * abs(creepage.spin_1_per_m)
+    share = spin_force / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0
+    if share < tolerance:
+        return "vermeulen-johnson", f"spin share {share:.3g} < tolerance {tolerance:g} (w' = {w:.3g})"
+    return "fastsim", f"spin share {share:.3g} >= tolerance {tolerance:g}"
+
+
+class AutoModel:
+    """The cheapest model whose expected error is under ``tolerance`` (criterion: module docstring).
+
+    Options: ``tolerance`` (relative creep-force error, default 0.05) and ``model_options`` (a
+    mapping name -> options passed to the chosen model, e.g. {"fastsim": {"nx": 40}}).
+    """
+
+    name = "auto"
+    description = "cheapest model meeting the tolerance for the patch"
+    defaults: dict = {"tolerance": 0.05, "model_options": None}
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+        start = time.perf_counter()
+        opts = _options(options, self.defaults, self.name)
+        tol = opts["tolerance"]
+        if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0):
+            raise ValueError(f"auto: tolerance = {tol!r}; expected a number > 0")
+        per_model = dict(opts["model_options"] or {})
+        if not geometry.is_elliptic:
+            chosen, reason = "bem", "non-elliptic geometry (is_elliptic False)"
+            try:
+                from rigid_dynamics.contact.registry import get_model
+
+                model = get_model("bem")
+            except ImportError as exc:
+                return ContactResult(
+                    method=self.name,
+                    success=False,
+                    status="unavailable",
+                    message=f"auto chose 'bem' ({reason}) but it cannot be imported: {exc}",
+                    normal_force_N=0.0,
+                    creepage=creepage,
+                    wall_time_s=time.perf_counter() - start,
+                    extra={"selected_model": chosen},
+                )
+        else:
+            hertz, why = _hertz(geometry, material, normal_force_N)
+            if hertz is None:
+                result = _base_result(self.name, geometry, creepage, None, why, start)
+                result.extra["selected_model"] = "hertz"
+                return result
+            chosen, reason = auto_choice(geometry, creepage, material, hertz, tol)
+            model = {"linear": LinearModel, "vermeulen-johnson": VermeulenJohnsonModel, "fastsim": FastsimModel}[
+                chosen
+            ]()
+        result = model.solve(geometry, creepage, material, normal_force_N=normal_force_N, options=per_model.get(chosen))
+        result.extra.update({"selected_model": chosen, "selection_reason": reason})
+        return result

@@ -1,0 +1,105 @@
+"""The registered analytic models (hertz, linear, vermeulen-johnson, fastsim, auto): contract tests.
+
+Physics references are in test_hertz/test_kalker/test_tangential/test_fastsim; here: the
+registry protocol, the ContactResult contract (contact area = pi a b, no-contact, options),
+the auto selection, and the Hertz sphere closed form through the model interface.
+"""
+
+import math
+
+import pytest
+
+from rigid_dynamics.contact.registry import ContactModel, get_model
+from rigid_dynamics.contact.types import ContactGeometry, Creepage, UndeformedDistance
+from rigid_dynamics.materials import Material
+
+MATERIAL = Material(82.0e9, 0.28, 0.3)
+NAMES = ["hertz", "linear", "vermeulen-johnson", "fastsim", "auto"]
+
+
+def geometry(approach=0.0):
+    return ContactGeometry(0.5 / 0.46, 0.5 / 0.30, approach)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_protocol_and_result_contract(name):
+    model = get_model(name)
+    assert isinstance(model, ContactModel)
+    r = model.solve(geometry(), Creepage(2e-4, -1e-4, 0.1, 20.0), MATERIAL, normal_force_N=80e3)
+    assert r.success and r.status == "ok"
+    assert r.contact_area_m2 == pytest.approx(math.pi * r.semi_axis_long_m * r.semi_axis_lat_m)
+    assert r.normal_force_N == pytest.approx(80e3)
+    assert r.max_pressure_Pa == pytest.approx(3 * 80e3 / (2 * math.pi * r.semi_axis_long_m * r.semi_axis_lat_m))
+    assert r.wall_time_s >= 0 and r.approach_m > 0
+    if name == "hertz":
+        assert r.creep_force_long_N == 0.0 and r.creep_force_lat_N == 0.0
+    else:
+        assert r.creep_force_long_N < 0  # opposes positive longitudinal creepage
+
+
+def test_hertz_model_sphere_closed_form():
+    radius = 0.46
+    g = ContactGeometry.quadric(radius, radius, approach_m=3e-5)
+    r = get_model("hertz").solve(g, Creepage(), MATERIAL)
+    a = math.sqrt(3e-5 * radius)
+    e_star = MATERIAL.combined_modulus_Pa
+    assert r.semi_axis_long_m == pytest.approx(a, rel=1e-12)
+    assert r.normal_force_N == pytest.approx(4 * e_star * a**3 / (3 * radius), rel=1e-12)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_no_contact(name):
+    r = get_model(name).solve(geometry(approach=-1e-6), Creepage(1e-3, 0, 0), MATERIAL)
+    assert r.success and r.status == "no-contact"
+    assert r.normal_force_N == 0 and r.creep_force_long_N == 0 and r.creep_force_lat_N == 0
+    r = get_model(name).solve(geometry(), Creepage(1e-3, 0, 0), MATERIAL, normal_force_N=0.0)
+    assert r.status == "no-contact"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_unknown_option_raises(name):
+    with pytest.raises(ValueError, match="unknown option.*'bogus'.*allowed"):
+        get_model(name).solve(geometry(), Creepage(), MATERIAL, normal_force_N=1e4, options={"bogus": 1})
+
+
+def test_fastsim_options():
+    model = get_model("fastsim")
+    r = model.solve(
+        geometry(), Creepage(0, 1e-3, 0.3), MATERIAL, normal_force_N=8e4, options={"nx": 30, "ny": 10, "fields": True}
+    )
+    assert r.fields is not None and r.fields.pressure_Pa.shape == (10, 30)
+    assert r.extra["flexibility"] == "three" and 0 < r.extra["slip_fraction"] < 1
+    with pytest.raises(ValueError, match="traction_bound.*allowed: elliptic, parabolic"):
+        model.solve(geometry(), Creepage(), MATERIAL, normal_force_N=8e4, options={"traction_bound": "flat"})
+    with pytest.raises(ValueError, match="flexibility"):
+        model.solve(geometry(), Creepage(), MATERIAL, normal_force_N=8e4, options={"flexibility": "many"})
+    with pytest.raises(ValueError, match="normal_force_N"):
+        model.solve(geometry(), Creepage(), MATERIAL, normal_force_N=math.nan)
+
+
+def test_auto_selection():
+    auto = get_model("auto")
+    small = auto.solve(geometry(), Creepage(1e-6, 0, 0), MATERIAL, normal_force_N=8e4)
+    assert small.extra["selected_model"] == "linear"
+    moderate = auto.solve(geometry(), Creepage(1e-3, 0, 0), MATERIAL, normal_force_N=8e4)
+    assert moderate.extra["selected_model"] == "vermeulen-johnson"
+    spin = auto.solve(geometry(), Creepage(0, -6.25e-4, 0.625), MATERIAL, normal_force_N=8e4)
+    assert spin.extra["selected_model"] == "fastsim"
+    loose = auto.solve(
+        geometry(), Creepage(0, -6.25e-4, 0.625), MATERIAL, normal_force_N=8e4, options={"tolerance": 2.0}
+    )
+    assert loose.extra["selected_model"] in ("linear", "vermeulen-johnson")
+    with pytest.raises(ValueError, match="tolerance"):
+        auto.solve(geometry(), Creepage(), MATERIAL, normal_force_N=8e4, options={"tolerance": -1})
+
+
+def test_auto_non_elliptic_goes_to_bem_or_reports_unavailable():
+    import numpy as np
+
+    x = np.linspace(-0.02, 0.02, 41)
+    y = np.linspace(-0.02, 0.02, 41)
+    gap = 1.0 * x[None, :] ** 2 + 2.0 * y[:, None] ** 2 - 5e-5
+    g = ContactGeometry(1.0, 2.0, 5e-5, undeformed=UndeformedDistance(x, y, gap), is_elliptic=False)
+    r = get_model("auto").solve(g, Creepage(1e-4, 0, 0), MATERIAL)
+    assert r.extra["selected_model"] == "bem"
+    assert r.status in ("ok", "unavailable", "not-converged")
