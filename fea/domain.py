@@ -1,0 +1,66 @@
+"""gmsh models -> distributed DOLFINx meshes with named tags (built on rank 0, partitioned over the communicator)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from meshing.quality import MeshQuality, MeshQualityError, QualityLimits, check_quality
+
+
+@dataclass(frozen=True, eq=False)
+class Domain:
+    """A DOLFINx mesh with its facet tags and the physical group names.
+
+    Attributes:
+        mesh: dolfinx.mesh.Mesh (distributed).
+        facet_tags: dolfinx.mesh.MeshTags of the facets.
+        groups: physical group name -> tag (facet groups and the body).
+        quality: quality report of the gmsh mesh (the same on every rank).
+        symmetry: "quarter" or "full"; the quarter model carries 1/4 of the load.
+    """
+
+    mesh: object
+    facet_tags: object
+    groups: dict
+    quality: MeshQuality
+    symmetry: str
+
+    @property
+    def symmetry_factor(self) -> float:
+        """Force on the whole patch / force on the modelled part."""
+        return 4.0 if self.symmetry == "quarter" else 1.0
+
+
+def hertz_block_domain(spec, comm=None, limits: QualityLimits | None = None) -> Domain:
+    """Mesh a :class:`meshing.hertz.HertzBlockSpec` on rank 0 and distribute it.
+
+    Raises:
+        MeshQualityError: (on every rank) the mesh fails ``limits``.
+    """
+    import dolfinx_solver  # noqa: F401  (must precede dolfinx/petsc4py/mpi4py)
+    from dolfinx.io import gmsh as gmsh_io
+    from mpi4py import MPI
+
+    from meshing.hertz import build_hertz_block
+    from meshing.quality import mesh_quality
+    from meshing.session import generate, gmsh_model
+
+    comm = MPI.COMM_WORLD if comm is None else comm
+    limits = QualityLimits() if limits is None else limits
+    error = None
+    quality = None
+    with gmsh_model("hertz-block") as model:
+        if comm.rank == 0:
+            try:
+                build_hertz_block(model, spec)
+                generate(model)
+                quality = check_quality(mesh_quality(model), limits)
+            except (MeshQualityError, ValueError) as exc:
+                error = f"{type(exc).__name__}: {exc}"
+        error = comm.bcast(error, root=0)
+        if error is not None:
+            raise MeshQualityError(error)
+        quality = comm.bcast(quality, root=0)
+        data = gmsh_io.model_to_mesh(model, comm, 0, gdim=3)
+    groups = {name: group.tag for name, group in data.physical_groups.items()}
+    return Domain(data.mesh, data.facet_tags, groups, quality, spec.symmetry)

@@ -1,0 +1,348 @@
+"""The ``fea`` contact model: FEniCSx normal contact of an elastic block and a rigid indenter.
+
+Registered as ``"fea.model:FeaModel"`` in :mod:`rigid_dynamics.contact.registry`. Importing this
+module is cheap: gmsh, DOLFINx and PETSc are imported inside :meth:`FeaModel.solve`.
+
+Model (see :mod:`fea.solver`): half-space theory of two quasi-identical bodies, i.e. one elastic
+block with E_body = E* (1 - nu^2) (E* = G / (1 - nu), :attr:`Material.combined_modulus_Pa`)
+against a rigid surface at the undeformed distance h(x, y) of the patch (``geometry.gap_m`` +
+approach). A quadric patch (``geometry.undeformed is None``) uses a quarter model with symmetry
+planes x = 0 and y = 0; a sampled gap uses the full block. Frictionless: creep forces are None.
+
+Frame: contact frame of the patch (x rolling, y lateral, z normal rail -> wheel); the block stands
+for the body below the contact plane, the pressure acts on the wheel along +z. Units SI.
+
+Runs unchanged under ``mpiexec -n N``: the mesh is built on rank 0 and partitioned, every rank
+returns the same :class:`ContactResult` (fields gathered); files are written collectively (XDMF)
+or by rank 0 (PNG).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
+from rigid_dynamics.materials import Material
+
+
+@dataclass(frozen=True)
+class FeaOptions:
+    """Options of :class:`FeaModel` (pass them as a mapping to ``solve``; unknown keys raise ValueError).
+
+    Attributes:
+        quick: coarse mesh (4 elements per semi-axis, block of 12 semi-axes) for a fast estimate.
+        mesh_size_factor: multiplies the element size at the patch (1 = min(a, b)/6), > 0.
+        elements_per_semi_axis: element count per semi-axis at the patch (overrides quick's 4 / default 6).
+        domain_factor: half-width and depth of the block in semi-axes (>= 4).
+        degree: displacement degree; only 1 is implemented.
+        linear_solver: "auto", "mumps" or "cg-gamg".
+        max_iterations: active-set iterations.
+        grid_points: points per side of the regular output grid of the pressure.
+        filter_radius_factor: pressure averaging radius in element sizes (see fea.postprocess).
+        stresses: compute subsurface stresses.
+        output_dir: folder for XDMF and PNG output, or None.
+        min_mesh_quality: smallest accepted minSICN. max_elements: largest accepted element count.
+    """
+
+    quick: bool = False
+    mesh_size_factor: float = 1.0
+    elements_per_semi_axis: float | None = None
+    domain_factor: float | None = None
+    degree: int = 1
+    linear_solver: str = "auto"
+    max_iterations: int = 40
+    grid_points: int = 64
+    filter_radius_factor: float = 1.5
+    stresses: bool = True
+    output_dir: str | None = None
+    min_mesh_quality: float = 0.05
+    max_elements: int = 2_000_000
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
+            raise ValueError(f"mesh_size_factor = {self.mesh_size_factor!r}: expected a finite number > 0")
+        if self.elements_per_semi_axis is not None and not self.elements_per_semi_axis >= 1:
+            raise ValueError(f"elements_per_semi_axis = {self.elements_per_semi_axis!r}: expected >= 1")
+        if self.domain_factor is not None and not self.domain_factor >= 4:
+            raise ValueError(f"domain_factor = {self.domain_factor!r}: expected >= 4")
+        if self.degree != 1:
+            raise ValueError(f"degree = {self.degree!r}: expected 1 (P2 contact is not implemented)")
+        if int(self.grid_points) != self.grid_points or self.grid_points < 8:
+            raise ValueError(f"grid_points = {self.grid_points!r}: expected an integer >= 8")
+        if not (math.isfinite(self.filter_radius_factor) and self.filter_radius_factor >= 0):
+            raise ValueError(f"filter_radius_factor = {self.filter_radius_factor!r}: expected a number >= 0")
+
+    @classmethod
+    def from_mapping(cls, options: Mapping | None) -> FeaOptions:
+        """Validate a mapping of options (unknown keys raise ValueError naming them)."""
+        options = dict(options or {})
+        known = set(cls.__dataclass_fields__)
+        unknown = sorted(set(options) - known)
+        if unknown:
+            raise ValueError(f"unknown fea option(s) {unknown}: expected some of {sorted(known)}")
+        return cls(**options)
+
+    @property
+    def n_per_semi_axis(self) -> float:
+        """Elements per semi-axis actually used."""
+        base = self.elements_per_semi_axis or (4.0 if self.quick else 6.0)
+        return base / self.mesh_size_factor
+
+    @property
+    def block_factor(self) -> float:
+        """Block size in semi-axes actually used."""
+        return self.domain_factor or (12.0 if self.quick else 20.0)
+
+
+class FeaModel:
+    """Finite-element normal contact (elastic block with combined modulus vs rigid indenter)."""
+
+    name = "fea"
+    description = "finite elements (FEniCSx): normal contact, subsurface stresses"
+
+    def solve(
+        self,
+        geometry: ContactGeometry,
+        creepage: Creepage,
+        material: Material,
+        *,
+        normal_force_N: float | None = None,
+        options: Mapping | None = None,
+        comm=None,
+    ) -> ContactResult:
+        """Solve the normal contact of one patch.
+
+        Args:
+            geometry: patch geometry (quadric if ``geometry.undeformed`` is None).
+            creepage: stored in the result; friction is not modelled (creep forces None).
+            material: elastic constants (E* = G/(1 - nu)).
+            normal_force_N: P (load control), N; None = approach control with ``geometry.approach_m``.
+            options: see :class:`FeaOptions`.
+            comm: MPI communicator (default COMM_WORLD).
+
+        Returns:
+            ContactResult with method "fea": normal force (sum of the nodal contact forces), max
+            pressure (filtered nodal field), semi-axes (elliptic fit; quadric patches only), contact
+            area, pressure on a regular grid; extra holds dofs, iterations, stress maxima and depths.
+        """
+        t0 = time.perf_counter()
+        opts = FeaOptions.from_mapping(options)
+        if normal_force_N is not None and not (math.isfinite(normal_force_N) and normal_force_N > 0):
+            raise ValueError(f"normal_force_N = {normal_force_N!r}: expected a finite number > 0 or None")
+        if normal_force_N is None and geometry.undeformed is None and geometry.approach_m <= 0:
+            return self._empty(geometry, creepage, "no-contact", "approach_m <= 0: the surfaces do not touch", t0)
+
+        import dolfinx_solver  # noqa: F401  (must precede dolfinx/petsc4py/mpi4py)
+        from mpi4py import MPI
+
+        from fea import postprocess as post
+        from fea.domain import hertz_block_domain
+        from fea.hertz_reference import hertz_elliptic, hertz_force_from_approach
+        from fea.solver import SolverSettings, solve_rigid_indenter
+        from meshing.hertz import HertzBlockSpec
+        from meshing.quality import QualityLimits
+
+        comm = MPI.COMM_WORLD if comm is None else comm
+        e_star = material.combined_modulus_Pa
+        nu = material.poisson_ratio
+        a_curv, b_curv = geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m
+        quadric = geometry.undeformed is None
+
+        # Expected patch (Hertz) sizes the mesh.
+        if quadric:
+            if normal_force_N is not None:
+                expected = hertz_elliptic(a_curv, b_curv, normal_force_N, e_star)
+            else:
+                expected = hertz_force_from_approach(a_curv, b_curv, geometry.approach_m, e_star)
+            semi = (expected.semi_axis_long_m, expected.semi_axis_lat_m)
+            center = (0.0, 0.0)
+            h_offset = 0.0
+            q0 = expected.approach_m
+
+            def gap0(x, y):
+                return a_curv * x**2 + b_curv * y**2
+
+        else:
+            und = geometry.undeformed
+            h_grid = und.distance_m + geometry.approach_m  # h at zero approach
+            finite = np.isfinite(h_grid)
+            if not finite.any():
+                raise ValueError("geometry.undeformed has no finite distance: expected a sampled gap")
+            h_offset = float(h_grid[finite].min())
+            if normal_force_N is not None:
+                expected = hertz_elliptic(a_curv, b_curv, normal_force_N, e_star)
+                q0 = h_offset + expected.approach_m
+            else:
+                q0 = geometry.approach_m
+                if q0 <= h_offset:
+                    return self._empty(geometry, creepage, "no-contact", "no overlap at the given approach", t0)
+            overlap = finite & (h_grid < q0)
+            gx, gy = np.meshgrid(und.x_m, und.y_m)
+            dx = float(np.diff(und.x_m).mean()) if len(und.x_m) > 1 else 0.0
+            dy = float(np.diff(und.y_m).mean()) if len(und.y_m) > 1 else 0.0
+            x_lo, x_hi = gx[overlap].min() - dx, gx[overlap].max() + dx
+            y_lo, y_hi = gy[overlap].min() - dy, gy[overlap].max() + dy
+            center = (0.5 * (x_lo + x_hi), 0.5 * (y_lo + y_hi))
+            semi = (0.5 * (x_hi - x_lo) / math.sqrt(2.0), 0.5 * (y_hi - y_lo) / math.sqrt(2.0))
+
+            def gap0(x, y):
+                return geometry.gap_m(x, y) + geometry.approach_m
+
+        spec = HertzBlockSpec(
+            semi_axis_long_m=semi[0],
+            semi_axis_lat_m=semi[1],
+            elements_per_semi_axis=opts.n_per_semi_axis,
+            domain_factor=opts.block_factor,
+            center_m=center,
+            symmetry="quarter" if quadric else "full",
+        )
+        t_mesh = time.perf_counter()
+        domain = hertz_block_domain(spec, comm, QualityLimits(opts.min_mesh_quality, opts.max_elements))
+        t_mesh = time.perf_counter() - t_mesh
+
+        def initial_active(x, y):
+            return ((x - center[0]) / semi[0]) ** 2 + ((y - center[1]) / semi[1]) ** 2 < 1.0
+
+        young_body = e_star * (1.0 - nu**2)
+        sol = solve_rigid_indenter(
+            domain,
+            gap0,
+            young_body,
+            nu,
+            normal_force_N=normal_force_N,
+            approach_m=None if normal_force_N is not None else geometry.approach_m,
+            initial_approach_m=q0,
+            initial_active=initial_active if quadric else None,
+            length_scale_m=min(semi),
+            settings=SolverSettings(linear_solver=opts.linear_solver, max_iterations=opts.max_iterations),
+        )
+
+        extra = {
+            "dofs": int(sol.dofs),
+            "newton_iterations": int(sol.iterations),
+            "mpi_ranks": int(comm.size),
+            "model": "quarter block, rigid quadric indenter" if quadric else "full block, rigid sampled indenter",
+            "young_modulus_block_Pa": young_body,
+            "element_size_m": spec.contact_size_m,
+            "block_half_width_m": spec.half_width_m,
+            "mesh": domain.quality.as_dict(),
+            "complementarity_residual": sol.complementarity_residual,
+            "timings_s": {"mesh": t_mesh, **{k: v for k, v in sol.timings.items() if k.endswith("_s")}},
+            "linear_solver": sol.timings.get("linear_solver", ""),
+            "approach_note": "approach of a clamped finite block, smaller than the half-space value",
+        }
+        if sol.status == "no-contact":
+            return self._empty(geometry, creepage, "no-contact", sol.message, t0, extra=extra)
+
+        # Pressure field (full patch).
+        xy, force, weight = sol.node_xy_m, sol.node_force_N, sol.node_weight_m2
+        if quadric:
+            xy, force, weight = post.mirror_quarter(xy, force, weight)
+        radius = opts.filter_radius_factor * spec.contact_size_m
+        in_contact_nodes = force > 0
+        if radius > 0:
+            pressure = post.filtered_pressure(
+                xy[in_contact_nodes], force[in_contact_nodes], weight[in_contact_nodes], xy, radius
+            )
+        else:
+            pressure = np.where(weight > 0, force / np.where(weight > 0, weight, 1.0), 0.0)
+        pressure = np.where(in_contact_nodes, pressure, 0.0)
+        max_pressure = float(pressure.max()) if pressure.size else 0.0
+        area_nodal = float(sol.node_weight_m2[sol.active].sum()) * domain.symmetry_factor
+        extra["max_nodal_pressure_Pa"] = float((sol.node_force_N / sol.node_weight_m2).max())
+        extra["contact_area_nodal_m2"] = area_nodal
+
+        semi_long = semi_lat = None
+        area = area_nodal
+        if quadric:
+            fit = post.fit_elliptic_pressure(xy, np.where(in_contact_nodes, force / weight, 0.0))
+            extra["elliptic_fit"] = fit
+            if math.isfinite(fit["semi_axis_long_m"]):
+                semi_long, semi_lat = fit["semi_axis_long_m"], fit["semi_axis_lat_m"]
+                area = math.pi * semi_long * semi_lat
+
+        fields = None
+        if in_contact_nodes.any():
+            act = xy[in_contact_nodes]
+            span_x = max(np.abs(act[:, 0] - center[0]).max() * 1.25, radius)
+            span_y = max(np.abs(act[:, 1] - center[1]).max() * 1.25, radius)
+            x_m = np.linspace(center[0] - span_x, center[0] + span_x, opts.grid_points)
+            y_m = np.linspace(center[1] - span_y, center[1] + span_y, opts.grid_points)
+            grid, mask = post.pressure_on_grid(xy, pressure, x_m, y_m)
+            fields = ContactFields(x_m=x_m, y_m=y_m, pressure_Pa=grid, in_contact=mask)
+
+        stress_fn = None
+        if opts.stresses:
+            stress_fn, coords, stress = post.recover_nodal_stress(sol.displacement, young_body, nu)
+            extra.update(_stress_maxima(comm, coords, stress, spec, quadric, post))
+
+        if opts.output_dir is not None:
+            from fea.output import write_outputs
+
+            extra["files"] = write_outputs(
+                opts.output_dir, sol, stress_fn, fields, domain, spec, young_body, nu, comm=comm
+            )
+
+        return ContactResult(
+            method=self.name,
+            success=sol.success,
+            status=sol.status,
+            message=sol.message,
+            normal_force_N=float(sol.normal_force_N),
+            max_pressure_Pa=max_pressure,
+            semi_axis_long_m=semi_long,
+            semi_axis_lat_m=semi_lat,
+            contact_area_m2=area,
+            approach_m=float(sol.approach_m),
+            creepage=creepage,
+            fields=fields,
+            iterations=int(sol.iterations),
+            residual=float(sol.complementarity_residual),
+            wall_time_s=time.perf_counter() - t0,
+            extra=extra,
+        )
+
+    def _empty(self, geometry, creepage, status, message, t0, extra=None) -> ContactResult:
+        return ContactResult(
+            method=self.name,
+            success=True,
+            status=status,
+            message=message,
+            normal_force_N=0.0,
+            max_pressure_Pa=0.0,
+            contact_area_m2=0.0,
+            approach_m=geometry.approach_m,
+            creepage=creepage,
+            wall_time_s=time.perf_counter() - t0,
+            extra=extra or {},
+        )
+
+
+def _stress_maxima(comm, coords, stress, spec, quadric, post) -> dict:
+    """Global maxima of von Mises and maximum shear with their points and depths (gathered)."""
+    measures = post.principal_measures(stress) if len(stress) else {"von_mises": np.zeros(0), "max_shear": np.zeros(0)}
+    out = {}
+    for key in ("von_mises", "max_shear"):
+        values = measures[key]
+        k = int(np.argmax(values)) if len(values) else -1
+        local = (float(values[k]), coords[k].tolist()) if k >= 0 else (-math.inf, [math.nan] * 3)
+        best = max(comm.allgather(local), key=lambda item: item[0])
+        out[f"max_{key}_Pa"] = best[0]
+        out[f"max_{key}_point_m"] = best[1]
+        out[f"max_{key}_depth_m"] = -best[1][2]
+    if quadric:
+        tol = 1e-9 * spec.half_width_m
+        on_axis = (np.abs(coords[:, 0]) < tol) & (np.abs(coords[:, 1]) < tol)
+        depth = np.concatenate(comm.allgather(-coords[on_axis, 2]))
+        for key in ("von_mises", "max_shear"):
+            vals = np.concatenate(comm.allgather(measures[key][on_axis]))
+            if len(vals) >= 3:
+                peak, z = post.axis_maximum(depth, vals)
+                out[f"axis_max_{key}_Pa"] = peak
+                out[f"axis_max_{key}_depth_m"] = z
+    return out

@@ -1,0 +1,173 @@
+"""Post-processing of the FE contact solution: pressure field, patch size, subsurface stresses.
+
+Pressure. The nodal contact forces N_i of a P1 solution with nodal contact constraints scatter by
+several per cent from node to node on an unstructured face mesh (their sum is exact). The pressure
+field is therefore the force-weighted patch average p_i = sum_{|x_j - x_i| < r} N_j / sum w_j
+(w_j the lumped face weights, r ~ 1.5 element sizes), which keeps the integral of the pressure and
+converges as O(h^2) for a smooth pressure.
+
+Semi-axes of a quadric (Hertzian) patch. The continuum pressure is p^2 = p0^2 (1 - x^2/a^2 - y^2/b^2)
+(Johnson 1985, eq 3.63): a least-squares fit of c0 + cx x^2 + cy y^2 to p^2 over the nodes in contact
+gives a = sqrt(-c0/cx), b = sqrt(-c0/cy); the relative rms residual of the fit is reported so a
+non-elliptic patch is visible.
+
+Stresses. sigma(u_h) (constant per P1 cell) is recovered at the nodes by a lumped L2 projection
+sigma_i = int sigma phi_i dx / int phi_i dx. Derived: principal stresses s1 >= s2 >= s3, von Mises
+sqrt(((s1-s2)^2 + (s2-s3)^2 + (s3-s1)^2)/2), maximum shear (Tresca) (s1 - s3)/2. Depth = -z, m.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def mirror_quarter(xy: np.ndarray, *values: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Reflect quarter-model node data (x >= 0, y >= 0) into the four quadrants.
+
+    Nodes on a symmetry plane appear twice (on the axis four times) with the forces and weights
+    of the quarter model, so force / weight sums over a neighbourhood stay exact.
+    """
+    signs = ((1, 1), (-1, 1), (1, -1), (-1, -1))
+    xy_full = np.concatenate([xy * np.array(s) for s in signs])
+    return (xy_full, *(np.tile(v, 4) for v in values))
+
+
+def filtered_pressure(
+    xy_all: np.ndarray, force_all: np.ndarray, weight_all: np.ndarray, points: np.ndarray, radius_m: float
+) -> np.ndarray:
+    """Force-weighted patch average of the nodal pressure at ``points`` (see the module docstring).
+
+    Args:
+        xy_all: (n, 2) node positions, m. force_all, weight_all: (n,) N_i (N) and w_i (m^2).
+        points: (k, 2) evaluation points, m. radius_m: averaging radius r, m.
+
+    Returns:
+        (k,) pressures, Pa.
+    """
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(xy_all)
+    out = np.zeros(len(points))
+    for i, neighbours in enumerate(tree.query_ball_point(points, radius_m)):
+        if neighbours:
+            out[i] = force_all[neighbours].sum() / weight_all[neighbours].sum()
+    return out
+
+
+def fit_elliptic_pressure(xy: np.ndarray, pressure: np.ndarray) -> dict:
+    """Fit p^2 = c0 + cx x^2 + cy y^2 over the nodes with p > 0 (see the module docstring).
+
+    Returns:
+        dict with max_pressure_Pa (sqrt c0), semi_axis_long_m, semi_axis_lat_m (nan if the fit is not
+        an ellipse) and relative_rms (rms residual of p^2 / c0).
+    """
+    mask = pressure > 0
+    nan = float("nan")
+    if mask.sum() < 4:
+        return {"max_pressure_Pa": nan, "semi_axis_long_m": nan, "semi_axis_lat_m": nan, "relative_rms": nan}
+    x, y, p = xy[mask, 0], xy[mask, 1], pressure[mask]
+    matrix = np.column_stack([np.ones_like(x), x**2, y**2])
+    coef, *_ = np.linalg.lstsq(matrix, p**2, rcond=None)
+    c0, cx, cy = coef
+    ok = c0 > 0 and cx < 0 and cy < 0
+    rms = float(np.sqrt(np.mean((matrix @ coef - p**2) ** 2)) / c0) if c0 > 0 else nan
+    return {
+        "max_pressure_Pa": float(np.sqrt(c0)) if c0 > 0 else nan,
+        "semi_axis_long_m": float(np.sqrt(-c0 / cx)) if ok else nan,
+        "semi_axis_lat_m": float(np.sqrt(-c0 / cy)) if ok else nan,
+        "relative_rms": rms,
+    }
+
+
+def pressure_on_grid(
+    xy: np.ndarray, pressure: np.ndarray, x_m: np.ndarray, y_m: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nodal pressures on the grid (y_m, x_m).
+
+    A grid point is in contact when its nearest node is (so the outline runs half-way between the
+    last node in contact and the first free one); the pressure there is the piecewise-linear
+    interpolation of the nodal pressures, 0 elsewhere. Duplicated (mirrored) nodes are merged.
+
+    Returns:
+        (pressure, in_contact): arrays of shape (len(y_m), len(x_m)), Pa and bool.
+    """
+    from scipy.interpolate import LinearNDInterpolator
+    from scipy.spatial import cKDTree
+
+    scale = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-300)
+    keys = np.round(xy / (scale * 1e-9)).astype(np.int64)
+    _, first = np.unique(keys, axis=0, return_index=True)
+    nodes, values = xy[first], pressure[first]
+    gx, gy = np.meshgrid(x_m, y_m)
+    points = np.column_stack([gx.ravel(), gy.ravel()])
+    _, nearest = cKDTree(nodes).query(points)
+    in_contact = (values[nearest] > 0).reshape(gx.shape)
+    origin = nodes.mean(axis=0)
+    interp = LinearNDInterpolator((nodes - origin) / scale, values, fill_value=0.0)  # unit scale: fast qhull search
+    grid = np.clip(interp((points - origin) / scale).reshape(gx.shape), 0.0, None)
+    return np.where(in_contact, grid, 0.0), in_contact
+
+
+def principal_measures(stress: np.ndarray) -> dict[str, np.ndarray]:
+    """Principal stresses, von Mises and maximum shear of stress tensors ``stress`` (n, 3, 3), Pa."""
+    eig = np.linalg.eigvalsh(0.5 * (stress + np.swapaxes(stress, 1, 2)))[:, ::-1]
+    s1, s2, s3 = eig[:, 0], eig[:, 1], eig[:, 2]
+    von_mises = np.sqrt(0.5 * ((s1 - s2) ** 2 + (s2 - s3) ** 2 + (s3 - s1) ** 2))
+    return {"principal": eig, "von_mises": von_mises, "max_shear": 0.5 * (s1 - s3)}
+
+
+def recover_nodal_stress(displacement, young_modulus_Pa: float, poisson_ratio: float):
+    """Lumped L2 projection of sigma(u) onto P1 tensors.
+
+    Returns:
+        (function, coords, stress): a dolfinx Function on a P1 (3, 3) space (for output), the (n, 3)
+        coordinates of the locally owned nodes (m) and their (n, 3, 3) stress tensors (Pa).
+    """
+    import dolfinx_solver  # noqa: F401
+    import ufl
+    from dolfinx import fem
+    from dolfinx.fem import petsc as fem_petsc
+    from petsc4py import PETSc
+
+    msh = displacement.function_space.mesh
+    mu = young_modulus_Pa / (2.0 * (1.0 + poisson_ratio))
+    lam = young_modulus_Pa * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio))
+    eps = ufl.sym(ufl.grad(displacement))
+    sigma = lam * ufl.tr(eps) * ufl.Identity(3) + 2.0 * mu * eps
+    W = fem.functionspace(msh, ("Lagrange", 1, (3, 3)))
+    S = fem.functionspace(msh, ("Lagrange", 1))
+    tau, s = ufl.TestFunction(W), ufl.TestFunction(S)
+    rhs = fem_petsc.assemble_vector(fem.form(ufl.inner(sigma, tau) * ufl.dx))
+    mass = fem_petsc.assemble_vector(fem.form(s * ufl.dx))
+    for vec in (rhs, mass):
+        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    n = W.dofmap.index_map.size_local
+    values = rhs.array.reshape(-1, 9)[:n] / mass.array[:n, None]
+    stress_fn = fem.Function(W, name="stress")
+    stress_fn.x.array[: n * 9] = values.ravel()
+    stress_fn.x.scatter_forward()
+    coords = W.tabulate_dof_coordinates()[:n]
+    rhs.destroy()
+    mass.destroy()
+    return stress_fn, coords, values.reshape(-1, 3, 3)
+
+
+def axis_maximum(depth: np.ndarray, value: np.ndarray) -> tuple[float, float]:
+    """Maximum of nodal samples along a line, refined by a parabola through the three best nodes.
+
+    Args:
+        depth: (k,) sample depths, m. value: (k,) samples.
+
+    Returns:
+        (maximum, depth of the maximum).
+    """
+    order = np.argsort(depth)
+    d, v = depth[order], value[order]
+    k = int(np.argmax(v))
+    if 0 < k < len(v) - 1:
+        coef = np.polyfit(d[k - 1 : k + 2], v[k - 1 : k + 2], 2)
+        if coef[0] < 0:
+            z = -coef[1] / (2 * coef[0])
+            if d[k - 1] <= z <= d[k + 1]:
+                return float(np.polyval(coef, z)), float(z)
+    return float(v[k]), float(d[k])

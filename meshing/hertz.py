@@ -1,0 +1,143 @@
+"""gmsh model of the canonical Hertz verification body: an elastic block under a rigid quadric.
+
+Within linear (half-space) contact theory the contact of two elastic quadric bodies equals the
+contact of one elastic half-space with the combined modulus E* against a rigid indenter whose
+surface is the undeformed gap h(x, y) = A x^2 + B y^2 (Johnson 1985, sec. 4.2). The block is the
+half-space truncated at a distance of many semi-axes; its top face z = 0 is the contact surface,
+the material is at z < 0 (z is the outward normal of the contact face), the base z = -depth is
+clamped.
+
+Model variants (``symmetry``):
+
+* ``"quarter"``: x >= 0, y >= 0 with symmetry planes x = 0 and y = 0 (an elliptic patch with its
+  axes along x and y, centred at the origin);
+* ``"full"``: the whole block |x - x_c|, |y - y_c| <= half-width (any gap shape).
+
+The mesh is refined in an elliptic region around the expected patch by a gmsh MathEval size
+field: size = min(h_max, h_c sqrt(1 + (rho/rho_0)^4)) with
+rho^2 = ((x - x_c)/a)^2 + ((y - y_c)/b)^2 + (z/sqrt(a b))^2, h_c = min(a, b)/n. a, b are the
+expected semi-axes (e.g. Hertz's), n the elements per semi-axis.
+
+Physical groups (named): ``body`` (3-D), ``contact`` (top face), ``base`` (bottom face),
+``symmetry_x`` (plane x = 0, quarter model), ``symmetry_y`` (plane y = 0, quarter model).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+SYMMETRIES = ("quarter", "full")
+
+
+@dataclass(frozen=True)
+class HertzBlockSpec:
+    """Parameters of the Hertz block mesh (SI units).
+
+    Attributes:
+        semi_axis_long_m: expected semi-axis a of the patch along x, m (> 0).
+        semi_axis_lat_m: expected semi-axis b along y, m (> 0).
+        elements_per_semi_axis: n, element size at the patch h_c = min(a, b)/n (>= 1).
+        domain_factor: half-width and depth of the block in units of max(a, b) (>= 4).
+        refine_radius: rho_0, size of the uniformly refined region in units of the semi-axes (> 0).
+        center_m: (x_c, y_c), centre of the refined region, m (must be (0, 0) for the quarter model).
+        symmetry: "quarter" or "full".
+    """
+
+    semi_axis_long_m: float
+    semi_axis_lat_m: float
+    elements_per_semi_axis: float = 6.0
+    domain_factor: float = 20.0
+    refine_radius: float = 1.3
+    center_m: tuple[float, float] = (0.0, 0.0)
+    symmetry: str = "quarter"
+
+    def __post_init__(self) -> None:
+        for name in ("semi_axis_long_m", "semi_axis_lat_m", "refine_radius"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+        if not (math.isfinite(self.elements_per_semi_axis) and self.elements_per_semi_axis >= 1):
+            raise ValueError(f"elements_per_semi_axis = {self.elements_per_semi_axis!r}: expected a number >= 1")
+        if not (math.isfinite(self.domain_factor) and self.domain_factor >= 4):
+            raise ValueError(f"domain_factor = {self.domain_factor!r}: expected a number >= 4")
+        if self.symmetry not in SYMMETRIES:
+            raise ValueError(f"symmetry = {self.symmetry!r}: expected one of {SYMMETRIES}")
+        if len(self.center_m) != 2 or not all(math.isfinite(c) for c in self.center_m):
+            raise ValueError(f"center_m = {self.center_m!r}: expected two finite numbers")
+        if self.symmetry == "quarter" and any(c != 0 for c in self.center_m):
+            raise ValueError(f"center_m = {self.center_m!r}: the quarter model needs the patch centre at (0, 0)")
+
+    @property
+    def contact_size_m(self) -> float:
+        """h_c, element size in the patch, m."""
+        return min(self.semi_axis_long_m, self.semi_axis_lat_m) / self.elements_per_semi_axis
+
+    @property
+    def half_width_m(self) -> float:
+        """Half-width (and depth) of the block, m."""
+        return self.domain_factor * max(self.semi_axis_long_m, self.semi_axis_lat_m)
+
+
+def build_hertz_block(model, spec: HertzBlockSpec) -> dict[str, tuple[int, int]]:
+    """Add the block geometry, its physical groups and the size field to the current gmsh model.
+
+    Args:
+        model: the ``gmsh.model`` API object; its current model receives the geometry (the caller
+            owns gmsh's initialisation and the model's lifetime, see :func:`meshing.session.gmsh_model`).
+        spec: block parameters.
+
+    Returns:
+        physical group name -> (dimension, physical tag).
+        The mesh is not generated (call :func:`meshing.session.generate`).
+    """
+    import numpy as np
+
+    half = spec.half_width_m
+    depth = half
+    xc, yc = spec.center_m
+    if spec.symmetry == "quarter":
+        x0, y0, dx, dy = 0.0, 0.0, half, half
+    else:
+        x0, y0, dx, dy = xc - half, yc - half, 2 * half, 2 * half
+    volume = model.occ.addBox(x0, y0, -depth, dx, dy, depth)
+    model.occ.synchronize()
+
+    # Classify the six faces by the coordinate that is constant on them (robust to gmsh's bbox padding).
+    faces = {}
+    for _, tag in model.getEntities(2):
+        lo_hi = np.array(model.getBoundingBox(2, tag)).reshape(2, 3)
+        axis = int(np.argmin(lo_hi[1] - lo_hi[0]))
+        faces[(axis, float(lo_hi.mean(axis=0)[axis]))] = tag
+
+    def faces_at(axis, value):
+        scale = max(half, 1e-300)
+        return [tag for (ax, val), tag in faces.items() if ax == axis and abs(val - value) < 1e-6 * scale]
+
+    groups: dict[str, tuple[int, int]] = {}
+
+    def add(dim, tags, name):
+        if not tags:
+            raise ValueError(f"physical group {name!r}: no entity found (geometry construction failed)")
+        groups[name] = (dim, model.addPhysicalGroup(dim, tags, name=name))
+
+    add(3, [volume], "body")
+    add(2, faces_at(2, 0.0), "contact")
+    add(2, faces_at(2, -depth), "base")
+    if spec.symmetry == "quarter":
+        add(2, faces_at(0, 0.0), "symmetry_x")
+        add(2, faces_at(1, 0.0), "symmetry_y")
+
+    def num(value):
+        return f"{float(value):.17g}"
+
+    a, b = spec.semi_axis_long_m, spec.semi_axis_lat_m
+    c = math.sqrt(a * b)
+    h_c = spec.contact_size_m
+    h_max = half / 3.0
+    rho2 = f"(((x-({num(xc)}))/{num(a)})^2+((y-({num(yc)}))/{num(b)})^2+(z/{num(c)})^2)"
+    expression = f"min({num(h_max)}, {num(h_c)}*sqrt(1+({rho2}/{num(spec.refine_radius**2)})^2))"
+    field = model.mesh.field.add("MathEval")
+    model.mesh.field.setString(field, "F", expression)
+    model.mesh.field.setAsBackgroundMesh(field)
+    return groups

@@ -1,0 +1,206 @@
+"""FEniCSx contact model (fea.model.FeaModel) against Hertz's closed forms.
+
+Reference case (issue 6 benchmark): wheel radius 460 mm rolling, transverse radii 300 mm (wheel)
+and 300 mm (rail head), i.e. relative radii R_long = 0.46 m, R_lat = 0.15 m; P = 100 kN; steel
+E = 210 GPa, nu = 0.3. Exact values from Johnson (1985) eq 3.64 (fea.hertz_reference, itself
+checked against Boussinesq integrals in test_fea_reference.py):
+p0 = 1604.6 MPa, a = 7.909 mm, b = 3.762 mm.
+Circular case for stresses: R = 0.3 m both ways; Johnson (1985): max tau_1 = 0.310 p0 at 0.481 a.
+"""
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fea.hertz_reference import circular_axis_maximum, hertz_elliptic
+from fea.model import FeaModel
+from rigid_dynamics.contact.types import ContactGeometry, Creepage, UndeformedDistance
+from rigid_dynamics.materials import Material
+
+pytestmark = pytest.mark.fea
+
+ROOT = Path(__file__).resolve().parents[1]
+STEEL_210 = Material.from_young(210e9, 0.3, 0.3)
+FORCE_N = 1e5
+ELLIPTIC = ContactGeometry.quadric(0.46, 0.15)
+
+
+@pytest.fixture(scope="module")
+def elliptic_result():
+    return FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N)
+
+
+def test_elliptic_hertz_p0_a_b_within_5_percent(elliptic_result):
+    r = elliptic_result
+    ref = hertz_elliptic(
+        ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m, FORCE_N, STEEL_210.combined_modulus_Pa
+    )
+    assert ref.max_pressure_Pa == pytest.approx(1604.6e6, rel=1e-4)
+    assert r.success and r.status == "ok" and r.method == "fea"
+    assert r.normal_force_N == pytest.approx(FORCE_N, rel=1e-6)  # load control: sum of contact forces
+    assert r.max_pressure_Pa == pytest.approx(ref.max_pressure_Pa, rel=0.05)
+    assert r.semi_axis_long_m == pytest.approx(ref.semi_axis_long_m, rel=0.05)
+    assert r.semi_axis_lat_m == pytest.approx(ref.semi_axis_lat_m, rel=0.05)
+    assert r.contact_area_m2 == pytest.approx(math.pi * ref.semi_axis_long_m * ref.semi_axis_lat_m, rel=0.05)
+    assert r.creep_force_long_N is None and r.creep_force_lat_N is None
+    assert r.extra["dofs"] > 0 and r.extra["newton_iterations"] >= 1
+
+
+def test_pressure_grid_integrates_to_the_force(elliptic_result):
+    f = elliptic_result.fields
+    assert f.pressure_Pa.shape == (len(f.y_m), len(f.x_m))
+    total = np.trapezoid(np.trapezoid(f.pressure_Pa, f.x_m, axis=1), f.y_m)
+    assert total == pytest.approx(FORCE_N, rel=0.05)
+    assert f.in_contact[len(f.y_m) // 2, len(f.x_m) // 2] and not f.in_contact[0, 0]
+
+
+def test_approach_control_reproduces_load_control(elliptic_result):
+    """Invariant: imposing the approach found under load control gives back the force.
+
+    The mesh is sized from the Hertz patch of the given approach, so it differs slightly from the
+    load-control mesh: agreement within 1 %, not to solver precision.
+    """
+    geo = ContactGeometry.quadric(0.46, 0.15, approach_m=elliptic_result.approach_m)
+    r = FeaModel().solve(geo, Creepage(), STEEL_210)
+    assert r.success
+    assert r.normal_force_N == pytest.approx(FORCE_N, rel=1e-2)
+
+
+def test_circular_subsurface_max_shear_and_von_mises_match_johnson():
+    geo = ContactGeometry.quadric(0.3, 0.3)
+    r = FeaModel().solve(geo, Creepage(), STEEL_210, normal_force_N=FORCE_N)
+    ref = hertz_elliptic(geo.curvature_long_1_per_m, geo.curvature_lat_1_per_m, FORCE_N, STEEL_210.combined_modulus_Pa)
+    tau, depth = circular_axis_maximum(0.3)  # 0.310, 0.481 (Johnson 1985)
+    p0, a = ref.max_pressure_Pa, ref.semi_axis_long_m
+    e = r.extra
+    assert e["axis_max_max_shear_Pa"] == pytest.approx(tau * p0, rel=0.05)
+    assert e["axis_max_max_shear_depth_m"] == pytest.approx(depth * a, rel=0.10)
+    assert e["axis_max_von_mises_Pa"] == pytest.approx(2 * tau * p0, rel=0.05)
+    assert e["max_max_shear_Pa"] == pytest.approx(tau * p0, rel=0.05)
+    assert e["max_von_mises_depth_m"] == pytest.approx(depth * a, rel=0.15)
+
+
+def test_sampled_gap_full_block_agrees_with_quadric_hertz():
+    """Second path: a sampled (off-centre) quadric gap on the full block gives Hertz's patch."""
+    A, B = ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m
+    x = np.linspace(-0.02, 0.02, 81)
+    y = np.linspace(-0.01, 0.012, 45)
+    X, Y = np.meshgrid(x, y)
+    und = UndeformedDistance(x, y, A * (X - 1e-3) ** 2 + B * (Y - 2e-3) ** 2 - 1e-4)
+    geo = ContactGeometry(A, B, approach_m=1e-4, undeformed=und, is_elliptic=False)
+    r = FeaModel().solve(geo, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"quick": True})
+    ref = hertz_elliptic(A, B, FORCE_N, STEEL_210.combined_modulus_Pa)
+    assert r.success
+    assert r.max_pressure_Pa == pytest.approx(ref.max_pressure_Pa, rel=0.05)
+    assert r.contact_area_m2 == pytest.approx(math.pi * ref.semi_axis_long_m * ref.semi_axis_lat_m, rel=0.08)
+    p = r.fields.pressure_Pa
+    xc = (r.fields.x_m[None, :] * p).sum() / p.sum()
+    yc = (r.fields.y_m[:, None] * p).sum() / p.sum()
+    assert xc == pytest.approx(1e-3, abs=2e-4) and yc == pytest.approx(2e-3, abs=2e-4)
+    assert r.semi_axis_long_m is None  # no elliptic fit for a sampled gap
+
+
+def test_non_convergence_is_reported_not_raised():
+    A, B = ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m
+    x = np.linspace(-0.02, 0.02, 41)
+    X, Y = np.meshgrid(x, x)
+    geo = ContactGeometry(A, B, approach_m=0.0, undeformed=UndeformedDistance(x, x, A * X**2 + B * Y**2))
+    r = FeaModel().solve(
+        geo,
+        Creepage(),
+        STEEL_210,
+        normal_force_N=FORCE_N,
+        options={"quick": True, "max_iterations": 1, "stresses": False},
+    )
+    assert not r.success and r.status == "not-converged" and "did not settle" in r.message
+
+
+def test_no_contact_at_zero_approach():
+    r = FeaModel().solve(ContactGeometry.quadric(0.46, 0.15), Creepage(), STEEL_210)
+    assert r.success and r.status == "no-contact" and r.normal_force_N == 0.0
+
+
+def test_mesh_quality_failure_is_an_error():
+    from meshing.quality import MeshQualityError
+
+    with pytest.raises(MeshQualityError, match="min quality"):
+        FeaModel().solve(
+            ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"quick": True, "min_mesh_quality": 0.99}
+        )
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"mesh_sise": 1.0}, "unknown fea option.*mesh_sise"),
+        ({"degree": 2}, "degree"),
+        ({"mesh_size_factor": 0.0}, "mesh_size_factor"),
+        ({"linear_solver": "hypre"}, "linear_solver"),
+    ],
+)
+def test_bad_options_raise(options, match):
+    with pytest.raises(ValueError, match=match):
+        FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options=options)
+
+
+def test_bad_force_raises():
+    with pytest.raises(ValueError, match="normal_force_N"):
+        FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=-1.0)
+
+
+def test_outputs_written(tmp_path):
+    r = FeaModel().solve(
+        ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"quick": True, "output_dir": str(tmp_path)}
+    )
+    for key in ("xdmf", "pressure_png", "von_mises_cut_png"):
+        assert Path(r.extra["files"][key]).is_file()
+
+
+def _mpiexec():
+    candidate = Path(sys.executable).parent / "mpiexec"
+    return str(candidate) if candidate.exists() else shutil.which("mpiexec")
+
+
+@pytest.mark.skipif(_mpiexec() is None, reason="mpiexec not found")
+def test_two_ranks_agree_with_one_rank(elliptic_result):
+    script = (
+        "import dolfinx_solver, json\n"
+        "from mpi4py import MPI\n"
+        "from fea.model import FeaModel\n"
+        "from rigid_dynamics.contact.types import ContactGeometry, Creepage\n"
+        "from rigid_dynamics.materials import Material\n"
+        "r = FeaModel().solve(ContactGeometry.quadric(0.46, 0.15), Creepage(), Material.from_young(210e9, 0.3, 0.3),"
+        " normal_force_N=1e5)\n"
+        "if MPI.COMM_WORLD.rank == 0:\n"
+        "    print(json.dumps([r.normal_force_N, r.max_pressure_Pa, r.semi_axis_long_m, r.semi_axis_lat_m,"
+        " r.approach_m, r.extra['max_von_mises_Pa'], r.extra['mpi_ranks']]))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [_mpiexec(), "-n", "2", sys.executable, "-c", script],
+        capture_output=True,
+        text=True,
+        timeout=240,
+        env=env,
+        cwd=ROOT,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    values = json.loads(out.stdout.strip().splitlines()[-1])
+    r = elliptic_result
+    assert values[-1] == 2
+    one = [
+        r.normal_force_N,
+        r.max_pressure_Pa,
+        r.semi_axis_long_m,
+        r.semi_axis_lat_m,
+        r.approach_m,
+        r.extra["max_von_mises_Pa"],
+    ]
+    np.testing.assert_allclose(values[:-1], one, rtol=1e-6)
