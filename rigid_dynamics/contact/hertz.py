@@ -31,6 +31,9 @@ To keep full precision for every ratio from 1 (A = B) to beyond 1e4 (b/a ~ 4e-3)
 * otherwise K comes from ``scipy.special.ellipkm1(p)`` (accurate as p -> 0, slender ellipses)
   and E from ``scipy.special.ellipe(m)``.
 
+Both scipy functions are called from numba-compiled loops (through ``scipy.special.cython_special``),
+so a batch of 1 costs a few microseconds and a batch of 10,000 well under 1 us per patch.
+
 The residual is evaluated to ~1e-15 relative, so the converged semi-axes carry that accuracy
 (the tests compare with an independent quadrature of Hertz's potential integrals to 1e-8).
 """
@@ -40,8 +43,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import llvmlite.binding as llvm
 import numpy as np
-from scipy.special import ellipe, ellipkm1
+from numba import njit, types
+from numba.extending import get_cython_function_address
 
 _SERIES_LIMIT = 0.1
 _N_SERIES = 24
@@ -64,11 +69,123 @@ _B_SERIES = 0.5 * math.pi * _C[:_N_SERIES] * (_C[:_N_SERIES] - _C[1 : _N_SERIES 
 _C_SERIES = 0.5 * math.pi * _C[1 : _N_SERIES + 1] * (2.0 * _C[2 : _N_SERIES + 2] - _C[1 : _N_SERIES + 1])
 
 
-def _horner(coefficients: np.ndarray, m: np.ndarray) -> np.ndarray:
-    out = np.full_like(m, coefficients[-1])
-    for c in coefficients[-2::-1]:
-        out = out * m + c
-    return out
+# scipy's complete elliptic integrals, called from compiled code (scipy.special.cython_special)
+# (registered as named external symbols so that the compiled kernels can be cached on disk)
+for _name in ("ellipkm1", "ellipe"):
+    llvm.add_symbol(f"wheelrail_scipy_{_name}", get_cython_function_address("scipy.special.cython_special", _name))
+_ellipkm1 = types.ExternalFunction("wheelrail_scipy_ellipkm1", types.float64(types.float64))
+_ellipe = types.ExternalFunction("wheelrail_scipy_ellipe", types.float64(types.float64))
+
+
+@njit(cache=True)
+def _kdbc(p):
+    """(K, D, B, C) of parameter m = 1 - p for one p in (0, 1] (see :func:`elliptic_kdbc`)."""
+    m = 1.0 - p
+    k = _ellipkm1(p)
+    if m < _SERIES_LIMIT:
+        d = _D_SERIES[-1]
+        b = _B_SERIES[-1]
+        c = _C_SERIES[-1]
+        for i in range(_N_SERIES - 2, -1, -1):
+            d = d * m + _D_SERIES[i]
+            b = b * m + _B_SERIES[i]
+            c = c * m + _C_SERIES[i]
+        return k, d, b, c
+    e = _ellipe(m)
+    d = (k - e) / m
+    b = (e - p * k) / m
+    return k, d, b, (d - b) / m
+
+
+@njit(cache=True)
+def _shape(r, rtol, max_iterations):
+    """Safeguarded Newton for s = ln p with B(m)/(p D(m)) = r; returns (p, iterations, converged)."""
+    if r == 1.0:
+        return 1.0, 0, True
+    log_r = math.log(r)
+    hi = -log_r
+    lo = -log_r - math.log(2.0 * (1.0 + math.log(16.0 * r)))
+    for _ in range(8):  # make sure g(lo) >= 0 (the bound is conservative; widened if ever needed)
+        _, d, b, _ = _kdbc(math.exp(lo))
+        if math.log(b) - lo - math.log(d) - log_r >= 0.0:
+            break
+        lo -= 2.0
+    s = min(max(-4.0 / 3.0 * log_r, lo), hi)
+    for it in range(1, max_iterations + 1):
+        p = math.exp(s)
+        _, d, b, c = _kdbc(p)
+        g = math.log(b) - s - math.log(d) - log_r
+        if g == 0.0:
+            return p, it, True
+        dg = -(p * c / (2.0 * b) + 0.5 + c / (2.0 * d))
+        if g > 0.0:
+            lo = s
+        else:
+            hi = s
+        s_new = s - g / dg
+        if not (lo <= s_new <= hi):
+            s_new = 0.5 * (lo + hi)
+        tol = rtol * (1.0 + abs(s))
+        if abs(s_new - s) <= tol or hi - lo <= tol:
+            return math.exp(s_new), it, True
+        s = s_new
+    return math.exp(s), max_iterations, False
+
+
+@njit(cache=True)
+def _kdbc_many(p, out):
+    for i in range(p.shape[0]):
+        k, d, b, c = _kdbc(p[i])
+        out[i, 0] = k
+        out[i, 1] = d
+        out[i, 2] = b
+        out[i, 3] = c
+
+
+@njit(cache=True)
+def _shape_many(r, rtol, max_iterations, p_out, it_out, ok_out):
+    for i in range(r.shape[0]):
+        p, it, ok = _shape(r[i], rtol, max_iterations)
+        p_out[i] = p
+        it_out[i] = it
+        ok_out[i] = ok
+
+
+@njit(cache=True)
+def _hertz_many(curv_long, curv_lat, load, force_control, e_star, rtol, max_iterations, out, it_out, ok_out):
+    """out[:, :] = (a, b, q, N, p0, m, major_along_x) per patch (zeros where load <= 0)."""
+    for i in range(curv_long.shape[0]):
+        A = curv_long[i]
+        B = curv_lat[i]
+        a_min = min(A, B)
+        p, it, ok = _shape(max(A, B) / a_min, rtol, max_iterations)
+        it_out[i] = it
+        ok_out[i] = ok
+        out[i, 5] = 1.0 - p
+        out[i, 6] = 1.0 if A <= B else 0.0
+        if load[i] <= 0.0:
+            for j in range(5):
+                out[i, j] = 0.0
+            continue
+        k, d, _, _ = _kdbc(p)
+        if force_control:
+            force = load[i]
+            major = (3.0 * force * d / (2.0 * math.pi * e_star * a_min)) ** (1.0 / 3.0)
+            approach = 3.0 * force * k / (2.0 * math.pi * e_star * major)
+        else:
+            approach = load[i]
+            major = math.sqrt(approach * d / (k * a_min))
+            force = 2.0 * math.pi * major * e_star * approach / (3.0 * k)
+        minor = major * math.sqrt(p)
+        if A <= B:
+            out[i, 0] = major
+            out[i, 1] = minor
+        else:
+            out[i, 0] = minor
+            out[i, 1] = major
+        out[i, 2] = approach
+        out[i, 3] = force
+        out[i, 4] = 3.0 * force / (2.0 * math.pi * major * minor)
 
 
 def elliptic_kdbc(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -80,22 +197,13 @@ def elliptic_kdbc(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     Returns:
         (K, D, B, C) with K = int dt/Delta, D = int sin^2/Delta, B = int cos^2/Delta,
         C = int sin^2 cos^2/Delta^3 over t in [0, pi/2], Delta = sqrt(1 - m sin^2 t) (Kalker 1990).
+        K from scipy's ``ellipkm1(p)``; for m >= 0.1 D, B, C from K and scipy's ``ellipe(m)``,
+        for m < 0.1 from their power series.
     """
     p = np.asarray(p, dtype=float)
-    m = 1.0 - p
-    k = ellipkm1(p)
-    small = m < _SERIES_LIMIT
-    with np.errstate(divide="ignore", invalid="ignore"):
-        e = ellipe(m)
-        d = np.where(small, 0.0, (k - e) / m)
-        b = np.where(small, 0.0, (e - p * k) / m)
-        c = np.where(small, 0.0, (d - b) / m)
-    if np.any(small):
-        ms = m[small]
-        d[small] = _horner(_D_SERIES, ms)
-        b[small] = _horner(_B_SERIES, ms)
-        c[small] = _horner(_C_SERIES, ms)
-    return k, d, b, c
+    out = np.empty((p.size, 4))
+    _kdbc_many(np.ascontiguousarray(p.ravel()), out)
+    return tuple(out[:, i].reshape(p.shape) for i in range(4))
 
 
 def ellipse_shape_from_curvature_ratio(
@@ -104,8 +212,9 @@ def ellipse_shape_from_curvature_ratio(
     """Invert the axial function: p = (b_minor/a_major)^2 from r = max(A, B)/min(A, B) >= 1.
 
     Solves ``ln B(m) - ln p - ln D(m) = ln r`` for s = ln p (m = 1 - p) by Newton's method
-    safeguarded by bisection inside a bracket that always contains the root; vectorised.
-    Derivative: d(ln r)/ds = -(p C/(2B) + 1/2 + C/(2D)) (from dD/dm = (D - C)/(2p), dB/dm = C/2).
+    safeguarded by bisection inside a bracket that always contains the root; compiled loop over
+    patches. Derivative: d(ln r)/ds = -(p C/(2B) + 1/2 + C/(2D)) (from dD/dm = (D - C)/(2p),
+    dB/dm = C/2).
 
     Args:
         curvature_ratio: r >= 1, array (any shape).
@@ -114,52 +223,17 @@ def ellipse_shape_from_curvature_ratio(
         max_iterations: iteration cap; patches not converged by then are flagged.
 
     Returns:
-        (p, iterations, converged): p in (0, 1]; iterations used (scalar array); bool mask.
+        (p, iterations, converged): p in (0, 1]; the largest number of iterations used; bool mask.
     """
     r = np.asarray(curvature_ratio, dtype=float)
-    shape = r.shape
-    r = r.ravel()
-    log_r = np.log(r)
-    hi = -log_r
-    lo = -log_r - np.log(2.0 * (1.0 + np.log(16.0 * r)))
-    # initial guess: small-eccentricity slope ln r ~ 3 m / 4 ~ -3 s / 4, clipped into the bracket
-    s = np.clip(-4.0 / 3.0 * log_r, lo, hi)
-    converged = r == 1.0
-    s[converged] = 0.0
-    # make sure the lower end really brackets the root (g(lo) >= 0)
-    for _ in range(8):
-        p_lo = np.exp(lo)
-        _, d_lo, b_lo, _ = elliptic_kdbc(p_lo)
-        g_lo = np.log(b_lo) - lo - np.log(d_lo) - log_r
-        bad = (g_lo < 0) & ~converged
-        if not np.any(bad):
-            break
-        lo[bad] -= 2.0
-    iterations = 0
-    active = ~converged
-    while np.any(active) and iterations < max_iterations:
-        iterations += 1
-        sa = s[active]
-        p = np.exp(sa)
-        _, d, b, c = elliptic_kdbc(p)
-        g = np.log(b) - sa - np.log(d) - log_r[active]
-        dg = -(p * c / (2.0 * b) + 0.5 + c / (2.0 * d))
-        lo_a, hi_a = lo[active], hi[active]
-        # g decreases with s: g > 0 means the root is above s
-        lo_a = np.where(g > 0, sa, lo_a)
-        hi_a = np.where(g <= 0, sa, hi_a)
-        step = -g / dg
-        s_new = sa + step
-        outside = ~((s_new >= lo_a) & (s_new <= hi_a))
-        s_new = np.where(outside, 0.5 * (lo_a + hi_a), s_new)
-        s_new = np.where(g == 0, sa, s_new)
-        tol = rtol * (1.0 + np.abs(sa))
-        done = (np.abs(s_new - sa) <= tol) | (g == 0) | (hi_a - lo_a <= tol)
-        lo[active], hi[active], s[active] = lo_a, hi_a, s_new
-        idx = np.flatnonzero(active)
-        converged[idx[done]] = True
-        active[idx[done]] = False
-    return np.exp(s).reshape(shape), np.asarray(iterations), converged.reshape(shape)
+    if not (np.all(np.isfinite(r)) and np.all(r >= 1.0)):
+        raise ValueError(f"curvature_ratio = {curvature_ratio!r}: expected finite values >= 1")
+    flat = np.ascontiguousarray(r.ravel())
+    p = np.empty(flat.size)
+    it = np.empty(flat.size, dtype=np.int64)
+    ok = np.empty(flat.size, dtype=np.bool_)
+    _shape_many(flat, rtol, max_iterations, p, it, ok)
+    return p.reshape(r.shape), np.asarray(it.max() if it.size else 0), ok.reshape(r.shape)
 
 
 @dataclass(frozen=True, eq=False)
@@ -252,37 +326,34 @@ def hertz_solve_batch(
         raise ValueError(f"{name} = {load!r}: expected finite values")
 
     e_star = shear_modulus_Pa / (1.0 - poisson_ratio)
-    a_min = np.minimum(A, B)
-    ratio = np.maximum(A, B) / a_min
-    p, iterations, converged = ellipse_shape_from_curvature_ratio(ratio)
-    k, d, _, _ = elliptic_kdbc(p.ravel())
-    k, d = k.reshape(p.shape), d.reshape(p.shape)
-    in_contact = load > 0
-    positive = np.where(in_contact, load, 1.0)
-    if approach_m is None:
-        force = positive
-        major = np.cbrt(3.0 * force * d / (2.0 * math.pi * e_star * a_min))
-        approach = 3.0 * force * k / (2.0 * math.pi * e_star * major)
-    else:
-        approach = positive
-        major = np.sqrt(approach * d / (k * a_min))
-        force = 2.0 * math.pi * major * e_star * approach / (3.0 * k)
-    minor = major * np.sqrt(p)
-    along_x = A <= B
-    a = np.where(along_x, major, minor)
-    b = np.where(along_x, minor, major)
-    p0 = 3.0 * force / (2.0 * math.pi * major * minor)
-    zero = np.zeros_like(a)
+    shape = A.shape
+    n = A.size
+    out = np.empty((n, 7))
+    it = np.empty(n, dtype=np.int64)
+    ok = np.empty(n, dtype=np.bool_)
+    _hertz_many(
+        np.ascontiguousarray(A.ravel()),
+        np.ascontiguousarray(B.ravel()),
+        np.ascontiguousarray(load.ravel()),
+        approach_m is None,
+        float(e_star),
+        1e-14,
+        60,
+        out,
+        it,
+        ok,
+    )
+    col = [out[:, j].reshape(shape) for j in range(7)]
     return HertzBatch(
-        semi_axis_long_m=np.where(in_contact, a, zero),
-        semi_axis_lat_m=np.where(in_contact, b, zero),
-        approach_m=np.where(in_contact, approach, zero),
-        normal_force_N=np.where(in_contact, force, zero),
-        max_pressure_Pa=np.where(in_contact, p0, zero),
-        ellipse_parameter=1.0 - p,
-        major_axis_along_x=along_x,
-        converged=converged,
-        iterations=int(iterations),
+        semi_axis_long_m=col[0],
+        semi_axis_lat_m=col[1],
+        approach_m=col[2],
+        normal_force_N=col[3],
+        max_pressure_Pa=col[4],
+        ellipse_parameter=col[5],
+        major_axis_along_x=col[6].astype(bool),
+        converged=ok.reshape(shape),
+        iterations=int(it.max()) if n else 0,
     )
 
 
