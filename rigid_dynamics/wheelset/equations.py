@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigid_dynamics.contact.creepage import patch_kinematics
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
 from rigid_dynamics.wheelset.parameters import DynamicsScene
@@ -103,6 +102,184 @@ def rotation_and_rates(yaw, roll, spin, yaw_rate, roll_rate, spin_rate):
     return rzx @ ry, rzx, omega
 
 
+def _cross_rows(vector, rows):
+    """vector x rows[i] for a 3-vector and an (n, 3) array."""
+    wx, wy, wz = vector
+    x, y, z = rows[:, 0], rows[:, 1], rows[:, 2]
+    return np.stack([wy * z - wz * y, wz * x - wx * z, wx * y - wy * x], axis=-1)
+
+
+def _cross_pairs(first, second):
+    """first[i] x second[i] for two (n, 3) arrays."""
+    a1, a2, a3 = first[:, 0], first[:, 1], first[:, 2]
+    b1, b2, b3 = second[:, 0], second[:, 1], second[:, 2]
+    return np.stack([a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1], axis=-1)
+
+
+def _cross3(a, b):
+    """a x b for two 3-vectors (plain arithmetic)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _creepages(lever, normal, omega, v_c):
+    """Contact frames and creepages of many points (eq 39-49; same formulas as contact.creepage).
+
+    e_x = v_p/|v_p| with v_p the rolling velocity v_rol = [x', 0, 0] projected on the contact plane,
+    e_y = n x e_x, e_z = n; V = |v_p|; xi = v_w . e_x / V, eta = v_w . e_y / V, spin = omega . n / V with
+    v_w = x_t' + omega x r_con the velocity of the wheel's material point (eq 44).
+
+    Returns:
+        (frames (n, 3, 3), V (n,), xi, eta, spin (n,)).
+    """
+    v_rol = np.array([v_c[0], 0.0, 0.0])
+    v_p = v_rol - (normal @ v_rol)[:, None] * normal
+    speed = np.sqrt(np.einsum("ij,ij->i", v_p, v_p))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        e_x = v_p / speed[:, None]
+        e_y = _cross_pairs(normal, e_x)
+        velocity = v_c + _cross_rows(omega, lever)
+        xi = np.einsum("ij,ij->i", velocity, e_x) / speed
+        eta = np.einsum("ij,ij->i", velocity, e_y) / speed
+        spin = (normal @ omega) / speed
+    frames = np.stack([e_x, e_y, normal], axis=-1)
+    return frames, speed, xi, eta, spin
+
+
+BATCH_MODELS = ("hertz", "linear", "vermeulen-johnson", "fastsim")
+"""Registered models evaluated for all patches at once through their vectorised kernels."""
+
+
+def _uniform_interp(x, grid, rows):
+    """Linear interpolation of several tables sampled on the same uniform grid (x inside the grid)."""
+    step = grid[1] - grid[0]
+    f = (x - grid[0]) / step
+    i = np.minimum(f.astype(np.intp), len(grid) - 2)
+    w = f - i
+    return [row[i] * (1.0 - w) + row[i + 1] * w for row in rows]
+
+
+class TabulatedHertzKalker:
+    """Hertz (approach control) and Kalker's C_ij for many patches by look-up tables, for speed.
+
+    Two smooth functions of one variable are tabulated once, on fine grids, from the project's own
+    solvers and interpolated linearly:
+
+    * the inverted axial function p = (b_minor/a_major)^2 of r = max(A, B)/min(A, B) and Kalker's
+      elliptic functions K(p), D(p) (contact.hertz.ellipse_shape_from_curvature_ratio, elliptic_kdbc),
+      on ``HERTZ_POINTS`` points of ln r in [0, ln 1e4];
+    * C11, C22, C23, C33 (contact.kalker.kalker_coefficients at the material's nu) on ``KALKER_POINTS``
+      points of ln(a/b) in [-ln 50, ln 50].
+
+    Then (hertz.py, approach control): a_major = sqrt(q D / (K min(A, B))), N = 2 pi a_major E* q / (3 K),
+    b_minor = a_major sqrt(p), E* = G/(1 - nu). Relative interpolation error < 1e-7 (the test compares
+    with hertz_solve_batch and kalker_coefficients). Ratios outside the grids fall back to the solvers.
+    """
+
+    HERTZ_POINTS = 20001
+    KALKER_POINTS = 8001
+
+    def __init__(self, material):
+        from rigid_dynamics.contact.hertz import ellipse_shape_from_curvature_ratio, elliptic_kdbc
+        from rigid_dynamics.contact.kalker import kalker_coefficients
+
+        self.shear = material.shear_modulus_Pa
+        self.nu = material.poisson_ratio
+        self.e_star = self.shear / (1.0 - self.nu)
+        self.log_r = np.linspace(0.0, math.log(1e4), self.HERTZ_POINTS)
+        p, _, _ = ellipse_shape_from_curvature_ratio(np.exp(self.log_r))
+        k, d, _, _ = elliptic_kdbc(p)
+        self.p, self.k, self.d = p, k, d
+        self.log_ab = np.linspace(-math.log(50.0), math.log(50.0), self.KALKER_POINTS)
+        coef = kalker_coefficients(np.exp(self.log_ab), self.nu)
+        self.c = np.stack([coef.c11, coef.c22, coef.c23, coef.c33])
+
+    def hertz(self, curv_a, curv_b, approach):
+        """(a, b, N) for approach control (arrays); exact solver outside the table."""
+        from rigid_dynamics.contact.hertz import hertz_solve_batch
+
+        a_min = np.minimum(curv_a, curv_b)
+        log_r = np.log(np.maximum(curv_a, curv_b) / a_min)
+        if np.any(log_r > self.log_r[-1]) or not np.all(a_min > 0):
+            sol = hertz_solve_batch(
+                curv_a, curv_b, approach_m=approach, shear_modulus_Pa=self.shear, poisson_ratio=self.nu
+            )
+            return sol.semi_axis_long_m, sol.semi_axis_lat_m, sol.normal_force_N
+        p, k, d = _uniform_interp(log_r, self.log_r, (self.p, self.k, self.d))
+        major = np.sqrt(approach * d / (k * a_min))
+        force = 2.0 * math.pi * major * self.e_star * approach / (3.0 * k)
+        minor = major * np.sqrt(p)
+        along_x = curv_a <= curv_b
+        return np.where(along_x, major, minor), np.where(along_x, minor, major), force
+
+    def coefficients(self, semi_a, semi_b):
+        """CreepCoefficients for a/b (table, exact outside)."""
+        from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+
+        log_ab = np.log(semi_a / semi_b)
+        if np.any(np.abs(log_ab) > self.log_ab[-1]):
+            return kalker_coefficients(semi_a / semi_b, self.nu)
+        return CreepCoefficients(*_uniform_interp(log_ab, self.log_ab, self.c))
+
+
+def batch_contact_function(name: str, material, options=None):
+    """A function (A, B, q, xi, eta, phi) -> (N, T_x, T_y, M_z, a, b) for all patches at once, or None.
+
+    Uses the vectorised kernels behind the registry's models (contact.linear.linear_creep_forces,
+    contact.vermeulen_johnson.vermeulen_johnson_saturation, contact.fastsim.fastsim_batch) with the same
+    defaults as the model classes (contact.models), Hertz and C_ij from :class:`TabulatedHertzKalker`, so
+    the result equals one ``solve`` per patch to interpolation accuracy (tests/test_dynamics_contact.py).
+    Approach control. Returns None for models without a batch path (then every patch is solved by
+    ``model.solve``).
+    """
+    if name not in BATCH_MODELS:
+        return None
+    from rigid_dynamics.contact.linear import linear_creep_forces
+
+    shear, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
+    opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
+    opts.update({k: v for k, v in (options or {}).items() if k in opts})
+    tables = TabulatedHertzKalker(material)
+
+    def solve(curv_a, curv_b, approach, xi, eta, spin):
+        semi_a, semi_b, normal = tables.hertz(curv_a, curv_b, approach)
+        zero = np.zeros_like(normal)
+        if name == "hertz":
+            return normal, zero, zero, zero, semi_a, semi_b
+        coef = tables.coefficients(semi_a, semi_b)
+        if name == "fastsim":
+            from rigid_dynamics.contact.fastsim import fastsim_batch
+
+            res = fastsim_batch(
+                semi_a, semi_b, normal, xi, eta, spin, shear_modulus_Pa=shear, poisson_ratio=nu,
+                friction_coefficient=mu, coefficients=coef, **opts,
+            )  # fmt: skip
+            return normal, res.creep_force_long_N, res.creep_force_lat_N, res.spin_moment_Nm, semi_a, semi_b
+        t_x, t_y, m_z = linear_creep_forces(
+            semi_a, semi_b, xi, eta, spin, shear_modulus_Pa=shear, poisson_ratio=nu, coefficients=coef
+        )
+        if name == "vermeulen-johnson":
+            from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+
+            t_x, t_y = vermeulen_johnson_saturation(t_x, t_y, normal, mu)
+            m_z = zero
+        return normal, np.asarray(t_x, float), np.asarray(t_y, float), np.asarray(m_z, float), semi_a, semi_b
+
+    return solve
+
+
+def _patch_values(patches) -> dict:
+    """PATCH_FIELDS arrays of a PatchSet: geometry filled in, forces 0 / creepages NaN until solved."""
+    n = len(patches)
+    values = {name: np.full(n, np.nan) for name in PATCH_FIELDS}
+    values["normal_force_N"] = np.zeros(n)
+    values["approach_m"] = np.asarray(patches.approach_m, float).copy()
+    values["contact_point_y_m"] = patches.point_m[:, 1].copy()
+    values["wheel_lateral_m"] = np.asarray(patches.wheel_lateral_m, float).copy()
+    values["rolling_radius_m"] = np.asarray(patches.rolling_radius_m, float).copy()
+    values["contact_angle_rad"] = np.asarray(patches.contact_angle_rad, float).copy()
+    return values
+
+
 @dataclass(eq=False)
 class ContactState:
     """Solved contact candidates of one state (arrays over candidates; forces on the wheel, main frame)."""
@@ -113,7 +290,7 @@ class ContactState:
     moment_Nm: np.ndarray  # (n, 3) main frame, about the contact point
     lever_m: np.ndarray  # (n, 3)
     point_velocity_m_per_s: np.ndarray  # (n, 3)
-    values: dict  # PATCH_FIELDS -> (n,)
+    values: dict | None  # PATCH_FIELDS -> (n,) when recorded
 
 
 class WheelsetModel:
@@ -131,6 +308,13 @@ class WheelsetModel:
         self.provider = provider
         self.model = contact_model
         self.model_options = model_options
+        name = getattr(contact_model, "name", "")
+        model_cls = type(contact_model).__module__
+        self.batch = (
+            batch_contact_function(name, scene.material, model_options)
+            if model_cls == "rigid_dynamics.contact.models"
+            else None
+        )
         ws = scene.wheelset
         self.mass = ws.mass_kg
         self.j_body = np.diag([ws.transverse_inertia_kg_m2, ws.axle_inertia_kg_m2, ws.transverse_inertia_kg_m2])
@@ -154,72 +338,84 @@ class WheelsetModel:
         self.rhs_evaluations = 0
 
     # ----------------------------------------------------------------------------------------------
-    def contact(self, state: np.ndarray) -> ContactState:
-        """Contact forces of every candidate in contact (approach > 0) for a 12-state."""
+    def contact(self, state: np.ndarray, record: bool = False) -> ContactState:
+        """Contact forces of every candidate in contact (approach > 0) for a 12-state.
+
+        With ``record`` the per-patch values (PATCH_FIELDS) are filled, else ``values`` is None.
+        """
         x, y, z, yaw, roll, spin = state[:6]
         centre = state[0:3]
         v_c = state[6:9]
         c_d, _, omega = rotation_and_rates(yaw, roll, spin, state[9], state[10], state[11])
         patches = self.provider.patches(centre, yaw, roll, spin)
         n = len(patches)
-        values = {name: np.full(n, np.nan) for name in PATCH_FIELDS}
-        values["approach_m"] = np.asarray(patches.approach_m, float).copy()
-        values["contact_point_y_m"] = patches.point_m[:, 1].copy()
-        values["wheel_lateral_m"] = np.asarray(patches.wheel_lateral_m, float).copy()
-        values["rolling_radius_m"] = np.asarray(patches.rolling_radius_m, float).copy()
-        values["contact_angle_rad"] = np.asarray(patches.contact_angle_rad, float).copy()
-        values["normal_force_N"] = np.zeros(n)
+        values = None
         force = np.zeros((n, 3))
         moment = np.zeros((n, 3))
         lever = patches.point_m - centre
-        velocity = v_c + np.cross(omega, lever)
+        velocity = v_c + _cross_rows(omega, lever)
         active = np.flatnonzero(patches.approach_m > 0)
         if len(active):
-            try:
-                kin = patch_kinematics(lever[active], np.eye(3), omega, v_c, patches.normal[active])
-            except ValueError as exc:
-                raise ContactFailure(f"creepages undefined: {exc}") from None
-            material = self.scene.material
-            for i, k in enumerate(active):
-                speed = float(kin.rolling_speed_m_per_s[i])
-                if not speed > 0 or not math.isfinite(speed):
-                    raise ContactFailure(f"rolling speed {speed!r} m/s at a contact: creepages undefined")
-                frame = kin.contact_frame[i]
-                if patches.geometries is not None:
-                    geometry = patches.geometries[k]
-                else:
-                    geometry = ContactGeometry(
-                        curvature_long_1_per_m=float(patches.curvature_long_1_per_m[k]),
-                        curvature_lat_1_per_m=float(patches.curvature_lat_1_per_m[k]),
-                        approach_m=float(patches.approach_m[k]),
-                        side=SIDES[patches.side[k]],
-                        point_m=patches.point_m[k],
-                        frame=frame,
-                        contact_angle_rad=float(patches.contact_angle_rad[k]),
-                        rolling_radius_m=float(patches.rolling_radius_m[k]),
-                    )
-                creepage = Creepage(
-                    float(kin.longitudinal[i]), float(kin.lateral[i]), float(kin.spin_1_per_m[i]), speed
+            frames, speed, xi, eta, spin = _creepages(lever[active], patches.normal[active], omega, v_c)
+            if not np.all(speed > 0) or not np.all(np.isfinite(speed)):
+                raise ContactFailure(f"rolling speed {speed.min()!r} m/s at a contact: creepages undefined")
+            if self.batch is not None and patches.geometries is None:
+                normal, t_x, t_y, m_z, semi_a, semi_b = self.batch(
+                    patches.curvature_long_1_per_m[active],
+                    patches.curvature_lat_1_per_m[active],
+                    patches.approach_m[active],
+                    xi,
+                    eta,
+                    spin,
                 )
-                result = self.model.solve(geometry, creepage, material, options=self.model_options)
-                if not result.success and result.status != "no-contact":
-                    raise ContactFailure(f"contact model {result.method!r} failed: {result.status}: {result.message}")
-                normal = result.normal_force_N or 0.0
-                t_x = result.creep_force_long_N or 0.0
-                t_y = result.creep_force_lat_N or 0.0
-                m_z = result.spin_moment_Nm or 0.0
-                force[k] = frame @ np.array([t_x, t_y, normal])
-                moment[k] = m_z * frame[:, 2]
-                values["normal_force_N"][k] = normal
-                values["creep_force_long_N"][k] = t_x
-                values["creep_force_lat_N"][k] = t_y
-                values["spin_moment_Nm"][k] = m_z
-                values["creepage_long"][k] = kin.longitudinal[i]
-                values["creepage_lat"][k] = kin.lateral[i]
-                values["spin_creepage_1_per_m"][k] = kin.spin_1_per_m[i]
-                values["semi_axis_long_m"][k] = result.semi_axis_long_m if result.semi_axis_long_m else np.nan
-                values["semi_axis_lat_m"][k] = result.semi_axis_lat_m if result.semi_axis_lat_m else np.nan
+            else:
+                normal, t_x, t_y, m_z, semi_a, semi_b = self._solve_each(patches, active, frames, speed, xi, eta, spin)
+            force[active] = (
+                frames[:, :, 0] * t_x[:, None] + frames[:, :, 1] * t_y[:, None] + frames[:, :, 2] * normal[:, None]
+            )
+            moment[active] = frames[:, :, 2] * m_z[:, None]
+            if record:
+                values = _patch_values(patches)
+                for key, val in (
+                    ("normal_force_N", normal), ("creep_force_long_N", t_x), ("creep_force_lat_N", t_y),
+                    ("spin_moment_Nm", m_z), ("creepage_long", xi), ("creepage_lat", eta),
+                    ("spin_creepage_1_per_m", spin), ("semi_axis_long_m", semi_a), ("semi_axis_lat_m", semi_b),
+                ):  # fmt: skip
+                    values[key][active] = val
+        elif record:
+            values = _patch_values(patches)
         return ContactState(patches.side, patches.slot, force, moment, lever, velocity, values)
+
+    def _solve_each(self, patches, active, frames, speed, xi, eta, spin):
+        """One ``model.solve`` per active patch (any registered model, sampled geometries)."""
+        n = len(active)
+        out = [np.zeros(n) for _ in range(6)]
+        material = self.scene.material
+        for i, k in enumerate(active):
+            if patches.geometries is not None:
+                geometry = patches.geometries[k]
+            else:
+                geometry = ContactGeometry(
+                    curvature_long_1_per_m=float(patches.curvature_long_1_per_m[k]),
+                    curvature_lat_1_per_m=float(patches.curvature_lat_1_per_m[k]),
+                    approach_m=float(patches.approach_m[k]),
+                    side=SIDES[patches.side[k]],
+                    point_m=patches.point_m[k],
+                    frame=frames[i],
+                    contact_angle_rad=float(patches.contact_angle_rad[k]),
+                    rolling_radius_m=float(patches.rolling_radius_m[k]),
+                )
+            creepage = Creepage(float(xi[i]), float(eta[i]), float(spin[i]), float(speed[i]))
+            result = self.model.solve(geometry, creepage, material, options=self.model_options)
+            if not result.success and result.status != "no-contact":
+                raise ContactFailure(f"contact model {result.method!r} failed: {result.status}: {result.message}")
+            out[0][i] = result.normal_force_N or 0.0
+            out[1][i] = result.creep_force_long_N or 0.0
+            out[2][i] = result.creep_force_lat_N or 0.0
+            out[3][i] = result.spin_moment_Nm or 0.0
+            out[4][i] = result.semi_axis_long_m or np.nan
+            out[5][i] = result.semi_axis_lat_m or np.nan
+        return out
 
     def exterior(self, t: float, state: np.ndarray, c_d: np.ndarray, omega: np.ndarray):
         """Exterior force and moment (eq 63-64) about the centre, and their power (main frame)."""
@@ -231,12 +427,12 @@ class WheelsetModel:
             for s in (-1.0, 1.0):
                 arm = c_d[:, 1] * (s * self.half_spacing)
                 point = state[0:3] + arm
-                vel = state[6:9] + np.cross(omega, arm)
+                vel = state[6:9] + _cross3(omega, arm)
                 rel = point - np.array([x_frame, s * self.half_spacing, self.z_frame])
                 rel_v = vel - np.array([self.speed, 0.0, 0.0])
                 f = -self.k * rel - self.c * rel_v
                 force += f
-                moment += np.cross(arm, f)
+                moment += _cross3(arm, f)
                 power += f @ vel
             m_yaw = -2.0 * (self.k_yaw * state[3] + self.c_yaw * state[9])
             moment[2] += m_yaw
@@ -256,13 +452,13 @@ class WheelsetModel:
         if contact is None:
             contact = self.contact(state[:12])
         f_con = contact.force_N.sum(axis=0)
-        m_con = np.cross(contact.lever_m, contact.force_N).sum(axis=0) + contact.moment_Nm.sum(axis=0)
+        m_con = _cross_pairs(contact.lever_m, contact.force_N).sum(axis=0) + contact.moment_Nm.sum(axis=0)
         p_con = float(np.sum(contact.force_N * contact.point_velocity_m_per_s) + contact.moment_Nm.sum(axis=0) @ omega)
         f_ext, m_ext, p_ext = self.exterior(t, state, c_d, omega)
         acc = (f_con + f_ext) / self.mass
         acc[2] += self.gravity
         j_main = rzx @ self.j_body @ rzx.T
-        torque = m_con + m_ext - np.cross(omega, j_main @ omega)
+        torque = m_con + m_ext - _cross3(omega, j_main @ omega)
         alpha = np.linalg.solve(j_main, torque)
         ax, ay, az = alpha
         sp, cp, st, ct = math.sin(yaw), math.cos(yaw), math.sin(roll), math.cos(roll)

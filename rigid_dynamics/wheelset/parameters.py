@@ -186,8 +186,9 @@ class Irregularities:
         flat_length_m: L, length of the (rounded) wheel flat along the circumference, m; 0 = none.
         flat_depth_m: d, depth of the flat, m; 0 means the depth of a fresh flat of chord L,
             d = L^2 / (16 r0).
-        flat_angle_rad: wheel angle alpha_d of the flat centre, rad (the wheel's lowest point is
-            at alpha_d = pi/2 - phi, so with phi(0) = 0 the value pi/2 + r0-arc puts it ahead).
+        flat_angle_rad: wheel angle alpha_d of the flat centre, rad. The wheel's lowest point is at
+            alpha_d = pi/2 - phi and phi grows by x / r0 when rolling a distance x, so a flat at
+            pi/2 - x_f / r0 reaches the rail after about x_f of travel.
         corrugation_wavelength_m: wavelength of sinusoidal rail corrugation, m; 0 = none.
         corrugation_amplitude_m: amplitude of N_irr = -A cos(2 pi x / wavelength), m.
         side: which wheels/rails carry the irregularities: "both", "left" or "right".
@@ -292,6 +293,7 @@ class InitialConditions:
         yaw_rad: psi(0), rad.
         lateral_velocity_m_per_s: y'(0), m/s.
         yaw_rate_rad_per_s: psi'(0), rad/s.
+        vertical_velocity_m_per_s: z'(0), m/s (z down).
         longitudinal_creepage: initial slip of the spin, phi'(0) = (1 - xi0) V / r0 (dimensionless).
     """
 
@@ -299,6 +301,7 @@ class InitialConditions:
     yaw_rad: float = 0.0
     lateral_velocity_m_per_s: float = 0.0
     yaw_rate_rad_per_s: float = 0.0
+    vertical_velocity_m_per_s: float = 0.0
     longitudinal_creepage: float = 0.0
 
     def __post_init__(self) -> None:

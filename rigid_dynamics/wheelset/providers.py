@@ -197,38 +197,45 @@ class ConicalProvider:
         x_c, y_c, z_c = float(centre_m[0]), float(centre_m[1]), float(centre_m[2])
         cps, sps = math.cos(yaw_rad), math.sin(yaw_rad)
         cth, sth = math.cos(roll_rad), math.sin(roll_rad)
-        s = SIDE_SIGNS
-        lam, r0, e0 = self.conicity, self.r0, self.e0
-        yd0 = s * e0
-        p_y = y_c + cps * (yd0 * cth - r0 * sth)
-        p_z = z_c + yd0 * sth + r0 * cth
-        d_y = cps * (cth + s * lam * sth)
-        d_z = sth - s * lam * cth
-        length = np.sqrt(d_y * d_y + d_z * d_z)
-        u_y, u_z = d_y / length, d_z / length
-        nl_y, nl_z = -u_z, u_y
-        delta = (self.rail_centre_y - p_y) * nl_y + (self.rail_centre_z - p_z) * nl_z
-        approach = self.rail_radius - delta
-        foot_y = self.rail_centre_y - delta * nl_y
-        foot_z = self.rail_centre_z - delta * nl_z
-        y_d = yd0 + ((foot_y - p_y) * u_y + (foot_z - p_z) * u_z) / length
-        radius = r0 + lam * (e0 - s * y_d)
-        x_off = -sps * (y_d * cth - radius * sth)
-        point = np.stack([x_c + x_off, foot_y, foot_z], axis=-1)
-        normal = np.stack([np.zeros(2), u_z, -u_y], axis=-1)
-        angle = np.arctan2(-s * normal[:, 1], -normal[:, 2])
-        curv_long = 0.5 / (radius * math.sqrt(1 + lam * lam))
+        lam, r0, e0, rail_r = self.conicity, self.r0, self.e0, self.rail_radius
+        rows = []
+        for i, s in enumerate((-1.0, 1.0)):
+            yd0 = s * e0
+            p_y = y_c + cps * (yd0 * cth - r0 * sth)
+            p_z = z_c + yd0 * sth + r0 * cth
+            d_y = cps * (cth + s * lam * sth)
+            d_z = sth - s * lam * cth
+            length = math.hypot(d_y, d_z)
+            u_y, u_z = d_y / length, d_z / length
+            nl_y, nl_z = -u_z, u_y
+            c_y, c_z = self.rail_centre_y[i], self.rail_centre_z[i]
+            delta = (c_y - p_y) * nl_y + (c_z - p_z) * nl_z
+            foot_y, foot_z = c_y - delta * nl_y, c_z - delta * nl_z
+            y_d = yd0 + ((foot_y - p_y) * u_y + (foot_z - p_z) * u_z) / length
+            radius = r0 + lam * (e0 - s * y_d)
+            x_off = -sps * (y_d * cth - radius * sth)
+            rows.append(
+                (
+                    rail_r - delta,
+                    (x_c + x_off, foot_y, foot_z),
+                    (0.0, u_z, -u_y),
+                    radius,
+                    math.atan2(-s * u_z, u_y),
+                    y_d,
+                )
+            )
+        radius = np.array([rows[0][3], rows[1][3]])
         patches = PatchSet(
             side=np.array([0, 1]),
             slot=np.array([0, 0]),
-            point_m=point,
-            normal=normal,
-            curvature_long_1_per_m=curv_long,
-            curvature_lat_1_per_m=np.full(2, 0.5 / self.rail_radius),
-            approach_m=approach,
+            point_m=np.array([rows[0][1], rows[1][1]]),
+            normal=np.array([rows[0][2], rows[1][2]]),
+            curvature_long_1_per_m=0.5 / (radius * math.sqrt(1 + lam * lam)),
+            curvature_lat_1_per_m=np.full(2, 0.5 / rail_r),
+            approach_m=np.array([rows[0][0], rows[1][0]]),
             rolling_radius_m=radius,
-            contact_angle_rad=angle,
-            wheel_lateral_m=y_d,
+            contact_angle_rad=np.array([rows[0][4], rows[1][4]]),
+            wheel_lateral_m=np.array([rows[0][5], rows[1][5]]),
         )
         if self.irregularities is not None:
             _running_irregularity(patches, self._irr_sides, centre_m, spin_rad, self.irregularities, r0)

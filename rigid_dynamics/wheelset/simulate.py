@@ -241,11 +241,20 @@ def build_provider(scene: DynamicsScene):
     raise ValueError(f"contact_provider = {choice!r}: unknown")  # pragma: no cover (validated by the scene)
 
 
-def build_contact_model(scene: DynamicsScene):
-    """The contact model of a scene by its registered name (registry.get_model)."""
+def get_contact_model(name_or_model):
+    """A contact model instance from a registered name or an instance (registry.get_model)."""
     from rigid_dynamics.contact.registry import get_model
 
-    return get_model(scene.contact_model)
+    return get_model(name_or_model)
+
+
+def model_options(name: str, scene: DynamicsScene) -> dict | None:
+    """Options handed to the contact model in a run: no FASTSIM fields; auto gets the scene's tolerance."""
+    if name == "fastsim":
+        return {"fields": False}
+    if name == "auto":
+        return {"tolerance": scene.contact_tolerance, "model_options": {"fastsim": {"fields": False}}}
+    return None
 
 
 def initial_state(scene: DynamicsScene) -> np.ndarray:
@@ -259,6 +268,7 @@ def initial_state(scene: DynamicsScene) -> np.ndarray:
     state[3] = ic.yaw_rad
     state[6] = v
     state[7] = ic.lateral_velocity_m_per_s
+    state[8] = ic.vertical_velocity_m_per_s
     state[9] = ic.yaw_rate_rad_per_s
     state[11] = (1.0 - ic.longitudinal_creepage) * v / r0
     return state
@@ -289,7 +299,7 @@ class _Recorder:
         state = full_state[:12]
         if not np.all(np.isfinite(full_state)):
             raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, state)
-        contact = self.model.contact(state)
+        contact = self.model.contact(state, record=True)
         table = {name: np.full((2, MAX_SLOTS), np.nan) for name in PATCH_FIELDS}
         for k in range(len(contact.side)):
             side, slot = int(contact.side[k]), int(contact.slot[k])
@@ -377,11 +387,9 @@ def simulate(
     Raises:
         ValueError: the scene cannot be set up (unknown model, provider that cannot serve it).
     """
-    from rigid_dynamics.contact.registry import get_model
-
     provider = provider if provider is not None else build_provider(scene)
-    model_obj = get_model(contact_model if contact_model is not None else scene.contact_model)
-    model = WheelsetModel(scene, provider, model_obj)
+    model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
+    model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
     settings = scene.integrator
     duration = scene.duration_s
     start = time.perf_counter()
