@@ -103,7 +103,7 @@ def rotation_and_rates(yaw, roll, spin, yaw_rate, roll_rate, spin_rate):
 
 
 def _cross_rows(vector, rows):
-    """vector x rows[i] for a 3-vector and an (n, 3) array."""
+    """Cross products vector x rows[i] for a 3-vector and an (n, 3) array."""
     wx, wy, wz = vector
     x, y, z = rows[:, 0], rows[:, 1], rows[:, 2]
     return np.stack([wy * z - wz * y, wz * x - wx * z, wx * y - wy * x], axis=-1)
@@ -117,7 +117,7 @@ def _cross_pairs(first, second):
 
 
 def _cross3(a, b):
-    """a x b for two 3-vectors (plain arithmetic)."""
+    """Cross product a x b of two 3-vectors (plain arithmetic)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
