@@ -33,8 +33,34 @@ Placement and surfaces (placement.py)
     RailSurface.evaluate(x_m, y_m) -> RailSurfaceValues(N, N_x, N_y, N_xx, N_xy, N_yy)
         .ideal_height(y_m) -> (N_id, dN/dy, d2N/dy2), .y_range_m, .to_profile_coordinates(y, z)
     side is "left" or "right". Values are NaN outside y_range_m.
+
+Analytic standard profiles (standard_profiles.py), exact curves usable wherever a profile is taken
+    s1002_wheel(), uic60_rail(side_depth_m=0.016), conical_wheel(conicity, y_min_m, y_max_m),
+    circular_wheel(radius_m, half_width_m), circular_rail(radius_m, half_width_m),
+    analytic_profile(name) ("S1002", "UIC60", "60E1"); each has .to_profile(spacing_m) -> Profile.
+    load_profile("S1002") / ("UIC60") / ("60E1") return them sampled every 0.05 mm.
+
+Irregularities (irregularities.py), frozen and validated, evaluate -> (value, 5 derivatives)
+    wheel, (angle_rad, y_p):  HarmonicOutOfRoundness(order, amplitude_m, phase_rad=0),
+        WheelFlat(length_m, wheel_radius_m, depth_m=None, centre_angle_rad=pi/2, shape="rounded"|"new"),
+        MeasuredWheelIrregularity(angle_rad, y_m, values_m)       (periodic in angle)
+    rail, (x_m, y_r):  RailCorrugation(wavelength_m, amplitude_m, phase_rad=0, centre_y_m=0,
+        half_width_m=0.015, taper_m=0.005), MeasuredRailIrregularity(x_m, y_m, values_m)
+    rail deflection N_d(x): TabulatedRailDeflection(x_m, deflection_m),
+        WinklerRailDeflection(load_N, load_position_m, bending_stiffness_Nm2, foundation_modulus_N_per_m2)
+    Pass them to WheelsetGeometry.wheel_surface(side, irregularities=[...]) and
+    TrackGeometry.rail_surface(side, irregularities=[...], deflection=...).
 """
 
+from .irregularities import (
+    HarmonicOutOfRoundness,
+    MeasuredRailIrregularity,
+    MeasuredWheelIrregularity,
+    RailCorrugation,
+    TabulatedRailDeflection,
+    WheelFlat,
+    WinklerRailDeflection,
+)
 from .placement import (
     SIDES,
     RailSurface,
@@ -52,8 +78,35 @@ from .profile import (
     find_self_intersection,
 )
 from .readers import builtin_profiles, load_profile, read_profile, write_profile_csv
+from .standard_profiles import (
+    ConicalWheelCurve,
+    S1002Curve,
+    UIC60Curve,
+    analytic_profile,
+    circular_rail,
+    circular_wheel,
+    conical_wheel,
+    s1002_wheel,
+    uic60_rail,
+)
 
 __all__ = [
+    "ConicalWheelCurve",
+    "HarmonicOutOfRoundness",
+    "MeasuredRailIrregularity",
+    "MeasuredWheelIrregularity",
+    "RailCorrugation",
+    "S1002Curve",
+    "TabulatedRailDeflection",
+    "UIC60Curve",
+    "WheelFlat",
+    "WinklerRailDeflection",
+    "analytic_profile",
+    "circular_rail",
+    "circular_wheel",
+    "conical_wheel",
+    "s1002_wheel",
+    "uic60_rail",
     "DEFAULT_SMOOTHING_WAVELENGTH_M",
     "SIDES",
     "CircularArcCurve",
