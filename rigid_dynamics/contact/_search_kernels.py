@@ -45,7 +45,6 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
     xd0, xd1, xd2 = r * ca, y, r * sa
     ta0, ta2 = -r * sa, r * ca  # R_a = 0 for an ideal wheel
     ty0, ty1, ty2 = r_y * ca, 1.0, r_y * sa
-    p0 = rot[0, 0] * xd0 + rot[0, 1] * xd1 + rot[0, 2] * xd2 + centre[0]
     p1 = rot[1, 0] * xd0 + rot[1, 1] * xd1 + rot[1, 2] * xd2 + centre[1]
     p2 = rot[2, 0] * xd0 + rot[2, 1] * xd1 + rot[2, 2] * xd2 + centre[2]
     a0 = rot[0, 0] * ta0 + rot[0, 2] * ta2
@@ -77,6 +76,9 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
             break
     py = p1 + h * n1
     if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
+        return math.inf
+    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
+    if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
         return math.inf
     return h
 

@@ -1,0 +1,342 @@
+"""The "wheelset" contact case: a wheelset on two rails at a given lateral shift and yaw, loaded per wheel.
+
+This is the set-up of the Manchester Contact Benchmark, case A-2.2 (P. Shackleton, S.D. Iwnicki, Vehicle
+System Dynamics 46 (2008) 129-149): the wheelset is shifted laterally by ``lateral_shift_m`` (towards main +y,
+the right rail) and yawed by ``yaw_rad`` (psi of eq 1: positive turns the wheelset's heading towards +y), and
+its vertical position z and roll angle theta are found so that each wheel carries ``wheel_load_N``:
+
+    sum over the wheel's patches of N_k (-n_z,k) = W       (left and right wheel; n_k rail -> wheel, z down)
+
+with the patch forces N_k from Hertz's theory (eq 32-38) for the patch's curvatures A, B and approach q
+(contact search, eq 5-33). The two equations are solved by Newton's method in the two wheel sinks
+(s_L, s_R) with z = z_0 + (s_L + s_R)/2 and theta = theta_0 + (s_R - s_L)/(2 b) (b half the distance of the
+wheels), residuals phi_i = (F_i / W)^(2/3) - 1 in contact (nearly linear in the approach, Hertz: F ~ q^1.5)
+and -gap_i / q_W - 1 out of contact (q_W ~ the Hertz approach at load W), with a finite-difference Jacobian.
+
+Each patch is then solved with the requested contact model (``registry.get_model``) under force control with
+its Hertz share of the wheel load (so every model carries the same load), with the creepages of a freely
+rolling wheelset (eq 39-49, creepage.py): centre velocity (V, 0, 0), yaw psi with zero yaw rate, roll theta,
+spin rate phi' = V / r0 (option ``spin_rate = "mean-rolling-radius"``: V over the mean rolling radius of the two
+wheels' main patches, the choice of CONTACT's A-2.2 example input, mbench_a22_right.inp, where the longitudinal
+creepages of the two wheels are equal and opposite).
+
+``approach_m`` instead of ``wheel_load_N`` prescribes the deepest approach on each wheel (approach control).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rigid_dynamics.contact.creepage import wheelset_creepage
+from rigid_dynamics.contact.search import SIDES, SideSearch, WheelsetPose
+from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
+from rigid_dynamics.materials import Material
+
+DEFAULT_CASE_OPTIONS: dict = {
+    "max_iterations": 40,
+    "force_tolerance": 1e-6,  # relative, on each wheel's vertical load
+    "approach_tolerance_m": 1e-10,
+    "spin_rate": "nominal",  # "nominal": phi' = V/r0; "mean-rolling-radius": V / mean of the wheels' radii
+    "search": None,  # options passed to search.search_side
+    "model": None,  # options passed to the contact model
+}
+
+
+@dataclass(frozen=True)
+class WheelsetCase:
+    """A wheelset contact case (the ``[geometry] kind = "wheelset"`` contract of the contact-case files).
+
+    Attributes:
+        wheel_profile: built-in profile name or file path (both wheels; the left one is mirrored).
+        rail_profile: built-in profile name or file path (both rails; mirrored on the left).
+        lateral_shift_m: wheelset lateral displacement towards main +y (the right rail), m.
+        yaw_rad: psi (eq 1), rad.
+        gauge_m: track gauge (distance between the gauge faces at gauge_height_m below the rail tops), m.
+        gauge_height_m: depth below the top of the rail where the gauge is measured, m (14 mm in EN 13848-1).
+        flange_back_distance_m: distance between the two wheels' inner (back) faces, m.
+        nominal_radius_m: r0, wheel radius at the tape circle, m.
+        rail_inclination_rad: cant of the rails towards the track centre, rad (1:40 -> atan(1/40)). Set 0 when
+            the rail profile is already canted (MBench_UIC60_v3.prr): it is applied to the profile as read.
+        wheel_load_N: vertical load per wheel, N (force control), or None.
+        approach_m: deepest approach per wheel, m (approach control), or None. Exactly one of the two.
+        rolling_speed_m_per_s: V, forward speed of the wheelset, m/s.
+    """
+
+    wheel_profile: str
+    rail_profile: str
+    lateral_shift_m: float = 0.0
+    yaw_rad: float = 0.0
+    gauge_m: float = 1.435
+    gauge_height_m: float = 0.014
+    flange_back_distance_m: float = 1.360
+    nominal_radius_m: float = 0.46
+    rail_inclination_rad: float = 0.0
+    wheel_load_N: float | None = None
+    approach_m: float | None = None
+    rolling_speed_m_per_s: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("wheel_profile", "rail_profile"):
+            value = getattr(self, name)
+            if not isinstance(value, str) or not value:
+                raise ValueError(f"{name} = {value!r}: expected a built-in profile name or a file path")
+        finite = (
+            "lateral_shift_m",
+            "yaw_rad",
+            "gauge_m",
+            "gauge_height_m",
+            "flange_back_distance_m",
+            "nominal_radius_m",
+            "rail_inclination_rad",
+            "rolling_speed_m_per_s",
+        )
+        for name in finite:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f"{name} = {value!r}: expected a finite number")
+        for name in ("gauge_m", "nominal_radius_m", "rolling_speed_m_per_s", "flange_back_distance_m"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name} = {getattr(self, name)!r}: expected > 0")
+        if self.gauge_height_m < 0:
+            raise ValueError(f"gauge_height_m = {self.gauge_height_m!r}: expected >= 0")
+        if self.flange_back_distance_m >= self.gauge_m:
+            raise ValueError(
+                f"flange_back_distance_m = {self.flange_back_distance_m!r}: "
+                f"expected less than gauge_m = {self.gauge_m!r}"
+            )
+        if abs(self.yaw_rad) > 0.2:
+            raise ValueError(f"yaw_rad = {self.yaw_rad!r}: expected |yaw| <= 0.2 rad")
+        if abs(self.rail_inclination_rad) > 0.2:
+            raise ValueError(f"rail_inclination_rad = {self.rail_inclination_rad!r}: expected |value| <= 0.2 rad")
+        if (self.wheel_load_N is None) == (self.approach_m is None):
+            raise ValueError(
+                f"wheel_load_N = {self.wheel_load_N!r}, approach_m = {self.approach_m!r}: expected exactly one of them"
+            )
+        for name in ("wheel_load_N", "approach_m"):
+            value = getattr(self, name)
+            if value is not None and (not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0):
+                raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+
+
+@dataclass(frozen=True, eq=False)
+class PatchSolution:
+    """One solved patch: its side, geometry, creepages and the contact model's result."""
+
+    side: str
+    geometry: ContactGeometry
+    creepage: Creepage
+    result: ContactResult
+
+    @property
+    def vertical_force_N(self) -> float:
+        """Upward load carried by this patch, N (normal force times -n_z; main z points down)."""
+        return float(self.result.normal_force_N * -self.geometry.frame[2, 2])
+
+
+@dataclass(frozen=True, eq=False)
+class WheelsetCaseSolution:
+    """Solution of a :class:`WheelsetCase`.
+
+    Attributes:
+        success, status, message: status "ok", "not-converged" (equilibrium iteration), "no-contact",
+            "search-failed" or "model-failed" (a patch's model did not succeed; see its result).
+        wall_time_s: s.
+        vertical_position_m: z of the wheelset centre (main frame, z down), m.
+        roll_rad: theta, rad.
+        patches: all patches, left first, deepest first per side.
+        wheel_vertical_load_N: {"left": ..., "right": ...} vertical load carried (Hertz, equilibrium), N.
+        iterations: equilibrium iterations.
+        pose: the final :class:`WheelsetPose`.
+    """
+
+    success: bool
+    status: str
+    message: str
+    wall_time_s: float
+    vertical_position_m: float
+    roll_rad: float
+    patches: list[PatchSolution]
+    wheel_vertical_load_N: dict
+    iterations: int
+    pose: WheelsetPose | None = None
+    extra: dict = field(default_factory=dict)
+
+
+def _hertz_loads(searches: dict[str, SideSearch], material: Material):
+    from rigid_dynamics.contact.hertz import hertz_force_from_approach
+
+    loads, forces = {}, {}
+    for side, result in searches.items():
+        if not result.patches:
+            loads[side], forces[side] = 0.0, np.zeros(0)
+            continue
+        a = np.array([p.curvature_long_1_per_m for p in result.patches])
+        b = np.array([p.curvature_lat_1_per_m for p in result.patches])
+        q = np.array([p.approach_m for p in result.patches])
+        f = hertz_force_from_approach(
+            a, b, q, shear_modulus_Pa=material.shear_modulus_Pa, poisson_ratio=material.poisson_ratio
+        )
+        up = np.array([-p.frame[2, 2] for p in result.patches])
+        loads[side], forces[side] = float(np.sum(f * up)), f
+    return loads, forces
+
+
+def solve_wheelset_case(
+    case: WheelsetCase,
+    material: Material,
+    model="hertz",
+    options: Mapping | None = None,
+    *,
+    track=None,
+) -> WheelsetCaseSolution:
+    """Find the wheelset's vertical position and roll carrying the load, then solve every patch.
+
+    Args:
+        case: the case.
+        material: elastic constants and friction of the pair.
+        model: contact model name (registry) or instance, used for the final patch solutions.
+        options: ``DEFAULT_CASE_OPTIONS`` keys.
+        track: optional pre-built :class:`~rigid_dynamics.contact.track.WheelsetTrack` (else built from the case).
+
+    Returns:
+        :class:`WheelsetCaseSolution` (never raises for non-convergence).
+
+    Raises:
+        ValueError: bad case, option or model name; unreadable profile.
+    """
+    from rigid_dynamics.contact.registry import get_model
+    from rigid_dynamics.contact.track import build_track
+
+    started = time.perf_counter()
+    opts = dict(DEFAULT_CASE_OPTIONS)
+    for key, value in (options or {}).items():
+        if key not in DEFAULT_CASE_OPTIONS:
+            raise ValueError(f"wheelset case option {key!r}: expected one of {', '.join(DEFAULT_CASE_OPTIONS)}")
+        opts[key] = value
+    if opts["spin_rate"] not in ("nominal", "mean-rolling-radius"):
+        raise ValueError(f"spin_rate = {opts['spin_rate']!r}: expected 'nominal' or 'mean-rolling-radius'")
+    contact_model = get_model(model)
+    if track is None:
+        track = build_track(case)
+    search_options = dict(opts["search"] or {})
+    search_options.setdefault("field", False)
+
+    def pose_of(sinks):
+        z = track.rest_z_m + 0.5 * (sinks[0] + sinks[1])
+        roll = (sinks[1] - sinks[0]) / (2.0 * track.half_wheel_distance_m)
+        return WheelsetPose(y_m=case.lateral_shift_m, z_m=float(z), yaw_rad=case.yaw_rad, roll_rad=float(roll))
+
+    def run(sinks, field_sampling=False):
+        pose = pose_of(sinks)
+        so = dict(search_options, field=field_sampling)
+        return pose, {side: track.search(pose, side, so) for side in SIDES}
+
+    q_ref = track.reference_approach_m(case, material)
+    target = case.wheel_load_N
+
+    def residual(searches):
+        out = np.zeros(2)
+        if target is not None:
+            loads, _ = _hertz_loads(searches, material)
+        for i, side in enumerate(SIDES):
+            result = searches[side]
+            if result.patches:
+                if target is not None:
+                    out[i] = (max(loads[side], 0.0) / target) ** (2.0 / 3.0) - 1.0
+                else:
+                    out[i] = max(p.approach_m for p in result.patches) / case.approach_m - 1.0
+            else:
+                out[i] = -result.min_gap_m / q_ref - 1.0
+        return out
+
+    def gaps(searches):
+        return np.array([searches[side].min_gap_m for side in SIDES]) / q_ref
+
+    def newton(func, sinks, tolerance, limit, max_iterations):
+        """Newton's method on the 2 sinks with a forward-difference Jacobian; returns (sinks, iterations, status)."""
+        step = 2.0e-7
+        for iteration in range(1, max_iterations + 1):
+            searches = run(sinks)[1]
+            if not all(np.isfinite(s.min_gap_m) for s in searches.values()):
+                return sinks, iteration, "search-failed"
+            r = func(searches)
+            if np.all(np.abs(r) < tolerance):
+                return sinks, iteration, "ok"
+            jac = np.zeros((2, 2))
+            for j in range(2):
+                ds = np.zeros(2)
+                ds[j] = step
+                jac[:, j] = (func(run(sinks + ds)[1]) - r) / step
+            try:
+                delta = np.linalg.solve(jac, -r)
+            except np.linalg.LinAlgError:
+                delta = -r * q_ref
+            sinks = sinks + np.clip(np.nan_to_num(delta), -limit, limit)
+        return sinks, max_iterations, "not-converged"
+
+    # Phase 1: rigid contact, both wheels just touching (smallest gap 0 on each side).
+    sinks, it1, status = newton(gaps, np.zeros(2), 1e-4, 2.0e-3, opts["max_iterations"])
+    # Phase 2: sink into the rails until each wheel carries its load (or the prescribed approach).
+    iterations = it1
+    if status == "ok":
+        tolerance = opts["force_tolerance"] if target is not None else opts["approach_tolerance_m"] / case.approach_m
+        sinks, it2, status = newton(residual, sinks, tolerance, 5.0 * q_ref, opts["max_iterations"])
+        iterations += it2
+    messages = {
+        "ok": f"equilibrium found in {iterations} iterations",
+        "search-failed": "the wheel misses its rail (no finite gap on one side)",
+        "not-converged": "equilibrium iteration did not converge",
+    }
+    message = messages[status]
+    pose, searches = run(sinks, field_sampling=bool((opts["search"] or {}).get("field", True)))
+    loads, forces = _hertz_loads(searches, material)
+    patches: list[PatchSolution] = []
+    failed = []
+    if opts["spin_rate"] == "nominal":
+        omega_spin = case.rolling_speed_m_per_s / case.nominal_radius_m
+    else:  # "mean-rolling-radius" (validated above)
+        radii = []
+        for side in SIDES:
+            if searches[side].patches:
+                k = int(np.argmax(forces[side])) if len(forces[side]) else 0
+                radii.append(searches[side].patches[k].rolling_radius_m)
+        mean_radius = float(np.mean(radii)) if radii else case.nominal_radius_m
+        omega_spin = case.rolling_speed_m_per_s / mean_radius
+    for side in SIDES:
+        for k, geometry in enumerate(searches[side].patches):
+            x_d = pose.rotation.T @ (geometry.point_m - pose.centre_m)
+            kin = wheelset_creepage(
+                x_d,
+                geometry.frame[:, 2],
+                yaw_rad=case.yaw_rad,
+                roll_rad=pose.roll_rad,
+                centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
+                spin_rate_rad_per_s=omega_spin,
+            )
+            creepage = kin.creepage()
+            force = float(forces[side][k]) if target is not None else None
+            result = contact_model.solve(geometry, creepage, material, normal_force_N=force, options=opts["model"])
+            if not result.success:
+                failed.append(f"{side} patch {k}: {result.message}")
+            patches.append(PatchSolution(side, geometry, creepage, result))
+    if status == "ok" and failed:
+        status, message = "model-failed", "; ".join(failed)
+    if status == "ok" and not patches:
+        status, message = "no-contact", "no patch found"
+    return WheelsetCaseSolution(
+        success=status == "ok",
+        status=status,
+        message=message,
+        wall_time_s=time.perf_counter() - started,
+        vertical_position_m=pose.z_m,
+        roll_rad=pose.roll_rad,
+        patches=patches,
+        wheel_vertical_load_N=loads,
+        iterations=iterations,
+        pose=pose,
+    )

@@ -1,0 +1,152 @@
+"""Wheelset contact case (Manchester benchmark A-2.2 set-up): equilibrium, placement, creepages, bad input.
+
+Independent reference for the equilibrium: the roll angles that the CONTACT program (E.A.H. Vollebregt,
+open source, Apache-2.0) computed for the same profiles, gauge, flange-back distance and load, recorded in its
+example input ``examples/mbench_a22_right.inp`` (repository eve70a/CONTACT): theta = -3.5540e-4 rad at 5.0 mm,
+-6.2720e-4 at 6.0 mm, -4.3760e-3 at 6.5 mm (the jump: flange contact), -6.3930e-3 at 7.0 mm and -1.126431e-2 at
+10.0 mm (yaw 2.4 mrad per mm of shift). Our profile splines are smoothed over 2 mm, so a few 1e-3 relative
+difference is expected.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from rigid_dynamics.contact.track import build_track
+from rigid_dynamics.contact.wheelset_case import WheelsetCase, solve_wheelset_case
+from rigid_dynamics.materials import STEEL
+
+CANT = math.atan(1 / 40)
+
+
+def a22(shift_mm, **kwargs):
+    args = dict(
+        wheel_profile="MBench_S1002_v3",
+        rail_profile="MBench_UIC60_v3",
+        lateral_shift_m=shift_mm * 1e-3,
+        yaw_rad=shift_mm * 2.4e-3,
+        rail_inclination_rad=CANT,
+        wheel_load_N=10e3,
+        rolling_speed_m_per_s=2.0,
+    )
+    args.update(kwargs)
+    return WheelsetCase(**args)
+
+
+NO_FIELD = {"search": {"field": False}}
+
+
+def test_centred_wheelset_is_symmetric_and_carries_the_load():
+    sol = solve_wheelset_case(a22(0.0), STEEL, "hertz", NO_FIELD)
+    assert sol.success, sol.message
+    assert sol.roll_rad == pytest.approx(0.0, abs=1e-12)
+    for side in ("left", "right"):
+        assert sol.wheel_vertical_load_N[side] == pytest.approx(10e3, rel=1e-5)
+    left, right = (p for p in sol.patches)
+    assert left.side == "left" and right.side == "right"
+    np.testing.assert_allclose(left.geometry.point_m * [1, -1, 1], right.geometry.point_m, atol=1e-9)
+    assert left.geometry.contact_angle_rad == pytest.approx(right.geometry.contact_angle_rad, abs=1e-9)
+    # Free rolling at phi' = V/r0 without yaw (hand derivation, see test_creepage.py): xi = 1 - R_c/r0 with R_c the
+    # lever of the contact point (wheel point + q/2 along n), spin = -/+ sin(gamma)/r0 on the left/right wheel.
+    for patch, sign in ((left, -1), (right, 1)):
+        g = patch.geometry
+        lever = g.rolling_radius_m * math.cos(0) - 0.5 * g.approach_m * math.cos(g.contact_angle_rad)
+        assert patch.creepage.longitudinal == pytest.approx(1 - lever / 0.46, abs=1e-7)
+        assert patch.creepage.spin_1_per_m == pytest.approx(sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6)
+        assert patch.creepage.lateral == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("shift_mm", "roll_ref", "flange"),
+    [(5.0, -3.5540e-4, False), (6.0, -6.2720e-4, False), (6.5, -4.3760e-3, True), (7.0, -6.3930e-3, True),
+     (10.0, -1.126431e-2, True)],
+)  # fmt: skip
+def test_roll_and_flange_contact_match_contact_program(shift_mm, roll_ref, flange):
+    sol = solve_wheelset_case(a22(shift_mm), STEEL, "hertz", NO_FIELD)
+    assert sol.success, sol.message
+    assert sol.roll_rad == pytest.approx(roll_ref, rel=0.03)
+    for side in ("left", "right"):
+        assert sol.wheel_vertical_load_N[side] == pytest.approx(10e3, rel=1e-5)
+    right_angles = [p.geometry.contact_angle_rad for p in sol.patches if p.side == "right"]
+    assert (max(right_angles) > 0.7) == flange  # flange contact: contact angle ~ 40-70 deg
+    left_angles = [p.geometry.contact_angle_rad for p in sol.patches if p.side == "left"]
+    assert max(left_angles) < 0.05  # the left wheel stays on its tread
+
+
+def test_approach_control_sets_the_deepest_approach_on_each_wheel():
+    sol = solve_wheelset_case(a22(3.0, wheel_load_N=None, approach_m=2e-5), STEEL, "hertz", NO_FIELD)
+    assert sol.success, sol.message
+    for side in ("left", "right"):
+        deepest = max(p.geometry.approach_m for p in sol.patches if p.side == side)
+        assert deepest == pytest.approx(2e-5, rel=1e-5)
+
+
+def test_mean_rolling_radius_spin_gives_opposite_longitudinal_creepages():
+    """With phi' = V / mean(R_left, R_right) the wheels' longitudinal creepages are nearly equal and opposite,
+    as in CONTACT's A-2.2 input: xi = 1 - phi' cos(psi) r_z / V with r_z the contact point's lever (R minus half
+    the approach along n), so xi_left + xi_right = O(psi^2 + q/r0)."""
+    options = {"search": {"field": False}, "spin_rate": "mean-rolling-radius"}
+    case = a22(3.0)
+    sol = solve_wheelset_case(case, STEEL, "hertz", options)
+    xi = {p.side: p.creepage.longitudinal for p in sol.patches}
+    q = max(p.geometry.approach_m for p in sol.patches)
+    assert abs(xi["left"] + xi["right"]) < case.yaw_rad**2 + 2 * q / 0.46
+    assert abs(xi["left"]) > 5e-4
+
+
+def test_patch_fields_and_rail_coordinates_are_filled():
+    sol = solve_wheelset_case(a22(7.0), STEEL, "hertz")
+    flange = max((p for p in sol.patches if p.side == "right"), key=lambda p: p.geometry.contact_angle_rad)
+    g = flange.geometry
+    assert g.undeformed is not None and g.undeformed.distance_m.shape == (31, 31)
+    assert np.nanmin(g.undeformed.distance_m) == pytest.approx(-g.approach_m, rel=0.05)
+    y_rail, z_rail = g.contact_point_rail_m
+    assert -0.045 < y_rail < -0.030 and 0.0 < z_rail < 0.015  # on the gauge face, below the top
+    assert g.rolling_radius_m > 0.47  # up the flange
+
+
+def test_canted_rail_file_is_not_canted_twice_and_flange_is_outside_r0():
+    track = build_track(a22(0.0))
+    assert track.rails["right"].cant_rad == pytest.approx(0.0, abs=1e-15)
+    vertical = build_track(a22(0.0, rail_profile="uic60_true"))
+    assert vertical.rails["right"].cant_rad == pytest.approx(CANT, rel=1e-12)
+    # S1002: flange height 28 mm above the tape circle, so the flange tip radius is r0 + 28 mm.
+    wheel = track.wheels["right"]
+    y = np.linspace(*wheel.y_range_m, 4001)
+    radius = wheel.evaluate(np.full_like(y, np.pi / 2), y)[0]
+    assert np.nanmax(radius) == pytest.approx(0.46 + 0.028, abs=2e-4)
+    assert wheel.evaluate(np.pi / 2, 0.75)[0] == pytest.approx(0.46, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"wheel_profile": ""}, "wheel_profile = ''"),
+        ({"lateral_shift_m": float("nan")}, "lateral_shift_m = nan"),
+        ({"gauge_m": -1.0}, "gauge_m = -1.0: expected > 0"),
+        ({"flange_back_distance_m": 1.5}, "flange_back_distance_m = 1.5"),
+        ({"yaw_rad": 0.5}, "yaw_rad = 0.5"),
+        ({"wheel_load_N": None}, "expected exactly one"),
+        ({"approach_m": 1e-5}, "expected exactly one"),
+        ({"wheel_load_N": -3.0}, "wheel_load_N = -3.0"),
+        ({"gauge_height_m": -0.01}, "gauge_height_m = -0.01"),
+        ({"rail_inclination_rad": 0.3}, "rail_inclination_rad = 0.3"),
+        ({"rolling_speed_m_per_s": 0.0}, "rolling_speed_m_per_s = 0.0"),
+    ],
+)
+def test_bad_case_raises(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        a22(0.0, **kwargs)
+
+
+def test_bad_options_and_model_raise():
+    case = a22(0.0)
+    with pytest.raises(ValueError, match="option 'grid'"):
+        solve_wheelset_case(case, STEEL, "hertz", {"grid": 1})
+    with pytest.raises(ValueError, match="spin_rate = 'fast'"):
+        solve_wheelset_case(case, STEEL, "hertz", {"spin_rate": "fast"})
+    with pytest.raises(ValueError, match="contact model = 'nope'"):
+        solve_wheelset_case(case, STEEL, "nope")
+    with pytest.raises(ValueError, match="no_such_profile"):
+        solve_wheelset_case(a22(0.0, rail_profile="no_such_profile"), STEEL, "hertz")
