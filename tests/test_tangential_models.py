@@ -103,3 +103,35 @@ def test_auto_non_elliptic_goes_to_bem_or_reports_unavailable():
     r = get_model("auto").solve(g, Creepage(1e-4, 0, 0), MATERIAL)
     assert r.extra["selected_model"] == "bem"
     assert r.status in ("ok", "unavailable", "not-converged")
+
+
+@pytest.mark.parametrize("method", ["hertz", "linear", "vermeulen-johnson", "fastsim", "auto"])
+def test_solve_batch_agrees_with_the_per_patch_models(method):
+    """Consistency of two code paths (vectorised batch vs registry model), not a physics reference."""
+    import numpy as np
+
+    from rigid_dynamics.contact.models import solve_batch
+
+    rng = np.random.default_rng(11)
+    n = 12
+    A, B = rng.uniform(0.3, 3.0, n), rng.uniform(0.3, 60.0, n)
+    force = rng.uniform(2e4, 1e5, n)
+    force[0] = -1.0
+    xi, eta, phi = rng.uniform(-2e-3, 2e-3, n), rng.uniform(-2e-3, 2e-3, n), rng.uniform(-1, 1, n)
+    xi[1], eta[1], phi[1] = 1e-7, 0.0, 0.0
+    phi[2] = 0.0
+    batch = solve_batch(method, A, B, xi, eta, phi, MATERIAL, normal_force_N=force)
+    for i in range(n):
+        one = get_model(method).solve(
+            ContactGeometry(A[i], B[i]), Creepage(xi[i], eta[i], phi[i]), MATERIAL, normal_force_N=force[i]
+        )
+        assert batch.normal_force_N[i] == pytest.approx(one.normal_force_N, rel=1e-12)
+        assert batch.creep_force_long_N[i] == pytest.approx(one.creep_force_long_N, rel=1e-10, abs=1e-9)
+        assert batch.creep_force_lat_N[i] == pytest.approx(one.creep_force_lat_N, rel=1e-10, abs=1e-9)
+        if method == "auto" and one.status == "ok":
+            assert batch.method[i] == one.extra["selected_model"]
+    assert batch.method[0] == "none"
+    with pytest.raises(ValueError, match="method"):
+        solve_batch("bem", A, B, xi, eta, phi, MATERIAL, normal_force_N=force)
+    with pytest.raises(ValueError, match="unknown option"):
+        solve_batch(method, A, B, xi, eta, phi, MATERIAL, normal_force_N=force, options={"grid": 3})

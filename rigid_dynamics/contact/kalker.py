@@ -49,6 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 from scipy.interpolate import PchipInterpolator
 
 _DATA_FILE = Path(__file__).resolve().parent / "data" / "kalker_creep_coefficients.csv"
@@ -114,23 +115,81 @@ KALKER_TABLE = _load_table()
 _LOG_INTERP = PchipInterpolator(
     np.log(KALKER_TABLE.a_over_b), np.log(KALKER_TABLE.values.reshape(len(KALKER_TABLE.a_over_b), 12)), axis=0
 )
+# the same piecewise cubics as plain arrays for the compiled kernels: breakpoints and coefficients
+_PP_X = np.ascontiguousarray(_LOG_INTERP.x)
+_PP_C = np.ascontiguousarray(_LOG_INTERP.c)  # (4, 18, 12): column = 3 * coefficient + nu column
+_NU0, _NU1, _NU2 = TABLE_POISSON_RATIOS
+_LOG4 = math.log(4.0)
 
 
-def _nu_weights(nu: np.ndarray) -> np.ndarray:
-    """Lagrange weights (n, 3) of the quadratic through nu = 0, 0.25, 0.5."""
-    n0, n1, n2 = TABLE_POISSON_RATIOS
-    w0 = (nu - n1) * (nu - n2) / ((n0 - n1) * (n0 - n2))
-    w1 = (nu - n0) * (nu - n2) / ((n1 - n0) * (n1 - n2))
-    w2 = (nu - n0) * (nu - n1) / ((n2 - n0) * (n2 - n1))
-    return np.stack([w0, w1, w2], axis=-1)
+@njit(cache=True)
+def _table_one(log_r, nu, out):
+    """Interpolated table at ln(a/b) inside the table: PCHIP in ln(a/b), quadratic of 1/C in nu."""
+    i = np.searchsorted(_PP_X, log_r) - 1
+    i = min(max(i, 0), _PP_X.shape[0] - 2)
+    t = log_r - _PP_X[i]
+    w0 = (nu - _NU1) * (nu - _NU2) / ((_NU0 - _NU1) * (_NU0 - _NU2))
+    w1 = (nu - _NU0) * (nu - _NU2) / ((_NU1 - _NU0) * (_NU1 - _NU2))
+    w2 = (nu - _NU0) * (nu - _NU1) / ((_NU2 - _NU0) * (_NU2 - _NU1))
+    for c in range(4):
+        inv = 0.0
+        for j in range(3):
+            col = 3 * c + j
+            v = ((_PP_C[0, i, col] * t + _PP_C[1, i, col]) * t + _PP_C[2, i, col]) * t + _PP_C[3, i, col]
+            w = w0 if j == 0 else (w1 if j == 1 else w2)
+            inv += w * math.exp(-v)
+        out[c] = 1.0 / inv
 
 
-def _table_interp(a_over_b: np.ndarray, nu: np.ndarray) -> np.ndarray:
-    """Interpolated table (n, 4) at a/b inside [0.1, 10]."""
-    logc = _LOG_INTERP(np.log(a_over_b)).reshape(-1, 4, 3)
-    inv = np.exp(-logc)
-    w = _nu_weights(nu)[:, None, :]
-    return 1.0 / np.sum(w * inv, axis=-1)
+@njit(cache=True)
+def _asymptote_one(a_over_b, nu, out):
+    """Kalker's slender-ellipse asymptotes (module docstring); C33 = nan for b/a -> 0."""
+    if a_over_b <= 1.0:
+        g = a_over_b
+        out[0] = math.pi**2 / (4.0 * (1.0 - nu))
+        out[1] = math.pi**2 / 4.0
+        out[2] = math.pi * math.sqrt(g) / (3.0 * (1.0 - nu)) * (1.0 + nu * (math.log(16.0 / g) - 5.0))
+        out[3] = math.pi**2 / (16.0 * (1.0 - nu) * g)
+    else:
+        g = 1.0 / a_over_b
+        lam = math.log(16.0 / (g * g))
+        k = 3.0 - _LOG4
+        out[0] = 2.0 * math.pi / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu))
+        den = (1.0 - nu) * lam + 2.0 * nu
+        out[1] = 2.0 * math.pi / g * (1.0 + (1.0 - nu) * k / den) / den
+        out[2] = 2.0 * math.pi / (3.0 * g**1.5 * ((1.0 - nu) * lam - 2.0 + 4.0 * nu))
+        out[3] = math.nan
+
+
+@njit(cache=True)
+def _coefficients_many(a_over_b, nu, out):
+    edge = np.empty(4)
+    asym_edge = np.empty(4)
+    asym = np.empty(4)
+    lo = _PP_X[0]
+    hi = _PP_X[-1]
+    for i in range(a_over_b.shape[0]):
+        r = a_over_b[i]
+        log_r = math.log(r)
+        if lo <= log_r <= hi:
+            _table_one(log_r, nu[i], out[i])
+            continue
+        edge_r = _EDGE if r < 1.0 else 1.0 / _EDGE
+        _table_one(lo if r < 1.0 else hi, nu[i], edge)
+        _asymptote_one(edge_r, nu[i], asym_edge)
+        _asymptote_one(r, nu[i], asym)
+        g_frac = (r if r < 1.0 else 1.0 / r) / _EDGE
+        for c in range(4):
+            if math.isnan(asym[c]):
+                out[i, c] = edge[c]  # C33 for b/a < 0.1: held at the table edge
+            else:
+                out[i, c] = asym[c] * (1.0 + (edge[c] / asym_edge[c] - 1.0) * g_frac)
+
+
+@njit(cache=True)
+def _asymptotes_many(a_over_b, nu, out):
+    for i in range(a_over_b.shape[0]):
+        _asymptote_one(a_over_b[i], nu[i], out[i])
 
 
 def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
@@ -141,26 +200,9 @@ def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
     """
     a_over_b = np.atleast_1d(np.asarray(a_over_b, dtype=float))
     nu = np.broadcast_to(np.asarray(poisson_ratio, dtype=float), a_over_b.shape)
-    out = np.empty(a_over_b.shape + (4,))
-    short = a_over_b <= 1.0
-    g = np.where(short, a_over_b, 1.0 / a_over_b)
-    # a/b -> 0 (rolling direction short)
-    c11_s = math.pi**2 / (4.0 * (1.0 - nu))
-    c22_s = np.full_like(g, math.pi**2 / 4.0)
-    c23_s = math.pi * np.sqrt(g) / (3.0 * (1.0 - nu)) * (1.0 + nu * (np.log(16.0 / g) - 5.0))
-    c33_s = math.pi**2 / (16.0 * (1.0 - nu) * g)
-    # b/a -> 0 (rolling direction long)
-    lam = np.log(16.0 / g**2)
-    k = 3.0 - math.log(4.0)
-    c11_l = 2.0 * math.pi / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu))
-    den = (1.0 - nu) * lam + 2.0 * nu
-    c22_l = 2.0 * math.pi / g * (1.0 + (1.0 - nu) * k / den) / den
-    c23_l = 2.0 * math.pi / (3.0 * g**1.5 * ((1.0 - nu) * lam - 2.0 + 4.0 * nu))
-    out[..., 0] = np.where(short, c11_s, c11_l)
-    out[..., 1] = np.where(short, c22_s, c22_l)
-    out[..., 2] = np.where(short, c23_s, c23_l)
-    out[..., 3] = np.where(short, c33_s, np.nan)
-    return out
+    out = np.empty((a_over_b.size, 4))
+    _asymptotes_many(np.ascontiguousarray(a_over_b.ravel()), np.ascontiguousarray(nu.ravel()), out)
+    return out.reshape(a_over_b.shape + (4,))
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,24 +234,6 @@ def kalker_coefficients(a_over_b, poisson_ratio) -> CreepCoefficients:
         raise ValueError(f"a_over_b = {a_over_b!r}: expected finite values > 0")
     if not (np.all(np.isfinite(nu)) and np.all((nu > -1.0) & (nu <= 0.5))):
         raise ValueError(f"poisson_ratio = {poisson_ratio!r}: expected values in (-1, 0.5]")
-    r = a_over_b.ravel()
-    nu = nu.ravel()
-    out = np.empty((r.size, 4))
-    inside = (r >= _EDGE) & (r <= 1.0 / _EDGE)
-    if np.any(inside):
-        out[inside] = _table_interp(r[inside], nu[inside])
-    for mask, edge in ((r < _EDGE, _EDGE), (r > 1.0 / _EDGE, 1.0 / _EDGE)):
-        if not np.any(mask):
-            continue
-        rm, num = r[mask], nu[mask]
-        edge_r = np.full_like(rm, edge)
-        at_edge = _table_interp(edge_r, num)
-        asym_edge = slender_asymptotes(edge_r, num)
-        asym = slender_asymptotes(rm, num)
-        g_frac = np.where(rm < 1.0, rm, 1.0 / rm) / _EDGE
-        rho = at_edge / asym_edge
-        matched = asym * (1.0 + (rho - 1.0) * g_frac[:, None])
-        # C33 for b/a < 0.1: no asymptote -> held at the table edge
-        matched[:, 3] = np.where(np.isnan(asym[:, 3]), at_edge[:, 3], matched[:, 3])
-        out[mask] = matched
+    out = np.empty((a_over_b.size, 4))
+    _coefficients_many(np.ascontiguousarray(a_over_b.ravel()), np.ascontiguousarray(nu.ravel()), out)
     return CreepCoefficients(*(out[:, i].reshape(shape) for i in range(4)))

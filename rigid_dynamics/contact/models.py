@@ -28,8 +28,14 @@ option ``tolerance`` (default 0.05):
    s = G (ab)^1.5 C23 |phi| / max(|T_lin|, mu N) (the spin's linear lateral force against the
    force level of the patch): Vermeulen-Johnson treats spin only through that linear term, so its
    error is bounded by this share; ``vermeulen-johnson`` when s < tolerance, else ``fastsim``.
-   (Calibration: for the CONTACT large-spin case, s = 1.0 and VJ's lateral force is 12 % off the
+   (Calibration: for the CONTACT large-spin case, s = 1.0 and VJ's lateral force is 12.5 % off the
    exact value while FASTSIM's is 2.5 % off; see benchmarks/results/analytic.md.)
+
+The result of ``auto`` is the chosen model's result (``method`` is its name) with
+``extra["selected_model"]`` and ``extra["selection_reason"]``.
+
+:func:`solve_batch` is the vectorised entry point for many patches at once (the dynamics):
+Hertz + one law (or the auto choice per patch) on arrays, returning :class:`AnalyticBatch`.
 """
 
 from __future__ import annotations
@@ -37,10 +43,13 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
+from dataclasses import dataclass
 
-from rigid_dynamics.contact.fastsim import FLEXIBILITIES, TRACTION_BOUNDS, fastsim_fields
+import numpy as np
+
+from rigid_dynamics.contact.fastsim import FLEXIBILITIES, TRACTION_BOUNDS, fastsim_batch, fastsim_fields
 from rigid_dynamics.contact.hertz import HertzBatch, hertz_solve_batch
-from rigid_dynamics.contact.kalker import kalker_coefficients
+from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
 from rigid_dynamics.contact.linear import linear_creep_forces
 from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
@@ -372,3 +381,140 @@ class AutoModel:
         result = model.solve(geometry, creepage, material, normal_force_N=normal_force_N, options=per_model.get(chosen))
         result.extra.update({"selected_model": chosen, "selection_reason": reason})
         return result
+
+
+@dataclass(frozen=True, eq=False)
+class AnalyticBatch:
+    """Results of :func:`solve_batch` for many elliptic patches (arrays of one shape).
+
+    Forces act on the wheel, contact frame (x rolling, y lateral, z normal). ``method`` holds the
+    model used per patch (for ``auto``: its choice; "none" where there is no contact).
+    ``spin_moment_Nm`` is 0 for ``hertz`` and ``vermeulen-johnson`` (which have none).
+    """
+
+    normal_force_N: np.ndarray
+    approach_m: np.ndarray
+    semi_axis_long_m: np.ndarray
+    semi_axis_lat_m: np.ndarray
+    max_pressure_Pa: np.ndarray
+    creep_force_long_N: np.ndarray
+    creep_force_lat_N: np.ndarray
+    spin_moment_Nm: np.ndarray
+    method: np.ndarray
+    converged: np.ndarray
+
+
+BATCH_METHODS = ("hertz", "linear", "vermeulen-johnson", "fastsim", "auto")
+
+
+def solve_batch(
+    method: str,
+    curvature_long_1_per_m,
+    curvature_lat_1_per_m,
+    longitudinal,
+    lateral,
+    spin_1_per_m,
+    material: Material,
+    *,
+    normal_force_N=None,
+    approach_m=None,
+    options: Mapping | None = None,
+) -> AnalyticBatch:
+    """Vectorised entry point for the dynamics: Hertz + the tangential law for many patches.
+
+    Same physics as the registry models (module docstring), without per-patch Python objects.
+    Exactly one of ``normal_force_N`` / ``approach_m`` (arrays broadcast with the curvatures and
+    creepages). Options: those of the chosen model (fastsim: nx, ny, traction_bound, flexibility;
+    auto: tolerance and the fastsim options).
+
+    Raises:
+        ValueError: unknown method or option, or bad input.
+    """
+    if method not in BATCH_METHODS:
+        raise ValueError(f"method = {method!r}: expected one of {', '.join(BATCH_METHODS)}")
+    fastsim_defaults = {k: v for k, v in FastsimModel.defaults.items() if k != "fields"}
+    defaults = {"fastsim": fastsim_defaults, "auto": {"tolerance": 0.05, **fastsim_defaults}}.get(method, {})
+    opts = _options(options, defaults, method)
+    hz = hertz_solve_batch(
+        curvature_long_1_per_m,
+        curvature_lat_1_per_m,
+        normal_force_N=normal_force_N,
+        approach_m=approach_m,
+        shear_modulus_Pa=material.shear_modulus_Pa,
+        poisson_ratio=material.poisson_ratio,
+    )
+    shape = hz.normal_force_N.shape
+    xi, eta, phi = (np.broadcast_to(np.asarray(v, dtype=float), shape) for v in (longitudinal, lateral, spin_1_per_m))
+    contact = hz.normal_force_N > 0
+    a = np.where(contact, hz.semi_axis_long_m, 1.0)
+    b = np.where(contact, hz.semi_axis_lat_m, 1.0)
+    fx = np.zeros(shape)
+    fy = np.zeros(shape)
+    mz = np.zeros(shape)
+    used = np.full(shape, method if method != "auto" else "", dtype=object)
+    if method != "hertz":
+        coef = kalker_coefficients(a / b, material.poisson_ratio)
+        tx, ty, tz = linear_creep_forces(
+            a,
+            b,
+            xi,
+            eta,
+            phi,
+            shear_modulus_Pa=material.shear_modulus_Pa,
+            poisson_ratio=material.poisson_ratio,
+            coefficients=coef,
+        )
+        mu_n = material.friction_coefficient * hz.normal_force_N
+        vx, vy = vermeulen_johnson_saturation(tx, ty, hz.normal_force_N, material.friction_coefficient)
+        fs_kw = (
+            {k: opts[k] for k in ("nx", "ny", "traction_bound", "flexibility")} if method in ("fastsim", "auto") else {}
+        )
+        if method == "auto":
+            tol = opts["tolerance"]
+            t_lin = np.hypot(tx, ty)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                w = np.where(mu_n > 0, t_lin / (3.0 * mu_n), np.inf)
+                share = material.shear_modulus_Pa * (a * b) ** 1.5 * coef.c23 * np.abs(phi) / np.maximum(t_lin, mu_n)
+            share = np.nan_to_num(share)
+            used = np.where(w < tol, "linear", np.where(share < tol, "vermeulen-johnson", "fastsim")).astype(object)
+        if method == "linear":
+            fx, fy, mz = tx, ty, tz
+        elif method == "vermeulen-johnson":
+            fx, fy = vx, vy
+        elif method == "fastsim":
+            r = fastsim_batch(
+                a, b, hz.normal_force_N, xi, eta, phi, shear_modulus_Pa=material.shear_modulus_Pa,
+                poisson_ratio=material.poisson_ratio, friction_coefficient=material.friction_coefficient,
+                coefficients=coef, **fs_kw,
+            )  # fmt: skip
+            fx, fy, mz = r.creep_force_long_N, r.creep_force_lat_N, r.spin_moment_Nm
+        else:
+            lin = used == "linear"
+            vj = used == "vermeulen-johnson"
+            fx = np.where(lin, tx, np.where(vj, vx, 0.0))
+            fy = np.where(lin, ty, np.where(vj, vy, 0.0))
+            mz = np.where(lin, tz, 0.0)
+            fs = used == "fastsim"
+            if np.any(fs & contact):
+                sel = fs & contact
+                sub = CreepCoefficients(*(np.asarray(c)[sel] for c in (coef.c11, coef.c22, coef.c23, coef.c33)))
+                r = fastsim_batch(
+                    a[sel], b[sel], hz.normal_force_N[sel], xi[sel], eta[sel], phi[sel],
+                    shear_modulus_Pa=material.shear_modulus_Pa, poisson_ratio=material.poisson_ratio,
+                    friction_coefficient=material.friction_coefficient, coefficients=sub, **fs_kw,
+                )  # fmt: skip
+                fx[sel], fy[sel], mz[sel] = r.creep_force_long_N, r.creep_force_lat_N, r.spin_moment_Nm
+    zero = np.zeros(shape)
+    used = np.where(contact, used, "none")
+    return AnalyticBatch(
+        normal_force_N=hz.normal_force_N,
+        approach_m=hz.approach_m,
+        semi_axis_long_m=hz.semi_axis_long_m,
+        semi_axis_lat_m=hz.semi_axis_lat_m,
+        max_pressure_Pa=hz.max_pressure_Pa,
+        creep_force_long_N=np.where(contact, fx, zero),
+        creep_force_lat_N=np.where(contact, fy, zero),
+        spin_moment_Nm=np.where(contact, mz, zero),
+        method=used,
+        converged=hz.converged,
+    )
