@@ -157,3 +157,79 @@ def test_bad_side_and_option():
         )  # fmt: skip
     with pytest.raises(ValueError, match="yaw_rad = nan"):
         WheelsetPose(yaw_rad=float("nan"))
+
+
+def dense_scan_regions(track, pose, side, d_alpha=0.002, d_y=1e-4):
+    """Brute force on the real profiles: h on a dense (alpha, y_d) grid with the numpy distance function (not the
+    compiled kernels the search uses), connected regions with h < 0, deepest point of each."""
+    from scipy import ndimage
+
+    from rigid_dynamics.contact.search import _SideGeometry
+
+    wheel, rail = track.fast[side]
+    geo = _SideGeometry(wheel, rail, pose, side, wheel.y_range_m, rail.y_range_m)
+    alphas = np.pi / 2 + np.arange(-0.1, 0.1 + 1e-12, d_alpha)
+    ys = np.arange(*wheel.y_range_m, d_y)
+    a, y = np.meshgrid(alphas, ys, indexing="ij")
+    h = geo.distance(a, y, 12)[0]
+    labels, count = ndimage.label(h < 0)
+    regions = []
+    for k in range(1, count + 1):
+        idx = np.argmin(np.where(labels == k, h, np.inf))
+        regions.append((y.flat[idx], -h.flat[idx]))
+    return sorted(regions)
+
+
+@pytest.mark.parametrize(
+    ("shift_mm", "z_m", "roll_rad", "n_right"),
+    [(5.0, -0.4599978, -3.5488e-4, 2), (6.5, -0.4629754, -4.2829e-3, 1), (0.0, -0.45980, 0.0, 1)],
+)
+def test_s1002_uic60_search_finds_every_patch_of_a_dense_scan(shift_mm, z_m, roll_rad, n_right):
+    """S1002 on UIC60 1:40 at the A-2.2 poses (tread + flange-root two-point contact at 5 mm, flange at 6.5 mm):
+    the search returns one patch per interpenetration region of a dense brute-force scan, as deep or deeper."""
+    from rigid_dynamics.contact.track import build_track
+    from rigid_dynamics.contact.wheelset_case import WheelsetCase
+
+    case = WheelsetCase(
+        "MBench_S1002_v3", "MBench_UIC60_v3", lateral_shift_m=shift_mm * 1e-3, yaw_rad=shift_mm * 2.4e-3,
+        rail_inclination_rad=math.atan(1 / 40), wheel_load_N=1e4,
+    )  # fmt: skip
+    track = build_track(case)
+    pose = WheelsetPose(y_m=case.lateral_shift_m, z_m=z_m, yaw_rad=case.yaw_rad, roll_rad=roll_rad)
+    for side in ("left", "right"):
+        got = track.search(pose, side, {"field": False})
+        brute = dense_scan_regions(track, pose, side)
+        assert len(got.patches) == len(brute), (side, got.patches, brute)
+        if side == "right":
+            assert len(brute) == n_right
+        found = sorted(zip(got.wheel_parameters[:, 1], (p.approach_m for p in got.patches), strict=True))
+        for (y_b, q_b), (y_s, q_s) in zip(brute, found, strict=True):
+            assert abs(y_b - y_s) < 1.5e-3
+            assert q_s >= q_b * (1 - 1e-9)
+            assert q_s == pytest.approx(q_b, rel=0.05, abs=2e-7)
+
+
+def test_irregular_rail_uses_general_path_and_matches_tabulated():
+    """A rail with a zero-amplitude irregularity takes the general (numpy, exact-surface) path; it must find the
+    same patch as the compiled path on the tabulated ideal surfaces (two implementations of eq 11)."""
+    from rigid_dynamics.contact.track import build_track
+    from rigid_dynamics.contact.wheelset_case import WheelsetCase
+
+    class Flat:
+        def evaluate(self, x, y):
+            zero = np.zeros(np.broadcast(x, y).shape)
+            return (zero,) * 6
+
+    case = WheelsetCase(
+        "MBench_S1002_v3", "MBench_UIC60_v3", lateral_shift_m=0.003, yaw_rad=0.0072,
+        rail_inclination_rad=math.atan(1 / 40), wheel_load_N=1e4,
+    )  # fmt: skip
+    ideal = build_track(case)
+    bumpy = build_track(case, rail_irregularities={"right": (Flat(),)})
+    pose = WheelsetPose(y_m=0.003, z_m=-0.4599, yaw_rad=0.0072)
+    a = ideal.search(pose, "right", {"field": False})
+    b = bumpy.search(pose, "right", {"field": False})
+    assert len(a.patches) == len(b.patches) == 1
+    assert b.patches[0].approach_m == pytest.approx(a.patches[0].approach_m, rel=1e-6)
+    np.testing.assert_allclose(b.patches[0].point_m, a.patches[0].point_m, atol=1e-6)
+    assert b.patches[0].curvature_lat_1_per_m == pytest.approx(a.patches[0].curvature_lat_1_per_m, rel=1e-6)
