@@ -171,3 +171,48 @@ def test_bad_input_raises():
         hertz_solve_batch(1.0, 1.0, normal_force_N=1.0, shear_modulus_Pa=G, poisson_ratio=0.5)
     with pytest.raises(ValueError, match="normal_force_N"):
         hertz_solve_batch(1.0, 1.0, normal_force_N=np.inf, shear_modulus_Pa=G, poisson_ratio=NU)
+
+
+@pytest.mark.parametrize(("A", "B"), [(0.8, 2.4), (2.4, 0.8), (1.0, 1.0 + 1e-6), (0.5, 500.0), (30.0, 0.7)])
+def test_seed_equations_34_to_38_as_printed(A, B):
+    """Seed eq 34-38 evaluated literally (brentq on eq 34 with scipy's K, E) give the same patch.
+
+    Note on eq 35: for D11 > D22 the seed sets k_e = 1/(1 - m^2); put into eq 36-37 as printed this
+    does not reproduce Hertz (checked below). With k_e = 1 - m^2 in eq 36-37 for both orientations,
+    eq 37 gives the semi-axis along the smaller relative curvature (as REFERENCES.md states) and
+    b = a sqrt(k_e) the other one; that is the reading used here.
+    """
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipk
+
+    def kalker_dce(m2):
+        k, e = ellipk(m2), ellipe(m2)
+        d = (k - e) / m2
+        b_ = k - d
+        c = (d - b_) / m2
+        return d, c, e
+
+    def axial(m2):  # eq 34
+        d, c, e = kalker_dce(m2)
+        return m2 * (d - c) / e
+
+    cos_t = abs(A - B) / (A + B)
+    m2 = brentq(lambda m2: axial(m2) - cos_t, 1e-9, 1 - 1e-12, xtol=1e-15, rtol=1e-15)
+    K, E = ellipk(m2), ellipe(m2)
+    q = 2.0e-5
+
+    def eq36_37(k_e):
+        force = 2 * math.pi * G / (3 * (1 - NU)) * math.sqrt(E * q**3 / ((A + B) * k_e * K**3))  # eq 36, h -> -q
+        a_ce = (3 * force * (1 - NU) * E / (2 * math.pi * G * (A + B) * k_e)) ** (1 / 3)  # eq 37
+        return force, a_ce, a_ce * math.sqrt(k_e)  # eq 38
+
+    force, major, minor = eq36_37(1 - m2)
+    sol = hertz_solve_batch(A, B, approach_m=q, shear_modulus_Pa=G, poisson_ratio=NU)
+    a_x, b_y = (major, minor) if A <= B else (minor, major)
+    rtol = 1e-6 if abs(A - B) < 1e-3 else 1e-9  # brentq on the printed form loses digits near A = B
+    assert sol.normal_force_N == pytest.approx(force, rel=rtol)
+    assert sol.semi_axis_long_m == pytest.approx(a_x, rel=rtol)
+    assert sol.semi_axis_lat_m == pytest.approx(b_y, rel=rtol)
+    if A > B:
+        literal_force, _, _ = eq36_37(1 / (1 - m2))
+        assert abs(literal_force / force - 1) > 0.1
