@@ -114,12 +114,15 @@ class WheelFlat:
 
     Shapes (s = r_w * wrap(a - a0): arc length from the flat centre, r_w the wheel radius):
 
-    * ``"rounded"`` (after wear; the shape commonly used for flats that have run for some time,
-      e.g. T.X. Wu & D.J. Thompson, "A hybrid model for the noise generation due to railway wheel
-      flats", J. Sound Vib. 251 (2002) 115-139):
+    * ``"rounded"`` (after wear, the haversine shape used in the wheel-flat literature for flats that
+      have run for some time, e.g. T.X. Wu & D.J. Thompson, "A hybrid model for the noise generation
+      due to railway wheel flats", J. Sound Vib. 251 (2002) 115-139 -- cited from memory, the paper
+      was not available here):
           R_irr = -(d/2) (1 + cos(2 pi s / L))   for |s| <= L/2, else 0,
-      C1 at the ends; default depth d = L^2 / (16 r_w) (the depth of a new flat of length L/sqrt(2):
-      rounding keeps the depth and lengthens the flat).
+      C1 at the ends; default depth d = L^2 / (16 r_w), the relation given in the project brief: it is
+      the depth of a new (chord) flat of length L/sqrt(2), d = (L/sqrt 2)^2 / (8 r_w), i.e. rounding
+      keeps the depth and lengthens the flat by sqrt(2). (A fresh chord flat of length L has
+      d = L^2/(8 r_w), not L^2/(16 r_w).)
     * ``"new"`` (freshly worn chord): the wheel is cut by the plane at distance r_w - d from the axle:
           R_irr = (r_w - d) / cos(a - a0) - r_w   for |a - a0| <= theta/2, cos(theta/2) = (r_w - d)/r_w,
       with the exact chord depth d = r_w - sqrt(r_w^2 - L^2/4) (~ L^2/(8 r_w)) by default. Kinks at the
@@ -199,7 +202,7 @@ def _check_grid(name, grid, minimum=4):
     return g
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MeasuredWheelIrregularity:
     """Measured R_irr(a, y) on a grid, periodic in a: bicubic spline, periodic cubic in a, cubic (not-a-knot) in y.
 
@@ -304,7 +307,7 @@ class RailCorrugation:
         return A * c * w, -A * k * s * w, A * c * dw, -A * k * k * c * w, -A * k * s * dw, A * c * d2w
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MeasuredRailIrregularity:
     """Measured N_irr(x, y) on a grid: interpolating bicubic spline (scipy RectBivariateSpline, s = 0).
 
@@ -343,7 +346,7 @@ class MeasuredRailIrregularity:
         return tuple(out)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TabulatedRailDeflection:
     """Rail deflection N_d(x) from a table: interpolating cubic spline (not-a-knot); constant beyond the ends.
 

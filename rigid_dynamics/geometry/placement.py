@@ -134,7 +134,7 @@ def _sum_irregularities(items, u, v, what):
 
 
 # --------------------------------------------------------------------------------------------- wheel
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class WheelSurface:
     """Surface of one wheel, R(a, y_d) = R_id(y_d) + R_irr(a, y_d) (eq 5), in the wheelset frame.
 
@@ -220,7 +220,7 @@ class WheelSurface:
         return WheelSurfaceValues(R, R_a, R_y, R_aa, R_ay, R_yy)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class WheelsetGeometry:
     """Wheelset dimensions and wheel profile (the same profile on both wheels, mirrored on the left).
 
@@ -266,7 +266,7 @@ class WheelsetGeometry:
 
 
 # --------------------------------------------------------------------------------------------- rail
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _CantedRail:
     """The canted rail profile as a parametric curve (Y(t), Z(t)) with a lookup table for inversion."""
 
@@ -359,7 +359,7 @@ def _gauge_point(canted: _CantedRail, gauge_height_m):
     return min(cands)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RailSurface:
     """Surface of one rail, N(x, y) = N_d(x) + N_id(y) + N_irr(x, y) (eq 6), in the main frame (z down).
 
@@ -445,7 +445,7 @@ class RailSurface:
         return RailSurfaceValues(N, N_x, N_y, N_xx, N_xy, N_yy)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TrackGeometry:
     """Track: rail profile, gauge, gauge height and rail inclination (the same rail on both sides, mirrored left).
 

@@ -126,7 +126,7 @@ def find_self_intersection(y, z):
     return None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Profile:
     """A wheel or rail profile as points z_p(y_p) in the internal profile convention (module docstring).
 
@@ -139,6 +139,8 @@ class Profile:
         outline_y_m, outline_z_m: optional full outline in the same coordinates, including the parts
             trimmed away because they were vertical or overhanging (shape (m,), or empty). Useful for
             meshing and for gauge measurement; must not self-intersect.
+
+    Equality and hashing are by identity (the arrays are read-only).
 
     Raises:
         ValueError: non-finite points, unsorted or duplicate abscissae, fewer than 5 points,
@@ -237,13 +239,21 @@ def _parametric_smoothing(y, z, wavelength_mm):
     return ys, zs
 
 
+DOMAIN_TOLERANCE_M = 1e-12
+
+
+def _outside(y, lo, hi):
+    """True where y lies outside [lo, hi] by more than DOMAIN_TOLERANCE_M (rounding at the ends is accepted)."""
+    return ~((y >= lo - DOMAIN_TOLERANCE_M) & (y <= hi + DOMAIN_TOLERANCE_M))
+
+
 def _eval_checked(fun, y, derivative):
     if derivative not in (0, 1, 2):
         raise ValueError(f"derivative must be 0, 1 or 2, got {derivative!r}")
     return fun(np.asarray(y, dtype=float), derivative)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ProfileCurve:
     """Smooth C2 curve z_p(y_p) of a `Profile`, with analytic first and second derivatives.
 
@@ -289,11 +299,11 @@ class ProfileCurve:
         return self._y_range[1]
 
     def _eval(self, y, derivative):
-        y_mm = y * _MM_PER_M
+        outside = _outside(y, self.y_min_m, self.y_max_m)
+        y_mm = np.clip(y, self.y_min_m, self.y_max_m) * _MM_PER_M
         out = self._spline(y_mm, nu=derivative)
         # z[m](y[m]) = z_mm(1000 y)/1000: d^k/dy^k scales by 1000^(k-1)
         out = out * _MM_PER_M ** (derivative - 1)
-        outside = (y < self.y_min_m) | (y > self.y_max_m) | ~np.isfinite(y)
         return np.where(outside, np.nan, out)
 
     def z(self, y_m, derivative: int = 0):
@@ -353,7 +363,8 @@ class CircularArcCurve:
 
     def _eval(self, y, derivative):
         R = self.radius_m
-        u = y - self.centre_y_m
+        outside = _outside(y, self.y_min_m, self.y_max_m)
+        u = np.clip(y, self.y_min_m, self.y_max_m) - self.centre_y_m
         with np.errstate(invalid="ignore"):
             root = np.sqrt(R * R - u * u)
             if derivative == 0:
@@ -362,7 +373,6 @@ class CircularArcCurve:
                 out = self.sign * u / root
             else:
                 out = self.sign * R * R / root**3
-        outside = (y < self.y_min_m) | (y > self.y_max_m) | ~np.isfinite(y)
         return np.where(outside, np.nan, out)
 
     def z(self, y_m, derivative: int = 0):

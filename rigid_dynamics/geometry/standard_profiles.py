@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .profile import MIN_PROFILE_POINTS, CircularArcCurve, Profile
+from .profile import MIN_PROFILE_POINTS, CircularArcCurve, Profile, _outside
 
 __all__ = [
     "ANALYTIC_PROFILES",
@@ -134,8 +134,8 @@ class _AnalyticCurve:
 
     def _eval_all(self, y):
         y = np.asarray(y, dtype=float)
-        F, dF, d2F = self._mm(y * _MM)
-        outside = (y < self.y_min_m) | (y > self.y_max_m) | ~np.isfinite(y)
+        outside = _outside(y, self.y_min_m, self.y_max_m)
+        F, dF, d2F = self._mm(np.clip(y, self.y_min_m, self.y_max_m) * _MM)
         nan = np.nan
         return (
             np.where(outside, nan, F / _MM),
