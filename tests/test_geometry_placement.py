@@ -161,3 +161,36 @@ def test_placement_errors():
         TrackGeometry(rail).rail_surface("left", deflection=2.0)
     with pytest.raises(ValueError, match="must contain the tape circle"):
         WheelsetGeometry(CircularArcCurve(0.1, 0.01, "wheel", centre_y_m=0.05))
+
+
+def _wheel_principal_curvatures(v):
+    """Principal curvatures of x(a, y) = [R cos a, y, R sin a] from R and its derivatives (fundamental forms)."""
+    R, Ra, Ry, Raa, Ray, Ryy = (np.asarray(q, float) for q in v)
+    ca, sa = np.cos(0.7), np.sin(0.7)
+    xa = np.stack([Ra * ca - R * sa, 0 * R, Ra * sa + R * ca], -1)
+    xy = np.stack([Ry * ca, 1 + 0 * R, Ry * sa], -1)
+    xaa = np.stack([Raa * ca - 2 * Ra * sa - R * ca, 0 * R, Raa * sa + 2 * Ra * ca - R * sa], -1)
+    xay = np.stack([Ray * ca - Ry * sa, 0 * R, Ray * sa + Ry * ca], -1)
+    xyy = np.stack([Ryy * ca, 0 * R, Ryy * sa], -1)
+    n = np.cross(xa, xy)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    G = np.array([[np.sum(xa * xa, -1), np.sum(xa * xy, -1)], [np.sum(xy * xa, -1), np.sum(xy * xy, -1)]])
+    Hm = np.array([[np.sum(n * xaa, -1), np.sum(n * xay, -1)], [np.sum(n * xay, -1), np.sum(n * xyy, -1)]])
+    G, Hm = np.moveaxis(G, (0, 1), (-2, -1)), np.moveaxis(Hm, (0, 1), (-2, -1))
+    return np.sort(np.abs(np.linalg.eigvals(np.linalg.solve(G, Hm)).real), axis=-1)
+
+
+def test_analytic_test_surfaces_sphere_and_cylinder_curvature():
+    """Wheel surfaces from exact curves: a circular profile of radius r0 centred on the axle is a sphere
+    (both principal curvatures 1/r0); a 0-conicity wheel is a cylinder (0 and 1/r0); to 1e-9 relative."""
+    r0 = 0.46
+    sphere = WheelsetGeometry(CircularArcCurve(r0, 0.06, "wheel"), nominal_radius_m=r0).wheel_surface("left")
+    y = -0.75 + np.linspace(-0.05, 0.05, 11)
+    k = _wheel_principal_curvatures(sphere.evaluate(0.7, y))
+    np.testing.assert_allclose(k, 1 / r0, rtol=1e-9)
+    from rigid_dynamics.geometry import conical_wheel
+
+    cyl = WheelsetGeometry(conical_wheel(0.0), nominal_radius_m=r0).wheel_surface("right")
+    k = _wheel_principal_curvatures(cyl.evaluate(0.7, 0.75 + np.linspace(-0.04, 0.05, 10)))
+    np.testing.assert_allclose(k[:, 0], 0.0, atol=1e-12)
+    np.testing.assert_allclose(k[:, 1], 1 / r0, rtol=1e-9)

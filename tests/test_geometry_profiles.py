@@ -289,3 +289,45 @@ def test_load_profile_errors(tmp_path):
 def test_write_profile_csv_needs_profile(tmp_path):
     with pytest.raises(ValueError, match="profile must be a Profile"):
         write_profile_csv(tmp_path / "x.csv", "S1002")
+
+
+@pytest.mark.parametrize(("mirror_y", "flip_z"), [(False, False), (True, False), (False, True), (True, True)])
+def test_miniprof_wheel_conventions_detected(tmp_path, mirror_y, flip_z):
+    """An S1002 wheel written MiniProf-style (y from the flange back, in either lateral direction, z up or down)
+    is read back onto the analytic S1002 (tape circle 70 mm from the flange back) to 1e-8 m (the z origin is
+    set by linear interpolation at y_p = 0 between points 0.1 mm apart: 4e-9 m)."""
+    from rigid_dynamics.geometry import s1002_wheel
+
+    s = s1002_wheel()
+    y = np.linspace(-0.0699, 0.060, 1301)
+    z = s.z(y)
+    yf = (y + 0.070) * 1000  # from the flange back, mm
+    zf = z * 1000
+    if mirror_y:
+        yf = -yf
+    if flip_z:
+        zf = -zf
+    lines = ["MINIPROF test", "synthetic.whl", "32.50 28.00 10.8 (Sd/Sh/qR)", ""]
+    lines += [f"{a:.9f} {b:.9f} 0.000" for a, b in zip(yf, zf, strict=True)]
+    p = read_profile(_write(tmp_path, "synthetic.whl", "\n".join(lines) + "\n"))
+    np.testing.assert_allclose(p.z_m, s.z(p.y_m), atol=1e-8)
+    assert p.y_min_m == pytest.approx(-0.0699, abs=1e-9)
+
+
+@pytest.mark.parametrize("flip_z", [False, True])
+def test_miniprof_rail_conventions_detected(tmp_path, flip_z):
+    """A canted UIC60 head written MiniProf-style (track centre at +y, z up or down) is read back
+    with the gauge side at -y and the top at z = 0."""
+    from rigid_dynamics.geometry import uic60_rail
+
+    u = uic60_rail()
+    t = np.linspace(-0.0365, 0.0365, 1461)
+    b = math.atan(1 / 20)
+    Y = math.cos(b) * t + math.sin(b) * u.z(t)
+    Z = -math.sin(b) * t + math.cos(b) * u.z(t)
+    yf, zf = -Y * 1000, (Z - Z.min()) * 1000 * (-1 if flip_z else 1)
+    lines = ["Filename=x.ban", "ColumnDef=X,Y", ""] + [f"{a:.9f}\t{c:.9f}" for a, c in zip(yf, zf, strict=True)]
+    p = read_profile(_write(tmp_path, "x.ban", "\n".join(lines) + "\n"))
+    i = int(np.argmin(p.z_m))
+    assert p.y_m[i] > 0.005  # a canted crown's top moves towards the field side (+y): 300 mm / 20 = 15 mm
+    assert p.z_m.min() == pytest.approx(0.0, abs=1e-15)
