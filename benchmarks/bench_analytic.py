@@ -131,7 +131,7 @@ def main():
     timings = []
     for n in BATCHES:
         cl, ct, fn, xi, eta, phi = patches(n, rng)
-        repeats = 200 if n == 1 else (50 if n == 100 else 5)
+        repeats = 200 if n == 1 else (50 if n == 100 else 10)
         hz = hertz_solve_batch(cl, ct, normal_force_N=fn, shear_modulus_Pa=G, poisson_ratio=NU)
         a, b = hz.semi_axis_long_m, hz.semi_axis_lat_m
         coef = kalker_coefficients(a / b, NU)

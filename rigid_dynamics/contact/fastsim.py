@@ -221,7 +221,7 @@ def _prepare(
         raise ValueError(f"shear_modulus_Pa = {shear_modulus_Pa!r}: expected a finite number > 0")
     arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, fn, xi, eta, phi, friction_coefficient)))
     shape = arrays[0].shape
-    a, b, fn, xi, eta, phi, mu = (np.ascontiguousarray(v.ravel()) for v in arrays)
+    a, b, fn, xi, eta, phi, mu = (np.array(v.ravel(), dtype=float) for v in arrays)
     if not (np.all(np.isfinite(a)) and np.all(a > 0) and np.all(np.isfinite(b)) and np.all(b > 0)):
         raise ValueError("semi_axis_long_m, semi_axis_lat_m: expected finite values > 0")
     if not (np.all(np.isfinite(mu)) and np.all(mu >= 0)):
@@ -246,7 +246,7 @@ def _prepare(
         coefficients=coef,
         flexibility=flexibility,
     )
-    l1, l2, l3 = (np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float) for v in (l1, l2, l3))
+    l1, l2, l3 = (np.array(np.broadcast_to(v, a.shape), dtype=float) for v in (l1, l2, l3))
     return shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3
 
 

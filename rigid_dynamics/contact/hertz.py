@@ -202,7 +202,7 @@ def elliptic_kdbc(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     """
     p = np.asarray(p, dtype=float)
     out = np.empty((p.size, 4))
-    _kdbc_many(np.ascontiguousarray(p.ravel()), out)
+    _kdbc_many(np.array(p.ravel(), dtype=float), out)
     return tuple(out[:, i].reshape(p.shape) for i in range(4))
 
 
@@ -228,7 +228,7 @@ def ellipse_shape_from_curvature_ratio(
     r = np.asarray(curvature_ratio, dtype=float)
     if not (np.all(np.isfinite(r)) and np.all(r >= 1.0)):
         raise ValueError(f"curvature_ratio = {curvature_ratio!r}: expected finite values >= 1")
-    flat = np.ascontiguousarray(r.ravel())
+    flat = np.array(r.ravel(), dtype=float)
     p = np.empty(flat.size)
     it = np.empty(flat.size, dtype=np.int64)
     ok = np.empty(flat.size, dtype=np.bool_)
@@ -332,9 +332,9 @@ def hertz_solve_batch(
     it = np.empty(n, dtype=np.int64)
     ok = np.empty(n, dtype=np.bool_)
     _hertz_many(
-        np.ascontiguousarray(A.ravel()),
-        np.ascontiguousarray(B.ravel()),
-        np.ascontiguousarray(load.ravel()),
+        np.array(A.ravel(), dtype=float),
+        np.array(B.ravel(), dtype=float),
+        np.array(load.ravel(), dtype=float),
         approach_m is None,
         float(e_star),
         1e-14,
