@@ -2,6 +2,12 @@
 
 Conventions (project-wide): main frame x along the track, y to the right, z DOWN; profiles in
 (y_p towards the field side, z_p down), wheel origin at the tape circle, rail z_p = 0 at the top.
+Wheel: R_id(y_d) = r0 + z_p(y_p) - z_p(0) with y_p = s y_d - e_w (s = +1 right, -1 left; z_p points
+away from the axle, so the S1002 flange tip has R = r0 + 28 mm). Rail: the profile is canted towards
+the track centre and placed so that the gauge faces (innermost points within gauge_height_m of the
+top) are gauge_m apart; rail tops at z = 0. Profiles built from points are smoothed by a C2
+spline with L_filt = 2 mm by default (smoothing_wavelength_m=0 interpolates); analytic curves
+(standard_profiles, CircularArcCurve) are evaluated exactly.
 
 Public API (stable):
 
