@@ -37,6 +37,11 @@ traction is computed at element midpoints x_k = a(y_j) - (k + 1/2) dx_j, integra
 loop is compiled with numba (cache=True) and allocates nothing per strip.
 
 Signs: Fx, Fy, Mz on the wheel, contact frame; Mz = sum (x p_y - y p_x) dA.
+
+Known limitation: the flexibilities are fitted to C11, C22, C23 only, so the simplified theory's
+spin moment does not follow Kalker's C32 = -C23 and C33: its small-creepage slopes dMz/deta and
+dMz/dphi are 0.61 and 1.00 (a/b = 0.3), 0.73 and 0.85 (a/b = 1), 0.78 and 0.80 (a/b = 2), 0.81
+and 0.73 (a/b = 5) of the linear theory's (nu = 0.28, 80 x 80; tests/test_fastsim.py).
 """
 
 from __future__ import annotations
