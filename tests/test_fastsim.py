@@ -214,10 +214,11 @@ def test_bad_options_raise():
 
 
 def test_spin_moment_slopes_known_deviation():
-    """The simplified theory does not reproduce C32/C33 (flexibilities fit C11, C22, C23 only).
+    """Regression test: the simplified theory does not reproduce C32/C33 (L fit C11, C22, C23 only).
 
-    Checked against Kalker's linear theory: same sign, magnitude 0.7-0.9 of it at a/b = 1
-    (recorded values 0.73 for d Mz/d eta and 0.85 for d Mz/d phi, nu = 0.28, 80 x 80).
+    The bands are around values this code produced (0.73 for d Mz/d eta and 0.85 for d Mz/d phi
+    relative to Kalker's linear theory, a/b = 1, nu = 0.28, 80 x 80); only the sign (same as the
+    linear theory) and the order of magnitude are independent facts.
     """
     from rigid_dynamics.contact.linear import linear_creep_forces
 
