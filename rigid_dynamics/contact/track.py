@@ -132,17 +132,17 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
     """Surfaces for a :class:`~rigid_dynamics.contact.wheelset_case.WheelsetCase` (or anything with its fields).
 
     Args:
-        case: provides wheel_profile, rail_profile (names or paths, or Profile objects), gauge_m, gauge_height_m,
-            flange_back_distance_m, nominal_radius_m, rail_inclination_rad.
+        case: provides wheel_profile, rail_profile (names or paths, Profile objects or profile curves), gauge_m,
+            gauge_height_m, flange_back_distance_m, nominal_radius_m, rail_inclination_rad.
         wheel_irregularities, rail_irregularities: optional side -> tuple of irregularities (geometry module).
 
     Raises:
         ValueError: unknown profile, bad placement (from rigid_dynamics.geometry).
     """
-    from rigid_dynamics.geometry import Profile, TrackGeometry, WheelsetGeometry, load_profile
+    from rigid_dynamics.geometry import TrackGeometry, WheelsetGeometry, load_profile
 
-    wheel = case.wheel_profile if isinstance(case.wheel_profile, Profile) else load_profile(case.wheel_profile, "wheel")
-    rail = case.rail_profile if isinstance(case.rail_profile, Profile) else load_profile(case.rail_profile, "rail")
+    wheel = load_profile(case.wheel_profile, "wheel") if isinstance(case.wheel_profile, str) else case.wheel_profile
+    rail = load_profile(case.rail_profile, "rail") if isinstance(case.rail_profile, str) else case.rail_profile
     wheelset = WheelsetGeometry(
         wheel, flange_back_distance_m=case.flange_back_distance_m, nominal_radius_m=case.nominal_radius_m
     )

@@ -186,6 +186,102 @@ def _hertz_loads(searches: dict[str, SideSearch], material: Material):
     return loads, forces
 
 
+def _pose(track, lateral_shift_m: float, yaw_rad: float, sinks) -> WheelsetPose:
+    """Pose from the two wheel sinks: z = z_rest + (s_L + s_R)/2, theta = (s_R - s_L)/(2 e_w)."""
+    z = track.rest_z_m + 0.5 * (sinks[0] + sinks[1])
+    roll = (sinks[1] - sinks[0]) / (2.0 * track.half_wheel_distance_m)
+    return WheelsetPose(y_m=lateral_shift_m, z_m=float(z), yaw_rad=yaw_rad, roll_rad=float(roll))
+
+
+def _search_both(track, lateral_shift_m: float, yaw_rad: float, sinks, search_options):
+    pose = _pose(track, lateral_shift_m, yaw_rad, sinks)
+    return pose, {side: track.search(pose, side, search_options) for side in SIDES}
+
+
+def _newton_sinks(searches_of, func, sinks, tolerance, limit, max_iterations):
+    """Newton's method on the 2 sinks with a forward-difference Jacobian; returns (sinks, iterations, status)."""
+    step = 2.0e-7
+    for iteration in range(1, max_iterations + 1):
+        searches = searches_of(sinks)
+        if not all(np.isfinite(s.min_gap_m) for s in searches.values()):
+            return sinks, iteration, "search-failed"
+        r = func(searches)
+        if np.all(np.abs(r) < tolerance):
+            return sinks, iteration, "ok"
+        jac = np.zeros((2, 2))
+        for j in range(2):
+            ds = np.zeros(2)
+            ds[j] = step
+            jac[:, j] = (func(searches_of(sinks + ds)) - r) / step
+        try:
+            delta = np.linalg.solve(jac, -r)
+        except np.linalg.LinAlgError:
+            delta = -r * limit
+        sinks = sinks + np.clip(np.nan_to_num(delta), -limit, limit)
+    return sinks, max_iterations, "not-converged"
+
+
+@dataclass(frozen=True, eq=False)
+class RigidContact:
+    """Wheelset position where both wheels just touch their rails (no elastic approach).
+
+    Attributes:
+        success, status: "ok", "not-converged" or "search-failed".
+        pose: the pose found (z and roll solved, shift and yaw given).
+        min_gap_m: side -> smallest gap (0 within the tolerance), m.
+        rolling_radius_m: side -> wheel radius at the touching point, m.
+        contact_point_m: side -> touching point on the wheel, main frame, m (shape (3,)).
+        iterations: Newton iterations.
+    """
+
+    success: bool
+    status: str
+    pose: WheelsetPose
+    min_gap_m: dict
+    rolling_radius_m: dict
+    contact_point_m: dict
+    iterations: int
+
+
+def rigid_contact(
+    track, lateral_shift_m: float, yaw_rad: float = 0.0, *, search_options=None, tolerance_m: float = 1e-9
+) -> RigidContact:
+    """Vertical position and roll of a wheelset (given shift and yaw) touching both rails: smallest gap 0 per side.
+
+    Args:
+        track: :class:`~rigid_dynamics.contact.track.WheelsetTrack`.
+        lateral_shift_m: y of the wheelset centre, m. yaw_rad: psi, rad.
+        search_options: options of the contact search.
+        tolerance_m: |smallest gap| accepted, m.
+    """
+    opts = {"field": False}
+    opts.update(search_options or {})
+
+    def searches_of(sinks):
+        return _search_both(track, lateral_shift_m, yaw_rad, sinks, opts)[1]
+
+    def gaps(searches):
+        return np.array([searches[side].min_gap_m for side in SIDES])
+
+    sinks, iterations, status = _newton_sinks(searches_of, gaps, np.zeros(2), tolerance_m, 2.0e-3, 40)
+    pose, searches = _search_both(track, lateral_shift_m, yaw_rad, sinks, opts)
+    radius, point, gap = {}, {}, {}
+    for side in SIDES:
+        cand = searches[side].candidates
+        gap[side] = searches[side].min_gap_m
+        if len(cand.gap_m) == 0:
+            radius[side], point[side] = math.nan, np.full(3, math.nan)
+            continue
+        k = int(np.argmin(cand.gap_m))
+        alpha, y_d = float(cand.alpha_rad[k]), float(cand.lateral_m[k])
+        values = track.wheels[side].evaluate(np.array([alpha]), np.array([y_d]))
+        r = float(values[0][0])
+        radius[side] = r
+        x_d = np.array([r * math.cos(alpha), y_d, r * math.sin(alpha)])
+        point[side] = pose.rotation @ x_d + pose.centre_m
+    return RigidContact(status == "ok", status, pose, gap, radius, point, iterations)
+
+
 def solve_wheelset_case(
     case: WheelsetCase,
     material: Material,
@@ -226,15 +322,9 @@ def solve_wheelset_case(
     search_options = dict(opts["search"] or {})
     search_options.setdefault("field", False)
 
-    def pose_of(sinks):
-        z = track.rest_z_m + 0.5 * (sinks[0] + sinks[1])
-        roll = (sinks[1] - sinks[0]) / (2.0 * track.half_wheel_distance_m)
-        return WheelsetPose(y_m=case.lateral_shift_m, z_m=float(z), yaw_rad=case.yaw_rad, roll_rad=float(roll))
-
     def run(sinks, field_sampling=False):
-        pose = pose_of(sinks)
         so = dict(search_options, field=field_sampling)
-        return pose, {side: track.search(pose, side, so) for side in SIDES}
+        return _search_both(track, case.lateral_shift_m, case.yaw_rad, sinks, so)
 
     q_ref = track.reference_approach_m(case, material)
     target = case.wheel_load_N
@@ -258,26 +348,7 @@ def solve_wheelset_case(
         return np.array([searches[side].min_gap_m for side in SIDES]) / q_ref
 
     def newton(func, sinks, tolerance, limit, max_iterations):
-        """Newton's method on the 2 sinks with a forward-difference Jacobian; returns (sinks, iterations, status)."""
-        step = 2.0e-7
-        for iteration in range(1, max_iterations + 1):
-            searches = run(sinks)[1]
-            if not all(np.isfinite(s.min_gap_m) for s in searches.values()):
-                return sinks, iteration, "search-failed"
-            r = func(searches)
-            if np.all(np.abs(r) < tolerance):
-                return sinks, iteration, "ok"
-            jac = np.zeros((2, 2))
-            for j in range(2):
-                ds = np.zeros(2)
-                ds[j] = step
-                jac[:, j] = (func(run(sinks + ds)[1]) - r) / step
-            try:
-                delta = np.linalg.solve(jac, -r)
-            except np.linalg.LinAlgError:
-                delta = -r * q_ref
-            sinks = sinks + np.clip(np.nan_to_num(delta), -limit, limit)
-        return sinks, max_iterations, "not-converged"
+        return _newton_sinks(lambda x: run(x)[1], func, sinks, tolerance, limit, max_iterations)
 
     # Phase 1: rigid contact, both wheels just touching (smallest gap 0 on each side).
     sinks, it1, status = newton(gaps, np.zeros(2), 1e-4, 2.0e-3, opts["max_iterations"])
