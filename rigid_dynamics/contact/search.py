@@ -504,7 +504,7 @@ def search_side(
     kept_arr = np.array(kept, int)
     candidates = ContactCandidates(alpha_c[kept_arr], y_c[kept_arr], h_c[kept_arr], converged[kept_arr])
     in_contact = kept_arr[h_c[kept_arr] < 0]
-    patches = [_patch(geo_exact, alpha_c[k], y_c[k], opts, float(h_c[k])) for k in in_contact]
+    patches = [_patch(geo_exact, alpha_c[k], y_c[k], opts, float(h_c[k]), geo) for k in in_contact]
     min_gap = float(np.min(h_c[kept_arr])) if len(kept_arr) else math.inf
     all_converged = bool(np.all(converged[in_contact]))
     if not patches:
@@ -526,8 +526,12 @@ def search_side(
     )
 
 
-def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts, h: float) -> ContactGeometry:
-    """Geometry of the patch at the refined minimum (alpha0, y0) with distance h (from the search)."""
+def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts, h: float, geo_field=None) -> ContactGeometry:
+    """Geometry of the patch at the refined minimum (alpha0, y0) with distance h (from the search).
+
+    Point, normal and curvatures come from ``geo`` (the exact surfaces); the sampled gap from ``geo_field``
+    (the search's surfaces, e.g. the Hermite tables of ideal profiles, accurate to ~1e-13 m) when given.
+    """
     a_arr, y_arr = np.array([alpha0]), np.array([y0])
     point, n_out, _, (t_a, t_y, x_aa, x_ay, x_yy), radius = geo.wheel_point(a_arr, y_arr, second=True)
     point, n_out = point[0], n_out[0]
@@ -567,7 +571,7 @@ def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts, h: float) -> Cont
         half_x, half_y = min(half_x, 0.05), min(half_y, 0.03)
         centre = 0.5 * (point + rail_point)
         undeformed = _sample_field(
-            geo, alpha0, y0, centre, frame, half_x, half_y, opts["field_points"], opts["newton_iterations"]
+            geo_field or geo, alpha0, y0, centre, frame, half_x, half_y, opts["field_points"], opts["newton_iterations"]
         )
         error = ellipticity_error(undeformed, a_use, b_use, angle, approach)
         elliptic = convex and error <= opts["ellipticity_tolerance"]
