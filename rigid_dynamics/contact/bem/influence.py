@@ -342,6 +342,25 @@ class InfluenceGrid:
             sy = sy + self._kernel_fft("yz", rolling) * fz
         return self._backward(sx), self._backward(sy)
 
+    def inverse_static(self, ux_m: np.ndarray, uy_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Approximate inverse of the static tangential operator: the padded circulant's inverse, by FFT.
+
+        A preconditioner only (exact for the periodic extension, not for the bounded grid).
+        """
+        if "inv" not in self._cache:
+            kxx = self._kernel_fft("xx", False).real
+            kyy = self._kernel_fft("yy", False).real
+            kxy = self._kernel_fft("xy", False).real
+            floor = 1e-3 * float(np.abs(kxx).max())
+            kxx = np.maximum(kxx, floor)
+            kyy = np.maximum(kyy, floor)
+            det = kxx * kyy - kxy * kxy
+            det = np.where(det > floor * floor, det, floor * floor)
+            self._cache["inv"] = (kyy / det, kxx / det, -kxy / det)
+        ixx, iyy, ixy = self._cache["inv"]
+        fx, fy = self._forward(ux_m), self._forward(uy_m)
+        return self._backward(ixx * fx + ixy * fy), self._backward(ixy * fx + iyy * fy)
+
     def dense(self, name: str, rolling: bool = False) -> np.ndarray:
         """Dense N x N matrix of one kernel (N = nx ny, row-major over [j, i]); only for grids up to 64 x 64."""
         if self.nx * self.ny > 64 * 64:

@@ -19,8 +19,12 @@ Method: an active-set Newton iteration in the manner of Kalker's TANG (Kalker 19
 the elements are split into adhesion H and slip S; in H the two traction components are unknown
 and s = 0 is imposed, in S the traction lies on the bound, t = g e(theta), and its direction angle
 theta is unknown with the equation e_perp . s = 0 (slip antiparallel to traction). Each Newton step
-is a linear system solved by GMRES whose matrix-vector products are FFT convolutions (O(N log N),
-no dense matrix). Between steps, adhesion elements whose traction exceeds the bound move to S
+is a linear system solved by restarted GMRES (inexact Newton: relative tolerance min(1e-2, 0.1 residual))
+whose matrix-vector products are FFT convolutions (O(N log N), no dense matrix). Right preconditioner:
+for rolling the operator factors exactly as L = C o D, D t = (t_I - t_(I+e_x))/dx (the upwind difference
+acting on the traction; both are convolutions), so D^-1 is a cumulative sum from the leading edge;
+C^-1 is approximated by the inverse of the zero-padded circulant (FFT); slip rows are scaled by
+their diagonal. Between steps, adhesion elements whose traction exceeds the bound move to S
 and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
 Linearisation of the slip-element equation (derivative of e_perp . s with respect to theta)::
 
@@ -32,9 +36,92 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
+
+
+@numba.njit(cache=True, fastmath=True)
+def _orthogonalize(basis, count, w):
+    """Classical Gram-Schmidt twice of w (in place) against basis[:count]; returns (coefficients, norm)."""
+    h = np.zeros(count)
+    n = w.size
+    for _ in range(2):
+        for i in range(count):
+            acc = 0.0
+            for j in range(n):
+                acc += basis[i, j] * w[j]
+            h[i] += acc
+            for j in range(n):
+                w[j] -= acc * basis[i, j]
+    norm = 0.0
+    for j in range(n):
+        norm += w[j] * w[j]
+    return h, math.sqrt(norm)
+
+
+@numba.njit(cache=True, fastmath=True)
+def _combine(basis, y):
+    """sum_i y[i] basis[i] (single-threaded)."""
+    out = np.zeros(basis.shape[1])
+    for i in range(y.size):
+        for j in range(basis.shape[1]):
+            out[j] += y[i] * basis[i, j]
+    return out
+
+
+def _gmres(apply, rhs: np.ndarray, rtol: float, max_iterations: int, restart: int = 40) -> tuple[np.ndarray, int]:
+    """Restarted GMRES (Saad & Schultz 1986) with classical Gram-Schmidt applied twice; x0 = 0.
+
+    ``apply`` is the (right-preconditioned) operator. Returns the solution and the iteration count.
+    """
+    n = rhs.size
+    x = np.zeros(n)
+    b_norm = math.sqrt(float((rhs * rhs).sum()))
+    if b_norm == 0.0:
+        return x, 0
+    total = 0
+    r = rhs.copy()
+    while total < max_iterations:
+        beta = math.sqrt(float((r * r).sum()))
+        if beta <= rtol * b_norm:
+            break
+        basis = np.zeros((restart + 1, n))
+        hess = np.zeros((restart + 1, restart))
+        cs = np.zeros(restart)
+        sn = np.zeros(restart)
+        g = np.zeros(restart + 1)
+        g[0] = beta
+        basis[0] = r / beta
+        k_used = 0
+        for k in range(restart):
+            w = apply(basis[k])
+            h, hn = _orthogonalize(basis, k + 1, w)
+            hess[: k + 1, k] = h
+            hess[k + 1, k] = hn
+            for i in range(k):
+                a, c = hess[i, k], hess[i + 1, k]
+                hess[i, k] = cs[i] * a + sn[i] * c
+                hess[i + 1, k] = -sn[i] * a + cs[i] * c
+            denom = math.hypot(hess[k, k], hess[k + 1, k])
+            cs[k], sn[k] = (hess[k, k] / denom, hess[k + 1, k] / denom) if denom > 0 else (1.0, 0.0)
+            hess[k, k] = denom
+            hess[k + 1, k] = 0.0
+            g[k + 1] = -sn[k] * g[k]
+            g[k] = cs[k] * g[k]
+            total += 1
+            k_used = k + 1
+            if abs(g[k + 1]) <= rtol * b_norm or hn == 0.0 or total >= max_iterations:
+                break
+            basis[k + 1] = w / hn
+        y = np.linalg.solve(
+            np.triu(hess[:k_used, :k_used]) + np.diag(np.where(np.diag(hess[:k_used, :k_used]) == 0, 1.0, 0.0)),
+            g[:k_used],
+        )
+        x = x + _combine(basis, y)
+        r = rhs - apply(x)
+    return x, total
 
 
 def rigid_slip(
@@ -99,8 +186,6 @@ def solve_tang(
     Returns:
         :class:`TangSolution`.
     """
-    from scipy.sparse.linalg import LinearOperator, gmres
-
     shape = (influence.ny, influence.nx)
     if problem not in ("rolling", "shift"):
         raise ValueError(f"problem = {problem!r}: expected 'rolling' or 'shift'")
@@ -132,12 +217,15 @@ def solve_tang(
     scale = float(np.max(np.hypot(wx, wy)[contact]))
     if scale == 0.0:
         return TangSolution(zeros, zeros.copy(), zeros.copy(), zeros.copy(), np.zeros(shape, bool), 0, 0, 0.0, True)
+
     m_x = influence.self_coefficient("xx", rolling)
+    m_y = influence.self_coefficient("yy", rolling)
 
     def slip_of(tx: np.ndarray, ty: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ux, uy = influence.tangential(tx, ty, rolling=rolling)
         return wx + ux, wy + uy
 
+    n = shape[0] * shape[1]
     tx = np.zeros(shape)
     ty = np.zeros(shape)
     stick = contact.copy()
@@ -156,59 +244,52 @@ def solve_tang(
         res_h = np.hypot(sx, sy)[stick]
         res_s = np.abs(s_perp[slip])
         residual = max(res_h.max() if res_h.size else 0.0, res_s.max() if res_s.size else 0.0) / scale
-        ih = np.flatnonzero(stick.ravel())
-        is_ = np.flatnonzero(slip.ravel())
-        nh, ns = ih.size, is_.size
         if residual < tolerance and it > 1:
             converged = True
             break
-        gs = bound.ravel()[is_]
-        epx, epy = -ey.ravel()[is_], ex.ravel()[is_]
-        diag_s = np.maximum(-s_par.ravel()[is_], 0.0)  # |s| for correctly oriented slip
+        epx, epy = -ey, ex
+        diag_s = np.where(slip, np.maximum(-s_par, 0.0), 0.0)  # |s| for correctly oriented slip
+        gb = np.where(slip, bound, 0.0)
+        fs = np.where(stick, 1.0, 0.0)
 
-        def matvec(v: np.ndarray, ih=ih, is_=is_, nh=nh, gs=gs, epx=epx, epy=epy, diag_s=diag_s) -> np.ndarray:
-            dtx = np.zeros(shape[0] * shape[1])
-            dty = np.zeros(shape[0] * shape[1])
-            dtx[ih] = v[:nh]
-            dty[ih] = v[nh : 2 * nh]
-            alpha = v[2 * nh :]
-            dtx[is_] = gs * epx * alpha
-            dty[is_] = gs * epy * alpha
-            ux, uy = influence.tangential(dtx.reshape(shape), dty.reshape(shape), rolling=rolling)
-            ux, uy = ux.ravel(), uy.ravel()
-            out_s = epx * ux[is_] + epy * uy[is_] + diag_s * alpha
-            return np.concatenate([ux[ih], uy[ih], out_s])
+        def matvec(v: np.ndarray, epx=epx, epy=epy, diag_s=diag_s, gb=gb, fs=fs, stick=stick, slip=slip) -> np.ndarray:
+            vx, vy, al = v[:n].reshape(shape), v[n : 2 * n].reshape(shape), v[2 * n :].reshape(shape)
+            dtx = fs * vx + gb * epx * al
+            dty = fs * vy + gb * epy * al
+            ux, uy = influence.tangential(dtx, dty, rolling=rolling)
+            ox = np.where(stick, ux, vx)
+            oy = np.where(stick, uy, vy)
+            os_ = np.where(slip, epx * ux + epy * uy + diag_s * al, al)
+            return np.concatenate([ox.ravel(), oy.ravel(), os_.ravel()])
 
-        n_unknown = 2 * nh + ns
-        # scale the unknowns: tractions by 1/m, angles by 1/(g m) (Jacobi-like right preconditioner)
-        d = np.concatenate([np.full(2 * nh, 1.0), 1.0 / np.maximum(gs * m_x + diag_s, 1e-300) * m_x])
-        op = LinearOperator((n_unknown, n_unknown), matvec=lambda v, d=d, mv=matvec: mv(d * v) / m_x)
-        rhs = -np.concatenate([sx.ravel()[ih], sy.ravel()[ih], s_perp.ravel()[is_]]) / m_x
-        count = [0]
+        def precondition(v: np.ndarray, epx=epx, epy=epy, diag_s=diag_s, gb=gb, stick=stick, slip=slip) -> np.ndarray:
+            vx = np.where(stick, v[:n].reshape(shape), 0.0)
+            vy = np.where(stick, v[n : 2 * n].reshape(shape), 0.0)
+            vx, vy = influence.inverse_static(vx, vy)
+            if rolling:
+                # L = C o D with D t = (t_I - t_(I+e_x))/dx: invert D by summing from the leading edge
+                vx = np.cumsum(np.where(stick, vx, 0.0)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
+                vy = np.cumsum(np.where(stick, vy, 0.0)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
+            px = np.where(stick, vx, v[:n].reshape(shape))
+            py = np.where(stick, vy, v[n : 2 * n].reshape(shape))
+            self_s = gb * (epx * epx * m_x + epy * epy * m_y) + diag_s
+            pa = np.where(slip, v[2 * n :].reshape(shape) / np.where(slip, self_s, 1.0), v[2 * n :].reshape(shape))
+            return np.concatenate([px.ravel(), py.ravel(), pa.ravel()])
 
-        def cb(_, count=count):
-            count[0] += 1
+        def op(z, mv=matvec, pc=precondition):
+            return mv(pc(z))
 
-        sol, _ = gmres(
-            op,
-            rhs,
-            rtol=max(min(1e-2, 0.1 * residual), 0.01 * tolerance),
-            atol=0.0,
-            restart=200,
-            maxiter=5,
-            callback=cb,
-            callback_type="pr_norm",
+        rhs = -np.concatenate(
+            [np.where(stick, sx, 0.0).ravel(), np.where(stick, sy, 0.0).ravel(), np.where(slip, s_perp, 0.0).ravel()]
         )
-        lin_total += count[0]
-        sol = d * sol
-        txf, tyf = tx.ravel().copy(), ty.ravel().copy()
-        txf[ih] += sol[:nh]
-        tyf[ih] += sol[nh : 2 * nh]
-        th = theta.ravel().copy()
-        th[is_] += sol[2 * nh :]
-        txf[is_] = bound.ravel()[is_] * np.cos(th[is_])
-        tyf[is_] = bound.ravel()[is_] * np.sin(th[is_])
-        tx, ty, theta = txf.reshape(shape), tyf.reshape(shape), th.reshape(shape)
+        sol, count = _gmres(op, rhs, rtol=max(min(1e-2, 0.1 * residual), 0.01 * tolerance), max_iterations=400)
+        lin_total += count
+        sol = precondition(sol)
+        tx = tx + np.where(stick, sol[:n].reshape(shape), 0.0)
+        ty = ty + np.where(stick, sol[n : 2 * n].reshape(shape), 0.0)
+        theta = theta + np.where(slip, sol[2 * n :].reshape(shape), 0.0)
+        tx = np.where(slip, bound * np.cos(theta), tx)
+        ty = np.where(slip, bound * np.sin(theta), ty)
         # set changes
         sx, sy = slip_of(tx, ty)
         tmag = np.hypot(tx, ty)
