@@ -133,10 +133,11 @@ def test_klingel_wavelength_linear_and_nonlinear():
 
 
 def test_s1002_on_uic60_1_40_regression():
-    """Regression (numbers this code produced, cross-checked only for plausibility): S1002 on UIC60 1:40 at gauge
-    1435 mm, flange-back 1360 mm, 3 mm amplitude. Published values for this combination lie around 0.15-0.2
-    (EN 15302 quotes the pairing as a typical new-profile case); CONTACT's A-2.2 roll angles, which depend on the
-    same Delta r function, are reproduced to < 1 % in tests/test_wheelset_case.py."""
+    """Regression test (the number this code produced): S1002 on UIC60 1:40 at gauge 1435 mm, flange-back
+    1360 mm, 3 mm amplitude: 0.1836. No published value for exactly this pairing and gauge was found to compare
+    with; the band 0.15-0.21 is only a plausibility check. The Delta r function behind it is checked indirectly:
+    CONTACT's A-2.2 roll angles, which follow from the same rigid-contact geometry, are reproduced to < 1 %
+    (tests/test_wheelset_case.py)."""
     got = equivalent_conicity_from_names("MBench_S1002_v3", "MBench_UIC60_v3", amplitude_m=0.003)
     assert got["success"]
     assert got["equivalent_conicity"] == pytest.approx(0.1836, abs=0.002)

@@ -27,6 +27,17 @@ twice. At each patch:
   nothing: it is h(x, y) - q, negative where the undeformed bodies overlap) and the Hertz-validity test
   ``is_elliptic`` (see :func:`ellipticity_error`).
 
+Speed. Surfaces without irregularities (the ideal geometry of eq 5-6: R = R_id(y_d), N = N_id(y)) are replaced
+for the search by fine cubic-Hermite tables (:func:`fast_surfaces`, 20 um spacing, value error ~1e-14 m) and the
+grid evaluation and the refinement then run in compiled numba kernels (_search_kernels.py): about 1 ms per side
+for the S1002/UIC60 pair (benchmarks/results/search.md). Surfaces with irregularities take the general numpy path
+with their own ``evaluate``. The patch's point, normal and curvatures always come from the exact surfaces.
+Option ``profile_only`` is the fast path for tables of ideal geometry without yaw: alpha is fixed at the lowest
+point and only y_d is searched (the problem reduces to the two profiles).
+
+Gap field. The sampled undeformed distance covers +-``field_scale`` (1.6) times the rigid-overlap semi-axes
+sqrt(q/A), sqrt(q/B), about 2.3 Hertz semi-axes (for Hertz, a^2 ~ q/(2A)), at least +-1 mm.
+
 Surfaces are duck-typed (rigid_dynamics.geometry provides them): the wheel's ``evaluate(alpha, y_d)`` returns R
 and its first and second partial derivatives (R, R_a, R_y, R_aa, R_ay, R_yy) in the wheelset frame; the rail's
 ``evaluate(x, y)`` returns (N, N_x, N_y, N_xx, N_xy, N_yy) in the main frame.
