@@ -233,3 +233,31 @@ def test_irregular_rail_uses_general_path_and_matches_tabulated():
     assert b.patches[0].approach_m == pytest.approx(a.patches[0].approach_m, rel=1e-6)
     np.testing.assert_allclose(b.patches[0].point_m, a.patches[0].point_m, atol=1e-6)
     assert b.patches[0].curvature_lat_1_per_m == pytest.approx(a.patches[0].curvature_lat_1_per_m, rel=1e-6)
+
+
+def test_real_patch_curvatures_match_a_quadratic_fit_of_the_gap():
+    """A, B and the ellipse angle from the fundamental forms (eq 12-33) against a least-squares quadratic fit of
+    the gap sampled along n on a small grid (+-0.15 mm) around an S1002/UIC60 flange patch (7 mm shift, yaw)."""
+    from rigid_dynamics.contact.track import build_track
+    from rigid_dynamics.contact.wheelset_case import WheelsetCase
+
+    case = WheelsetCase(
+        "MBench_S1002_v3", "MBench_UIC60_v3", lateral_shift_m=0.007, yaw_rad=0.0168,
+        rail_inclination_rad=math.atan(1 / 40), wheel_load_N=1e4,
+    )  # fmt: skip
+    track = build_track(case)
+    pose = WheelsetPose(y_m=0.007, z_m=-0.4645538, yaw_rad=0.0168, roll_rad=-6.3582e-3)
+    options = {"field": True, "field_scale": 1e-6, "field_min_half_size_m": 1.5e-4, "field_points": 9}
+    got = track.search(pose, "right", options)
+    patch = max(got.patches, key=lambda p: p.contact_angle_rad)
+    assert patch.contact_angle_rad > 0.9
+    f = patch.undeformed
+    x, y = np.meshgrid(f.x_m, f.y_m)
+    design = np.stack([x.ravel() ** 2, x.ravel() * y.ravel(), y.ravel() ** 2, x.ravel(), y.ravel(), np.ones(x.size)], 1)
+    c = np.linalg.lstsq(design, f.distance_m.ravel(), rcond=None)[0]
+    d = np.array([[c[0], c[1] / 2], [c[1] / 2, c[2]]])
+    rot = np.array([[math.cos(patch.ellipse_angle_rad), -math.sin(patch.ellipse_angle_rad)],
+                    [math.sin(patch.ellipse_angle_rad), math.cos(patch.ellipse_angle_rad)]])  # fmt: skip
+    expected = rot @ np.diag([patch.curvature_long_1_per_m, patch.curvature_lat_1_per_m]) @ rot.T
+    np.testing.assert_allclose(d, expected, rtol=0.02, atol=0.02 * patch.curvature_long_1_per_m)
+    assert c[5] == pytest.approx(-patch.approach_m, rel=1e-3)

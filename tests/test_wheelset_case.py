@@ -150,3 +150,20 @@ def test_bad_options_and_model_raise():
         solve_wheelset_case(case, STEEL, "nope")
     with pytest.raises(ValueError, match="no_such_profile"):
         solve_wheelset_case(a22(0.0, rail_profile="no_such_profile"), STEEL, "hertz")
+
+
+def test_mirrored_case_mirrors_the_solution():
+    """Invariant: shifting and yawing the other way mirrors everything (y -> -y, roll -> -roll, left <-> right);
+    the flange contact then sits on the left wheel with the same (positive) contact angle."""
+    right = solve_wheelset_case(a22(7.0), STEEL, "hertz", NO_FIELD)
+    left = solve_wheelset_case(a22(-7.0), STEEL, "hertz", NO_FIELD)
+    assert left.roll_rad == pytest.approx(-right.roll_rad, rel=1e-6)
+    assert left.vertical_position_m == pytest.approx(right.vertical_position_m, abs=1e-9)
+    mirror = {"left": "right", "right": "left"}
+    for p in right.patches:
+        q = next(q for q in left.patches if q.side == mirror[p.side])
+        np.testing.assert_allclose(q.geometry.point_m * [1, -1, 1], p.geometry.point_m, atol=2e-7)
+        assert q.geometry.contact_angle_rad == pytest.approx(p.geometry.contact_angle_rad, abs=1e-6)
+        assert q.geometry.rolling_radius_m == pytest.approx(p.geometry.rolling_radius_m, abs=1e-8)
+        assert q.creepage.longitudinal == pytest.approx(p.creepage.longitudinal, abs=1e-8)
+        assert q.creepage.spin_1_per_m == pytest.approx(-p.creepage.spin_1_per_m, rel=1e-5)
