@@ -29,6 +29,8 @@ import numpy as np
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
+FORMULATIONS = ("rigid", "two-body")
+
 
 @dataclass(frozen=True)
 class FeaOptions:
@@ -36,6 +38,9 @@ class FeaOptions:
 
     Attributes:
         quick: coarse mesh (4 elements per semi-axis, block of 12 semi-axes) for a fast estimate.
+        formulation: "rigid" (one block with E* against the rigid gap; fast verification mode) or
+            "two-body" (two elastic quadric bodies with E, nu each, node-to-surface pairing; quadric
+            geometries only, see fea.two_body).
         mesh_size_factor: multiplies the element size at the patch (1 = min(a, b)/6), > 0.
         elements_per_semi_axis: element count per semi-axis at the patch (overrides quick's 4 / default 6).
         domain_factor: half-width and depth of the block in semi-axes (>= 4).
@@ -50,6 +55,7 @@ class FeaOptions:
     """
 
     quick: bool = False
+    formulation: str = "rigid"
     mesh_size_factor: float = 1.0
     elements_per_semi_axis: float | None = None
     domain_factor: float | None = None
@@ -70,6 +76,8 @@ class FeaOptions:
             raise ValueError(f"elements_per_semi_axis = {self.elements_per_semi_axis!r}: expected >= 1")
         if self.domain_factor is not None and not self.domain_factor >= 4:
             raise ValueError(f"domain_factor = {self.domain_factor!r}: expected >= 4")
+        if self.formulation not in FORMULATIONS:
+            raise ValueError(f"formulation = {self.formulation!r}: expected one of {FORMULATIONS}")
         if self.degree != 1:
             raise ValueError(f"degree = {self.degree!r}: expected 1 (P2 contact is not implemented)")
         if int(self.grid_points) != self.grid_points or self.grid_points < 8:
@@ -193,6 +201,11 @@ class FeaModel:
             def gap0(x, y):
                 return geometry.gap_m(x, y) + geometry.approach_m
 
+        if opts.formulation == "two-body" and not quadric:
+            raise ValueError(
+                "formulation = 'two-body': expected a quadric geometry (geometry.undeformed is None); "
+                "sampled gaps use the rigid formulation"
+            )
         spec = HertzBlockSpec(
             semi_axis_long_m=semi[0],
             semi_axis_lat_m=semi[1],
@@ -202,32 +215,58 @@ class FeaModel:
             symmetry="quarter" if quadric else "full",
         )
         t_mesh = time.perf_counter()
-        domain = hertz_block_domain(spec, comm, QualityLimits(opts.min_mesh_quality, opts.max_elements))
-        t_mesh = time.perf_counter() - t_mesh
+        limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
+        settings = SolverSettings(linear_solver=opts.linear_solver, max_iterations=opts.max_iterations)
+        if opts.formulation == "two-body":
+            from fea.two_body import hertz_pair_domain, solve_two_body
 
-        def initial_active(x, y):
-            return ((x - center[0]) / semi[0]) ** 2 + ((y - center[1]) / semi[1]) ** 2 < 1.0
+            half_curv = (0.5 * a_curv, 0.5 * b_curv)
+            domain = hertz_pair_domain(spec, half_curv, half_curv, comm, limits)
+            t_mesh = time.perf_counter() - t_mesh
+            young_body = material.young_modulus_Pa
+            sol = solve_two_body(
+                domain,
+                young_body,
+                nu,
+                normal_force_N=normal_force_N,
+                approach_m=None if normal_force_N is not None else geometry.approach_m,
+                initial_approach_m=q0,
+                contact_size_m=spec.contact_size_m,
+                settings=settings,
+            )
+        else:
+            domain = hertz_block_domain(spec, comm, limits)
+            t_mesh = time.perf_counter() - t_mesh
 
-        young_body = e_star * (1.0 - nu**2)
-        sol = solve_rigid_indenter(
-            domain,
-            gap0,
-            young_body,
-            nu,
-            normal_force_N=normal_force_N,
-            approach_m=None if normal_force_N is not None else geometry.approach_m,
-            initial_approach_m=q0,
-            initial_active=initial_active if quadric else None,
-            length_scale_m=min(semi),
-            settings=SolverSettings(linear_solver=opts.linear_solver, max_iterations=opts.max_iterations),
-        )
+            def initial_active(x, y):
+                return ((x - center[0]) / semi[0]) ** 2 + ((y - center[1]) / semi[1]) ** 2 < 1.0
+
+            young_body = e_star * (1.0 - nu**2)
+            sol = solve_rigid_indenter(
+                domain,
+                gap0,
+                young_body,
+                nu,
+                normal_force_N=normal_force_N,
+                approach_m=None if normal_force_N is not None else geometry.approach_m,
+                initial_approach_m=q0,
+                initial_active=initial_active if quadric else None,
+                length_scale_m=min(semi),
+                settings=settings,
+            )
 
         extra = {
             "dofs": int(sol.dofs),
             "newton_iterations": int(sol.iterations),
             "mpi_ranks": int(comm.size),
-            "model": "quarter block, rigid quadric indenter" if quadric else "full block, rigid sampled indenter",
-            "young_modulus_block_Pa": young_body,
+            "model": (
+                "two elastic quadric bodies (quarter model), node-to-surface penalty"
+                if opts.formulation == "two-body"
+                else "quarter block, rigid quadric indenter"
+                if quadric
+                else "full block, rigid sampled indenter"
+            ),
+            "young_modulus_Pa": young_body,
             "element_size_m": spec.contact_size_m,
             "block_half_width_m": spec.half_width_m,
             "mesh": domain.quality.as_dict(),
@@ -279,7 +318,8 @@ class FeaModel:
         stress_fn = None
         if opts.stresses:
             stress_fn, coords, stress = post.recover_nodal_stress(sol.displacement, young_body, nu)
-            extra.update(_stress_maxima(comm, coords, stress, spec, quadric, post))
+            lower = coords[:, 2] <= 1e-12 * spec.half_width_m  # the body below the contact plane
+            extra.update(_stress_maxima(comm, coords[lower], stress[lower], spec, quadric, post))
 
         if opts.output_dir is not None:
             from fea.output import write_outputs

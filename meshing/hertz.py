@@ -128,16 +128,67 @@ def build_hertz_block(model, spec: HertzBlockSpec) -> dict[str, tuple[int, int]]
         add(2, faces_at(0, 0.0), "symmetry_x")
         add(2, faces_at(1, 0.0), "symmetry_y")
 
+    _size_field(model, spec)
+    return groups
+
+
+def build_hertz_pair(model, spec: HertzBlockSpec) -> dict[str, tuple[int, int]]:
+    """Two blocks touching at z = 0 (not fused: each has its own contact face and nodes).
+
+    ``lower`` occupies z in [-depth, 0], ``upper`` z in [0, depth], same lateral extent as
+    :func:`build_hertz_block`. The caller gives the faces their curvature (e.g. by morphing the mesh:
+    lower top to z = -f1(x, y), upper bottom to z = +f2(x, y)), so that the undeformed distance is
+    h = f1 + f2. Groups: ``lower``, ``upper`` (3-D), ``lower_contact``, ``upper_contact``,
+    ``lower_base`` (z = -depth), ``upper_base`` (z = +depth), and for the quarter model
+    ``symmetry_x``, ``symmetry_y`` (faces of both blocks).
+    """
+    import numpy as np
+
+    half = spec.half_width_m
+    xc, yc = spec.center_m
+    if spec.symmetry == "quarter":
+        x0, y0, dx, dy = 0.0, 0.0, half, half
+    else:
+        x0, y0, dx, dy = xc - half, yc - half, 2 * half, 2 * half
+    lower = model.occ.addBox(x0, y0, -half, dx, dy, half)
+    upper = model.occ.addBox(x0, y0, 0.0, dx, dy, half)
+    model.occ.synchronize()
+    groups: dict[str, tuple[int, int]] = {}
+    sym_x, sym_y = [], []
+    for body, name in ((lower, "lower"), (upper, "upper")):
+        groups[name] = (3, model.addPhysicalGroup(3, [body], name=name))
+        faces = {}
+        for _, tag in model.getBoundary([(3, body)], oriented=False):
+            lo_hi = np.array(model.getBoundingBox(2, tag)).reshape(2, 3)
+            axis = int(np.argmin(lo_hi[1] - lo_hi[0]))
+            faces[tag] = (axis, float(lo_hi.mean(axis=0)[axis]))
+        tol = 1e-6 * half
+        contact = [t for t, (ax, v) in faces.items() if ax == 2 and abs(v) < tol]
+        base = [t for t, (ax, v) in faces.items() if ax == 2 and abs(abs(v) - half) < tol]
+        groups[f"{name}_contact"] = (2, model.addPhysicalGroup(2, contact, name=f"{name}_contact"))
+        groups[f"{name}_base"] = (2, model.addPhysicalGroup(2, base, name=f"{name}_base"))
+        if spec.symmetry == "quarter":
+            sym_x += [t for t, (ax, v) in faces.items() if ax == 0 and abs(v) < tol]
+            sym_y += [t for t, (ax, v) in faces.items() if ax == 1 and abs(v) < tol]
+    if spec.symmetry == "quarter":
+        groups["symmetry_x"] = (2, model.addPhysicalGroup(2, sym_x, name="symmetry_x"))
+        groups["symmetry_y"] = (2, model.addPhysicalGroup(2, sym_y, name="symmetry_y"))
+    _size_field(model, spec)
+    return groups
+
+
+def _size_field(model, spec: HertzBlockSpec) -> None:
+    """MathEval size field of the module docstring (refined around the expected patch)."""
+
     def num(value):
         return f"{float(value):.17g}"
 
+    xc, yc = spec.center_m
     a, b = spec.semi_axis_long_m, spec.semi_axis_lat_m
     c = math.sqrt(a * b)
-    h_c = spec.contact_size_m
-    h_max = half / 3.0
+    h_max = spec.half_width_m / 3.0
     rho2 = f"(((x-({num(xc)}))/{num(a)})^2+((y-({num(yc)}))/{num(b)})^2+(z/{num(c)})^2)"
-    expression = f"min({num(h_max)}, {num(h_c)}*sqrt(1+({rho2}/{num(spec.refine_radius**2)})^2))"
+    expression = f"min({num(h_max)}, {num(spec.contact_size_m)}*sqrt(1+({rho2}/{num(spec.refine_radius**2)})^2))"
     field = model.mesh.field.add("MathEval")
     model.mesh.field.setString(field, "F", expression)
     model.mesh.field.setAsBackgroundMesh(field)
-    return groups

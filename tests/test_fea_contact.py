@@ -87,6 +87,28 @@ def test_circular_subsurface_max_shear_and_von_mises_match_johnson():
     assert e["max_von_mises_depth_m"] == pytest.approx(depth * a, rel=0.15)
 
 
+def test_two_elastic_bodies_match_hertz():
+    """Two elastic quadric bodies (E, nu each; curvature split equally) with node-to-surface pairing."""
+    r = FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"formulation": "two-body"})
+    ref = hertz_elliptic(
+        ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m, FORCE_N, STEEL_210.combined_modulus_Pa
+    )
+    assert r.success and "pairing converged" in r.message
+    assert r.normal_force_N == pytest.approx(FORCE_N, rel=1e-6)
+    assert r.max_pressure_Pa == pytest.approx(ref.max_pressure_Pa, rel=0.05)
+    assert r.semi_axis_long_m == pytest.approx(ref.semi_axis_long_m, rel=0.05)
+    assert r.semi_axis_lat_m == pytest.approx(ref.semi_axis_lat_m, rel=0.05)
+    assert r.extra["young_modulus_Pa"] == pytest.approx(210e9)
+
+
+def test_two_body_needs_quadric_geometry():
+    x = np.linspace(-0.01, 0.01, 11)
+    X, Y = np.meshgrid(x, x)
+    geo = ContactGeometry(1.0, 1.0, approach_m=1e-5, undeformed=UndeformedDistance(x, x, X**2 + Y**2 - 1e-5))
+    with pytest.raises(ValueError, match="two-body.*quadric"):
+        FeaModel().solve(geo, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"formulation": "two-body"})
+
+
 def test_sampled_gap_full_block_agrees_with_quadric_hertz():
     """Second path: a sampled (off-centre) quadric gap on the full block gives Hertz's patch."""
     A, B = ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m
@@ -143,6 +165,7 @@ def test_mesh_quality_failure_is_an_error():
         ({"degree": 2}, "degree"),
         ({"mesh_size_factor": 0.0}, "mesh_size_factor"),
         ({"linear_solver": "hypre"}, "linear_solver"),
+        ({"formulation": "mortar"}, "formulation"),
     ],
 )
 def test_bad_options_raise(options, match):
@@ -178,9 +201,11 @@ def test_two_ranks_agree_with_one_rank(elliptic_result):
         "from rigid_dynamics.materials import Material\n"
         "r = FeaModel().solve(ContactGeometry.quadric(0.46, 0.15), Creepage(), Material.from_young(210e9, 0.3, 0.3),"
         " normal_force_N=1e5)\n"
+        "t = FeaModel().solve(ContactGeometry.quadric(0.46, 0.15), Creepage(), Material.from_young(210e9, 0.3, 0.3),"
+        " normal_force_N=1e5, options={'formulation': 'two-body', 'quick': True, 'stresses': False})\n"
         "if MPI.COMM_WORLD.rank == 0:\n"
         "    print(json.dumps([r.normal_force_N, r.max_pressure_Pa, r.semi_axis_long_m, r.semi_axis_lat_m,"
-        " r.approach_m, r.extra['max_von_mises_Pa'], r.extra['mpi_ranks']]))\n"
+        " r.approach_m, r.extra['max_von_mises_Pa'], t.max_pressure_Pa, t.approach_m, r.extra['mpi_ranks']]))\n"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
     out = subprocess.run(
@@ -195,6 +220,13 @@ def test_two_ranks_agree_with_one_rank(elliptic_result):
     values = json.loads(out.stdout.strip().splitlines()[-1])
     r = elliptic_result
     assert values[-1] == 2
+    t = FeaModel().solve(
+        ELLIPTIC,
+        Creepage(),
+        STEEL_210,
+        normal_force_N=FORCE_N,
+        options={"formulation": "two-body", "quick": True, "stresses": False},
+    )
     one = [
         r.normal_force_N,
         r.max_pressure_Pa,
@@ -202,5 +234,7 @@ def test_two_ranks_agree_with_one_rank(elliptic_result):
         r.semi_axis_lat_m,
         r.approach_m,
         r.extra["max_von_mises_Pa"],
+        t.max_pressure_Pa,
+        t.approach_m,
     ]
     np.testing.assert_allclose(values[:-1], one, rtol=1e-6)
