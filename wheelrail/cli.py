@@ -209,10 +209,21 @@ def cmd_stress(args) -> int:
 
 def cmd_conicity(args) -> int:
     from rigid_dynamics.contact.conicity import equivalent_conicity_from_names
+    from rigid_dynamics.geometry import load_profile
 
+    profiles = {}
+    for option, value, kind in (("--wheel", args.wheel, "wheel"), ("--rail", args.rail, "rail")):
+        try:
+            profiles[kind] = load_profile(value, kind)
+        except ValueError as exc:
+            raise ConfigError(f"{option} {value!r}: {exc}") from None
+    for option in ("gauge_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
+        value = getattr(args, option)
+        if not (value > 0 and value < float("inf")):
+            raise ConfigError(f"--{option.replace('_', '-')} {value!r}: expected a finite number > 0")
     result = equivalent_conicity_from_names(
-        wheel_profile=args.wheel,
-        rail_profile=args.rail,
+        wheel_profile=profiles["wheel"],
+        rail_profile=profiles["rail"],
         gauge_m=args.gauge_m,
         gauge_height_m=args.gauge_height_m,
         flange_back_distance_m=args.flange_back_distance_m,
@@ -273,15 +284,13 @@ def build_parser() -> argparse.ArgumentParser:
     contact.set_defaults(func=cmd_contact)
 
     conicity = sub.add_parser("conicity", help="equivalent conicity (EN 15302 method)")
-    conicity.add_argument("--wheel", default="MBench_S1002", help="wheel profile: built-in name or file")
-    conicity.add_argument("--rail", default="MBench_UIC60", help="rail profile: built-in name or file")
+    conicity.add_argument("--wheel", default="MBench_S1002_v3", help="wheel profile: built-in name or file")
+    conicity.add_argument("--rail", default="MBench_UIC60_v3", help="rail profile: built-in name or file")
     conicity.add_argument("--gauge-m", type=float, default=1.435)
     conicity.add_argument("--gauge-height-m", type=float, default=0.014)
     conicity.add_argument("--flange-back-distance-m", type=float, default=1.360)
     conicity.add_argument("--nominal-radius-m", type=float, default=0.46)
-    conicity.add_argument(
-        "--rail-inclination-rad", type=float, default=None, help="cant of the rail (default: from the profile)"
-    )
+    conicity.add_argument("--rail-inclination-rad", type=float, default=None, help="cant of the rail (default: 1:40)")
     conicity.add_argument("--amplitude-m", type=float, default=0.003, help="wheelset amplitude (EN 15302: 3 mm)")
     conicity.add_argument("--json", action="store_true")
     conicity.set_defaults(func=cmd_conicity)

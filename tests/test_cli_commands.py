@@ -1,0 +1,92 @@
+"""The CLI commands end to end on the embedded cases (examples are tests).
+
+The physics behind each number is verified in the model tests; here the contract of the
+front is checked: the JSON keys of ``wheelrail contact --json``, null semi-axes where a patch is
+not elliptic, output folders with the input, a summary and atomically written data.
+"""
+
+import json
+import math
+
+import pytest
+
+from wheelrail.cli import main
+
+PATCH_KEYS = {
+    "side",
+    "normal_force_N",
+    "creep_force_long_N",
+    "creep_force_lat_N",
+    "spin_moment_Nm",
+    "max_pressure_Pa",
+    "semi_axis_long_m",
+    "semi_axis_lat_m",
+    "contact_area_m2",
+    "approach_m",
+    "contact_angle_rad",
+    "contact_point_rail_m",
+    "creepage_long",
+    "creepage_lat",
+    "spin_creepage_1_per_m",
+}
+
+
+def run_json(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr().out
+    return code, json.loads(out)
+
+
+def test_models_lists_every_registered_name(capsys):
+    assert main(["models"]) == 0
+    out = capsys.readouterr().out
+    for name in ("hertz", "linear", "vermeulen-johnson", "fastsim", "bem", "fea", "auto"):
+        assert name in out
+
+
+def test_cases_and_scenes_listed(capsys):
+    assert main(["cases"]) == 0
+    assert "manchester-a22" in capsys.readouterr().out
+    assert main(["scenes"]) == 0
+
+
+@pytest.mark.parametrize("method", ["hertz", "linear", "vermeulen-johnson", "fastsim", "bem", "auto"])
+def test_contact_json_contract_quadric(capsys, method):
+    code, record = run_json(capsys, "contact", "hertz-quadric", "--method", method, "--json")
+    assert code == 0
+    assert {"method", "success", "message", "wall_time_s", "patches"} <= set(record)
+    assert record["method"] == method and record["success"] is True
+    (patch,) = record["patches"]
+    assert PATCH_KEYS <= set(patch)
+    assert patch["normal_force_N"] > 0
+    if method == "hertz":
+        assert patch["creep_force_long_N"] == 0 and patch["creep_force_lat_N"] == 0
+
+
+@pytest.mark.parametrize("method", ["hertz", "fastsim"])
+def test_contact_json_contract_wheelset(capsys, method):
+    code, record = run_json(capsys, "contact", "manchester-a22", "--method", method, "--json")
+    assert code == 0
+    assert {p["side"] for p in record["patches"]} == {"left", "right"}
+    for patch in record["patches"]:
+        assert PATCH_KEYS <= set(patch)
+        y, z = patch["contact_point_rail_m"]
+        assert math.isfinite(y) and math.isfinite(z)
+    vertical = sum(p["normal_force_N"] * math.cos(p["contact_angle_rad"]) for p in record["patches"])
+    assert vertical == pytest.approx(2 * 10e3, rel=0.02)
+
+
+def test_contact_writes_output_folder(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["contact", "hertz-quadric", "--method", "fastsim", "--out", str(out), "--plot"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["patches"][0]["normal_force_N"] > 0
+    assert (out / "case.toml").exists()
+    assert summary["plots"] and all((out / name).stat().st_size > 1000 for name in summary["plots"])
+    assert not list(out.glob("*.part"))
+
+
+def test_conicity_command(capsys):
+    code, record = run_json(capsys, "conicity", "--json")
+    assert code == 0
+    assert 0.05 < record["equivalent_conicity"] < 0.4
