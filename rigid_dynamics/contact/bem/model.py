@@ -7,7 +7,9 @@ Steps (Kalker 1990, ch. 5; the approach of his program CONTACT):
    force or approach, m the margin). For a sampled undeformed distance h it is the bounding box of
    {h <= h_min + (-h_min) m^2/2} (approach control) or {h <= h_min + delta_H m^2/2} (force control,
    delta_H the Hertz approach of the quadric part for that force); for a Hertzian h both give the
-   Hertz contact enlarged by m (the rigid overlap region is sqrt(2) times the contact).
+   Hertz contact enlarged by m (the rigid overlap region is sqrt(2) times the contact). If the
+   contact found by NORM touches the edge of that area it is enlarged by 1.3 (within the sampled
+   field) and NORM is redone, up to 3 times.
 2. NORM (:func:`~.norm.solve_norm`) for the pressure; TANG (:func:`~.tang.solve_tang`) for the
    tractions of steady rolling with rigid slip w = (xi - phi y, eta + phi x) and Coulomb friction.
    For different materials (option ``difference_parameter`` K != 0) both are alternated until the
@@ -156,7 +158,7 @@ class BemModel:
 
         Returns:
             ContactResult with fields on the grid; semi-axes (extents of the contact along x, y)
-            only for an elliptic geometry without a sampled field; ``success`` False with status
+            only when ``geometry.is_elliptic`` (else None); ``success`` False with status
             "not-converged" when NORM or TANG did not converge.
         """
         start = time.perf_counter()
@@ -218,37 +220,56 @@ class BemModel:
             y_lim = (float(ys[jj].min()) - hy, float(ys[jj].max()) + hy)
             if x_lim[1] <= x_lim[0] or y_lim[1] <= y_lim[0]:
                 return no_contact("the sampled undeformed distance gives an empty potential contact area")
-        dx = (x_lim[1] - x_lim[0]) / nx
-        dy = (y_lim[1] - y_lim[0]) / ny
-        x = x_lim[0] + dx * (np.arange(nx) + 0.5)
-        y = y_lim[0] + dy * (np.arange(ny) + 0.5)
-        xx, yy = np.meshgrid(x, y)
-        h = np.asarray(geometry.gap_m(xx, yy), float)
         k_diff = float(opts["difference_parameter"])
-        influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
-
-        # 2. NORM and TANG (alternated for K != 0)
         tol, max_it = float(opts["tolerance"]), int(opts["max_iterations"])
+        if geometry.undeformed is not None:
+            xs, ys = np.asarray(geometry.undeformed.x_m), np.asarray(geometry.undeformed.y_m)
+            field_box = (float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
+        grown = 0
+        while True:
+            dx = (x_lim[1] - x_lim[0]) / nx
+            dy = (y_lim[1] - y_lim[0]) / ny
+            x = x_lim[0] + dx * (np.arange(nx) + 0.5)
+            y = y_lim[0] + dy * (np.arange(ny) + 0.5)
+            xx, yy = np.meshgrid(x, y)
+            h = np.asarray(geometry.gap_m(xx, yy), float)
+            influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
+            norm = solve_norm(influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it)
+            contact = norm.pressure_Pa > 0
+            edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
+            if not edge or geometry.undeformed is None or grown >= 3:
+                break
+            # a sampled field's contact reached the potential area's edge: enlarge it (within the field) and redo
+            cx, cy = 0.5 * (x_lim[0] + x_lim[1]), 0.5 * (y_lim[0] + y_lim[1])
+            hx, hy = 0.65 * (x_lim[1] - x_lim[0]), 0.65 * (y_lim[1] - y_lim[0])
+            new_x = (max(cx - hx, field_box[0]), min(cx + hx, field_box[1]))
+            new_y = (max(cy - hy, field_box[2]), min(cy + hy, field_box[3]))
+            if new_x == x_lim and new_y == y_lim:
+                break
+            x_lim, y_lim = new_x, new_y
+            grown += 1
+
+        # 2. TANG (alternated with NORM for K != 0: Panagiotopoulos' process)
         wx, wy = rigid_slip(x, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
-        tractions = None
-        norm = tang = None
-        outer = 1 if k_diff == 0.0 else 20
-        previous = math.inf
-        for _ in range(outer):
+        previous = norm.normal_force_N
+        for _ in range(1 if k_diff == 0.0 else 20):
+            tang = solve_tang(influence, norm.pressure_Pa, mu, wx, wy, tolerance=tol, max_iterations=max_it)
+            if k_diff == 0.0:
+                break
             norm = solve_norm(
                 influence,
                 h,
                 normal_force_N=normal_force_N,
                 tolerance=tol,
                 max_iterations=max_it,
-                tractions_Pa=tractions,
-                initial_pressure_Pa=None if norm is None else norm.pressure_Pa,
+                tractions_Pa=(tang.traction_x_Pa, tang.traction_y_Pa),
+                initial_pressure_Pa=norm.pressure_Pa,
             )
-            tang = solve_tang(influence, norm.pressure_Pa, mu, wx, wy, tolerance=tol, max_iterations=max_it)
-            tractions = (tang.traction_x_Pa, tang.traction_y_Pa)
-            if abs(norm.normal_force_N - previous) <= tol * max(norm.normal_force_N, 1e-300):
-                break
+            change = abs(norm.normal_force_N - previous)
             previous = norm.normal_force_N
+            if change <= tol * max(norm.normal_force_N, 1e-300) and np.array_equal(norm.pressure_Pa > 0, contact):
+                break
+            contact = norm.pressure_Pa > 0
         p = norm.pressure_Pa
         contact = p > 0
         if not contact.any():
@@ -269,7 +290,7 @@ class BemModel:
             in_slip=tang.in_slip & contact,
         )
         semi_long = semi_lat = None
-        if geometry.undeformed is None and geometry.is_elliptic:
+        if geometry.is_elliptic:
             jj, ii = np.nonzero(contact)
             semi_long = float(0.5 * (x[ii].max() - x[ii].min() + dx))
             semi_lat = float(0.5 * (y[jj].max() - y[jj].min() + dy))
@@ -284,7 +305,9 @@ class BemModel:
             if not tang.converged:
                 parts.append(f"TANG did not converge in {tang.iterations} iterations (residual {tang.residual:.3g})")
             message = "; ".join(parts)
-        edge = contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any()
+        edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
+        if edge:
+            message += "; the contact reaches the edge of the potential contact area (enlarge margin or the field)"
         return ContactResult(
             method=self.name,
             success=success,
@@ -316,6 +339,7 @@ class BemModel:
                 "tang_linear_iterations": int(tang.linear_iterations),
                 "tang_residual": float(tang.residual),
                 "slip_elements": int((tang.in_slip & contact).sum()),
-                "contact_touches_potential_area_edge": bool(edge),
+                "contact_touches_potential_area_edge": edge,
+                "potential_area_enlargements": grown,
             },
         )
