@@ -504,6 +504,16 @@ class WheelsetModel:
                 return np.array([1e3, 1e3])
             return np.array([d[8], d[10] * 0.1])
 
+        # bring both wheels to about the static approach before iterating (no contact = flat residual)
+        for _ in range(3):
+            patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
+            deepest = [
+                np.max(patches.approach_m[patches.side == i]) if np.any(patches.side == i) else 0.0 for i in (0, 1)
+            ]
+            shift = 1e-4 - min(deepest)
+            if abs(shift) < 1e-6:
+                break
+            work[2] += shift
         guess = np.array([work[2], work[4]])
         sol = root(residual, guess, method="hybr", options={"xtol": 1e-13})
         work[2], work[4] = sol.x

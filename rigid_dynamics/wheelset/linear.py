@@ -11,7 +11,7 @@ at speed V with spin rate V/r0::
                                                                   sign flips on both sides alike)
     longitudinal creepage, right     xi_R  = -e0 psi'/V - lambda y/r0,   left xi_L = -xi_R
 
-    m y''    = -2 f22 (y'/V - psi) - (k_y + k_g) y - c_y y'
+    m y''    = [-2 f22 ((1 + kappa) y'/V - psi) - k_g y] / (1 - kappa) - k_y y - c_y y'
     J_z psi'' = -2 f11 e0 (e0 psi'/V + lambda y / r0) - k_psi psi - c_psi psi'
 
 Symbols: m mass (kg), J_z yaw inertia (kg m^2), f11 = G a b C11 and f22 = G a b C22 Kalker's
@@ -21,7 +21,12 @@ k_psi = 2 (k_long b^2 + k_yaw) (N m/rad), c_psi = 2 (c_long b^2 + c_yaw) (N m s/
 half spacing (m), and k_g = W lambda / e0 the gravitational stiffness of coned wheels (W the total
 vertical load, N): a lateral shift y rolls the axle by -lambda y / e0, which tilts both contact normals
 so that their lateral components add to -W lambda y / e0 (derived for a cone touching a rail at a
-fixed point; Wickens 2003 sec. 2.3 discusses the gravitational stiffness). Spin-creep coupling
+fixed point; Wickens 2003 sec. 2.3 discusses the gravitational stiffness). With kappa = 0 this is the
+classic model. kappa = lambda r0 / e0 adds the two first-order effects of the quasi-static roll
+theta = -lambda y / e0 that the contact points below the centre bring (derived here): (i) the roll rate
+moves the contact point laterally by -r0 theta', so eta = (1 + kappa) y'/V - psi; (ii) the lateral contact
+force F acting r0 below the centre transfers load N_R - N_L = -r0 F / e0, whose normal forces, tilted by
++-lambda, add lambda r0 F / e0 to F, so the total is (F_creep + F_grav) / (1 - kappa). Spin-creep coupling
 (f23 terms) and the gyroscopic couple are left out, as in the classic model; for the small conicity
 and the spin levels of a conical tread they change the critical speed by far less than 1 %.
 
@@ -52,6 +57,7 @@ class LinearWheelset:
         lateral_stiffness_N_per_m, lateral_damping_N_s_per_m: k_y, c_y for the whole wheelset.
         yaw_stiffness_N_m_per_rad, yaw_damping_N_m_s_per_rad: k_psi, c_psi for the whole wheelset.
         gravitational_stiffness_N_per_m: k_g.
+        roll_coupling: kappa (0 for the classic model).
     """
 
     mass_kg: float
@@ -66,6 +72,7 @@ class LinearWheelset:
     yaw_stiffness_N_m_per_rad: float = 0.0
     yaw_damping_N_m_s_per_rad: float = 0.0
     gravitational_stiffness_N_per_m: float = 0.0
+    roll_coupling: float = 0.0
 
     def __post_init__(self) -> None:
         for name in self.__dataclass_fields__:
@@ -75,6 +82,8 @@ class LinearWheelset:
         for name in ("mass_kg", "yaw_inertia_kg_m2", "nominal_radius_m", "contact_half_distance_m"):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected > 0")
+        if not 0 <= self.roll_coupling < 1:
+            raise ValueError(f"roll_coupling = {self.roll_coupling!r}: expected a value in [0, 1)")
         for name in ("creep_long_N", "creep_lat_N", "conicity"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected >= 0")
@@ -87,12 +96,13 @@ class LinearWheelset:
         m, jz = self.mass_kg, self.yaw_inertia_kg_m2
         lam, r0, e0 = self.conicity, self.nominal_radius_m, self.contact_half_distance_m
         f11, f22 = self.creep_long_N, self.creep_lat_N
-        ky = self.lateral_stiffness_N_per_m + self.gravitational_stiffness_N_per_m
+        kappa = self.roll_coupling
+        amplify = 1.0 / (1.0 - kappa)
         a = np.zeros((4, 4))
         a[0, 2] = a[1, 3] = 1.0
-        a[2, 0] = -ky / m
-        a[2, 1] = 2 * f22 / m
-        a[2, 2] = -(2 * f22 / v + self.lateral_damping_N_s_per_m) / m
+        a[2, 0] = -(self.gravitational_stiffness_N_per_m * amplify + self.lateral_stiffness_N_per_m) / m
+        a[2, 1] = 2 * f22 * amplify / m
+        a[2, 2] = -(2 * f22 * (1 + kappa) * amplify / v + self.lateral_damping_N_s_per_m) / m
         a[3, 0] = -2 * f11 * e0 * lam / (r0 * jz)
         a[3, 1] = -self.yaw_stiffness_N_m_per_rad / jz
         a[3, 3] = -(2 * f11 * e0 * e0 / v + self.yaw_damping_N_m_s_per_rad) / jz
@@ -144,11 +154,14 @@ def critical_speed(
     return CriticalSpeed(True, "ok", "zero crossing of the largest real part", float(speed), freq)
 
 
-def linear_model_for_scene(scene: DynamicsScene, creep_long_N: float, creep_lat_N: float) -> LinearWheelset:
+def linear_model_for_scene(
+    scene: DynamicsScene, creep_long_N: float, creep_lat_N: float, *, classic: bool = False
+) -> LinearWheelset:
     """The linear model of a conical scene, given the creep coefficients f11, f22 per wheel (N).
 
     The conicity is the effective one of the analytic conical provider,
-    lambda / (1 - lambda R_r / e0) (providers.py), and W = m g + axle load.
+    lambda / (1 - lambda R_r / e0) (providers.py), and W = m g + axle load. ``classic`` drops the
+    roll coupling (kappa = 0).
     """
     ws, susp, track = scene.wheelset, scene.suspension, scene.track
     lam, e0 = track.conicity, ws.contact_half_distance_m
@@ -167,7 +180,8 @@ def linear_model_for_scene(scene: DynamicsScene, creep_long_N: float, creep_lat_
         lateral_damping_N_s_per_m=2 * susp.lateral_damping_N_s_per_m,
         yaw_stiffness_N_m_per_rad=2 * (susp.longitudinal_stiffness_N_per_m * b * b + susp.yaw_stiffness_N_m_per_rad),
         yaw_damping_N_m_s_per_rad=2 * (susp.longitudinal_damping_N_s_per_m * b * b + susp.yaw_damping_N_m_s_per_rad),
-        gravitational_stiffness_N_per_m=weight * lam / e0,
+        gravitational_stiffness_N_per_m=weight * lam_eff / e0,
+        roll_coupling=0.0 if classic else lam_eff * ws.nominal_radius_m / e0,
     )
 
 

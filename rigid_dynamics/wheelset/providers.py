@@ -247,8 +247,9 @@ class TableProvider:
 
     Built by sampling a *section* provider (any provider whose patches do not depend on x, yaw, spin)
     at the nominal centre height z_ref = -r0 on a (theta, y) grid. For each side and candidate slot it
-    stores the approach q_ref, dq/dz (finite difference in z: for a locally straight wheel profile
-    exactly the normal's z component), the contact point (y, z relative to the centre), the normal,
+    stores the approach q_ref, dq/dz = cos(gamma) = -n_z (exact for the conical provider and for the
+    profile section, whose approach is the vertical overlap times cos(gamma)), the contact point (y, z
+    relative to the centre), the normal,
     the curvatures, rolling radius, contact angle and wheel lateral position. At run time all
     quantities are interpolated bilinearly and q = q_ref + (z - z_ref) dq/dz. Yaw enters only the
     kinematics (creepages) and the x offset of the contact point, -sin(psi) y_d.
@@ -294,15 +295,13 @@ class TableProvider:
         n = len(probe)
         # quantities: q, dq/dz, py, pz, ny, nz, A, B, radius, angle, y_d  (11)
         table = np.empty((11, n, len(self.roll_grid), len(self.y_grid)))
-        dz = 1e-5
         for i, theta in enumerate(self.roll_grid):
             for j, y in enumerate(self.y_grid):
                 p = section.patches(np.array([0.0, y, self.z_ref]), 0.0, theta, 0.0)
-                p2 = section.patches(np.array([0.0, y, self.z_ref + dz]), 0.0, theta, 0.0)
                 if len(p) != n:
                     raise ValueError(f"section provider {section.name!r} changed its number of candidates")
                 table[0, :, i, j] = p.approach_m
-                table[1, :, i, j] = (p2.approach_m - p.approach_m) / dz
+                table[1, :, i, j] = -p.normal[:, 2]
                 table[2, :, i, j] = p.point_m[:, 1] - y
                 table[3, :, i, j] = p.point_m[:, 2] - self.z_ref
                 table[4, :, i, j] = p.normal[:, 1]

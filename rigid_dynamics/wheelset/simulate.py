@@ -131,6 +131,8 @@ class SimulationResult:
     def energy_residual_J(self) -> np.ndarray:
         """(T + V_g)(t) - (T + V_g)(0) - W_contact(t) - W_exterior(t), J (0 for exact integration)."""
         energy = self.kinetic_energy_J + self.potential_energy_J
+        if len(energy) == 0:
+            return energy
         return energy - energy[0] - self.work_contact_J - self.work_exterior_J
 
     def summary(self) -> dict:
@@ -171,9 +173,11 @@ class SimulationResult:
 
 
 def dominant_wavelength_m(distance_m, lateral_m) -> float:
-    """Dominant wavelength of y(x): twice the mean spacing of the zero crossings of y - mean(y).
+    """Dominant wavelength of y(x): mean spacing of successive same-direction crossings of y - mean(y).
 
-    Crossings are located by linear interpolation in the travelled distance x. Falls back to the
+    Crossings are located by linear interpolation in the travelled distance x; upward crossings are
+    compared with upward ones and downward with downward ones, so an offset of the mean (a record that
+    is not a whole number of cycles) does not bias the result. Falls back to the
     peak of the FFT of y resampled on a uniform x grid when there are fewer than 3 crossings
     (then the resolution is the record length). NaN when neither gives an answer.
 
@@ -193,7 +197,9 @@ def dominant_wavelength_m(distance_m, lateral_m) -> float:
     if len(idx) >= 3:
         x0, x1, y0, y1 = x[idx], x[idx + 1], y[idx], y[idx + 1]
         crossings = x0 - y0 * (x1 - x0) / (y1 - y0)
-        return float(2.0 * np.mean(np.diff(crossings)))
+        upward = y1 > y0
+        spacings = np.concatenate([np.diff(crossings[upward]), np.diff(crossings[~upward])])
+        return float(np.mean(spacings))
     grid = np.linspace(x[0], x[-1], max(len(x), 64))
     yy = np.interp(grid, x, y)
     spectrum = np.abs(np.fft.rfft(yy))
@@ -410,19 +416,32 @@ def simulate(
                 last_fraction[0] = fraction
                 progress(fraction)
 
+    implicit = settings.method in ("Radau", "BDF")
+    bad_trials = [0]
+
+    def trouble(status, message, t, y):
+        # Implicit methods evaluate trial states inside their Newton iterations; a wild trial is
+        # answered with NaN so that the solver rejects the step and retries smaller. Only many such
+        # answers in a row (or trouble on an accepted step, checked after each step) end the run.
+        if implicit and bad_trials[0] < 50:
+            bad_trials[0] += 1
+            return np.full(len(y), np.nan)
+        raise _Stop(status, message, t, y[:12])
+
     def fun(t, y):
         if model.rhs_evaluations >= settings.max_rhs_evaluations:
             raise _Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
         if time.perf_counter() - start > settings.max_wall_time_s:
             raise _Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
         if not np.all(np.isfinite(y)):
-            raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, y[:12])
+            return trouble("blow-up", f"non-finite state at t = {t:.6g} s", t, y)
         try:
             d = model.derivative(t, y)
         except ContactFailure as exc:
-            raise _Stop("contact-failed", f"{exc} (t = {t:.6g} s)", t, y[:12]) from None
+            return trouble("contact-failed", f"{exc} (t = {t:.6g} s)", t, y)
         if not np.all(np.isfinite(d)):
-            raise _Stop("blow-up", f"non-finite state derivative at t = {t:.6g} s", t, y[:12])
+            return trouble("blow-up", f"non-finite state derivative at t = {t:.6g} s", t, y)
+        bad_trials[0] = 0
         return d
 
     n_out = int(math.floor(duration / settings.output_step_s + 1e-9))
@@ -500,10 +519,18 @@ def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scen
     while solver.status == "running":
         t_before = solver.t
         try:
-            message = solver.step()
+            with np.errstate(over="ignore", invalid="ignore"):
+                message = solver.step()
         except _Stop as stop:
             stop.steps = steps
             raise
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            # e.g. a Jacobian with non-finite entries after a wild trial step of an implicit method
+            stop = _Stop(
+                "solver-failed", f"{settings.method} failed at t = {solver.t:.6g} s: {exc}", solver.t, solver.y
+            )
+            stop.steps = steps
+            raise stop from None
         steps += 1
         if solver.status == "failed":
             exc = _Stop("solver-failed", f"{settings.method}: {message} (t = {t_before:.6g} s)", t_before, solver.y)
