@@ -43,7 +43,7 @@ DEFAULT_OPTIONS: dict = {
     "nx": 40,
     "ny": 40,
     "margin": 1.15,
-    "tolerance": 1e-8,
+    "tolerance": 1e-6,
     "max_iterations": 500,
     "difference_parameter": 0.0,
 }
