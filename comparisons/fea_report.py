@@ -7,8 +7,10 @@ undeformed distance h(x, y) of each patch. Every patch is then solved, under the
 (its Hertz share of the wheel load), by
 
 * ``bem``: half-space boundary elements (Kalker's NORM), and
-* ``fea``: FEniCSx, an elastic block with the combined modulus against the same sampled gap
-  (fea.model; half-space-equivalent, so both solve the same problem).
+* ``fea`` (rigid): FEniCSx, an elastic block with the combined modulus against the same sampled gap
+  (fea.model; half-space-equivalent, so both solve the same problem), and
+* ``fea`` (profiles): FEniCSx, two elastic bodies, local rail and wheel sections meshed from the real
+  profiles around the search's contact points (finite bodies, yaw neglected).
 
 Metrics on the BEM grid (cells of equal area; the FEA pressure interpolated bilinearly onto it):
 
@@ -135,6 +137,14 @@ def run_fea_report(
         t_bem = time.perf_counter() - t
         options = {**dict(fea_options or DEFAULT_FEA_OPTIONS), "output_dir": str(out / f"fea_{tag}")}
         r_fea = fea.solve(patch.geometry, patch.creepage, material, normal_force_N=force, options=options)
+        options_p = {
+            **options,
+            "formulation": "profiles",
+            "wheel_profile": wheel_profile,
+            "rail_profile": rail_profile,
+            "output_dir": str(out / f"fea_profiles_{tag}"),
+        }
+        r_prof = fea.solve(patch.geometry, patch.creepage, material, normal_force_N=force, options=options_p)
         entry = {
             "side": patch.side,
             "index": k,
@@ -144,7 +154,13 @@ def run_fea_report(
             "hertz": _numbers(patch.result),
             "bem": {**_numbers(r_bem), "wall_time_s": t_bem},
             "fea": {**_numbers(r_fea), "dofs": r_fea.extra.get("dofs"), "iterations": r_fea.iterations},
+            "fea_profiles": {**_numbers(r_prof), "dofs": r_prof.extra.get("dofs"), "iterations": r_prof.iterations},
         }
+        if r_bem.success and r_prof.success and r_prof.fields is not None:
+            metrics_p = compare_fields(r_bem.fields, r_prof.fields)
+            entry["profiles_pressure_difference_force_weighted"] = metrics_p["pressure_difference_force_weighted"]
+            entry["profiles_outline_mismatch"] = metrics_p["outline_mismatch"]
+            entry["profiles_contact_area_difference"] = r_prof.contact_area_m2 / r_bem.contact_area_m2 - 1.0
         if r_bem.success and r_fea.success and r_bem.fields is not None and r_fea.fields is not None:
             metrics = compare_fields(r_bem.fields, r_fea.fields)
             entry["pressure_difference_force_weighted"] = metrics["pressure_difference_force_weighted"]
@@ -214,7 +230,10 @@ def _markdown(summary: dict) -> str:
         "D_p = sum|p_fea - p_bem| / sum p_bem on the BEM grid; D_A = A_fea/A_bem - 1; "
         "D_O = outline mismatch area / A_bem.",
         "",
-        "| patch | N / kN | p_max Hertz / BEM / FEA (MPa) | area Hertz / BEM / FEA (mm^2) | D_p | D_A | D_O |",
+        "FEA = rigid-indenter block on the sampled gap; FEA-prof = two elastic bodies from the real profiles.",
+        "",
+        "| patch | N / kN | p_max Hertz / BEM / FEA / FEA-prof (MPa) | area Hertz / BEM / FEA / FEA-prof (mm^2) "
+        "| D_p FEA / prof | D_A FEA / prof | D_O FEA / prof |",
         "|---|---|---|---|---|---|---|",
     ]
     for p in summary["patches"]:
@@ -222,13 +241,20 @@ def _markdown(summary: dict) -> str:
         def f(x, scale):
             return "-" if x is None else f"{x * scale:.0f}"
 
+        def g(key, fmt, p=p):
+            value = p.get(key)
+            return "-" if value is None else format(value, fmt)
+
         lines.append(
             f"| {p['side']} {p['index']} | {p['normal_force_N'] / 1e3:.1f} | "
             f"{f(p['hertz']['max_pressure_Pa'], 1e-6)} / {f(p['bem']['max_pressure_Pa'], 1e-6)} / "
-            f"{f(p['fea']['max_pressure_Pa'], 1e-6)} | {f(p['hertz']['contact_area_m2'], 1e6)} / "
-            f"{f(p['bem']['contact_area_m2'], 1e6)} / {f(p['fea']['contact_area_m2'], 1e6)} | "
-            f"{p.get('pressure_difference_force_weighted', float('nan')):.3f} | "
-            f"{p.get('contact_area_difference', float('nan')):+.3f} | {p.get('outline_mismatch', float('nan')):.3f} |"
+            f"{f(p['fea']['max_pressure_Pa'], 1e-6)} / {f(p['fea_profiles']['max_pressure_Pa'], 1e-6)} | "
+            f"{f(p['hertz']['contact_area_m2'], 1e6)} / {f(p['bem']['contact_area_m2'], 1e6)} / "
+            f"{f(p['fea']['contact_area_m2'], 1e6)} / {f(p['fea_profiles']['contact_area_m2'], 1e6)} | "
+            f"{g('pressure_difference_force_weighted', '.3f')} / "
+            f"{g('profiles_pressure_difference_force_weighted', '.3f')} | "
+            f"{g('contact_area_difference', '+.3f')} / {g('profiles_contact_area_difference', '+.3f')} | "
+            f"{g('outline_mismatch', '.3f')} / {g('profiles_outline_mismatch', '.3f')} |"
         )
     return "\n".join(lines) + "\n"
 

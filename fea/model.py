@@ -29,7 +29,7 @@ import numpy as np
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
-FORMULATIONS = ("rigid", "two-body")
+FORMULATIONS = ("rigid", "two-body", "profiles")
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,10 @@ class FeaOptions:
         quick: coarse mesh (4 elements per semi-axis, block of 12 semi-axes) for a fast estimate.
         formulation: "rigid" (one block with E* against the rigid gap; fast verification mode) or
             "two-body" (two elastic quadric bodies with E, nu each, node-to-surface pairing; quadric
-            geometries only, see fea.two_body).
+            geometries only, see fea.two_body) or "profiles" (local rail and wheel sections meshed from the
+            real profiles ``rail_profile`` / ``wheel_profile`` around the patch's contact points, two elastic
+            bodies with node-to-surface pairing; yaw neglected).
+        wheel_profile, rail_profile: built-in profile names or files (formulation "profiles").
         mesh_size_factor: multiplies the element size at the patch (1 = min(a, b)/6), > 0.
         elements_per_semi_axis: element count per semi-axis at the patch (overrides quick's 4 / default 6).
         domain_factor: half-width and depth of the block in semi-axes (>= 4).
@@ -56,6 +59,8 @@ class FeaOptions:
 
     quick: bool = False
     formulation: str = "rigid"
+    wheel_profile: str | None = None
+    rail_profile: str | None = None
     mesh_size_factor: float = 1.0
     elements_per_semi_axis: float | None = None
     domain_factor: float | None = None
@@ -78,6 +83,8 @@ class FeaOptions:
             raise ValueError(f"domain_factor = {self.domain_factor!r}: expected >= 4")
         if self.formulation not in FORMULATIONS:
             raise ValueError(f"formulation = {self.formulation!r}: expected one of {FORMULATIONS}")
+        if self.formulation == "profiles" and (not self.wheel_profile or not self.rail_profile):
+            raise ValueError("formulation = 'profiles': expected the options wheel_profile and rail_profile")
         if self.degree != 1:
             raise ValueError(f"degree = {self.degree!r}: expected 1 (P2 contact is not implemented)")
         if int(self.grid_points) != self.grid_points or self.grid_points < 8:
@@ -206,18 +213,43 @@ class FeaModel:
                 "formulation = 'two-body': expected a quadric geometry (geometry.undeformed is None); "
                 "sampled gaps use the rigid formulation"
             )
+        if opts.formulation == "profiles":
+            semi = (expected.semi_axis_long_m, expected.semi_axis_lat_m)
+            center = (0.0, 0.0)
+            q0 = expected.approach_m
+            for name in ("contact_point_rail_m", "contact_point_wheel_m"):
+                if not all(math.isfinite(v) for v in getattr(geometry, name)):
+                    raise ValueError(f"geometry.{name} = {getattr(geometry, name)!r}: expected profile coordinates")
         spec = HertzBlockSpec(
             semi_axis_long_m=semi[0],
             semi_axis_lat_m=semi[1],
             elements_per_semi_axis=opts.n_per_semi_axis,
             domain_factor=opts.block_factor,
             center_m=center,
-            symmetry="quarter" if quadric else "full",
+            symmetry="quarter" if quadric and opts.formulation != "profiles" else "full",
         )
         t_mesh = time.perf_counter()
         limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
         settings = SolverSettings(linear_solver=opts.linear_solver, max_iterations=opts.max_iterations)
-        if opts.formulation == "two-body":
+        if opts.formulation == "profiles":
+            from fea.two_body import solve_two_body
+
+            domain, sections = _profile_domain(geometry, opts, semi, spec.contact_size_m, comm, limits)
+            t_mesh = time.perf_counter() - t_mesh
+            young_body = material.young_modulus_Pa
+            sol = solve_two_body(
+                domain,
+                young_body,
+                nu,
+                normal_force_N=normal_force_N,
+                approach_m=None if normal_force_N is not None else geometry.approach_m,
+                initial_approach_m=q0,
+                contact_size_m=spec.contact_size_m,
+                settings=settings,
+            )
+            sol.node_xy_m[:, 1] *= _lateral_sign(geometry)
+            quadric = False
+        elif opts.formulation == "two-body":
             from fea.two_body import hertz_pair_domain, solve_two_body
 
             half_curv = (0.5 * a_curv, 0.5 * b_curv)
@@ -260,7 +292,9 @@ class FeaModel:
             "newton_iterations": int(sol.iterations),
             "mpi_ranks": int(comm.size),
             "model": (
-                "two elastic quadric bodies (quarter model), node-to-surface penalty"
+                "rail and wheel sections from real profiles, node-to-surface penalty"
+                if opts.formulation == "profiles"
+                else "two elastic quadric bodies (quarter model), node-to-surface penalty"
                 if opts.formulation == "two-body"
                 else "quarter block, rigid quadric indenter"
                 if quadric
@@ -318,7 +352,7 @@ class FeaModel:
         stress_fn = None
         if opts.stresses:
             stress_fn, coords, stress = post.recover_nodal_stress(sol.displacement, young_body, nu)
-            lower = coords[:, 2] <= 1e-12 * spec.half_width_m  # the body below the contact plane
+            lower = _lower_body_nodes(domain, stress_fn, len(coords), coords, spec)
             extra.update(_stress_maxima(comm, coords[lower], stress[lower], spec, quadric, post))
 
         if opts.output_dir is not None:
@@ -361,6 +395,55 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra or {},
         )
+
+
+def _lower_body_nodes(domain, stress_fn, n, coords, spec):
+    """Mask of the owned stress nodes in the body below the contact plane (rail / block)."""
+    if "lower" not in domain.groups:
+        return np.ones(n, dtype=bool)
+    from dolfinx import fem
+
+    cells = domain.cell_tags.find(domain.groups["lower"])
+    blocks = fem.locate_dofs_topological(stress_fn.function_space, 3, cells)
+    mask = np.zeros(n, dtype=bool)
+    mask[blocks[blocks < n]] = True
+    return mask
+
+
+def _lateral_sign(geometry) -> float:
+    """+1 if the contact frame's y axis points towards the field side (profile y_p), else -1."""
+    toward_field = {"right": 1.0, "left": -1.0}.get(geometry.side, 0.0)
+    if toward_field == 0.0:
+        return 1.0
+    return 1.0 if geometry.frame[1, 1] * toward_field >= 0 else -1.0
+
+
+def _profile_domain(geometry, opts, semi, contact_size_m, comm, limits):
+    """Rail and wheel sections around the patch's contact points (sizes in units of the Hertz semi-axes)."""
+    import dataclasses
+
+    from fea.two_body import profile_pair_domain
+    from meshing.profile_sections import ProfileSectionSpec, section_surface_points
+    from rigid_dynamics.geometry.readers import load_profile
+
+    rail_curve = load_profile(opts.rail_profile, "rail").curve()
+    wheel_curve = load_profile(opts.wheel_profile, "wheel").curve()
+    a, b = semi
+    width, length, depth = 2.0 * max(a, b), 5.0 * a, 3.0 * max(a, b)
+    n = min(a, b) / contact_size_m
+    radius = geometry.rolling_radius_m if math.isfinite(geometry.rolling_radius_m) else 0.46
+    rail = ProfileSectionSpec("rail", geometry.contact_point_rail_m[0], width, length, 1.0, a, b, n)
+    wheel = ProfileSectionSpec("wheel", geometry.contact_point_wheel_m[0], width, length, 1.0, a, b, n, radius)
+    _, z_rail = section_surface_points(rail_curve, rail)
+    _, z_wheel = section_surface_points(wheel_curve, wheel)
+    rail = dataclasses.replace(rail, depth_m=depth - min(float(z_rail.min()), 0.0))
+    wheel = dataclasses.replace(wheel, depth_m=depth + max(float(z_wheel.max()), 0.0))
+    # The wheel builder takes R(y_c) from r0 and the profile; pass r0 so that R(y_c) = rolling radius.
+    z_tape = float(wheel_curve.z(0.0)) if wheel_curve.y_min_m < 0.0 < wheel_curve.y_max_m else 0.0
+    r0 = radius - (float(wheel_curve.z(wheel.contact_y_m)) - z_tape)
+    wheel = dataclasses.replace(wheel, nominal_radius_m=r0)
+    domain = profile_pair_domain(rail_curve, wheel_curve, rail, wheel, comm, limits)
+    return domain, (rail, wheel)
 
 
 def _stress_maxima(comm, coords, stress, spec, quadric, post) -> dict:

@@ -103,7 +103,9 @@ def normal_angle_rad(curve, contact_y_m: float) -> float:
     return math.atan(slope)
 
 
-def build_profile_section(model, curve, spec: ProfileSectionSpec, *, align_normal: bool = True) -> dict:
+def build_profile_section(
+    model, curve, spec: ProfileSectionSpec, *, align_normal: bool = True, prefix: str = "", size_field: bool = True
+) -> dict:
     """Add a rail or wheel section (see the module docstring) to the current gmsh model.
 
     Args:
@@ -111,6 +113,9 @@ def build_profile_section(model, curve, spec: ProfileSectionSpec, *, align_norma
         curve: profile curve with ``z(y_m, derivative=0)``, ``y_min_m``, ``y_max_m``.
         spec: section parameters.
         align_normal: rotate about X so the contact plane is Z = 0.
+        prefix: group names become ``prefix`` (body) and ``prefix_contact`` etc. (default: plain names),
+            so a rail and a wheel section can share one model.
+        size_field: install the refinement field (once per model is enough).
 
     Returns:
         physical group name -> (dimension, tag). The mesh is not generated.
@@ -178,7 +183,11 @@ def build_profile_section(model, curve, spec: ProfileSectionSpec, *, align_norma
     ends = [t for t in faces if t not in contact and t not in base]
     groups = {}
     for name, dim, tags in (("body", 3, volumes), ("contact", 2, contact), ("base", 2, base), ("ends", 2, ends)):
+        if prefix:
+            name = prefix if name == "body" else f"{prefix}_{name}"
         groups[name] = (dim, model.addPhysicalGroup(dim, tags, name=name))
+    if not size_field:
+        return groups
 
     a, b = spec.semi_axis_long_m, spec.semi_axis_lat_m
     c = math.sqrt(a * b)

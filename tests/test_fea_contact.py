@@ -109,6 +109,12 @@ def test_two_body_needs_quadric_geometry():
         FeaModel().solve(geo, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"formulation": "two-body"})
 
 
+def test_profiles_formulation_needs_contact_points():
+    options = {"formulation": "profiles", "wheel_profile": "MBench_S1002_v3", "rail_profile": "MBench_UIC60_v3"}
+    with pytest.raises(ValueError, match="contact_point_rail_m"):
+        FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options=options)
+
+
 def test_sampled_gap_full_block_agrees_with_quadric_hertz():
     """Second path: a sampled (off-centre) quadric gap on the full block gives Hertz's patch."""
     A, B = ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m
@@ -166,6 +172,7 @@ def test_mesh_quality_failure_is_an_error():
         ({"mesh_size_factor": 0.0}, "mesh_size_factor"),
         ({"linear_solver": "hypre"}, "linear_solver"),
         ({"formulation": "mortar"}, "formulation"),
+        ({"formulation": "profiles", "wheel_profile": "MBench_S1002_v3"}, "wheel_profile and rail_profile"),
     ],
 )
 def test_bad_options_raise(options, match):

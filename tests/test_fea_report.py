@@ -27,5 +27,9 @@ def test_fea_and_bem_agree_on_a_manchester_patch(tmp_path):
     assert patch["fea"]["normal_force_N"] == pytest.approx(patch["bem"]["normal_force_N"], rel=1e-6)
     assert patch["pressure_difference_force_weighted"] < 0.25
     assert abs(patch["contact_area_difference"]) < 0.15
+    # two elastic bodies meshed from the real profiles: same problem up to finite-body effects
+    assert patch["fea_profiles"]["success"]
+    assert patch["profiles_pressure_difference_force_weighted"] < 0.25
+    assert abs(patch["profiles_contact_area_difference"]) < 0.15
     assert json.loads((tmp_path / "fea_report.json").read_text())["patches"][0]["side"] == "right"
     assert (tmp_path / "fea_vs_bem_right_0.png").is_file()
