@@ -291,49 +291,54 @@ def solve_tang(
         if residual < tolerance and it > 1:
             converged = True
             break
-        epx, epy = -ey, ex
-        diag_s = np.where(slip, np.maximum(-s_par, 0.0), 0.0)  # |s| for correctly oriented slip
-        gb = np.where(slip, bound, 0.0)
-        fs = np.where(stick, 1.0, 0.0)
+        # compact unknowns: adhesion (t_x, t_y) increments, then slip angle increments
+        ih = np.flatnonzero(stick.ravel())
+        isl = np.flatnonzero(slip.ravel())
+        nh = ih.size
+        epx, epy = -ey.ravel()[isl], ex.ravel()[isl]
+        diag_s = np.maximum(-s_par.ravel()[isl], 0.0)  # |s| for correctly oriented slip
+        gb = bound.ravel()[isl]
+        self_s = gb * (epx * epx * m_x + epy * epy * m_y) + diag_s
+        stick_f = stick.astype(float)
 
-        def matvec(v: np.ndarray, epx=epx, epy=epy, diag_s=diag_s, gb=gb, fs=fs, stick=stick, slip=slip) -> np.ndarray:
-            vx, vy, al = v[:n].reshape(shape), v[n : 2 * n].reshape(shape), v[2 * n :].reshape(shape)
-            dtx = fs * vx + gb * epx * al
-            dty = fs * vy + gb * epy * al
-            ux, uy = influence.tangential(dtx, dty, rolling=rolling)
-            ox = np.where(stick, ux, vx)
-            oy = np.where(stick, uy, vy)
-            os_ = np.where(slip, epx * ux + epy * uy + diag_s * al, al)
-            return np.concatenate([ox.ravel(), oy.ravel(), os_.ravel()])
+        def matvec(v: np.ndarray, ih=ih, isl=isl, nh=nh, epx=epx, epy=epy, diag_s=diag_s, gb=gb) -> np.ndarray:
+            dtx = np.zeros(n)
+            dty = np.zeros(n)
+            dtx[ih] = v[:nh]
+            dty[ih] = v[nh : 2 * nh]
+            al = v[2 * nh :]
+            dtx[isl] = gb * epx * al
+            dty[isl] = gb * epy * al
+            ux, uy = influence.tangential(dtx.reshape(shape), dty.reshape(shape), rolling=rolling)
+            ux, uy = ux.ravel(), uy.ravel()
+            return np.concatenate([ux[ih], uy[ih], epx * ux[isl] + epy * uy[isl] + diag_s * al])
 
-        def precondition(v: np.ndarray, epx=epx, epy=epy, diag_s=diag_s, gb=gb, stick=stick, slip=slip) -> np.ndarray:
-            vx = np.where(stick, v[:n].reshape(shape), 0.0)
-            vy = np.where(stick, v[n : 2 * n].reshape(shape), 0.0)
-            vx, vy = influence.inverse_static(vx, vy)
+        def precondition(v: np.ndarray, ih=ih, nh=nh, self_s=self_s, stick_f=stick_f) -> np.ndarray:
+            rx = np.zeros(n)
+            ry = np.zeros(n)
+            rx[ih] = v[:nh]
+            ry[ih] = v[nh : 2 * nh]
+            ux, uy = influence.inverse_static(rx.reshape(shape), ry.reshape(shape))
             if rolling:
                 # L = C o D with D t = (t_I - t_(I+e_x))/dx: invert D by summing from the leading edge
-                vx = np.cumsum(np.where(stick, vx, 0.0)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
-                vy = np.cumsum(np.where(stick, vy, 0.0)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
-            px = np.where(stick, vx, v[:n].reshape(shape))
-            py = np.where(stick, vy, v[n : 2 * n].reshape(shape))
-            self_s = gb * (epx * epx * m_x + epy * epy * m_y) + diag_s
-            pa = np.where(slip, v[2 * n :].reshape(shape) / np.where(slip, self_s, 1.0), v[2 * n :].reshape(shape))
-            return np.concatenate([px.ravel(), py.ravel(), pa.ravel()])
+                ux = np.cumsum((ux * stick_f)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
+                uy = np.cumsum((uy * stick_f)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
+            return np.concatenate([ux.ravel()[ih], uy.ravel()[ih], v[2 * nh :] / self_s])
 
         def op(z, mv=matvec, pc=precondition):
             return mv(pc(z))
 
-        rhs = -np.concatenate(
-            [np.where(stick, sx, 0.0).ravel(), np.where(stick, sy, 0.0).ravel(), np.where(slip, s_perp, 0.0).ravel()]
-        )
+        rhs = -np.concatenate([sx.ravel()[ih], sy.ravel()[ih], s_perp.ravel()[isl]])
         sol, count = _gmres(
             op, rhs, rtol=min(1e-2, max(0.1 * residual, 0.3 * tolerance / residual)), max_iterations=400
         )
         lin_total += count
         sol = precondition(sol)
-        tx = tx + np.where(stick, sol[:n].reshape(shape), 0.0)
-        ty = ty + np.where(stick, sol[n : 2 * n].reshape(shape), 0.0)
-        theta = theta + np.where(slip, sol[2 * n :].reshape(shape), 0.0)
+        txf, tyf, thf = tx.ravel().copy(), ty.ravel().copy(), theta.ravel().copy()
+        txf[ih] += sol[:nh]
+        tyf[ih] += sol[nh : 2 * nh]
+        thf[isl] += sol[2 * nh :]
+        tx, ty, theta = txf.reshape(shape), tyf.reshape(shape), thf.reshape(shape)
         tx = np.where(slip, bound * np.cos(theta), tx)
         ty = np.where(slip, bound * np.sin(theta), ty)
         # set changes
