@@ -143,20 +143,22 @@ def test_no_contact_and_not_converged():
     assert not res.success and res.status == "not-converged" and "did not converge" in res.message
 
 
-def test_different_materials_alternation_converges():
-    """K != 0 (Panagiotopoulos alternation) converges; with xi = 0 and no spin nothing changes (symmetry).
+def test_different_materials_coupling_antisymmetric_in_k():
+    """Dissimilar bodies (Kalker's K != 0): free rolling is not traction-free (Bentall & Johnson 1967).
 
-    Regression-type check of the coupling path (no closed form used).
+    At zero creepage the pressure's tangential displacement (kernel A_xz = -K X/(pi G r^2)) enters the
+    steady-state slip, so F_x != 0; the influence is odd in K, so F_x(K) = -F_x(-K), and F_y = 0 by symmetry.
     """
     model = BemModel()
     geometry = ContactGeometry.quadric(0.46, 0.3)
-    base = model.solve(geometry, Creepage(), STEEL, normal_force_N=5e4, options={"nx": 16, "ny": 16})
-    coupled = model.solve(
-        geometry, Creepage(), STEEL, normal_force_N=5e4, options={"nx": 16, "ny": 16, "difference_parameter": 0.1}
-    )
-    assert coupled.success
-    # pressure-induced tangential slip from K: shift-free rolling gives a traction, but no net F_x by symmetry in y
-    assert coupled.normal_force_N == pytest.approx(base.normal_force_N, rel=1e-9)
+    opts = {"nx": 16, "ny": 16}
+    plus = model.solve(geometry, Creepage(), STEEL, normal_force_N=5e4, options={**opts, "difference_parameter": 0.1})
+    minus = model.solve(geometry, Creepage(), STEEL, normal_force_N=5e4, options={**opts, "difference_parameter": -0.1})
+    assert plus.success and minus.success
+    assert abs(plus.creep_force_long_N) > 1e-3 * 0.3 * 5e4
+    assert plus.creep_force_long_N == pytest.approx(-minus.creep_force_long_N, rel=1e-6)
+    assert abs(plus.creep_force_lat_N) < 1e-9 * 5e4
+    assert plus.normal_force_N == pytest.approx(5e4, rel=1e-12)
 
 
 def test_bad_options():
