@@ -283,16 +283,6 @@ class InfluenceGrid:
         """Coefficient of an element on itself (offset 0)."""
         return float(self.kernel(name, rolling)[self.ny - 1, self.nx - 1])
 
-    def window(self, name: str, rolling: bool, half_x: int, half_y: int) -> np.ndarray:
-        """Coefficients for offsets |di| <= half_x, |dj| <= half_y, shape (2 half_y + 1, 2 half_x + 1), zero-filled."""
-        out = np.zeros((2 * half_y + 1, 2 * half_x + 1))
-        k = self.kernel(name, rolling)
-        for a in range(-half_y, half_y + 1):
-            for b in range(-half_x, half_x + 1):
-                if abs(a) < self.ny and abs(b) < self.nx:
-                    out[a + half_y, b + half_x] = k[a + self.ny - 1, b + self.nx - 1]
-        return out
-
     def _kernel_fft(self, name: str, rolling: bool) -> np.ndarray:
         key = (name, rolling)
         cache = self._cache["fft"]
