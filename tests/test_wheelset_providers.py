@@ -97,7 +97,7 @@ def test_running_irregularities_symmetric_extremes():
     """At a symmetric extreme under the wheel the approach changes by exactly the irregularity.
 
     Polygon order 3 with its crest at the lowest point (alpha = pi/2 - phi = 0): +A. Rounded flat centred at
-    the lowest point (convex: d < L^2/(2 pi^2 r0)): -d. Rail corrugation crest (N_irr = -A at x = 0): +A.
+    the lowest point (convex: d < L^2/(2 pi^2 r0)): -d. Rail corrugation crest (N_irr = -A at x = w/2): +A.
     """
     centre = np.array([0.0, 0.0, -R0 + 1e-4])
     base = conical().patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m
@@ -107,7 +107,8 @@ def test_running_irregularities_symmetric_extremes():
     got = conical(irregularities=flat).patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m - base
     np.testing.assert_allclose(got, -5e-4, atol=1e-12)
     corrugation = Irregularities(corrugation_wavelength_m=0.05, corrugation_amplitude_m=3e-5, side="right")
-    got = conical(irregularities=corrugation).patches(centre, 0.0, 0.0, 0.0).approach_m - base
+    crest = centre + np.array([0.025, 0.0, 0.0])
+    got = conical(irregularities=corrugation).patches(crest, 0.0, 0.0, 0.0).approach_m - base
     np.testing.assert_allclose(got, [0.0, 3e-5], atol=1e-12)
 
 

@@ -359,7 +359,8 @@ class WheelsetModel:
             frames, speed, xi, eta, spin = _creepages(lever[active], patches.normal[active], omega, v_c)
             if not np.all(speed > 0) or not np.all(np.isfinite(speed)):
                 raise ContactFailure(f"rolling speed {speed.min()!r} m/s at a contact: creepages undefined")
-            if self.batch is not None and patches.geometries is None:
+            elliptic = patches.geometries is None or all(patches.geometries[k].is_elliptic for k in active)
+            if self.batch is not None and elliptic:
                 normal, t_x, t_y, m_z, semi_a, semi_b = self.batch(
                     patches.curvature_long_1_per_m[active],
                     patches.curvature_lat_1_per_m[active],

@@ -8,10 +8,11 @@ alpha_d, the track coordinate x): the lateral extent is the whole tread.
 * Rounded wheel flat of length L and depth d centred at alpha_f, arc coordinate s = r0 wrap(alpha - alpha_f):
   R_irr = -(d/2) (1 + cos(2 pi s / L)) for |s| < L/2, else 0. This is the rounded ("haversine") flat
   profile used for worn flats by Newton & Clark (1979, J. Mech. Eng. Sci. 21, 287-297) and by
-  Wu & Thompson (2002, J. Sound Vib. 251, 115-139). With d = 0 the depth of a fresh flat of chord L,
-  d = L^2/(16 r0), is used (chord of a circle).
-* Sinusoidal rail corrugation of wavelength w and amplitude A: N_irr = -A cos(2 pi x / w)
-  (z down: N smaller = rail higher, so the crest is at x = 0).
+  Wu & Thompson (2002, J. Sound Vib. 251, 115-139). With d = 0 the default depth d = L^2/(16 r0) is used,
+  the depth of a fresh chord flat of length L/sqrt(2) (rounding keeps the depth and lengthens the flat by
+  sqrt(2)), as in rigid_dynamics.geometry.WheelFlat.
+* Sinusoidal rail corrugation of wavelength w and amplitude A: N_irr = A cos(2 pi x / w)
+  (z down: the rail is lowest at x = 0 and highest at x = w/2), as geometry.RailCorrugation.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from rigid_dynamics.wheelset.parameters import Irregularities
 
 
 def flat_depth_m(irregularities: Irregularities, nominal_radius_m: float) -> float:
-    """Depth d of the flat: the given one, or L^2/(16 r0) (a fresh flat of chord L) when 0, m."""
+    """Depth d of the flat: the given one, or L^2/(16 r0) when 0 (module docstring), m."""
     if irregularities.flat_depth_m > 0:
         return irregularities.flat_depth_m
     return irregularities.flat_length_m**2 / (16.0 * nominal_radius_m)
@@ -73,7 +74,7 @@ def rail_irregularity(irregularities: Irregularities, x_m):
         return zero, zero, zero
     k = 2 * math.pi / irr.corrugation_wavelength_m
     amp = irr.corrugation_amplitude_m
-    return -amp * np.cos(k * x), amp * k * np.sin(k * x), amp * k * k * np.cos(k * x)
+    return amp * np.cos(k * x), -amp * k * np.sin(k * x), -amp * k * k * np.cos(k * x)
 
 
 def applies_to(irregularities: Irregularities, side: str) -> bool:

@@ -184,13 +184,12 @@ class Irregularities:
         polygon_amplitude_m: amplitude of R_irr = A cos(n alpha + phase), m.
         polygon_phase_rad: phase, rad.
         flat_length_m: L, length of the (rounded) wheel flat along the circumference, m; 0 = none.
-        flat_depth_m: d, depth of the flat, m; 0 means the depth of a fresh flat of chord L,
-            d = L^2 / (16 r0).
+        flat_depth_m: d, depth of the flat, m; 0 means d = L^2 / (16 r0) (irregular.py).
         flat_angle_rad: wheel angle alpha_d of the flat centre, rad. The wheel's lowest point is at
             alpha_d = pi/2 - phi and phi grows by x / r0 when rolling a distance x, so a flat at
             pi/2 - x_f / r0 reaches the rail after about x_f of travel.
         corrugation_wavelength_m: wavelength of sinusoidal rail corrugation, m; 0 = none.
-        corrugation_amplitude_m: amplitude of N_irr = -A cos(2 pi x / wavelength), m.
+        corrugation_amplitude_m: amplitude of N_irr = A cos(2 pi x / wavelength), m (z down).
         side: which wheels/rails carry the irregularities: "both", "left" or "right".
     """
 

@@ -42,14 +42,24 @@ MIN_LATERAL_CURVATURE_1_PER_M = 0.05
 def build_surfaces(wheelset: WheelsetParameters, track: TrackGeometry, irregularities: Irregularities | None = None):
     """Wheel and rail surfaces of both sides from the scene's profiles (contact.track.build_track).
 
+    A conical track (wheel_profile "conical", rail_profile "circular") uses geometry.conical_wheel(conicity)
+    and geometry.circular_rail(rail_head_radius_m), placed by the gauge and flange-back distance like any
+    profile (so its contact points are not exactly at +-e0: read them from the provider).
+
     Returns:
         The WheelsetTrack (``wheels``, ``rails`` dicts by side, ``search(pose, side, options)``).
     """
     from rigid_dynamics.contact.track import build_track
 
+    wheel_profile, rail_profile = track.wheel_profile, track.rail_profile
+    if track.is_conical:
+        from rigid_dynamics.geometry import circular_rail, conical_wheel
+
+        wheel_profile = conical_wheel(track.conicity).to_profile()
+        rail_profile = circular_rail(track.rail_head_radius_m).to_profile()
     case = SimpleNamespace(
-        wheel_profile=track.wheel_profile,
-        rail_profile=track.rail_profile,
+        wheel_profile=wheel_profile,
+        rail_profile=rail_profile,
         gauge_m=track.gauge_m,
         gauge_height_m=track.gauge_height_m,
         flange_back_distance_m=track.flange_back_distance_m,
@@ -68,41 +78,35 @@ def geometry_irregularities(irregularities: Irregularities, nominal_radius_m: fl
     Returns:
         (wheel side -> tuple, rail side -> tuple).
 
-    Raises:
-        ValueError: the geometry package does not offer a needed irregularity.
+    The rounded flat, the polygon and the corrugation are the same functions as in
+    rigid_dynamics.wheelset.irregular (which the analytic providers use): geometry.WheelFlat "rounded",
+    HarmonicOutOfRoundness, RailCorrugation (A cos(2 pi x / wavelength), over the rail head's central band).
     """
+    from rigid_dynamics import geometry as geo
     from rigid_dynamics.wheelset.irregular import applies_to
 
-    try:
-        from rigid_dynamics import geometry as geo
-    except ImportError as exc:  # pragma: no cover
-        raise ValueError(f"irregularities need rigid_dynamics.geometry: {exc}") from None
     wheel, rail = [], []
     irr = irregularities
-    try:
-        if irr.polygon_order > 0 and irr.polygon_amplitude_m > 0:
-            wheel.append(
-                geo.HarmonicOutOfRoundness(
-                    order=irr.polygon_order, amplitude_m=irr.polygon_amplitude_m, phase_rad=irr.polygon_phase_rad
-                )
+    if irr.polygon_order > 0 and irr.polygon_amplitude_m > 0:
+        wheel.append(
+            geo.HarmonicOutOfRoundness(
+                order=irr.polygon_order, amplitude_m=irr.polygon_amplitude_m, phase_rad=irr.polygon_phase_rad
             )
-        if irr.flat_length_m > 0:
-            from rigid_dynamics.wheelset.irregular import flat_depth_m
-
-            wheel.append(
-                geo.WheelFlat(
-                    length_m=irr.flat_length_m,
-                    depth_m=flat_depth_m(irr, nominal_radius_m),
-                    angle_rad=irr.flat_angle_rad,
-                    rounded=True,
-                )
+        )
+    if irr.flat_length_m > 0:
+        wheel.append(
+            geo.WheelFlat(
+                length_m=irr.flat_length_m,
+                wheel_radius_m=nominal_radius_m,
+                depth_m=irr.flat_depth_m if irr.flat_depth_m > 0 else None,
+                centre_angle_rad=irr.flat_angle_rad,
+                shape="rounded",
             )
-        if irr.corrugation_amplitude_m > 0:
-            rail.append(
-                geo.RailCorrugation(wavelength_m=irr.corrugation_wavelength_m, amplitude_m=irr.corrugation_amplitude_m)
-            )
-    except (AttributeError, TypeError) as exc:
-        raise ValueError(f"rigid_dynamics.geometry does not offer this irregularity yet: {exc}") from None
+        )
+    if irr.corrugation_amplitude_m > 0:
+        rail.append(
+            geo.RailCorrugation(wavelength_m=irr.corrugation_wavelength_m, amplitude_m=irr.corrugation_amplitude_m)
+        )
     sides_w = {s: tuple(wheel) for s in SIDES if applies_to(irr, s)}
     sides_r = {s: tuple(rail) for s in SIDES if applies_to(irr, s)}
     return sides_w, sides_r
