@@ -94,22 +94,25 @@ def test_table_matches_conical_off_grid():
 
 
 def test_running_irregularities_symmetric_extremes():
-    """At a symmetric extreme under the wheel the approach changes by exactly the irregularity.
+    """At a symmetric extreme under the wheel the approach changes by the irregularity times cos(gamma).
 
     Polygon order 3 with its crest at the lowest point (alpha = pi/2 - phi = 0): +A. Rounded flat centred at
     the lowest point (convex: d < L^2/(2 pi^2 r0)): -d. Rail corrugation crest (N_irr = -A at x = w/2): +A.
     """
     centre = np.array([0.0, 0.0, -R0 + 1e-4])
     base = conical().patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m
+    cos_gamma = 1 / math.sqrt(1 + LAM**2)
     polygon = conical(irregularities=Irregularities(polygon_order=3, polygon_amplitude_m=3e-4))
-    np.testing.assert_allclose(polygon.patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m - base, 3e-4, atol=1e-12)
+    np.testing.assert_allclose(
+        polygon.patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m - base, 3e-4 * cos_gamma, atol=1e-12
+    )
     flat = Irregularities(flat_length_m=0.1, flat_depth_m=5e-4, flat_angle_rad=0.0)
     got = conical(irregularities=flat).patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m - base
-    np.testing.assert_allclose(got, -5e-4, atol=1e-12)
+    np.testing.assert_allclose(got, -5e-4 * cos_gamma, atol=1e-12)
     corrugation = Irregularities(corrugation_wavelength_m=0.05, corrugation_amplitude_m=3e-5, side="right")
     crest = centre + np.array([0.025, 0.0, 0.0])
     got = conical(irregularities=corrugation).patches(crest, 0.0, 0.0, 0.0).approach_m - base
-    np.testing.assert_allclose(got, [0.0, 3e-5], atol=1e-12)
+    np.testing.assert_allclose(got, [0.0, 3e-5 * cos_gamma], atol=1e-12)
 
 
 def test_rotation_and_rates_match_kinematics():

@@ -44,7 +44,8 @@ Running-direction irregularities (R_irr(alpha) of the wheel, N_irr(x) of the rai
 added by a section in the rolling plane: the wheel point at beta from the lowest point (material angle
 alpha = pi/2 + beta - phi, kinematics.py) has radius r(beta) = R + R_irr(alpha) and reaches
 (r cos(beta) - R) further down than the ideal lowest point, at x offset -r sin(beta); the approach is
-q(beta) = q0 + r cos(beta) - R - N_irr(x + x_offset), maximised over beta (grid, then Newton). The
+q(beta) = q0 + [r cos(beta) - R - N_irr(x + x_offset)] cos(gamma), maximised over beta (grid, then Newton;
+the bracket is the extra vertical overlap, projected on the contact normal of contact angle gamma). The
 normal is the rail's, (N_irr', N_y, -1) normalised; A is built from the polar curvature of r(beta)
 and N_irr''. Where a flat makes the wheel locally concave, A is floored at ``MIN_LONGITUDINAL_CURVATURE_FRACTION``
 times its nominal value (a Hertzian stand-in for what is a two-point, non-Hertzian contact).
@@ -171,7 +172,8 @@ def _running_irregularity(patches: PatchSet, sides_mask, centre_m, spin_rad, irr
     new_normal = np.stack([n1, slope_y, -np.ones_like(n1)], axis=-1)
     new_normal /= np.linalg.norm(new_normal, axis=1, keepdims=True)
     floor = MIN_LONGITUDINAL_CURVATURE_FRACTION * 0.5 / r0
-    patches.approach_m[sel] = patches.approach_m[sel] + qv
+    # qv is the extra overlap measured vertically; the approach is along the normal (cos(gamma) = -n_z)
+    patches.approach_m[sel] = patches.approach_m[sel] + qv * -normal[:, 2]
     patches.point_m[sel, 0] += xo
     patches.point_m[sel, 2] += r * np.cos(beta) - radius[:, 0]
     patches.normal[sel] = new_normal

@@ -1,0 +1,69 @@
+"""The 3-D contact search (rigid_dynamics.contact.search) as the dynamics' contact provider.
+
+Independent references: the exact line-circle contact of the analytic ConicalProvider (a second method for the
+same cone on circular rail heads) and Klingel's wavelength 2 pi sqrt(r0 e0 / lambda) for a run whose every
+contact patch comes from the search.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from rigid_dynamics.wheelset.parameters import (
+    DynamicsScene,
+    InitialConditions,
+    IntegratorSettings,
+    Irregularities,
+    TrackGeometry,
+    WheelsetParameters,
+)
+from rigid_dynamics.wheelset.profiles import SearchProvider
+from rigid_dynamics.wheelset.providers import ConicalProvider
+from rigid_dynamics.wheelset.simulate import simulate
+
+TRACK = TrackGeometry(conicity=0.05, rail_head_radius_m=0.05)
+
+
+@pytest.mark.parametrize(("shift", "yaw", "roll"), [(0.0, 0.0, 0.0), (0.002, 0.002, 2e-4), (-0.003, -0.001, -3e-4)])
+def test_search_matches_analytic_cone(shift, yaw, roll):
+    ws = WheelsetParameters()
+    centre = np.array([0.3, shift, -ws.nominal_radius_m + 5e-4])
+    exact = ConicalProvider(ws, TRACK).patches(centre, yaw, roll, 0.4)
+    found = SearchProvider(ws, TRACK).patches(centre, yaw, roll, 0.4)
+    np.testing.assert_array_equal(found.side, [0, 1])
+    # the analytic provider neglects the O(psi lambda) shift of the cone's contact point off its lowest line
+    np.testing.assert_allclose(found.approach_m, exact.approach_m, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(found.rolling_radius_m, exact.rolling_radius_m, rtol=0, atol=2e-6)
+    np.testing.assert_allclose(found.normal, exact.normal, rtol=0, atol=1e-5)
+    np.testing.assert_allclose(found.curvature_lat_1_per_m, exact.curvature_lat_1_per_m, rtol=1e-4)
+
+
+def test_search_sees_the_polygon():
+    """A 3rd-order polygon with its crest at the lowest point adds A cos(gamma) to the (normal) approach."""
+    ws = WheelsetParameters()
+    centre = np.array([0.0, 0.0, -ws.nominal_radius_m + 1e-4])
+    ideal = SearchProvider(ws, TRACK).patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m
+    polygon = Irregularities(polygon_order=3, polygon_amplitude_m=3e-4)
+    rough = SearchProvider(ws, TRACK, polygon).patches(centre, 0.0, 0.0, 0.5 * math.pi).approach_m
+    np.testing.assert_allclose(rough - ideal, 3e-4 / math.sqrt(1 + 0.05**2), atol=1e-9)
+
+
+def test_klingel_through_the_search():
+    scene = DynamicsScene(
+        track=TRACK,
+        speed_m_per_s=30.0,
+        duration_s=1.2,
+        contact_model="linear",
+        contact_provider="search",
+        initial=InitialConditions(lateral_displacement_m=0.003),
+        integrator=IntegratorSettings(method="RK4", fixed_step_s=1e-3, output_step_s=2e-3),
+    )
+    provider = SearchProvider(scene.wheelset, scene.track, options={"profile_only": True})
+    result = simulate(scene, provider=provider)
+    assert result.success, result.message
+    assert result.provider == "search"
+    klingel = 2 * math.pi * math.sqrt(0.46 * 0.75 / 0.05)
+    measured = result.summary()["dominant_lateral_wavelength_m"]
+    print(f"Klingel {klingel:.4f} m, through the 3-D search {measured:.4f} m ({measured / klingel - 1:+.3%})")
+    assert measured == pytest.approx(klingel, rel=0.01)
