@@ -1,0 +1,319 @@
+"""Numerical-stability stress tests of the wheelset simulation.
+
+A sweep varies one setting of a base scene at a time (step size of the fixed-step method, tolerance of an
+adaptive method, speed through the critical speed, friction, irregularity amplitude, contact stiffness) and
+runs each variant with :func:`rigid_dynamics.wheelset.simulate`. Every run ends with a status (never a hang:
+the runs carry RHS-evaluation and wall-time caps; never NaN written silently: a failing run stops at its last
+good sample with status and failure state). Per run the record holds:
+
+* ``status``, ``success``, ``message``, ``failure_time_s``;
+* ``energy_balance_relative``: max |(T + V_g)(t) - (T + V_g)(0) - W_contact(t) - W_exterior(t)| divided by the
+  largest of the swing of T, |W_contact|, |W_exterior| and 1 J (the work of the contact and suspension forces
+  against the change of kinetic and potential energy; 0 for exact integration);
+* ``max_force_ratio``: the largest normal force over the static wheel load (the force anomaly measure;
+  the run stops as "force-anomaly" above ``IntegratorSettings.max_force_factor``);
+* ``max_approach_m``: the deepest interpenetration (the constraint measure of an elastic contact);
+* ``max_abs_lateral_displacement_m``, ``real_time_factor``, ``rhs_evaluations``, ``wall_time_s``.
+
+Entry points: :func:`stress_sweep` (records as a list of dicts), :func:`write_records` (CSV and JSON,
+written atomically), :func:`default_sweeps` (the standard set for a scene), :func:`nonlinear_critical_speed`
+(bisection over speed with short runs: decaying or growing lateral oscillation). Runs are serial by default;
+with a ``dask.distributed`` client (``client=``) they are mapped on its workers (dask is imported only then).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import tempfile
+from collections.abc import Callable, Iterable
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from rigid_dynamics.wheelset.parameters import DynamicsScene
+from rigid_dynamics.wheelset.simulate import SimulationResult, simulate
+
+SWEEP_PARAMETERS = (
+    "fixed_step_s",
+    "relative_tolerance",
+    "speed_m_per_s",
+    "friction_coefficient",
+    "irregularity_scale",
+    "shear_modulus_Pa",
+)
+"""Names accepted by :func:`stress_sweep` (keys of its ``sweeps`` mapping)."""
+
+RECORD_FIELDS = (
+    "parameter",
+    "value",
+    "status",
+    "success",
+    "message",
+    "simulated_time_s",
+    "failure_time_s",
+    "wall_time_s",
+    "real_time_factor",
+    "rhs_evaluations",
+    "energy_balance_relative",
+    "max_force_ratio",
+    "max_approach_m",
+    "max_abs_lateral_displacement_m",
+    "method",
+    "provider",
+    "contact_model",
+)
+
+
+def scene_variant(base: DynamicsScene, parameter: str, value: float) -> DynamicsScene:
+    """The base scene with one setting changed (see SWEEP_PARAMETERS).
+
+    ``fixed_step_s`` switches to RK4 with that step; ``relative_tolerance`` keeps the base method unless it is
+    RK4 (then RK45), with absolute tolerance 1e-3 x rtol; ``irregularity_scale`` multiplies every amplitude.
+
+    Raises:
+        ValueError: unknown parameter or invalid value (from the dataclasses).
+    """
+    integ = base.integrator
+    if parameter == "fixed_step_s":
+        return replace(base, integrator=replace(integ, method="RK4", fixed_step_s=float(value)))
+    if parameter == "relative_tolerance":
+        method = integ.method if integ.method != "RK4" else "RK45"
+        return replace(
+            base,
+            integrator=replace(
+                integ, method=method, relative_tolerance=float(value), absolute_tolerance=1e-3 * float(value)
+            ),
+        )
+    if parameter == "speed_m_per_s":
+        return replace(base, speed_m_per_s=float(value))
+    if parameter == "friction_coefficient":
+        return replace(base, material=replace(base.material, friction_coefficient=float(value)))
+    if parameter == "shear_modulus_Pa":
+        return replace(base, material=replace(base.material, shear_modulus_Pa=float(value)))
+    if parameter == "irregularity_scale":
+        irr = base.irregularities
+        return replace(
+            base,
+            irregularities=replace(
+                irr,
+                polygon_amplitude_m=irr.polygon_amplitude_m * value,
+                flat_depth_m=irr.flat_depth_m * value,
+                flat_length_m=irr.flat_length_m * math.sqrt(value) if irr.flat_depth_m == 0 else irr.flat_length_m,
+                corrugation_amplitude_m=irr.corrugation_amplitude_m * value,
+            ),
+        )
+    raise ValueError(f"parameter = {parameter!r}: expected one of {', '.join(SWEEP_PARAMETERS)}")
+
+
+def run_record(result: SimulationResult, parameter: str = "", value: float = math.nan) -> dict:
+    """The stress record of one finished run (module docstring)."""
+    scene = result.scene
+    n = len(result.t)
+    if n:
+        residual = np.abs(result.energy_residual_J)
+        scale = max(
+            float(np.ptp(result.kinetic_energy_J)),
+            float(np.max(np.abs(result.work_contact_J))),
+            float(np.max(np.abs(result.work_exterior_J))),
+            1.0,
+        )
+        energy = float(np.max(residual)) / scale
+        force_ratio = float(np.max(result.wheel_normal_force_N)) / scene.static_wheel_load_N
+        approach = result.patches["approach_m"]
+        max_approach = float(np.nanmax(approach)) if np.any(np.isfinite(approach)) else math.nan
+        lateral = float(np.max(np.abs(result.states[:, 1])))
+    else:
+        energy = force_ratio = max_approach = lateral = math.nan
+
+    def num(v):
+        return None if v is None or not math.isfinite(v) else float(v)
+
+    return {
+        "parameter": parameter,
+        "value": num(value),
+        "status": result.status,
+        "success": result.success,
+        "message": result.message,
+        "simulated_time_s": num(result.simulated_time_s),
+        "failure_time_s": num(result.failure_time_s),
+        "wall_time_s": num(result.wall_time_s),
+        "real_time_factor": num(result.real_time_factor),
+        "rhs_evaluations": int(result.rhs_evaluations),
+        "energy_balance_relative": num(energy),
+        "max_force_ratio": num(force_ratio),
+        "max_approach_m": num(max_approach),
+        "max_abs_lateral_displacement_m": num(lateral),
+        "method": result.method,
+        "provider": result.provider,
+        "contact_model": result.contact_model,
+    }
+
+
+def _run_one(task):
+    """Run one (scene, parameter, value) task and return its record (module-level: picklable for dask)."""
+    scene, parameter, value = task
+    return run_record(simulate(scene), parameter, value)
+
+
+def default_sweeps(base: DynamicsScene, critical_speed_m_per_s: float | None = None) -> dict[str, tuple]:
+    """The standard sweep of a scene: steps from fine to unstable, tolerances, speeds through the critical
+    speed (0.5 to 1.3 x, or 0.5 to 2 x the scene speed), friction 0.05-0.6, irregularities x0-x4, contact
+    stiffness G x0.1-x10.
+    """
+    v = critical_speed_m_per_s or base.speed_m_per_s
+    factors = (0.5, 0.8, 0.95, 1.05, 1.3) if critical_speed_m_per_s else (0.5, 1.0, 1.5, 2.0)
+    sweeps = {
+        "fixed_step_s": (1e-4, 5e-4, 2e-3, 1e-2),
+        "relative_tolerance": (1e-3, 1e-5, 1e-7),
+        "speed_m_per_s": tuple(v * f for f in factors),
+        "friction_coefficient": (0.05, 0.3, 0.6),
+        "shear_modulus_Pa": tuple(base.material.shear_modulus_Pa * f for f in (0.1, 1.0, 10.0)),
+    }
+    if base.irregularities.any:
+        sweeps["irregularity_scale"] = (0.0, 1.0, 2.0, 4.0)
+    return sweeps
+
+
+def stress_sweep(
+    base: DynamicsScene,
+    sweeps: dict[str, Iterable[float]] | None = None,
+    *,
+    duration_s: float | None = None,
+    max_wall_time_s: float | None = 120.0,
+    progress: Callable[[float], None] | None = None,
+    client=None,
+) -> list[dict]:
+    """Run every variant of ``base`` in ``sweeps`` (parameter -> values) and return one record per run.
+
+    Args:
+        base: the scene to vary.
+        sweeps: parameter -> values (SWEEP_PARAMETERS); default :func:`default_sweeps`.
+        duration_s: shorter simulated time for every run (default: the scene's).
+        max_wall_time_s: wall-time cap per run (status "budget-exceeded" beyond), s; None keeps the scene's.
+        progress: callable(fraction) after every finished run.
+        client: optional ``dask.distributed.Client``; the runs are mapped on its workers.
+
+    Raises:
+        ValueError: unknown parameter or invalid value (before any run).
+    """
+    sweeps = default_sweeps(base) if sweeps is None else sweeps
+    if duration_s is not None:
+        base = replace(base, duration_s=float(duration_s))
+    if max_wall_time_s is not None:
+        base = replace(base, integrator=replace(base.integrator, max_wall_time_s=float(max_wall_time_s)))
+    tasks = [(scene_variant(base, p, v), p, float(v)) for p, values in sweeps.items() for v in values]
+    if client is not None:
+        futures = client.map(_run_one, tasks, pure=False)
+        records = client.gather(futures)
+        if progress is not None:
+            progress(1.0)
+        return list(records)
+    records = []
+    for i, task in enumerate(tasks):
+        records.append(_run_one(task))
+        if progress is not None:
+            progress((i + 1) / len(tasks))
+    return records
+
+
+def nonlinear_critical_speed(
+    scene: DynamicsScene,
+    low_m_per_s: float,
+    high_m_per_s: float,
+    *,
+    relative_tolerance: float = 0.01,
+    duration_s: float = 1.5,
+    skip_s: float = 0.2,
+    max_runs: int = 12,
+) -> dict:
+    """Speed where the lateral oscillation of the nonlinear simulation turns from decaying to growing (bisection).
+
+    The growth rate of a run is the slope of ln|y| through the extremes of y(t) after ``skip_s``. ``low`` must
+    decay and ``high`` grow. Returns a dict with ``success``, ``status``, ``message``, ``speed_m_per_s`` and the
+    ``runs`` (speed, growth rate 1/s, status).
+    """
+    runs = []
+
+    def growth(speed):
+        result = simulate(replace(scene, speed_m_per_s=float(speed), duration_s=duration_s))
+        rate = math.nan
+        if result.success:
+            keep = result.t > skip_s
+            t, y = result.t[keep], np.abs(result.states[keep, 1])
+            peaks = [i for i in range(1, len(y) - 1) if y[i] >= y[i - 1] and y[i] >= y[i + 1] and y[i] > 0]
+            if len(peaks) >= 3:
+                rate = float(np.polyfit(t[peaks], np.log(y[peaks]), 1)[0])
+        runs.append({"speed_m_per_s": float(speed), "growth_rate_1_per_s": rate, "status": result.status})
+        return rate
+
+    g_low, g_high = growth(low_m_per_s), growth(high_m_per_s)
+    if not (g_low < 0 < g_high):
+        return {
+            "success": False,
+            "status": "not-bracketed",
+            "message": f"growth {g_low} 1/s at {low_m_per_s} m/s and {g_high} 1/s at {high_m_per_s} m/s",
+            "speed_m_per_s": None,
+            "runs": runs,
+        }
+    lo, hi = low_m_per_s, high_m_per_s
+    while (hi - lo) > relative_tolerance * lo and len(runs) < max_runs:
+        mid = 0.5 * (lo + hi)
+        g = growth(mid)
+        if not math.isfinite(g):
+            break
+        if g < 0:
+            lo = mid
+        else:
+            hi = mid
+    converged = (hi - lo) <= relative_tolerance * lo
+    return {
+        "success": converged,
+        "status": "ok" if converged else "not-converged",
+        "message": f"critical speed in [{lo:.4g}, {hi:.4g}] m/s after {len(runs)} runs",
+        "speed_m_per_s": 0.5 * (lo + hi),
+        "runs": runs,
+    }
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_records(records: list[dict], folder: str | Path, stem: str = "stress") -> dict[str, Path]:
+    """Write records as ``<stem>.csv`` and ``<stem>.json`` into ``folder`` (each atomically). Returns the paths."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = {"csv": folder / f"{stem}.csv", "json": folder / f"{stem}.json"}
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(RECORD_FIELDS), extrasaction="ignore")
+    writer.writeheader()
+    for record in records:
+        writer.writerow({k: ("" if record.get(k) is None else record.get(k)) for k in RECORD_FIELDS})
+    _atomic_write(paths["csv"], buffer.getvalue())
+    _atomic_write(paths["json"], json.dumps(records, indent=2) + "\n")
+    return paths
+
+
+__all__ = [
+    "RECORD_FIELDS",
+    "SWEEP_PARAMETERS",
+    "default_sweeps",
+    "nonlinear_critical_speed",
+    "run_record",
+    "scene_variant",
+    "stress_sweep",
+    "write_records",
+]
