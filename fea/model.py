@@ -47,7 +47,7 @@ class FeaOptions:
         mesh_size_factor: multiplies the element size at the patch (1 = min(a, b)/6), > 0.
         elements_per_semi_axis: element count per semi-axis at the patch (overrides quick's 4 / default 6).
         domain_factor: half-width and depth of the block in semi-axes (>= 4).
-        degree: displacement degree; only 1 is implemented.
+        degree: displacement degree, 1 or 2 (2: rigid formulation only).
         linear_solver: "auto", "mumps" or "cg-gamg".
         max_iterations: active-set iterations.
         grid_points: points per side of the regular output grid of the pressure.
@@ -85,8 +85,10 @@ class FeaOptions:
             raise ValueError(f"formulation = {self.formulation!r}: expected one of {FORMULATIONS}")
         if self.formulation == "profiles" and (not self.wheel_profile or not self.rail_profile):
             raise ValueError("formulation = 'profiles': expected the options wheel_profile and rail_profile")
-        if self.degree != 1:
-            raise ValueError(f"degree = {self.degree!r}: expected 1 (P2 contact is not implemented)")
+        if self.degree not in (1, 2):
+            raise ValueError(f"degree = {self.degree!r}: expected 1 or 2")
+        if self.degree == 2 and self.formulation != "rigid":
+            raise ValueError(f"degree = 2 with formulation = {self.formulation!r}: expected formulation 'rigid'")
         if int(self.grid_points) != self.grid_points or self.grid_points < 8:
             raise ValueError(f"grid_points = {self.grid_points!r}: expected an integer >= 8")
         if not (math.isfinite(self.filter_radius_factor) and self.filter_radius_factor >= 0):
@@ -230,7 +232,9 @@ class FeaModel:
         )
         t_mesh = time.perf_counter()
         limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
-        settings = SolverSettings(linear_solver=opts.linear_solver, max_iterations=opts.max_iterations)
+        settings = SolverSettings(
+            degree=opts.degree, linear_solver=opts.linear_solver, max_iterations=opts.max_iterations
+        )
         if opts.formulation == "profiles":
             from fea.two_body import solve_two_body
 
@@ -316,8 +320,8 @@ class FeaModel:
         xy, force, weight = sol.node_xy_m, sol.node_force_N, sol.node_weight_m2
         if quadric:
             xy, force, weight = post.mirror_quarter(xy, force, weight)
-        radius = opts.filter_radius_factor * spec.contact_size_m
-        in_contact_nodes = force > 0
+        radius = opts.filter_radius_factor * spec.contact_size_m / opts.degree  # P2: nodes at h/2
+        in_contact_nodes = np.tile(sol.active, 4) if len(xy) == 4 * len(sol.active) else sol.active.copy()
         if radius > 0:
             pressure = post.filtered_pressure(
                 xy[in_contact_nodes], force[in_contact_nodes], weight[in_contact_nodes], xy, radius
@@ -327,13 +331,17 @@ class FeaModel:
         pressure = np.where(in_contact_nodes, pressure, 0.0)
         max_pressure = float(pressure.max()) if pressure.size else 0.0
         area_nodal = float(sol.node_weight_m2[sol.active].sum()) * domain.symmetry_factor
-        extra["max_nodal_pressure_Pa"] = float((sol.node_force_N / sol.node_weight_m2).max())
+        weighted = sol.node_weight_m2 > 1e-9 * sol.node_weight_m2.max()
+        extra["max_nodal_pressure_Pa"] = float((sol.node_force_N[weighted] / sol.node_weight_m2[weighted]).max())
         extra["contact_area_nodal_m2"] = area_nodal
 
         semi_long = semi_lat = None
         area = area_nodal
         if quadric:
-            fit = post.fit_elliptic_pressure(xy, np.where(in_contact_nodes, force / weight, 0.0))
+            # nodes with a lumped weight (all P1 nodes; P2 edge midpoints, whose N_i / w_i is the pressure)
+            has_weight = weight > 1e-9 * weight.max()  # P2 vertices have w = 0 (rounding)
+            raw = np.where(in_contact_nodes & has_weight, force / np.where(has_weight, weight, 1.0), 0.0)
+            fit = post.fit_elliptic_pressure(xy[has_weight], raw[has_weight])
             extra["elliptic_fit"] = fit
             if math.isfinite(fit["semi_axis_long_m"]):
                 semi_long, semi_lat = fit["semi_axis_long_m"], fit["semi_axis_lat_m"]

@@ -101,6 +101,19 @@ def test_two_elastic_bodies_match_hertz():
     assert r.extra["young_modulus_Pa"] == pytest.approx(210e9)
 
 
+def test_quadratic_elements_match_hertz():
+    """P2 displacements (constraint at vertices and edge midpoints) on the quick mesh."""
+    r = FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"degree": 2, "quick": True})
+    ref = hertz_elliptic(
+        ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m, FORCE_N, STEEL_210.combined_modulus_Pa
+    )
+    assert r.success
+    assert r.normal_force_N == pytest.approx(FORCE_N, rel=1e-6)
+    assert r.max_pressure_Pa == pytest.approx(ref.max_pressure_Pa, rel=0.05)
+    assert r.semi_axis_long_m == pytest.approx(ref.semi_axis_long_m, rel=0.05)
+    assert r.semi_axis_lat_m == pytest.approx(ref.semi_axis_lat_m, rel=0.05)
+
+
 def test_two_body_needs_quadric_geometry():
     x = np.linspace(-0.01, 0.01, 11)
     X, Y = np.meshgrid(x, x)
@@ -168,7 +181,8 @@ def test_mesh_quality_failure_is_an_error():
     ("options", "match"),
     [
         ({"mesh_sise": 1.0}, "unknown fea option.*mesh_sise"),
-        ({"degree": 2}, "degree"),
+        ({"degree": 3}, "degree"),
+        ({"degree": 2, "formulation": "two-body"}, "formulation 'rigid'"),
         ({"mesh_size_factor": 0.0}, "mesh_size_factor"),
         ({"linear_solver": "hypre"}, "linear_solver"),
         ({"formulation": "mortar"}, "formulation"),
