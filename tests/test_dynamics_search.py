@@ -67,3 +67,31 @@ def test_klingel_through_the_search():
     measured = result.summary()["dominant_lateral_wavelength_m"]
     print(f"Klingel {klingel:.4f} m, through the 3-D search {measured:.4f} m ({measured / klingel - 1:+.3%})")
     assert measured == pytest.approx(klingel, rel=0.01)
+
+
+def test_profile_section_agrees_with_search_on_s1002_uic60():
+    """Second method on real profiles: the 2-D profile section (tables) against the 3-D search, S1002/UIC60 1:40.
+
+    Same patches in contact per side (a connected overlap is one patch for both) and the same approach, rolling
+    radius and contact angle of the deepest patch.
+    """
+    from rigid_dynamics.wheelset.profiles import ProfileSectionProvider, build_surfaces
+
+    ws = WheelsetParameters()
+    track = TrackGeometry(wheel_profile="S1002", rail_profile="UIC60", rail_inclination_rad=0.025)
+    surfaces = build_surfaces(ws, track)
+    section = ProfileSectionProvider(ws, track, surfaces=surfaces)
+    search = SearchProvider(ws, track, surfaces=surfaces)
+    for shift, z in ((0.0, -0.4598), (0.0, -0.4597), (0.001, -0.4597), (0.003, -0.4597), (-0.002, -0.4597)):
+        centre = np.array([0.0, shift, z])
+        a, b = section.patches(centre), search.patches(centre, 0.0, 0.0, 0.0)
+        for side in (0, 1):
+            in_a = (a.side == side) & (a.approach_m > 0)
+            in_b = (b.side == side) & (b.approach_m > 0)
+            assert in_a.sum() == in_b.sum(), (shift, z, side)
+            if in_a.any():
+                ka = np.flatnonzero(in_a)[np.argmax(a.approach_m[in_a])]
+                kb = np.flatnonzero(in_b)[np.argmax(b.approach_m[in_b])]
+                assert a.approach_m[ka] == pytest.approx(b.approach_m[kb], rel=1e-3, abs=5e-8)
+                assert a.rolling_radius_m[ka] == pytest.approx(b.rolling_radius_m[kb], abs=2e-5)
+                assert a.contact_angle_rad[ka] == pytest.approx(b.contact_angle_rad[kb], abs=5e-4)

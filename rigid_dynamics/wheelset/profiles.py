@@ -13,7 +13,10 @@ the wheel's lowest points (alpha = pi/2) of a wheelset with roll theta (yaw and 
 and the vertical gap to the rail is g(y_d) = N(P_y) - P_z (> 0: gap). Candidate 0 is the global minimum of
 g (continuous in the pose, so the approach interpolates well in a table); candidate 1 is the deepest other
 local minimum separated from it by a rise of g (two-point contact: tread and flange), else a gap of
-``ABSENT_GAP_M``. Minima are refined by a parabola through three samples. At a candidate:
+``ABSENT_GAP_M``. When the rise between the two minima also overlaps (its gap < 0) the bodies touch in one
+connected region, which is kept as one patch (candidate 1 dropped), as the 3-D search merges such minima;
+the overlap of the rise is reported as ``merge_approach_m`` so that the tables can apply the same rule.
+Minima are refined by a parabola through three samples. At a candidate:
 normal n = (0, N_y, -1)/|.| (the rail's normal, which equals the wheel's at a tangency), approach
 q = -g cos(gamma) (vertical penetration projected on the normal, exact for locally straight profiles),
 A = 1/(2 R sqrt(1 + R_y^2)) (normal curvature of the wheel along the rolling direction; the rail is straight),
@@ -226,18 +229,19 @@ class ProfileSectionProvider:
         found = [k0]
         interior = (gap[1:-1] < gap[:-2]) & (gap[1:-1] <= gap[2:])
         minima = np.flatnonzero(interior) + 1
-        best, best_gap = None, math.inf
+        best, best_gap, best_hump = None, math.inf, math.inf
         for k in minima:
             if abs(k - k0) < 2 or not math.isfinite(gap[k]):
                 continue
             lo_k, hi_k = min(k, k0), max(k, k0)
             hump = np.max(gap[lo_k : hi_k + 1])
             if hump > max(gap[k], gap[k0]) + 1e-6 and gap[k] < best_gap:
-                best, best_gap = k, gap[k]
+                best, best_gap, best_hump = k, gap[k], hump
         if best is not None:
             found.append(best)
         out = []
-        for k in found:
+        humps = [math.inf, best_hump]
+        for slot, k in enumerate(found):
             k = min(max(k, 1), len(gap) - 2)
             g0, g1, g2 = gap[k - 1], gap[k], gap[k + 1]
             denom = g0 - 2 * g1 + g2
@@ -266,11 +270,12 @@ class ProfileSectionProvider:
                     rad,
                     math.atan2(-SIDE_SIGNS[i] * normal[1], -normal[2]),
                     yd,
+                    -humps[slot] * cos_gamma,
                 )
             )
         if len(out) == 1:
-            q, point, normal, ca, cb, rad, ang, yd = out[0]
-            out.append((-ABSENT_GAP_M, point.copy(), normal.copy(), ca, cb, rad, ang, yd))
+            q, point, normal, ca, cb, rad, ang, yd, _ = out[0]
+            out.append((-ABSENT_GAP_M, point.copy(), normal.copy(), ca, cb, rad, ang, yd, -math.inf))
         return out
 
     def patches(self, centre_m, yaw_rad=0.0, roll_rad=0.0, spin_rad=0.0) -> PatchSet:
@@ -280,6 +285,10 @@ class ProfileSectionProvider:
                 rows.append((i, *candidate))
         point = np.array([r[2] for r in rows])
         point[:, 0] = float(centre_m[0])
+        merge = np.array([r[9] for r in rows])
+        approach = np.array([r[1] for r in rows])
+        # a second minimum whose hump also overlaps belongs to the same (connected) patch: drop it
+        approach = np.where(merge > 0, -ABSENT_GAP_M, approach)
         return PatchSet(
             side=np.array([r[0] for r in rows]),
             slot=np.array([0, 1, 0, 1]),
@@ -287,10 +296,11 @@ class ProfileSectionProvider:
             normal=np.array([r[3] for r in rows]),
             curvature_long_1_per_m=np.array([r[4] for r in rows]),
             curvature_lat_1_per_m=np.array([r[5] for r in rows]),
-            approach_m=np.array([r[1] for r in rows]),
+            approach_m=approach,
             rolling_radius_m=np.array([r[6] for r in rows]),
             contact_angle_rad=np.array([r[7] for r in rows]),
             wheel_lateral_m=np.array([r[8] for r in rows]),
+            merge_approach_m=merge,
         )
 
 

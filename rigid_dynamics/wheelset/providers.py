@@ -83,6 +83,9 @@ class PatchSet:
         contact_angle_rad: angle of the normal to the vertical, positive towards the track centre, (n,).
         wheel_lateral_m: y_d of the contact point on the wheel (wheelset frame), (n,), m.
         geometries: optional ContactGeometry per candidate (a search gives sampled gap fields).
+        merge_approach_m: optional, per candidate: overlap of the rise of the gap between this candidate and
+            the deepest one of its side (-inf for the deepest); > 0 means both lie in one connected contact
+            region and this candidate is not a separate patch (profiles.ProfileSectionProvider).
     """
 
     side: np.ndarray
@@ -96,6 +99,7 @@ class PatchSet:
     contact_angle_rad: np.ndarray
     wheel_lateral_m: np.ndarray
     geometries: list | None = None
+    merge_approach_m: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.side)
@@ -267,7 +271,9 @@ class TableProvider:
     relative to the centre), the normal,
     the curvatures, rolling radius, contact angle and wheel lateral position. At run time all
     quantities are interpolated bilinearly and q = q_ref + (z - z_ref) dq/dz. Yaw enters only the
-    kinematics (creepages) and the x offset of the contact point, -sin(psi) y_d.
+    kinematics (creepages) and the x offset of the contact point, -sin(psi) y_d. A second candidate whose
+    tabulated merge approach (PatchSet.merge_approach_m, shifted with z like q) is positive lies in the same
+    connected contact region as the first and is dropped.
 
     Args:
         section: the provider to tabulate.
@@ -308,8 +314,8 @@ class TableProvider:
         self.side = probe.side.copy()
         self.slot = probe.slot.copy()
         n = len(probe)
-        # quantities: q, dq/dz, py, pz, ny, nz, A, B, radius, angle, y_d  (11)
-        table = np.empty((11, n, len(self.roll_grid), len(self.y_grid)))
+        # quantities: q, dq/dz, py, pz, ny, nz, A, B, radius, angle, y_d, merge approach (12)
+        table = np.empty((12, n, len(self.roll_grid), len(self.y_grid)))
         for i, theta in enumerate(self.roll_grid):
             for j, y in enumerate(self.y_grid):
                 p = section.patches(np.array([0.0, y, self.z_ref]), 0.0, theta, 0.0)
@@ -326,6 +332,8 @@ class TableProvider:
                 table[8, :, i, j] = p.rolling_radius_m
                 table[9, :, i, j] = p.contact_angle_rad
                 table[10, :, i, j] = p.wheel_lateral_m
+                merge = p.merge_approach_m if p.merge_approach_m is not None else np.full(n, -np.inf)
+                table[11, :, i, j] = np.maximum(merge, -1.0)  # finite, for the interpolation
         self.table = table
         self.irregularities = irregularities if irregularities is not None and irregularities.any else None
         if self.irregularities is not None:
@@ -345,6 +353,8 @@ class TableProvider:
             (1 - wy) * t[:, :, i + 1, j] + wy * t[:, :, i + 1, j + 1]
         )
         approach = v[0] + (z_c - self.z_ref) * v[1]
+        merged = v[11] + (z_c - self.z_ref) * v[1] > 0
+        approach = np.where(merged & (self.slot > 0), -0.01, approach)
         n_y, n_z = v[4], v[5]
         norm = np.sqrt(n_y * n_y + n_z * n_z)
         normal = np.stack([np.zeros_like(n_y), n_y / norm, n_z / norm], axis=-1)
