@@ -275,7 +275,9 @@ class ProfileSectionProvider:
             )
         if len(out) == 1:
             q, point, normal, ca, cb, rad, ang, yd, _ = out[0]
-            out.append((-ABSENT_GAP_M, point.copy(), normal.copy(), ca, cb, rad, ang, yd, -math.inf))
+            # no second minimum: mark it as merged too, so that a table interpolating between cells with and
+            # without a second minimum keeps it off rather than inventing a patch
+            out.append((-ABSENT_GAP_M, point.copy(), normal.copy(), ca, cb, rad, ang, yd, ABSENT_GAP_M))
         return out
 
     def patches(self, centre_m, yaw_rad=0.0, roll_rad=0.0, spin_rad=0.0) -> PatchSet:
