@@ -1,13 +1,22 @@
-"""The ``fea`` contact model: FEniCSx normal contact of an elastic block and a rigid indenter.
+"""The ``fea`` contact model: FEniCSx frictionless normal contact of one patch (three formulations).
 
 Registered as ``"fea.model:FeaModel"`` in :mod:`rigid_dynamics.contact.registry`. Importing this
 module is cheap: gmsh, DOLFINx and PETSc are imported inside :meth:`FeaModel.solve`.
 
-Model (see :mod:`fea.solver`): half-space theory of two quasi-identical bodies, i.e. one elastic
-block with E_body = E* (1 - nu^2) (E* = G / (1 - nu), :attr:`Material.combined_modulus_Pa`)
-against a rigid surface at the undeformed distance h(x, y) of the patch (``geometry.gap_m`` +
-approach). A quadric patch (``geometry.undeformed is None``) uses a quarter model with symmetry
-planes x = 0 and y = 0; a sampled gap uses the full block. Frictionless: creep forces are None.
+Formulations (option ``formulation``):
+
+* ``"rigid"`` (default, fast verification mode; :mod:`fea.solver`): half-space theory of two
+  quasi-identical bodies, i.e. one elastic block with E_body = E* (1 - nu^2) (E* = G / (1 - nu),
+  :attr:`Material.combined_modulus_Pa`) against a rigid surface at the undeformed distance h(x, y)
+  of the patch (``geometry.gap_m`` + approach). A quadric patch (``geometry.undeformed is None``)
+  uses a quarter model with symmetry planes x = 0 and y = 0; a sampled gap uses the full block.
+  P1 or P2 displacements.
+* ``"two-body"`` (:mod:`fea.two_body`): two elastic quadric bodies (E, nu each, the relative
+  curvature split equally), node-to-surface pairing updated in the Newton iterations.
+* ``"profiles"``: local rail and wheel sections meshed from the real profiles around the patch's
+  contact points (:mod:`meshing.profile_sections`), same two-body solver; yaw is neglected.
+
+Frictionless in all cases: creep forces are None.
 
 Frame: contact frame of the patch (x rolling, y lateral, z normal rail -> wheel); the block stands
 for the body below the contact plane, the pressure acts on the wheel along +z. Units SI.

@@ -12,7 +12,7 @@ elastic quadric bodies of equal constants, one elastic block with Young's modulu
 E_body = E* (1 - nu^2) against the rigid gap reproduces Hertz (Johnson 1985, sec. 4.2), E* the
 combined modulus of :class:`rigid_dynamics.materials.Material`.
 
-Discretisation: Lagrange P1 displacements; the contact condition is imposed at the contact-face
+Discretisation: Lagrange P1 (or P2) displacements; the contact condition is imposed at the contact-face
 nodes (the gap h is interpolated into the displacement space, i.e. sampled at the nodes), the
 pressure is the nodal contact reaction divided by the lumped face weight w_i = int_Gamma phi_i ds.
 
