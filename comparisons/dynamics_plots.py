@@ -1,6 +1,7 @@
 """Plots of a wheelset dynamics run (matplotlib, imported inside the functions).
 
-:func:`plot_dynamics` draws four panels against the travelled distance x - x(0): lateral displacement y (mm),
+:func:`plot_dynamics` (and :func:`plot_simulation`, the CLI's entry) draws four panels against the travelled
+distance x - x(0): lateral displacement y (mm),
 yaw psi (mrad), the normal force of each wheel (kN), and the creep forces of each wheel (kN, longitudinal and
 lateral, contact frame, on the wheel). A failed run is plotted up to its last good sample with its status in
 the title. :func:`plot_stress` draws the records of comparisons.stress (energy balance and force ratio per
@@ -85,6 +86,11 @@ def plot_dynamics(result, path: str | Path | None = None, *, title: str | None =
         return _save(fig, path)
     finally:
         plt.close(fig)
+
+
+def plot_simulation(result, out_dir: str | Path) -> list[Path]:
+    """The plots of a run into ``out_dir`` (used by ``wheelrail run``): ``dynamics.png`` (plot_dynamics)."""
+    return [plot_dynamics(result, Path(out_dir) / "dynamics.png")]
 
 
 def plot_stress(records: list[dict], path: str | Path | None = None):

@@ -15,7 +15,8 @@ good sample with status and failure state). Per run the record holds:
 * ``max_approach_m``: the deepest interpenetration (the constraint measure of an elastic contact);
 * ``max_abs_lateral_displacement_m``, ``real_time_factor``, ``rhs_evaluations``, ``wall_time_s``.
 
-Entry points: :func:`stress_sweep` (records as a list of dicts), :func:`write_records` (CSV and JSON,
+Entry points: :func:`run_stress_sweep` (the CLI's: default sweep, files, summary), :func:`stress_sweep`
+(records as a list of dicts), :func:`write_records` (CSV and JSON,
 written atomically), :func:`default_sweeps` (the standard set for a scene), :func:`nonlinear_critical_speed`
 (bisection over speed with short runs: decaying or growing lateral oscillation). Runs are serial by default;
 with a ``dask.distributed`` client (``client=``) they are mapped on its workers (dask is imported only then).
@@ -280,6 +281,45 @@ def nonlinear_critical_speed(
     }
 
 
+def run_stress_sweep(scene: DynamicsScene, out_dir: str | Path | None = None, *, quick: bool = False, client=None):
+    """The standard stress sweep of a scene (the entry of ``wheelrail stress``).
+
+    Runs :func:`default_sweeps` (``quick``: three values per parameter and at most 0.2 s simulated per run;
+    otherwise the scene's duration capped at 2 s), writes ``stress.csv``, ``stress.json`` and ``stress.png`` into
+    ``out_dir`` when given, and returns a summary dict: ``runs`` (the records), ``finished``, ``stopped``,
+    ``statuses`` (status -> count), ``max_energy_balance_relative`` of the finished runs, ``files``.
+    """
+    sweeps = default_sweeps(scene)
+    if quick:
+        sweeps = {k: tuple(v)[:: max(1, len(v) // 3)][:3] for k, v in sweeps.items()}
+    duration = min(scene.duration_s, 0.2 if quick else 2.0)
+    records = stress_sweep(scene, sweeps, duration_s=duration, client=client)
+    files = []
+    if out_dir is not None:
+        paths = write_records(records, out_dir)
+        files = [p.name for p in paths.values()]
+        try:
+            from comparisons.dynamics_plots import plot_stress
+
+            files.append(plot_stress(records, Path(out_dir) / "stress.png").name)
+        except ImportError:  # pragma: no cover (matplotlib missing)
+            pass
+    statuses: dict[str, int] = {}
+    for r in records:
+        statuses[r["status"]] = statuses.get(r["status"], 0) + 1
+    finished = [r for r in records if r["success"]]
+    energies = [r["energy_balance_relative"] for r in finished if r["energy_balance_relative"] is not None]
+    return {
+        "scene": scene.name,
+        "runs": records,
+        "finished": len(finished),
+        "stopped": len(records) - len(finished),
+        "statuses": statuses,
+        "max_energy_balance_relative": max(energies) if energies else None,
+        "files": files,
+    }
+
+
 def _atomic_write(path: Path, text: str) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -313,6 +353,7 @@ __all__ = [
     "default_sweeps",
     "nonlinear_critical_speed",
     "run_record",
+    "run_stress_sweep",
     "scene_variant",
     "stress_sweep",
     "write_records",

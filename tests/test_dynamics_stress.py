@@ -61,3 +61,19 @@ def test_plot_dynamics_writes_png(tmp_path):
 
     path = plot_dynamics(simulate(BASE), tmp_path / "run")
     assert path.name == "run.png" and path.stat().st_size > 1000
+
+
+def test_cli_entry_points(tmp_path):
+    """The functions ``wheelrail run`` / ``wheelrail stress`` call (regression of their contract)."""
+    from comparisons.dynamics_plots import plot_simulation
+    from comparisons.stress import run_stress_sweep
+    from rigid_dynamics.wheelset import simulate, timeseries_arrays
+
+    result = simulate(BASE)
+    arrays = timeseries_arrays(result)
+    assert arrays["states"].shape == (len(result.t), 12) and "patch_normal_force_N" in arrays
+    assert [p.name for p in plot_simulation(result, tmp_path)] == ["dynamics.png"]
+    quick = DynamicsScene(**{**BASE.__dict__, "duration_s": 0.01})
+    report = run_stress_sweep(quick, out_dir=tmp_path / "stress", quick=True)
+    assert report["finished"] + report["stopped"] == len(report["runs"]) > 5
+    assert sorted(report["files"]) == ["stress.csv", "stress.json", "stress.png"]

@@ -32,6 +32,7 @@ from rigid_dynamics.wheelset.simulate import (
     dominant_wavelength_m,
     save_timeseries,
     simulate,
+    timeseries_arrays,
 )
 
 __all__ = [
@@ -55,4 +56,5 @@ __all__ = [
     "linear_model_for_scene",
     "save_timeseries",
     "simulate",
+    "timeseries_arrays",
 ]

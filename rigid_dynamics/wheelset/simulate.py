@@ -592,22 +592,15 @@ def _run_rk4(fun, y0, duration, settings, out_times, recorder, report) -> int:
     return n_steps
 
 
-def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
-    """Write the time series of a result to an NPZ file, atomically (temporary name, then os.replace).
+def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
+    """The time series of a result as named arrays (what :func:`save_timeseries` writes).
 
     Arrays: ``t`` (n,), ``states`` (n, 12) with ``state_names``, ``patch_<field>`` (n, 2, 2) for every
     PATCH_FIELDS entry (sides left/right, slots tread/flange), ``contact_force_N`` (n, 2, 3),
     ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
-    ``status``/``message`` as strings. NaN marks candidates without contact, never a failed number:
+    ``status``/``message``/``sides`` as strings. NaN marks candidates without contact, never a failed number:
     a failed run stops at its last good sample and says so in ``status``.
-
-    Returns:
-        The path written (suffix .npz added when missing).
     """
-    path = Path(path)
-    if path.suffix != ".npz":
-        path = path.with_suffix(".npz")
-    path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {
         "t": result.t,
         "states": result.states,
@@ -623,6 +616,22 @@ def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
     }
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
+    return arrays
+
+
+def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
+    """Write the time series of a result to an NPZ file, atomically (temporary name, then os.replace).
+
+    The arrays are those of :func:`timeseries_arrays`.
+
+    Returns:
+        The path written (suffix .npz added when missing).
+    """
+    path = Path(path)
+    if path.suffix != ".npz":
+        path = path.with_suffix(".npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = timeseries_arrays(result)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".npz.tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as handle:
