@@ -74,8 +74,8 @@ def worker(options: dict) -> None:
             "a_error": r.semi_axis_long_m / ref.semi_axis_long_m - 1,
             "b_error": r.semi_axis_lat_m / ref.semi_axis_lat_m - 1,
             "force_error": r.normal_force_N / 1e5 - 1,
-            "max_shear_over_p0": r.extra["max_max_shear_Pa"] / ref.max_pressure_Pa,
-            "max_shear_depth_over_b": r.extra["max_max_shear_depth_m"] / ref.semi_axis_lat_m,
+            "max_shear_over_p0": r.extra["max_shear_Pa"] / ref.max_pressure_Pa,
+            "max_shear_depth_over_b": r.extra["max_shear_depth_m"] / ref.semi_axis_lat_m,
         }
         print("RESULT " + json.dumps(out))
 

@@ -464,25 +464,38 @@ def _profile_domain(geometry, opts, semi, contact_size_m, comm, limits):
 
 
 def _stress_maxima(comm, coords, stress, spec, quadric, post) -> dict:
-    """Global maxima of von Mises and maximum shear with their points and depths (gathered)."""
-    measures = post.principal_measures(stress) if len(stress) else {"von_mises": np.zeros(0), "max_shear": np.zeros(0)}
+    """Extremes of von Mises, maximum shear (Tresca, (s1 - s3)/2) and the most compressive principal stress.
+
+    Keys: ``max_von_mises_Pa``, ``max_shear_Pa``, ``min_principal_Pa`` (most negative s3), each with
+    ``_point_m`` (x, y, z) and ``_depth_m`` (-z); for quadric patches also the maxima along the axis
+    x = y = 0 refined by a parabola (``axis_max_von_mises_*``, ``axis_max_shear_*``).
+    """
+    if len(stress):
+        measures = post.principal_measures(stress)
+        measures["compression"] = -measures["principal"][:, 2]
+    else:
+        measures = {"von_mises": np.zeros(0), "max_shear": np.zeros(0), "compression": np.zeros(0)}
     out = {}
-    for key in ("von_mises", "max_shear"):
+    for key, name, sign in (
+        ("von_mises", "max_von_mises", 1.0),
+        ("max_shear", "max_shear", 1.0),
+        ("compression", "min_principal", -1.0),
+    ):
         values = measures[key]
         k = int(np.argmax(values)) if len(values) else -1
         local = (float(values[k]), coords[k].tolist()) if k >= 0 else (-math.inf, [math.nan] * 3)
         best = max(comm.allgather(local), key=lambda item: item[0])
-        out[f"max_{key}_Pa"] = best[0]
-        out[f"max_{key}_point_m"] = best[1]
-        out[f"max_{key}_depth_m"] = -best[1][2]
+        out[f"{name}_Pa"] = sign * best[0]
+        out[f"{name}_point_m"] = best[1]
+        out[f"{name}_depth_m"] = -best[1][2]
     if quadric:
         tol = 1e-9 * spec.half_width_m
         on_axis = (np.abs(coords[:, 0]) < tol) & (np.abs(coords[:, 1]) < tol)
         depth = np.concatenate(comm.allgather(-coords[on_axis, 2]))
-        for key in ("von_mises", "max_shear"):
+        for key, name in (("von_mises", "axis_max_von_mises"), ("max_shear", "axis_max_shear")):
             vals = np.concatenate(comm.allgather(measures[key][on_axis]))
             if len(vals) >= 3:
                 peak, z = post.axis_maximum(depth, vals)
-                out[f"axis_max_{key}_Pa"] = peak
-                out[f"axis_max_{key}_depth_m"] = z
+                out[f"{name}_Pa"] = peak
+                out[f"{name}_depth_m"] = z
     return out
