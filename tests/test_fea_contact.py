@@ -262,3 +262,33 @@ def test_two_ranks_agree_with_one_rank(elliptic_result):
         t.approach_m,
     ]
     np.testing.assert_allclose(values[:-1], one, rtol=1e-6)
+
+
+def test_pressure_field_converges_at_first_order():
+    """Force-weighted L1 distance to Hertz's p0 sqrt(1 - x^2/a^2 - y^2/b^2) over three refinements.
+
+    The contact edge is located to within about one element, so the L1 error of the pressure is
+    O(h): the observed order fitted over h, h/2, h/4 must be about 1 (measured 1.18 and 1.00).
+    """
+    ref = hertz_elliptic(
+        ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m, FORCE_N, STEEL_210.combined_modulus_Pa
+    )
+    sizes, errors = [], []
+    for n in (3, 6, 12):
+        r = FeaModel().solve(
+            ELLIPTIC,
+            Creepage(),
+            STEEL_210,
+            normal_force_N=FORCE_N,
+            options={"elements_per_semi_axis": n, "domain_factor": 12, "stresses": False},
+        )
+        f = r.fields
+        X, Y = np.meshgrid(f.x_m, f.y_m)
+        exact = ref.max_pressure_Pa * np.sqrt(
+            np.clip(1 - (X / ref.semi_axis_long_m) ** 2 - (Y / ref.semi_axis_lat_m) ** 2, 0, None)
+        )
+        sizes.append(1.0 / n)
+        errors.append(np.abs(f.pressure_Pa - exact).sum() / exact.sum())
+    order = np.polyfit(np.log(sizes), np.log(errors), 1)[0]
+    assert 0.7 < order < 2.0, f"observed order {order:.2f}, errors {errors}"
+    assert errors[-1] < 0.04
