@@ -317,12 +317,24 @@ class InfluenceGrid:
                 spec = spec + self._kernel_fft("zy", False) * self._forward(traction_y_Pa)
         return self._backward(spec)
 
+    def _forward_pair(self, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+        """Spectra of two (ny, nx) fields in one batched FFT call, shape (2, ly, lx/2 + 1)."""
+        ly, lx = self._cache["shape"]
+        buf = np.zeros((2, ly, lx))
+        buf[0, : self.ny, : self.nx] = first
+        buf[1, : self.ny, : self.nx] = second
+        return scipy.fft.rfft2(buf)
+
+    def _backward_pair(self, first: np.ndarray, second: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Inverse of two spectra in one batched FFT call, each cropped to (ny, nx)."""
+        out = scipy.fft.irfft2(np.stack((first, second)), s=self._cache["shape"])
+        return out[0, : self.ny, : self.nx], out[1, : self.ny, : self.nx]
+
     def tangential(
         self, traction_x_Pa: np.ndarray, traction_y_Pa: np.ndarray, rolling: bool = False, pressure_Pa=None
     ) -> tuple[np.ndarray, np.ndarray]:
         """Tangential displacement differences (u_x, u_y) (static, m) or their rolling differences (-du/dx, -)."""
-        fx = self._forward(traction_x_Pa)
-        fy = self._forward(traction_y_Pa)
+        fx, fy = self._forward_pair(traction_x_Pa, traction_y_Pa)
         kxy = self._kernel_fft("xy", rolling)
         sx = self._kernel_fft("xx", rolling) * fx + kxy * fy
         sy = kxy * fx + self._kernel_fft("yy", rolling) * fy
@@ -330,7 +342,7 @@ class InfluenceGrid:
             fz = self._forward(pressure_Pa)
             sx = sx + self._kernel_fft("xz", rolling) * fz
             sy = sy + self._kernel_fft("yz", rolling) * fz
-        return self._backward(sx), self._backward(sy)
+        return self._backward_pair(sx, sy)
 
     def inverse_static(self, ux_m: np.ndarray, uy_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Approximate inverse of the static tangential operator: the padded circulant's inverse, by FFT.
@@ -348,8 +360,8 @@ class InfluenceGrid:
             det = np.where(det > floor * floor, det, floor * floor)
             self._cache["inv"] = (kyy / det, kxx / det, -kxy / det)
         ixx, iyy, ixy = self._cache["inv"]
-        fx, fy = self._forward(ux_m), self._forward(uy_m)
-        return self._backward(ixx * fx + ixy * fy), self._backward(ixy * fx + iyy * fy)
+        fx, fy = self._forward_pair(ux_m, uy_m)
+        return self._backward_pair(ixx * fx + ixy * fy, ixy * fx + iyy * fy)
 
     def dense(self, name: str, rolling: bool = False) -> np.ndarray:
         """Dense N x N matrix of one kernel (N = nx ny, row-major over [j, i]); only for grids up to 64 x 64."""
