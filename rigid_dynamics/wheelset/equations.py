@@ -30,6 +30,7 @@ the material point the force acts on). The appended states integrate P_contact a
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -221,6 +222,14 @@ class TabulatedHertzKalker:
         return CreepCoefficients(*_uniform_interp(log_ab, self.log_ab, self.c))
 
 
+@functools.lru_cache(maxsize=8)
+def _tables_for(shear_modulus_Pa: float, poisson_ratio: float) -> TabulatedHertzKalker:
+    """TabulatedHertzKalker per material (built once per process: ~0.5 s)."""
+    from rigid_dynamics.materials import Material
+
+    return TabulatedHertzKalker(Material(shear_modulus_Pa, poisson_ratio, 0.0))
+
+
 def batch_contact_function(name: str, material, options=None):
     """A function (A, B, q, xi, eta, phi) -> (N, T_x, T_y, M_z, a, b) for all patches at once, or None.
 
@@ -238,7 +247,7 @@ def batch_contact_function(name: str, material, options=None):
     shear, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
     opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
     opts.update({k: v for k, v in (options or {}).items() if k in opts})
-    tables = TabulatedHertzKalker(material)
+    tables = _tables_for(material.shear_modulus_Pa, material.poisson_ratio)
 
     def solve(curv_a, curv_b, approach, xi, eta, spin):
         semi_a, semi_b, normal = tables.hertz(curv_a, curv_b, approach)
@@ -264,6 +273,7 @@ def batch_contact_function(name: str, material, options=None):
             m_z = zero
         return normal, np.asarray(t_x, float), np.asarray(t_y, float), np.asarray(m_z, float), semi_a, semi_b
 
+    solve.tables = tables
     return solve
 
 

@@ -315,6 +315,11 @@ class _Recorder:
                 table[name][side, slot] = contact.values[name][k]
         forces = np.zeros((2, 3))
         np.add.at(forces, contact.side, contact.force_N)
+        self.append(t, full_state, table, forces)
+
+    def append(self, t: float, full_state: np.ndarray, table: dict, forces: np.ndarray) -> None:
+        """Check and store one sample (patch table: PATCH_FIELDS -> (2, 2); forces per side (2, 3))."""
+        state = full_state[:12]
         normal = np.nansum(table["normal_force_N"], axis=1)
         if not (np.all(np.isfinite(forces)) and np.all(np.isfinite(normal))):
             raise _Stop("blow-up", f"non-finite contact force at t = {t:.6g} s", t, state)
@@ -359,6 +364,66 @@ class _Recorder:
             side = SIDES[int(np.argmin(touching))]
             raise _Stop("wheel-lift", f"the {side} wheel lost contact at t = {t:.6g} s", t, state)
 
+    def append_many(self, times, full_states, tables: dict, forces) -> None:
+        """Vectorised :meth:`append` for many samples (tables: name -> (n, 2, 2); forces (n, 2, 3))."""
+        n = len(times)
+        if n == 0:
+            return
+        normal = np.nansum(tables["normal_force_N"], axis=2)
+        bad = ~(np.all(np.isfinite(full_states), axis=1) & np.all(np.isfinite(forces), axis=(1, 2)))
+        bad |= ~np.all(np.isfinite(normal), axis=1)
+        bad |= np.max(normal, axis=1) > self.limit_force
+        bad |= np.abs(full_states[:, 1]) > self.limit_y
+        touching = normal > 0
+        if self.scene.integrator.stop_at_wheel_lift:
+            bad |= ~np.all(touching, axis=1)
+        stop = int(np.argmax(bad)) if np.any(bad) else n
+        if stop < n:
+            # store the good samples, then let append() raise with the right status on the bad one
+            if stop:
+                self.append_many(
+                    times[:stop], full_states[:stop], {k: v[:stop] for k, v in tables.items()}, forces[:stop]
+                )
+            self.append(float(times[stop]), full_states[stop], {k: v[stop] for k, v in tables.items()}, forces[stop])
+            return
+        flange = np.any((tables["contact_angle_rad"] > self.flange_angle) & (tables["normal_force_N"] > 0), axis=2)
+        prev_touch = np.vstack([self.in_contact if self.in_contact is not None else touching[:1], touching[:-1]])
+        prev_flange = np.vstack([self.flange if self.flange is not None else flange[:1], flange[:-1]])
+        for k, i in zip(*np.nonzero(prev_touch & ~touching), strict=True):
+            self.events.append(("wheel-lift", SIDES[i], float(times[k])))
+        for k, i in zip(*np.nonzero(~prev_touch & touching), strict=True):
+            self.events.append(("contact-restored", SIDES[i], float(times[k])))
+        for k, i in zip(*np.nonzero(flange & ~prev_flange), strict=True):
+            self.events.append(("flange-contact", SIDES[i], float(times[k])))
+        self.events.sort(key=lambda e: e[2])
+        self.in_contact, self.flange = touching[-1], flange[-1]
+        states = full_states[:, :12]
+        self.t.extend(float(v) for v in times)
+        self.states.extend(states.copy())
+        for name in PATCH_FIELDS:
+            self.patches[name].extend(tables[name])
+        self.forces.extend(np.asarray(forces))
+        # kinetic energy m|v|^2/2 + omega.J omega/2, J = R diag(Jt, Ja, Jt) R^T (R = R_z R_x), vectorised
+        psi, theta = states[:, 3], states[:, 4]
+        yr, rr, sr = states[:, 9], states[:, 10], states[:, 11]
+        cps, sps, cth, sth = np.cos(psi), np.sin(psi), np.cos(theta), np.sin(theta)
+        omega = np.stack([rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth], axis=-1)
+        rzx = np.stack(
+            [
+                np.stack([cps, -sps * cth, sps * sth], -1),
+                np.stack([sps, cps * cth, -cps * sth], -1),
+                np.stack([np.zeros_like(cps), sth, cth], -1),
+            ],
+            -2,
+        )
+        body = np.einsum("nji,nj->ni", rzx, omega)
+        j_diag = np.diag(self.model.j_body)
+        kinetic = 0.5 * self.model.mass * np.sum(states[:, 6:9] ** 2, axis=1) + 0.5 * np.sum(j_diag * body**2, axis=1)
+        self.kinetic.extend(kinetic)
+        self.potential.extend(-self.model.mass * self.model.gravity * states[:, 2])
+        self.work_contact.extend(full_states[:, 12])
+        self.work_exterior.extend(full_states[:, 13])
+
     def arrays(self):
         n = len(self.t)
         patches = {name: (np.array(v) if n else np.zeros((0, 2, MAX_SLOTS))) for name, v in self.patches.items()}
@@ -380,6 +445,7 @@ def simulate(
     *,
     provider=None,
     contact_model=None,
+    compiled: bool | None = None,
 ) -> SimulationResult:
     """Run a scene and return its :class:`SimulationResult` (never raises for numerical trouble).
 
@@ -389,6 +455,8 @@ def simulate(
         provider: optional provider instance overriding the scene's ``contact_provider`` (e.g. a
             prebuilt TableProvider reused across runs).
         contact_model: optional model instance or registered name overriding ``scene.contact_model``.
+        compiled: use the compiled RK4 loop (rigid_dynamics.wheelset.compiled) when it supports the run
+            (None: whenever it does; False: never; True: required, ValueError if unsupported).
 
     Raises:
         ValueError: the scene cannot be set up (unknown model, provider that cannot serve it).
@@ -396,6 +464,15 @@ def simulate(
     provider = provider if provider is not None else build_provider(scene)
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
     model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
+    from rigid_dynamics.wheelset import compiled as _compiled
+
+    can_compile = _compiled.supported(scene, provider, model_obj) and model.batch is not None
+    if compiled and not can_compile:
+        raise ValueError(
+            "compiled = True: the compiled path needs method RK4, a TableProvider without irregularities and one of "
+            f"the models {', '.join(_compiled.MODEL_CODES)}"
+        )
+    use_compiled = can_compile and compiled is not False
     settings = scene.integrator
     duration = scene.duration_s
     start = time.perf_counter()
@@ -454,7 +531,9 @@ def simulate(
             raise _Stop("invalid-initial-state", f"no static equilibrium of z and roll found: {why}", 0.0, state0)
         recorder.record(0.0, full0)
         next_out = 1
-        if settings.method == "RK4":
+        if use_compiled:
+            steps = _run_compiled(model, provider, full0, duration, settings, recorder, report, start)
+        elif settings.method == "RK4":
             steps = _run_rk4(fun, full0, duration, settings, out_times, recorder, report)
         else:
             steps = _run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
@@ -552,6 +631,63 @@ def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scen
                 next_out += 1
         report(solver.t)
     return steps
+
+
+_COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed"}
+
+
+def _run_compiled(model, provider, y0, duration, settings, recorder, report, start) -> int:
+    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
+    from rigid_dynamics.wheelset import compiled
+
+    par, table, grid, slots, sides, hz, kk = compiled.pack(model, provider, model.batch.tables, model.model.name)
+    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
+    h = duration / n_steps
+    out_every = max(1, int(round(settings.output_step_s / h)))
+    n_out = n_steps // out_every
+    ncand = table.shape[1]
+    states = np.zeros((n_out, 14))
+    recs = np.zeros((n_out, ncand + 2, compiled.N_FIELDS))
+    y, t, done, k_out = y0.copy(), 0.0, 0, 0
+    chunk = max(out_every, (2000 // out_every) * out_every)
+    fields_ = PATCH_FIELDS
+    while done < n_steps:
+        todo = min(chunk, n_steps - done)
+        status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
+            y, t, h, todo, out_every, par, table, grid, slots, sides, hz, kk, states, recs, k_out
+        )
+        model.rhs_evaluations += int(evals)
+        if k_new > k_out:
+            block = recs[k_out:k_new]
+            tables = {name: np.full((k_new - k_out, 2, MAX_SLOTS), np.nan) for name in fields_}
+            for c in range(ncand):
+                if slots[c] < MAX_SLOTS:
+                    for f, name in enumerate(fields_):
+                        tables[name][:, sides[c], slots[c]] = block[:, c, f]
+            times = (done // out_every + np.arange(1, k_new - k_out + 1)) * out_every * h
+            recorder.append_many(times, states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy())
+        k_out = k_new
+        if status != 0:
+            stop = _Stop(
+                _COMPILED_STATUS[int(status)],
+                f"compiled RK4 stopped ({_COMPILED_STATUS[int(status)]}) at t = {t_end:.6g} s",
+                float(t_end),
+                np.array(y_end[:12]),
+            )
+            stop.steps = done + int(did)
+            raise stop
+        done += todo
+        y, t = y_end, t_end
+        if model.rhs_evaluations >= settings.max_rhs_evaluations:
+            stop = _Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
+            stop.steps = done
+            raise stop
+        if time.perf_counter() - start > settings.max_wall_time_s:
+            stop = _Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
+            stop.steps = done
+            raise stop
+        report(t)
+    return n_steps
 
 
 def _run_rk4(fun, y0, duration, settings, out_times, recorder, report) -> int:

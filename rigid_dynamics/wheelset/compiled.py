@@ -1,0 +1,326 @@
+"""Compiled (numba) fixed-step path of the wheelset simulation for contact-geometry tables.
+
+The same equations as rigid_dynamics.wheelset.equations (eq 59-71 with the gyroscopic term), the same table
+look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
+closed-form creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory,
+eq 50-52, contact/linear.py) and ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py),
+integrated by the classical RK4 method with a fixed step, all inside one compiled loop. Used automatically by
+``simulate`` when the scene runs RK4 on a TableProvider without irregularities and with one of these models;
+tests/test_dynamics_compiled.py checks that it reproduces the Python path.
+
+Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2}
+N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
+
+# indices into the parameter vector
+(
+    P_MASS, P_JT, P_JA, P_G, P_KX, P_KY, P_KZ, P_CX, P_CY, P_CZ, P_KYAW, P_CYAW, P_BS, P_ZF, P_XF0, P_V, P_AXLE,
+    P_TORQUE, P_SHEAR, P_ESTAR, P_MU, P_MODEL, P_ZREF, P_FMAX, P_YMAX,
+) = range(25)  # fmt: skip
+N_PAR = 25
+
+
+@njit(cache=True)
+def _lookup(table, y0, dy, ny, r0, dr, nr, y, roll, out):
+    fy = (min(max(y, y0), y0 + (ny - 1) * dy) - y0) / dy
+    j = min(int(fy), ny - 2)
+    wy = fy - j
+    fr = (min(max(roll, r0), r0 + (nr - 1) * dr) - r0) / dr
+    i = min(int(fr), nr - 2)
+    wr = fr - i
+    nq, nc = table.shape[0], table.shape[1]
+    for q in range(nq):
+        for c in range(nc):
+            out[q, c] = (1 - wr) * ((1 - wy) * table[q, c, i, j] + wy * table[q, c, i, j + 1]) + wr * (
+                (1 - wy) * table[q, c, i + 1, j] + wy * table[q, c, i + 1, j + 1]
+            )
+
+
+@njit(cache=True)
+def _uniform(x, x0, step, n):
+    f = (x - x0) / step
+    if f < 0.0:
+        f = 0.0
+    if f > n - 1.0:
+        f = n - 1.0
+    i = min(int(f), n - 2)
+    return i, f - i
+
+
+@njit(cache=True)
+def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record):
+    """d/dt of the 14-state; fills rec (ncand, N_FIELDS) and the side forces when ``record``. Returns status."""
+    out = np.zeros(14)
+    xc, yc, zc = y[0], y[1], y[2]
+    yaw, roll = y[3], y[4]
+    vx, vy, vz = y[6], y[7], y[8]
+    yr, rr, sr = y[9], y[10], y[11]
+    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
+    rzx = np.array([[cps, -sps * cth, sps * sth], [sps, cps * cth, -cps * sth], [0.0, sth, cth]])
+    om = np.array([rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth])
+    _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, roll, work)
+    zref = par[P_ZREF]
+    force = np.zeros(3)
+    moment = np.zeros(3)
+    p_con = 0.0
+    side_force = np.zeros((2, 3))
+    ncand = table.shape[1]
+    for c in range(ncand):
+        q = work[0, c] + (zc - zref) * work[1, c]
+        if slots[c] > 0 and work[11, c] + (zc - zref) * work[1, c] > 0:
+            q = -0.01
+        ny_, nz_ = work[4, c], work[5, c]
+        nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
+        n = np.array([0.0, ny_ / nn, nz_ / nn])
+        lever = np.array([-sps * work[10, c], work[2, c], work[3, c]])
+        if record:
+            for f in range(N_FIELDS):
+                rec[c, f] = np.nan
+            rec[c, 0] = 0.0
+            rec[c, 7] = q
+            rec[c, 8] = yc + work[2, c]
+            rec[c, 9] = work[10, c]
+            rec[c, 10] = work[8, c]
+            rec[c, 11] = work[9, c]
+        if q <= 0.0:
+            continue
+        vel = np.array(
+            [
+                vx + om[1] * lever[2] - om[2] * lever[1],
+                vy + om[2] * lever[0] - om[0] * lever[2],
+                vz + om[0] * lever[1] - om[1] * lever[0],
+            ]
+        )
+        vp = np.array([vx, 0.0, 0.0]) - (n[0] * vx) * n
+        speed = math.sqrt(vp[0] ** 2 + vp[1] ** 2 + vp[2] ** 2)
+        if not speed > 0.0:
+            return 4, out
+        ex = vp / speed
+        ey = np.array([n[1] * ex[2] - n[2] * ex[1], n[2] * ex[0] - n[0] * ex[2], n[0] * ex[1] - n[1] * ex[0]])
+        xi = (vel[0] * ex[0] + vel[1] * ex[1] + vel[2] * ex[2]) / speed
+        eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
+        spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
+        # Hertz, approach control (tables of the axial function)
+        ca, cb = work[6, c], work[7, c]
+        amin, amax = min(ca, cb), max(ca, cb)
+        i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
+        pp = hz[1, i] * (1 - w) + hz[1, i + 1] * w
+        kk_ = hz[2, i] * (1 - w) + hz[2, i + 1] * w
+        dd = hz[3, i] * (1 - w) + hz[3, i + 1] * w
+        major = math.sqrt(q * dd / (kk_ * amin))
+        normal = 2.0 * math.pi * major * par[P_ESTAR] * q / (3.0 * kk_)
+        minor = major * math.sqrt(pp)
+        sa, sb = (major, minor) if ca <= cb else (minor, major)
+        tx, ty, mz = 0.0, 0.0, 0.0
+        if par[P_MODEL] >= 1:
+            i, w = _uniform(math.log(sa / sb), kk[0, 0], kk[0, 1], kk.shape[1])
+            c11 = kk[1, i] * (1 - w) + kk[1, i + 1] * w
+            c22 = kk[2, i] * (1 - w) + kk[2, i + 1] * w
+            c23 = kk[3, i] * (1 - w) + kk[3, i + 1] * w
+            c33 = kk[4, i] * (1 - w) + kk[4, i + 1] * w
+            ab = sa * sb
+            gab = par[P_SHEAR] * ab
+            gab15 = gab * math.sqrt(ab)
+            tx = -gab * c11 * xi
+            ty = -gab * c22 * eta - gab15 * c23 * spin
+            mz = gab15 * c23 * eta - gab * ab * c33 * spin
+            if par[P_MODEL] == 2:
+                tt = math.hypot(tx, ty)
+                limit = par[P_MU] * normal
+                if tt > 0.0:
+                    wprime = tt / (3.0 * limit) if limit > 0 else np.inf
+                    one = max(1.0 - wprime, 0.0)
+                    scale = limit * (1.0 - one**3) / tt
+                    tx *= scale
+                    ty *= scale
+                mz = 0.0
+        f = ex * tx + ey * ty + n * normal
+        m = n * mz
+        force += f
+        moment += (
+            np.array(
+                [
+                    lever[1] * f[2] - lever[2] * f[1],
+                    lever[2] * f[0] - lever[0] * f[2],
+                    lever[0] * f[1] - lever[1] * f[0],
+                ]
+            )
+            + m
+        )
+        p_con += f[0] * vel[0] + f[1] * vel[1] + f[2] * vel[2] + m[0] * om[0] + m[1] * om[1] + m[2] * om[2]
+        if record:
+            side_force[sides[c]] += f
+            rec[c, 0] = normal
+            rec[c, 1] = tx
+            rec[c, 2] = ty
+            rec[c, 3] = mz
+            rec[c, 4] = xi
+            rec[c, 5] = eta
+            rec[c, 6] = spin
+            rec[c, 12] = sa
+            rec[c, 13] = sb
+    # exterior forces (equations.WheelsetModel.exterior)
+    fext = np.array([0.0, 0.0, par[P_AXLE]])
+    mext = np.zeros(3)
+    p_ext = par[P_AXLE] * vz
+    axle = np.array([-sps * cth, cps * cth, sth])
+    for s in (-1.0, 1.0):
+        arm = axle * (s * par[P_BS])
+        pt = np.array([xc, yc, zc]) + arm
+        vel = np.array(
+            [
+                vx + om[1] * arm[2] - om[2] * arm[1],
+                vy + om[2] * arm[0] - om[0] * arm[2],
+                vz + om[0] * arm[1] - om[1] * arm[0],
+            ]
+        )
+        rel = pt - np.array([par[P_XF0] + par[P_V] * t, s * par[P_BS], par[P_ZF]])
+        relv = vel - np.array([par[P_V], 0.0, 0.0])
+        fs = np.array(
+            [
+                -par[P_KX] * rel[0] - par[P_CX] * relv[0],
+                -par[P_KY] * rel[1] - par[P_CY] * relv[1],
+                -par[P_KZ] * rel[2] - par[P_CZ] * relv[2],
+            ]
+        )
+        fext += fs
+        mext += np.array(
+            [arm[1] * fs[2] - arm[2] * fs[1], arm[2] * fs[0] - arm[0] * fs[2], arm[0] * fs[1] - arm[1] * fs[0]]
+        )
+        p_ext += fs[0] * vel[0] + fs[1] * vel[1] + fs[2] * vel[2]
+    myaw = -2.0 * (par[P_KYAW] * yaw + par[P_CYAW] * yr)
+    mext[2] += myaw
+    p_ext += myaw * om[2]
+    if par[P_TORQUE] != 0.0:
+        mt = -par[P_TORQUE] * axle
+        mext += mt
+        p_ext += mt[0] * om[0] + mt[1] * om[1] + mt[2] * om[2]
+    acc = (force + fext) / par[P_MASS]
+    acc[2] += par[P_G]
+    jb = np.array([par[P_JT], par[P_JA], par[P_JT]])
+    jm = np.zeros((3, 3))
+    for a in range(3):
+        for b in range(3):
+            jm[a, b] = rzx[a, 0] * jb[0] * rzx[b, 0] + rzx[a, 1] * jb[1] * rzx[b, 1] + rzx[a, 2] * jb[2] * rzx[b, 2]
+    jw = jm @ om
+    tq = (
+        moment
+        + mext
+        - np.array([om[1] * jw[2] - om[2] * jw[1], om[2] * jw[0] - om[0] * jw[2], om[0] * jw[1] - om[1] * jw[0]])
+    )
+    al = np.linalg.solve(jm, tq)
+    out[0], out[1], out[2] = vx, vy, vz
+    out[3], out[4], out[5] = yr, rr, sr
+    out[6], out[7], out[8] = acc[0], acc[1], acc[2]
+    out[9] = (al[0] * sps * sth - al[1] * cps * sth + al[2] * cth + yr * rr * sth + rr * sr) / cth
+    out[11] = (al[0] * sps - al[1] * cps + yr * rr + rr * sr * sth) / cth
+    out[10] = al[0] * cps + al[1] * sps - yr * sr * cth
+    out[12], out[13] = p_con, p_ext
+    if record:
+        for sd in range(2):
+            for k in range(3):
+                rec[ncand + sd, k] = side_force[sd, k]
+    return 0, out
+
+
+@njit(cache=True)
+def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk, states, recs, out_start):
+    """Advance ``n_steps`` RK4 steps from (t0, y); record every ``out_every`` steps into states/recs from
+    index ``out_start``. Returns (status, steps done, next output index, t, y, rhs evaluations).
+    """
+    ncand = table.shape[1]
+    work = np.empty((table.shape[0], ncand))
+    rec = np.empty((ncand + 2, N_FIELDS))
+    t = t0
+    k_out = out_start
+    evals = 0
+    fmax, ymax = par[P_FMAX], par[P_YMAX]
+    for step in range(n_steps):
+        st, k1 = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        if st != 0:
+            return st, step, k_out, t, y, evals
+        st, k2 = _rhs(t + 0.5 * h, y + 0.5 * h * k1, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        if st != 0:
+            return st, step, k_out, t, y, evals
+        st, k3 = _rhs(t + 0.5 * h, y + 0.5 * h * k2, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        if st != 0:
+            return st, step, k_out, t, y, evals
+        st, k4 = _rhs(t + h, y + h * k3, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        evals += 4
+        if st != 0:
+            return st, step, k_out, t, y, evals
+        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        for v in y_new:
+            if not np.isfinite(v):
+                return 1, step, k_out, t, y, evals
+        y = y_new
+        t = t0 + (step + 1) * h
+        if (step + 1) % out_every == 0 and k_out < states.shape[0]:
+            st, _ = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True)
+            evals += 1
+            if st != 0:
+                return st, step + 1, k_out, t, y, evals
+            states[k_out, :] = y
+            recs[k_out, :, :] = rec
+            k_out += 1
+            for sd in range(2):
+                total = 0.0
+                for c in range(ncand):
+                    if sides[c] == sd:
+                        total += rec[c, 0]
+                if total > fmax:
+                    return 2, step + 1, k_out, t, y, evals
+            if abs(y[1]) > ymax:
+                return 3, step + 1, k_out, t, y, evals
+    return 0, n_steps, k_out, t, y, evals
+
+
+def supported(scene, provider, model) -> bool:
+    """Whether the compiled path can run this combination (RK4, TableProvider without irregularities, model)."""
+    from rigid_dynamics.wheelset.providers import TableProvider
+
+    return (
+        scene.integrator.method == "RK4"
+        and type(provider) is TableProvider
+        and provider.irregularities is None
+        and getattr(model, "name", None) in MODEL_CODES
+        and type(model).__module__ == "rigid_dynamics.contact.models"
+    )
+
+
+def pack(model_wheelset, provider, tables, model_name):
+    """Parameter vector and arrays of the compiled RHS from a WheelsetModel, its TableProvider and tables."""
+    m = model_wheelset
+    scene = m.scene
+    par = np.zeros(N_PAR)
+    par[P_MASS], par[P_JT], par[P_JA] = m.mass, m.j_body[0, 0], m.j_body[1, 1]
+    par[P_G] = m.gravity
+    par[P_KX], par[P_KY], par[P_KZ] = m.k
+    par[P_CX], par[P_CY], par[P_CZ] = m.c
+    par[P_KYAW], par[P_CYAW] = m.k_yaw, m.c_yaw
+    par[P_BS], par[P_ZF], par[P_XF0], par[P_V] = m.half_spacing, m.z_frame, m.frame_x0, m.speed
+    par[P_AXLE], par[P_TORQUE] = m.axle_load, m.torque
+    par[P_SHEAR] = scene.material.shear_modulus_Pa
+    par[P_ESTAR] = tables.e_star
+    par[P_MU] = scene.material.friction_coefficient
+    par[P_MODEL] = MODEL_CODES[model_name]
+    par[P_ZREF] = provider.z_ref
+    par[P_FMAX] = scene.integrator.max_force_factor * scene.static_wheel_load_N
+    par[P_YMAX] = scene.integrator.max_lateral_displacement_m
+    yg, rg = provider.y_grid, provider.roll_grid
+    grid = np.array([yg[0], yg[1] - yg[0], len(yg), rg[0], rg[1] - rg[0], len(rg)], float)
+    hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
+    hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
+    kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
+    kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
+    table = np.ascontiguousarray(provider.table)
+    return par, table, grid, np.asarray(provider.slot, np.int64), np.asarray(provider.side, np.int64), hz, kk
