@@ -16,6 +16,8 @@ from wheelrail.config import ConfigError, build_dataclass, read_toml
 SCENES_DIR = Path(__file__).parent / "scenes"
 DEFAULT_SCENE = "hunting-conical"
 DEFAULT_STRESS_SCENE = "hunting-conical"
+ANALYTIC_TRACK_NAMES = {"conical", "circular"}
+"""Profile names a scene's track may use for the analytic conical-wheel / circular-rail pair (no file)."""
 
 
 def embedded_scenes() -> dict[str, Path]:
@@ -51,7 +53,7 @@ def _check_profiles(table: dict, prefix: str = "") -> None:
         dotted = f"{prefix}.{key}" if prefix else key
         if isinstance(value, dict):
             _check_profiles(value, dotted)
-        elif key.endswith("_profile") and isinstance(value, str):
+        elif key.endswith("_profile") and isinstance(value, str) and value.lower() not in ANALYTIC_TRACK_NAMES:
             kind = "rail" if "rail" in key else "wheel"
             try:
                 load_profile(value, kind)
