@@ -344,10 +344,20 @@ class InfluenceGrid:
             sy = sy + self._kernel_fft("yz", rolling) * fz
         return self._backward_pair(sx, sy)
 
-    def inverse_static(self, ux_m: np.ndarray, uy_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Approximate inverse of the static tangential operator: the padded circulant's inverse, by FFT.
+    @property
+    def padded_shape(self) -> tuple[int, int]:
+        """(ly, lx): the zero-padded FFT period along y and x (>= 2 ny - 1, 2 nx - 1)."""
+        return self._cache["shape"]
 
-        A preconditioner only (exact for the periodic extension, not for the bounded grid).
+    def tangential_spectra(self, rolling: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """rfft2 spectra (kxx, kxy, kyy) of the tangential kernels on the padded period, complex (ly, lx/2 + 1)."""
+        return self._kernel_fft("xx", rolling), self._kernel_fft("xy", rolling), self._kernel_fft("yy", rolling)
+
+    def inverse_static_spectra(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Spectra (ixx, ixy, iyy) of the padded circulant's inverse of the static tangential operator.
+
+        The 2 x 2 symbol [[kxx, kxy], [kxy, kyy]] is inverted per frequency (real parts, floored at
+        1e-3 max kxx against the near-zero symbols of the padding); a preconditioner only.
         """
         if "inv" not in self._cache:
             kxx = self._kernel_fft("xx", False).real
@@ -358,8 +368,17 @@ class InfluenceGrid:
             kyy = np.maximum(kyy, floor)
             det = kxx * kyy - kxy * kxy
             det = np.where(det > floor * floor, det, floor * floor)
-            self._cache["inv"] = (kyy / det, kxx / det, -kxy / det)
-        ixx, iyy, ixy = self._cache["inv"]
+            self._cache["inv"] = tuple(
+                np.ascontiguousarray(v, dtype=complex) for v in (kyy / det, -kxy / det, kxx / det)
+            )
+        return self._cache["inv"]
+
+    def inverse_static(self, ux_m: np.ndarray, uy_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Approximate inverse of the static tangential operator: the padded circulant's inverse, by FFT.
+
+        A preconditioner only (exact for the periodic extension, not for the bounded grid).
+        """
+        ixx, ixy, iyy = self.inverse_static_spectra()
         fx, fy = self._forward_pair(ux_m, uy_m)
         return self._backward_pair(ixx * fx + ixy * fy, ixy * fx + iyy * fy)
 

@@ -25,7 +25,9 @@ whose matrix-vector products are FFT convolutions (O(N log N), no dense matrix).
 for rolling the operator factors exactly as L = C o D, D t = (t_I - t_(I+e_x))/dx (the upwind difference
 acting on the traction; both are convolutions), so D^-1 is a cumulative sum from the leading edge;
 C^-1 is approximated by the inverse of the zero-padded circulant (FFT); slip rows are scaled by
-their diagonal. Between steps, adhesion elements whose traction exceeds the bound move to S
+their diagonal. The scatter/gather and the 2 x 2 spectral products of each GMRES step are numba
+kernels around two batched real FFT pairs (one for the operator, one for the preconditioner).
+Between steps, adhesion elements whose traction exceeds the bound move to S
 and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
 Linearisation of the slip-element equation (derivative of e_perp . s with respect to theta)::
 
@@ -39,6 +41,7 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+import scipy.fft
 
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
 
@@ -70,6 +73,93 @@ def _combine(basis, y):
         for j in range(basis.shape[1]):
             out[j] += y[i] * basis[i, j]
     return out
+
+
+@numba.njit(cache=True)
+def _spread(v, kind, idx, nh, gex, gey, buf):
+    """Write the traction increments of the compact vector v into the padded buffer buf (2, ly, lx).
+
+    kind[j, i]: 0 outside the unknowns, 1 adhesion (v[idx], v[nh + idx] are t_x, t_y), 2 slip
+    (v[idx] is the angle increment, traction g e_perp times it: gex, gey). Only the (ny, nx) corner is written.
+    """
+    ny, nx = kind.shape
+    for j in range(ny):
+        for i in range(nx):
+            k = kind[j, i]
+            if k == 1:
+                buf[0, j, i] = v[idx[j, i]]
+                buf[1, j, i] = v[nh + idx[j, i]]
+            elif k == 2:
+                a = v[idx[j, i]]
+                buf[0, j, i] = gex[j, i] * a
+                buf[1, j, i] = gey[j, i] * a
+            else:
+                buf[0, j, i] = 0.0
+                buf[1, j, i] = 0.0
+
+
+@numba.njit(cache=True)
+def _mix(spec, kxx, kxy, kyy, out):
+    """Multiply by the symmetric 2 x 2 symbol per frequency: out = [[kxx, kxy], [kxy, kyy]] spec (complex)."""
+    ly, lc = kxx.shape
+    for j in range(ly):
+        for i in range(lc):
+            a = spec[0, j, i]
+            b = spec[1, j, i]
+            out[0, j, i] = kxx[j, i] * a + kxy[j, i] * b
+            out[1, j, i] = kxy[j, i] * a + kyy[j, i] * b
+
+
+@numba.njit(cache=True)
+def _gather_residual(u, v, kind, idx, nh, epx, epy, diag, out):
+    """Jacobian rows from the displacement (rate) u (2, ly, lx): adhesion s_x, s_y; slip e_perp . s + |s| alpha."""
+    ny, nx = kind.shape
+    for j in range(ny):
+        for i in range(nx):
+            k = kind[j, i]
+            if k == 1:
+                out[idx[j, i]] = u[0, j, i]
+                out[nh + idx[j, i]] = u[1, j, i]
+            elif k == 2:
+                m = idx[j, i]
+                out[m] = epx[j, i] * u[0, j, i] + epy[j, i] * u[1, j, i] + diag[j, i] * v[m]
+
+
+@numba.njit(cache=True)
+def _spread_adhesion(v, kind, idx, nh, buf):
+    """Adhesion rows of v into the padded buffer (slip and outside elements zero)."""
+    ny, nx = kind.shape
+    for j in range(ny):
+        for i in range(nx):
+            if kind[j, i] == 1:
+                buf[0, j, i] = v[idx[j, i]]
+                buf[1, j, i] = v[nh + idx[j, i]]
+            else:
+                buf[0, j, i] = 0.0
+                buf[1, j, i] = 0.0
+
+
+@numba.njit(cache=True)
+def _precondition_out(u, v, kind, idx, nh, self_s, dx, rolling, out):
+    """Preconditioned vector: adhesion from u (with D^-1, the sum from the leading edge, if rolling), slip v/self_s."""
+    ny, nx = kind.shape
+    for j in range(ny):
+        cx = 0.0
+        cy = 0.0
+        for i in range(nx - 1, -1, -1):
+            k = kind[j, i]
+            if rolling:
+                if k == 1:
+                    cx += u[0, j, i] * dx
+                    cy += u[1, j, i] * dx
+                    out[idx[j, i]] = cx
+                    out[nh + idx[j, i]] = cy
+            elif k == 1:
+                out[idx[j, i]] = u[0, j, i]
+                out[nh + idx[j, i]] = u[1, j, i]
+            if k == 2:
+                m = idx[j, i]
+                out[m] = v[m] / self_s[j, i]
 
 
 def _gmres(apply, rhs: np.ndarray, rtol: float, max_iterations: int, restart: int = 40) -> tuple[np.ndarray, int]:
@@ -234,6 +324,11 @@ def solve_tang(
 
     lin_total = 0
     n = shape[0] * shape[1]
+    padded = influence.padded_shape
+    buf = np.zeros((2, *padded))  # zero-padded traction pair; only the (ny, nx) corner is ever written
+    mixed = np.empty((2, padded[0], padded[1] // 2 + 1), complex)
+    k_roll = influence.tangential_spectra(rolling)
+    k_inv = influence.inverse_static_spectra()
     tx = np.zeros(shape)
     ty = np.zeros(shape)
     stick = contact.copy()
@@ -301,31 +396,38 @@ def solve_tang(
         diag_s = np.maximum(-s_par.ravel()[isl], 0.0)  # |s| for correctly oriented slip
         gb = bound.ravel()[isl]
         self_s = gb * (epx * epx * m_x + epy * epy * m_y) + diag_s
-        stick_f = stick.astype(float)
+        kind = np.where(stick, 1, np.where(slip, 2, 0)).astype(np.int64)
+        idx = np.zeros(shape, np.int64)
+        idx.ravel()[ih] = np.arange(nh)
+        idx.ravel()[isl] = 2 * nh + np.arange(isl.size)
+        grid_of = np.zeros(n)
 
-        def matvec(v: np.ndarray, ih=ih, isl=isl, nh=nh, epx=epx, epy=epy, diag_s=diag_s, gb=gb) -> np.ndarray:
-            dtx = np.zeros(n)
-            dty = np.zeros(n)
-            dtx[ih] = v[:nh]
-            dty[ih] = v[nh : 2 * nh]
-            al = v[2 * nh :]
-            dtx[isl] = gb * epx * al
-            dty[isl] = gb * epy * al
-            ux, uy = influence.tangential(dtx.reshape(shape), dty.reshape(shape), rolling=rolling)
-            ux, uy = ux.ravel(), uy.ravel()
-            return np.concatenate([ux[ih], uy[ih], epx * ux[isl] + epy * uy[isl] + diag_s * al])
+        def on_grid(values: np.ndarray, isl=isl, grid_of=grid_of) -> np.ndarray:
+            out = grid_of.copy()
+            out[isl] = values
+            return out.reshape(shape)
 
-        def precondition(v: np.ndarray, ih=ih, nh=nh, self_s=self_s, stick_f=stick_f) -> np.ndarray:
-            rx = np.zeros(n)
-            ry = np.zeros(n)
-            rx[ih] = v[:nh]
-            ry[ih] = v[nh : 2 * nh]
-            ux, uy = influence.inverse_static(rx.reshape(shape), ry.reshape(shape))
-            if rolling:
-                # L = C o D with D t = (t_I - t_(I+e_x))/dx: invert D by summing from the leading edge
-                ux = np.cumsum((ux * stick_f)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
-                uy = np.cumsum((uy * stick_f)[:, ::-1], axis=1)[:, ::-1] * influence.dx_m
-            return np.concatenate([ux.ravel()[ih], uy.ravel()[ih], v[2 * nh :] / self_s])
+        gex, gey = on_grid(gb * epx), on_grid(gb * epy)
+        epx_g, epy_g, diag_g, self_g = on_grid(epx), on_grid(epy), on_grid(diag_s), on_grid(self_s)
+        size = 2 * nh + isl.size
+
+        def matvec(v, kind=kind, idx=idx, nh=nh, gex=gex, gey=gey, e=(epx_g, epy_g, diag_g), size=size):
+            _spread(v, kind, idx, nh, gex, gey, buf)
+            spec = scipy.fft.rfft2(buf)
+            _mix(spec, *k_roll, mixed)
+            u = scipy.fft.irfft2(mixed, s=padded)
+            out = np.empty(size)
+            _gather_residual(u, v, kind, idx, nh, *e, out)
+            return out
+
+        def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, size=size):
+            _spread_adhesion(v, kind, idx, nh, buf)
+            spec = scipy.fft.rfft2(buf)
+            _mix(spec, *k_inv, mixed)
+            u = scipy.fft.irfft2(mixed, s=padded)
+            out = np.empty(size)
+            _precondition_out(u, v, kind, idx, nh, self_g, influence.dx_m, rolling, out)
+            return out
 
         def op(z, mv=matvec, pc=precondition):
             return mv(pc(z))
