@@ -24,11 +24,13 @@ then min(0.1, max(0.1 residual, 0.3 tolerance/residual)))
 whose matrix-vector products are FFT convolutions (O(N log N), no dense matrix). Right preconditioner:
 for rolling the operator factors exactly as L = C o D, D t = (t_I - t_(I+e_x))/dx (the upwind difference
 acting on the traction; both are convolutions), so D^-1 is a cumulative sum from the leading edge;
-C^-1 is approximated by the inverse of the zero-padded circulant (FFT); slip rows are scaled by
-their diagonal. The scatter/gather and the 2 x 2 spectral products of each GMRES step are numba
-kernels around two batched real FFT pairs (one for the operator, one for the preconditioner).
-Between steps, adhesion elements whose traction exceeds the bound move to S
-and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
+C^-1 is approximated by the inverse of the zero-padded circulant (FFT). The slip rows keep their
+diagonal and their strong coupling to the slip element ahead (the rolling kernel at offset -e_x is
+about minus the self-coefficient): that bidiagonal part is solved exactly along each row from the
+leading edge (for the shift problem only the diagonal). The scatter/gather and the 2 x 2 spectral
+products of each GMRES step are numba kernels around two batched real FFT pairs (one for the
+operator, one for the preconditioner). Between steps, adhesion elements whose traction exceeds
+the bound move to S and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
 Linearisation of the slip-element equation (derivative of e_perp . s with respect to theta)::
 
     d(e_perp . s)/d theta = -e . s + e_perp . (L g e_perp)      (-e . s = |s| > 0 at a solution)
@@ -140,12 +142,18 @@ def _spread_adhesion(v, kind, idx, nh, buf):
 
 
 @numba.njit(cache=True)
-def _precondition_out(u, v, kind, idx, nh, self_s, dx, rolling, out):
-    """Preconditioned vector: adhesion from u (with D^-1, the sum from the leading edge, if rolling), slip v/self_s."""
+def _precondition_out(u, v, kind, idx, nh, self_s, ahead, dx, rolling, out):
+    """Preconditioned vector from u = C^-1 r (2, ly, lx) and the slip rows of v.
+
+    Adhesion: u itself (shift) or D^-1 u, the sum from the leading edge (rolling). Slip: the
+    bidiagonal part of the slip rows solved exactly along each row from the leading edge,
+    alpha_I = (v_I - ahead_I alpha_(I+e_x))/self_I (ahead = 0 where the element ahead is not in slip).
+    """
     ny, nx = kind.shape
     for j in range(ny):
         cx = 0.0
         cy = 0.0
+        alpha = 0.0
         for i in range(nx - 1, -1, -1):
             k = kind[j, i]
             if rolling:
@@ -159,7 +167,10 @@ def _precondition_out(u, v, kind, idx, nh, self_s, dx, rolling, out):
                 out[nh + idx[j, i]] = u[1, j, i]
             if k == 2:
                 m = idx[j, i]
-                out[m] = v[m] / self_s[j, i]
+                alpha = (v[m] - ahead[j, i] * alpha) / self_s[j, i]
+                out[m] = alpha
+            else:
+                alpha = 0.0
 
 
 def _gmres(apply, rhs: np.ndarray, rtol: float, max_iterations: int, restart: int = 40) -> tuple[np.ndarray, int]:
@@ -317,6 +328,8 @@ def solve_tang(
 
     m_x = influence.self_coefficient("xx", rolling)
     m_y = influence.self_coefficient("yy", rolling)
+    l_xx = float(influence.kernel("xx", rolling)[influence.ny - 1, influence.nx - 2]) if influence.nx > 1 else 0.0
+    l_yy = float(influence.kernel("yy", rolling)[influence.ny - 1, influence.nx - 2]) if influence.nx > 1 else 0.0
 
     def slip_of(tx: np.ndarray, ty: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ux, uy = influence.tangential(tx, ty, rolling=rolling)
@@ -410,6 +423,13 @@ def solve_tang(
         gex, gey = on_grid(gb * epx), on_grid(gb * epy)
         epx_g, epy_g, diag_g, self_g = on_grid(epx), on_grid(epy), on_grid(diag_s), on_grid(self_s)
         size = 2 * nh + isl.size
+        # coupling of a slip row to the slip angle of the element ahead (+x), the rolling kernel at offset -e_x
+        ahead_g = np.zeros(shape)
+        if rolling and nx > 1:
+            gpx, gpy = gex[:, 1:], gey[:, 1:]
+            ahead_g[:, :-1] = np.where(
+                slip[:, :-1] & slip[:, 1:], epx_g[:, :-1] * gpx * l_xx + epy_g[:, :-1] * gpy * l_yy, 0.0
+            )
 
         def matvec(v, kind=kind, idx=idx, nh=nh, gex=gex, gey=gey, e=(epx_g, epy_g, diag_g), size=size):
             _spread(v, kind, idx, nh, gex, gey, buf)
@@ -420,13 +440,13 @@ def solve_tang(
             _gather_residual(u, v, kind, idx, nh, *e, out)
             return out
 
-        def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, size=size):
+        def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, ahead_g=ahead_g, size=size):
             _spread_adhesion(v, kind, idx, nh, buf)
             spec = scipy.fft.rfft2(buf)
             _mix(spec, *k_inv, mixed)
             u = scipy.fft.irfft2(mixed, s=padded)
             out = np.empty(size)
-            _precondition_out(u, v, kind, idx, nh, self_g, influence.dx_m, rolling, out)
+            _precondition_out(u, v, kind, idx, nh, self_g, ahead_g, influence.dx_m, rolling, out)
             return out
 
         def op(z, mv=matvec, pc=precondition):
