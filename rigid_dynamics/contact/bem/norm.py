@@ -11,7 +11,8 @@ unknown fixed by ``dA sum p = F_N`` (the approach becomes q + d).
 
 Method: conjugate gradients restricted to the current contact set with projection onto p >= 0
 and re-entry of overlapping elements, force control built in (Polonsky & Keer, Wear 231 (1999)
-206-219, section 3). Each iteration costs two FFT convolutions (O(N log N)); the iteration count
+206-219, section 3). Each iteration costs two FFT convolutions (O(N log N)) and two numba passes over
+the grid (direction, then step/projection/force scaling); the iteration count
 grows only mildly with N (see benchmarks/results/bem.md).
 """
 
@@ -20,9 +21,109 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
+
+
+@numba.njit(cache=True)
+def _direction(u, h, p, t, delta, g_old, force_control, gap):
+    """First half of a CG step: gap = A p + h (minus its mean over the active set in force control), new direction t.
+
+    Writes gap and t in place; returns (shift, g_now) with g_now = sum over the active set of gap^2.
+    """
+    ny, nx = p.shape
+    shift = 0.0
+    count = 0
+    for j in range(ny):
+        for i in range(nx):
+            gap[j, i] = u[j, i] + h[j, i]
+            if p[j, i] > 0:
+                shift += gap[j, i]
+                count += 1
+    if force_control and count > 0:
+        shift /= count
+        for j in range(ny):
+            for i in range(nx):
+                gap[j, i] -= shift
+    else:
+        shift = 0.0
+    g_now = 0.0
+    for j in range(ny):
+        for i in range(nx):
+            if p[j, i] > 0:
+                g_now += gap[j, i] * gap[j, i]
+    beta = delta * g_now / g_old
+    for j in range(ny):
+        for i in range(nx):
+            t[j, i] = gap[j, i] + beta * t[j, i] if p[j, i] > 0 else 0.0
+    return shift, g_now
+
+
+@numba.njit(cache=True)
+def _update(r, u, gap, t, p, allowed, force_control, normal_force, area, p_new):
+    """Second half of a CG step: step length, projection onto p >= 0, re-entry of overlaps, force scaling.
+
+    ``r`` = A t. Writes the new pressure into p_new; returns (delta, step, residual) as in solve_norm.
+    """
+    ny, nx = p.shape
+    r_mean = 0.0
+    count = 0
+    for j in range(ny):
+        for i in range(nx):
+            if p[j, i] > 0:
+                r_mean += r[j, i]
+                count += 1
+    if force_control and count > 0:
+        r_mean /= count
+    else:
+        r_mean = 0.0
+    denom = 0.0
+    numer = 0.0
+    for j in range(ny):
+        for i in range(nx):
+            if p[j, i] > 0:
+                denom += (r[j, i] - r_mean) * t[j, i]
+                numer += gap[j, i] * t[j, i]
+    tau = numer / denom if denom != 0.0 else 0.0
+    overlap = False
+    for j in range(ny):
+        for i in range(nx):
+            q = max(p[j, i] - tau * t[j, i], 0.0) if p[j, i] > 0 else 0.0
+            if q == 0.0 and gap[j, i] < 0.0 and allowed[j, i]:
+                overlap = True
+            p_new[j, i] = q
+    if overlap:
+        for j in range(ny):
+            for i in range(nx):
+                if p_new[j, i] == 0.0 and gap[j, i] < 0.0 and allowed[j, i]:
+                    p_new[j, i] = -tau * gap[j, i]
+    total = 0.0
+    for j in range(ny):
+        for i in range(nx):
+            total += p_new[j, i]
+    if force_control:
+        factor = normal_force / (area * total)
+        total = 0.0
+        for j in range(ny):
+            for i in range(nx):
+                p_new[j, i] *= factor
+                total += p_new[j, i]
+    diff = 0.0
+    u_max = 0.0
+    viol = 0.0
+    for j in range(ny):
+        for i in range(nx):
+            diff += abs(p_new[j, i] - p[j, i])
+            u_max = max(u_max, abs(u[j, i]))
+            if p_new[j, i] > 0:
+                viol = max(viol, abs(gap[j, i]))
+            elif allowed[j, i]:
+                viol = max(viol, -gap[j, i])
+    step = diff / max(abs(total), 1e-300)
+    residual = viol / max(u_max, 1e-300)
+    return (0.0 if overlap else 1.0), step, residual
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,44 +210,22 @@ def solve_norm(
         return NormSolution(np.zeros(shape), np.where(allowed, h, np.inf), 0.0, 0.0, 0, 0.0, True)
 
     t = np.zeros(shape)
+    gap = np.empty(shape)
+    p_new = np.empty(shape)
     g_old = 1.0
     delta = 0.0
     shift = 0.0
     converged = False
     residual = math.inf
     it = 0
+    normal_force = float(normal_force_N) if force_control else 0.0
     for it in range(1, int(max_iterations) + 1):  # noqa: B007 (the count is returned)
         u = influence.normal(p)
-        gap = u + h
-        active = p > 0
-        if force_control:
-            shift = float(gap[active].mean())
-            gap = gap - shift
-        g_now = float(np.sum(gap[active] ** 2))
-        t = np.where(active, gap + (delta * g_now / g_old) * t, 0.0)
+        shift, g_now = _direction(u, h, p, t, delta, g_old, force_control, gap)
         g_old = max(g_now, 1e-300)
         r = influence.normal(t)
-        if force_control:
-            r = r - r[active].mean()
-        denom = float(np.sum(r[active] * t[active]))
-        tau = float(np.sum(gap[active] * t[active])) / denom if denom != 0.0 else 0.0
-        p_old = p
-        p = np.where(active, p - tau * t, 0.0)
-        p = np.maximum(p, 0.0)
-        overlap = (p == 0.0) & (gap < 0.0) & allowed
-        if overlap.any():
-            delta = 0.0
-            p = np.where(overlap, p - tau * gap, p)
-        else:
-            delta = 1.0
-        if force_control:
-            p *= normal_force_N / (area * p.sum())
-        step = float(np.abs(p - p_old).sum() / max(np.abs(p).sum(), 1e-300))
-        scale = max(float(np.abs(u).max()), 1e-300)
-        in_c = p > 0
-        viol_c = float(np.abs(gap[in_c]).max()) if in_c.any() else 0.0
-        viol_n = float(np.maximum(-gap[~in_c & allowed], 0.0).max()) if (~in_c & allowed).any() else 0.0
-        residual = max(viol_c, viol_n) / scale
+        delta, step, residual = _update(r, u, gap, t, p, allowed, force_control, normal_force, area, p_new)
+        p, p_new = p_new, p
         if step < tolerance and residual < 100 * tolerance:
             converged = True
             break
