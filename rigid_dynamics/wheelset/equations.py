@@ -516,17 +516,50 @@ class WheelsetModel:
             return np.array([d[8], d[10] * 0.1])
 
         # bring both wheels to about the static approach before iterating (no contact = flat residual)
-        for _ in range(3):
+        # (a roll theta lowers the right wheel by about e0 theta and lifts the left one: level them first)
+        e0 = self.scene.wheelset.contact_half_distance_m
+        for _ in range(6):
             patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
             deepest = [
                 np.max(patches.approach_m[patches.side == i]) if np.any(patches.side == i) else 0.0 for i in (0, 1)
             ]
-            shift = 1e-4 - min(deepest)
-            if abs(shift) < 1e-6:
-                break
+            work[4] += (deepest[0] - deepest[1]) / (2.0 * e0)
+            shift = 1e-4 - 0.5 * (deepest[0] + deepest[1])
             work[2] += shift
+            if abs(shift) < 1e-7 and abs(deepest[0] - deepest[1]) < 1e-7:
+                break
         guess = np.array([work[2], work[4]])
-        sol = root(residual, guess, method="hybr", options={"xtol": 1e-13})
-        work[2], work[4] = sol.x
-        ok = bool(sol.success) and bool(np.all(np.abs(residual(sol.x)) < 1e-3))
-        return work, ok, str(sol.message)
+        # damped Newton with a finite-difference Jacobian and limited steps (the tables are only piecewise
+        # smooth in roll), then scipy's hybrid method as a fallback
+        x = guess.copy()
+        r = residual(x)
+        limit = np.array([1e-4, 5e-4])
+        for _ in range(60):
+            if np.max(np.abs(r)) < 1e-6:
+                break
+            jac = np.empty((2, 2))
+            for k, h in enumerate((1e-8, 1e-7)):
+                xp = x.copy()
+                xp[k] += h
+                jac[:, k] = (residual(xp) - r) / h
+            try:
+                step = np.linalg.solve(jac, -r)
+            except np.linalg.LinAlgError:
+                break
+            step = np.clip(step, -limit, limit)
+            for _damp in range(8):
+                trial = residual(x + step)
+                if np.max(np.abs(trial)) < np.max(np.abs(r)):
+                    break
+                step *= 0.5
+            x, r = x + step, trial
+        best, message = (x, float(np.max(np.abs(r)))), "damped Newton"
+        if best[1] >= 1e-3:
+            sol = root(residual, guess, method="hybr", options={"xtol": 1e-13})
+            size = float(np.max(np.abs(residual(sol.x))))
+            if size < best[1]:
+                best, message = (sol.x, size), f"hybr: {sol.message}"
+        work[2], work[4] = best[0]
+        # accept a residual acceleration below 1e-3 m/s^2 (vertical) / 1e-2 rad/s^2 (roll)
+        ok = best[1] < 1e-3
+        return work, ok, message
