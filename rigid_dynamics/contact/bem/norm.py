@@ -199,8 +199,13 @@ def solve_norm(
         p = np.zeros(shape)
     if not p.any():
         if force_control:
-            candidates = allowed & (h <= np.min(h[allowed]) + 0.5 * (np.max(h[allowed]) - np.min(h[allowed])))
-            p = np.where(candidates, 1.0, 0.0)
+            # Hertz-like start: p ~ sqrt(level - h) inside the level set halfway between min h and max h
+            # (for a quadric h over its ellipse's bounding box this is the Hertz pressure's shape)
+            level = np.min(h[allowed]) + 0.5 * (np.max(h[allowed]) - np.min(h[allowed]))
+            candidates = allowed & (h < level)
+            p = np.where(candidates, np.sqrt(np.where(candidates, level - h, 0.0)), 0.0)
+            if not p.any():
+                p = np.where(allowed & (h <= level), 1.0, 0.0)
         else:
             p = np.where(allowed & (h < 0), -h / influence.self_coefficient("zz"), 0.0)
     if force_control:
