@@ -562,4 +562,8 @@ class WheelsetModel:
         work[2], work[4] = best[0]
         # accept a residual acceleration below 1e-3 m/s^2 (vertical) / 1e-2 rad/s^2 (roll)
         ok = best[1] < 1e-3
+        patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
+        touching = [bool(np.any((patches.side == i) & (patches.approach_m > 0))) for i in (0, 1)]
+        if ok and not all(touching):
+            ok, message = False, "the equilibrium found has a wheel off its rail (no contact at rest)"
         return work, ok, message
