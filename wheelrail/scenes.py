@@ -16,6 +16,8 @@ from wheelrail.config import ConfigError, build_dataclass, read_toml
 SCENES_DIR = Path(__file__).parent / "scenes"
 DEFAULT_SCENE = "hunting-conical"
 DEFAULT_STRESS_SCENE = "hunting-conical"
+REQUIRED_SCENE_KEYS = ("speed_m_per_s", "duration_s")
+"""Keys a scene must state although the dataclass has defaults for them (a run's speed and length)."""
 ANALYTIC_TRACK_NAMES = {"conical", "circular"}
 """Profile names a scene's track may use for the analytic conical-wheel / circular-rail pair (no file)."""
 
@@ -72,6 +74,9 @@ def parse_scene(doc: dict):
             value = doc.pop(informative)
             if not isinstance(value, str):
                 raise ConfigError(f"key {informative!r} = {value!r}: expected a string")
+    for key in REQUIRED_SCENE_KEYS:
+        if key not in doc:
+            raise ConfigError(f"missing key {key!r}: expected a finite number (every scene states it)")
     _check_profiles(doc)
     return build_dataclass(DynamicsScene, doc)
 
