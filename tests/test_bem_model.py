@@ -236,3 +236,26 @@ def test_bad_options():
         model.solve(geometry, Creepage(), STEEL, normal_force_N=-5.0)
     with pytest.raises(ValueError, match="exactly one"):
         hertz_ellipse(1.0, 2.0, E_STAR)
+
+
+def test_search_field_holds_the_whole_overlap_of_the_long_tread_patch():
+    """The search's gap field (default: fitted to the rigid overlap) holds the whole overlap of the long,
+    non-elliptic tread patch of Manchester A-2.2 step 0 (no shift, no yaw), which the former fixed box of
+    +-1.6 quadric semi-axes truncated at its lateral edge; the fixed box is still available (field_scale)."""
+    from comparisons.manchester import MATERIAL, a22_case
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    def overlap_edges(field):
+        over = np.isfinite(field.distance_m) & (field.distance_m < 0)
+        return over[0].any() or over[-1].any() or over[:, 0].any() or over[:, -1].any()
+
+    case = a22_case(0)
+    fitted = solve_wheelset_case(case, MATERIAL, model="hertz")
+    fixed = solve_wheelset_case(case, MATERIAL, model="hertz", options={"search": {"field_scale": 1.6}})
+    assert fitted.success and fixed.success
+    for patch in fitted.patches:
+        field = patch.geometry.undeformed
+        assert not overlap_edges(field)
+        assert np.nanmin(field.distance_m) == pytest.approx(-patch.geometry.approach_m, rel=0.05)
+        assert field.x_m[0] < 0 < field.x_m[-1] and field.y_m[0] < 0 < field.y_m[-1]
+    assert any(overlap_edges(p.geometry.undeformed) for p in fixed.patches)

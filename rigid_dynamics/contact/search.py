@@ -35,8 +35,12 @@ with their own ``evaluate``. The patch's point, normal and curvatures always com
 Option ``profile_only`` is the fast path for tables of ideal geometry without yaw: alpha is fixed at the lowest
 point and only y_d is searched (the problem reduces to the two profiles).
 
-Gap field. The sampled undeformed distance covers +-``field_scale`` (1.6) times the rigid-overlap semi-axes
-sqrt(q/A), sqrt(q/B), about 2.3 Hertz semi-axes (for Hertz, a^2 ~ q/(2A)), at least +-1 mm.
+Gap field. By default (``field_scale`` None) the sampled undeformed distance is fitted to the rigid-overlap
+region h < 0 actually found: it starts at +-1.6 times the quadric's overlap semi-axes sqrt(q/A), sqrt(q/B)
+(at least +-1 mm), pushes out every side the overlap touches, then shrinks to the overlap's extent plus
+``field_margin`` (25 %) of it on each side and two sample spacings, so long non-elliptic patches (e.g. the
+Manchester A-2.2 tread patch at zero shift) are not truncated. A number ``field_scale`` gives the fixed box
++-field_scale times the quadric semi-axes (for Hertz, a^2 ~ q/(2A)). ``field_points`` (31) per direction.
 
 Surfaces are duck-typed (rigid_dynamics.geometry provides them): the wheel's ``evaluate(alpha, y_d)`` returns R
 and its first and second partial derivatives (R, R_a, R_y, R_aa, R_ay, R_yy) in the wheelset frame; the rail's
@@ -69,7 +73,9 @@ DEFAULT_OPTIONS: dict = {
     "refine_tolerance_m": 1.0e-9,
     "field": True,  # sample the undeformed distance
     "field_points": 31,  # per direction
-    "field_scale": 1.6,  # half-size = field_scale x the rigid-overlap semi-axis sqrt(q/A), sqrt(q/B)
+    "field_scale": None,  # None: fitted to the rigid overlap (see _fitted_field); a number: fixed half-size =
+    # field_scale x the rigid-overlap semi-axes sqrt(q/A), sqrt(q/B)
+    "field_margin": 0.25,  # fitted field: margin on each side of the overlap, as a fraction of its extent
     "field_min_half_size_m": 1.0e-3,
     "ellipticity_tolerance": 0.2,
     "rolling_direction": (1.0, 0.0, 0.0),  # eq 39: main x
@@ -379,10 +385,13 @@ def ellipticity_error(undeformed: UndeformedDistance, a_1_per_m, b_1_per_m, angl
     return float(np.max(np.abs(g[region] - quadric[region])) / approach_m)
 
 
-def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, half_x, half_y, npts, iterations):
-    """Gap along n between the wheel and the rail surfaces on a grid of the contact plane (vectorised)."""
-    xs = np.linspace(-half_x, half_x, npts)
-    ys = np.linspace(-half_y, half_y, npts)
+def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, x_range, y_range, npts, iterations):
+    """Gap along n between the wheel and the rail surfaces on a grid of the contact plane (vectorised).
+
+    ``x_range``, ``y_range``: (lower, upper) contact-frame coordinates of the grid, m; npts points per direction.
+    """
+    xs = np.linspace(x_range[0], x_range[1], npts)
+    ys = np.linspace(y_range[0], y_range[1], npts)
     gx, gy = np.meshgrid(xs, ys)
     e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
     base = centre + gx[..., None] * e_x + gy[..., None] * e_y
@@ -402,6 +411,51 @@ def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, half_x, half_y,
     inside = (lat >= geo.y_range[0]) & (lat <= geo.y_range[1])
     gap = np.where(inside, s - t_rail, np.inf)
     return UndeformedDistance(x_m=xs, y_m=ys, distance_m=gap)
+
+
+_FIELD_LIMITS_M = (0.05, 0.03)  # largest |x|, |y| of the sampled field, m
+
+
+def _fitted_field(sample, half_x: float, half_y: float, margin: float, max_passes: int = 4):
+    """Sample the gap on a box that holds the whole rigid-overlap region (gap < 0) with a margin.
+
+    ``sample(x_range, y_range)`` returns an :class:`UndeformedDistance`. Starting from +-half_x, +-half_y, a side
+    of the box that the overlap touches is pushed out by the box's width (up to ``_FIELD_LIMITS_M``); then the
+    box is shrunk to the overlap's extent plus ``margin`` times that extent plus two sample spacings on each side
+    (the sampled outline is exact to one spacing), and sampled again when that saves over 20 % of a side.
+    """
+    x_rng, y_rng = [-half_x, half_x], [-half_y, half_y]
+    lim_x, lim_y = _FIELD_LIMITS_M
+    field = sample(tuple(x_rng), tuple(y_rng))
+    for _ in range(max_passes):
+        over = np.isfinite(field.distance_m) & (field.distance_m < 0)
+        if not over.any():
+            return field
+        cols, rows = np.flatnonzero(over.any(axis=0)), np.flatnonzero(over.any(axis=1))
+        grown = False
+        for rng, idx, count, lim in ((x_rng, cols, field.x_m.size, lim_x), (y_rng, rows, field.y_m.size, lim_y)):
+            width = rng[1] - rng[0]
+            if idx[0] == 0 and rng[0] > -lim:
+                rng[0], grown = max(rng[0] - width, -lim), True
+            if idx[-1] == count - 1 and rng[1] < lim:
+                rng[1], grown = min(rng[1] + width, lim), True
+        if not grown:
+            break
+        field = sample(tuple(x_rng), tuple(y_rng))
+    over = np.isfinite(field.distance_m) & (field.distance_m < 0)
+    if not over.any():
+        return field
+    cols, rows = np.flatnonzero(over.any(axis=0)), np.flatnonzero(over.any(axis=1))
+    fitted = []
+    for coords, idx, rng, lim in ((field.x_m, cols, x_rng, lim_x), (field.y_m, rows, y_rng, lim_y)):
+        spacing = (rng[1] - rng[0]) / max(coords.size - 1, 1)
+        lo, hi = coords[idx[0]], coords[idx[-1]]
+        pad = margin * (hi - lo) + 2 * spacing
+        fitted.append((max(min(lo - pad, -spacing), -lim, rng[0]), min(max(hi + pad, spacing), lim, rng[1])))
+    (fx, fy) = fitted
+    if fx[1] - fx[0] < 0.8 * (x_rng[1] - x_rng[0]) or fy[1] - fy[0] < 0.8 * (y_rng[1] - y_rng[0]):
+        field = sample(fx, fy)
+    return field
 
 
 def search_side(
@@ -577,13 +631,22 @@ def _patch(geo: _SideGeometry, alpha0: float, y0: float, opts, h: float, geo_fie
     undeformed = None
     elliptic = convex
     if opts["field"]:
-        half_x = max(opts["field_scale"] * math.sqrt(max(approach, 0) / a_use), opts["field_min_half_size_m"])
-        half_y = max(opts["field_scale"] * math.sqrt(max(approach, 0) / b_use), opts["field_min_half_size_m"])
-        half_x, half_y = min(half_x, 0.05), min(half_y, 0.03)
+        scale = 1.6 if opts["field_scale"] is None else opts["field_scale"]
+        half_x = max(scale * math.sqrt(max(approach, 0) / a_use), opts["field_min_half_size_m"])
+        half_y = max(scale * math.sqrt(max(approach, 0) / b_use), opts["field_min_half_size_m"])
+        half_x, half_y = min(half_x, _FIELD_LIMITS_M[0]), min(half_y, _FIELD_LIMITS_M[1])
         centre = 0.5 * (point + rail_point)
-        undeformed = _sample_field(
-            geo_field or geo, alpha0, y0, centre, frame, half_x, half_y, opts["field_points"], opts["newton_iterations"]
-        )
+
+        def sample(x_range, y_range):
+            return _sample_field(
+                geo_field or geo, alpha0, y0, centre, frame, x_range, y_range, opts["field_points"],
+                opts["newton_iterations"],
+            )  # fmt: skip
+
+        if opts["field_scale"] is None:
+            undeformed = _fitted_field(sample, half_x, half_y, opts["field_margin"])
+        else:
+            undeformed = sample((-half_x, half_x), (-half_y, half_y))
         error = ellipticity_error(undeformed, a_use, b_use, angle, approach)
         elliptic = convex and error <= opts["ellipticity_tolerance"]
     rail_profile_point = (math.nan, math.nan)
