@@ -376,7 +376,15 @@ class FeaModel:
             from fea.output import write_outputs
 
             extra["files"] = write_outputs(
-                opts.output_dir, sol, stress_fn, fields, domain, spec, young_body, nu, comm=comm
+                _patch_output_dir(opts.output_dir, geometry),
+                sol,
+                stress_fn,
+                fields,
+                domain,
+                spec,
+                young_body,
+                nu,
+                comm=comm,
             )
 
         return ContactResult(
@@ -499,3 +507,18 @@ def _stress_maxima(comm, coords, stress, spec, quadric, post) -> dict:
                 out[f"{name}_Pa"] = peak
                 out[f"{name}_depth_m"] = z
     return out
+
+
+def _patch_output_dir(output_dir, geometry: ContactGeometry) -> str:
+    """``output_dir`` itself for a single patch; a sub-folder per patch of a wheelset case.
+
+    A wheelset case solves several patches with the same options, so each writes into
+    ``<output_dir>/<side>-<contact angle in whole degrees>deg`` (e.g. ``right-17deg``).
+    """
+    if not geometry.side:
+        return str(output_dir)
+    import math
+    from pathlib import Path
+
+    angle = round(math.degrees(geometry.contact_angle_rad))
+    return str(Path(output_dir) / f"{geometry.side}-{angle}deg")

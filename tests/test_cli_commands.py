@@ -90,3 +90,14 @@ def test_conicity_command(capsys):
     code, record = run_json(capsys, "conicity", "--json")
     assert code == 0
     assert 0.05 < record["equivalent_conicity"] < 0.4
+
+
+@pytest.mark.fea
+def test_contact_fea_plot_writes_stress_maps(tmp_path, capsys):
+    out = tmp_path / "fea-out"
+    code, record = run_json(capsys, "contact", "hertz-quadric", "--method", "fea", "--json", "--plot", "--out", str(out))
+    assert code == 0
+    (patch,) = record["patches"]
+    assert patch["creep_force_long_N"] is None and patch["normal_force_N"] > 0
+    for name in ("fea_pressure.png", "fea_von_mises_cut.png", "fea_solution.xdmf"):
+        assert (out / "fea" / name).stat().st_size > 0

@@ -88,6 +88,8 @@ def cmd_contact(args) -> int:
     if args.method not in MODELS:
         raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
     case = load_case(args.case)
+    if args.method == "fea" and (args.out is not None or args.plot):
+        case = _with_fea_output(case, args)
     solution = solve_case(case, args.method)
     record = solution_record(solution)
     out_dir = None
@@ -106,6 +108,29 @@ def cmd_contact(args) -> int:
         if out_dir is not None:
             _print(f"output written to {out_dir}")
     return EXIT_OK if solution.success else EXIT_FAILED
+
+
+def _with_fea_output(case, args):
+    """Ask the FEA model to write its XDMF and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
+    import dataclasses
+
+    if args.out is None and _mpi_rank() != 0 or args.out is None and "PMI_RANK" in os.environ:
+        raise ConfigError("--method fea with --plot under mpiexec: give --out DIR so every rank writes to one folder")
+    if args.out is None:
+        args.out = new_output_dir_for(case)
+    fea_dir = str(Path(args.out) / "fea")
+    options = dict(case.solver_options)
+    if case.kind == "quadric":
+        options["output_dir"] = fea_dir
+    else:
+        options["model"] = dict(options.get("model") or {}, output_dir=fea_dir)
+    return dataclasses.replace(case, solver_options=options)
+
+
+def new_output_dir_for(case) -> Path:
+    from wheelrail.output import new_output_dir
+
+    return new_output_dir(None, f"contact-{case.name or 'case'}")
 
 
 def _plot_patches(solution, out_dir: Path) -> list[str]:
