@@ -95,7 +95,8 @@ def test_conicity_command(capsys):
 @pytest.mark.fea
 def test_contact_fea_plot_writes_stress_maps(tmp_path, capsys):
     out = tmp_path / "fea-out"
-    code, record = run_json(capsys, "contact", "hertz-quadric", "--method", "fea", "--json", "--plot", "--out", str(out))
+    argv = ["contact", "hertz-quadric", "--method", "fea", "--json", "--plot", "--out", str(out)]
+    code, record = run_json(capsys, *argv)
     assert code == 0
     (patch,) = record["patches"]
     assert patch["creep_force_long_N"] is None and patch["normal_force_N"] > 0
