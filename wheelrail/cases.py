@@ -25,7 +25,7 @@ from typing import Any
 
 from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
-from wheelrail.config import ConfigError, check_keys, get_number, get_table, read_toml
+from wheelrail.config import ConfigError, check_keys, get_number, get_table, read_toml, resolve_embedded
 
 TOP_LEVEL_TABLES = {"name", "description", "material", "geometry", "loading", "kinematics", "solver"}
 QUADRIC_GEOMETRY_KEYS = {"kind", "radius_long_m", "radius_lat_m"}
@@ -178,15 +178,7 @@ def embedded_cases() -> dict[str, Path]:
 
 def resolve_case_path(path: str | Path) -> Path:
     """A file path, or the path of an embedded case of that name."""
-    candidate = Path(path)
-    if candidate.exists() or candidate.suffix:
-        return candidate
-    cases = embedded_cases()
-    if str(path) in cases:
-        return cases[str(path)]
-    raise ConfigError(
-        f"case {str(path)!r}: no such file and no embedded case of that name (embedded: {', '.join(cases)})"
-    )
+    return resolve_embedded(path, embedded_cases(), "case")
 
 
 @dataclass(frozen=True, eq=False)

@@ -37,6 +37,18 @@ def read_toml(path: str | Path, what: str = "file") -> dict:
         raise ConfigError(f"{what} {str(path)!r}: not valid TOML ({exc})") from None
 
 
+def resolve_embedded(name: str | Path, embedded: dict[str, Path], what: str) -> Path:
+    """A file path, or the path of the embedded ``what`` (scene, case) called ``name``."""
+    candidate = Path(name)
+    if candidate.exists() or candidate.suffix:
+        return candidate
+    if str(name) in embedded:
+        return embedded[str(name)]
+    raise ConfigError(
+        f"{what} {str(name)!r}: no such file and no embedded {what} of that name (embedded: {', '.join(embedded)})"
+    )
+
+
 def _key(prefix: str, name: str) -> str:
     return f"{prefix}.{name}" if prefix else name
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from wheelrail.config import ConfigError, build_dataclass, read_toml
+from wheelrail.config import ConfigError, build_dataclass, read_toml, resolve_embedded
 
 SCENES_DIR = Path(__file__).parent / "scenes"
 DEFAULT_SCENE = "hunting-conical"
@@ -37,15 +37,7 @@ def scene_description(path: Path) -> str:
 
 def resolve_scene_path(scene: str | Path) -> Path:
     """A file path, or the path of the embedded scene of that name."""
-    candidate = Path(scene)
-    if candidate.exists() or candidate.suffix:
-        return candidate
-    scenes = embedded_scenes()
-    if str(scene) in scenes:
-        return scenes[str(scene)]
-    raise ConfigError(
-        f"scene {str(scene)!r}: no such file and no embedded scene of that name (embedded: {', '.join(scenes)})"
-    )
+    return resolve_embedded(scene, embedded_scenes(), "scene")
 
 
 def _check_profiles(table: dict, prefix: str = "") -> None:
