@@ -236,6 +236,7 @@ def patch_record(side: str, geometry: ContactGeometry, creepage: Creepage | None
     creepage = creepage or result.creepage
     return {
         "side": side,
+        "model": str(result.extra.get("selected_model", result.method)),
         "success": bool(result.success),
         "status": result.status,
         "normal_force_N": _number(result.normal_force_N),
