@@ -14,6 +14,7 @@ from rigid_dynamics.wheelset.parameters import (
     DynamicsScene,
     InitialConditions,
     IntegratorSettings,
+    Irregularities,
     SuspensionParameters,
     TrackGeometry,
 )
@@ -32,9 +33,30 @@ SCENE = DynamicsScene(
 )
 
 
-@pytest.mark.parametrize("model", ["hertz", "linear", "vermeulen-johnson"])
-def test_compiled_equals_python(model):
-    scene = replace(SCENE, contact_model=model)
+IRREGULARITIES = {
+    "none": Irregularities(),
+    "polygon": Irregularities(polygon_order=3, polygon_amplitude_m=3e-4),
+    "flat": Irregularities(flat_length_m=0.05),
+    "corrugation-right": Irregularities(corrugation_wavelength_m=0.05, corrugation_amplitude_m=3e-5, side="right"),
+}
+
+
+@pytest.mark.parametrize(
+    ("model", "irregularity"),
+    [
+        ("hertz", "none"),
+        ("linear", "none"),
+        ("vermeulen-johnson", "none"),
+        ("fastsim", "none"),
+        ("fastsim", "polygon"),
+        ("vermeulen-johnson", "flat"),
+        ("linear", "corrugation-right"),
+    ],
+)
+def test_compiled_equals_python(model, irregularity):
+    """FASTSIM (the contact package's strip kernel) and the running-direction irregularities (polygon, rounded flat,
+    corrugation on one side) evaluated in the compiled loop must equal the Python path (providers and batch kernels)."""
+    scene = replace(SCENE, contact_model=model, irregularities=IRREGULARITIES[irregularity])
     provider = build_provider(scene)
     fast = simulate(scene, provider=provider, compiled=True)
     slow = simulate(scene, provider=provider, compiled=False)
@@ -47,6 +69,9 @@ def test_compiled_equals_python(model):
     np.testing.assert_allclose(fast.kinetic_energy_J, slow.kinetic_energy_J, rtol=1e-12)
     assert fast.events == slow.events
     assert fast.rhs_evaluations > 0
+    for name in ("approach_m", "rolling_radius_m", "semi_axis_long_m", "creepage_lat", "spin_creepage_1_per_m"):
+        np.testing.assert_allclose(fast.patches[name], slow.patches[name], rtol=1e-9, atol=1e-15, err_msg=name)
+    np.testing.assert_allclose(fast.patches["creep_force_lat_N"], slow.patches["creep_force_lat_N"], rtol=0, atol=1e-3)
 
 
 def test_compiled_stops_and_refuses():

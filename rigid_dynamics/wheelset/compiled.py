@@ -2,11 +2,23 @@
 
 The same equations as rigid_dynamics.wheelset.equations (eq 59-71 with the gyroscopic term), the same table
 look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
-closed-form creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory,
-eq 50-52, contact/linear.py) and ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py),
-integrated by the classical RK4 method with a fixed step, all inside one compiled loop. Used automatically by
-``simulate`` when the scene runs RK4 on a TableProvider without irregularities and with one of these models;
-tests/test_dynamics_compiled.py checks that it reproduces the Python path.
+creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
+contact/linear.py), ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py) and ``fastsim``
+(the contact package's compiled strip kernel contact.fastsim._fastsim_one with the flexibilities of
+contact.fastsim.effective_flexibilities, options nx, ny, traction_bound, flexibility as in the Python path),
+integrated by the classical RK4 method with a fixed step, all inside one compiled loop.
+
+Running-direction irregularities of the TableProvider (polygonal wheel R_irr = A cos(n alpha + phase), rounded
+flat, rail corrugation N_irr(x); irregular.py) are evaluated in the loop exactly as
+providers._running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
+angle beta from the lowest point (81-point grid, then 3 limited Newton steps), the extra overlap projected on the
+normal, the normal tilted by N_irr', the longitudinal curvature from the polar curvature of r(beta) (floored for a
+concave flat); candidates whose gap exceeds the provider's reach are left alone.
+
+Used automatically by ``simulate`` whenever the scene runs RK4 on a TableProvider (ideal geometry or with these
+irregularities) with one of MODEL_CODES from the registry (``compiled=False`` forces the Python path); the adaptive
+scipy methods, the conical and search providers, ``auto``, ``bem`` and user models stay on the Python path.
+tests/test_dynamics_compiled.py checks that it reproduces the Python path (states to ~1e-14 relative).
 
 Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined.
 """
@@ -18,15 +30,24 @@ import math
 import numpy as np
 from numba import njit
 
-MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2}
+from rigid_dynamics.contact.fastsim import _fastsim_one
+
+MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
+FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
 N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
 
 # indices into the parameter vector
 (
     P_MASS, P_JT, P_JA, P_G, P_KX, P_KY, P_KZ, P_CX, P_CY, P_CZ, P_KYAW, P_CYAW, P_BS, P_ZF, P_XF0, P_V, P_AXLE,
     P_TORQUE, P_SHEAR, P_ESTAR, P_MU, P_MODEL, P_ZREF, P_FMAX, P_YMAX,
-) = range(25)  # fmt: skip
-N_PAR = 25
+    P_NX, P_NY, P_PARAB, P_FLEX,
+    P_IRR, P_R0, P_POLY_N, P_POLY_A, P_POLY_PH, P_FLAT_L, P_FLAT_D, P_FLAT_ANG, P_CORR_W, P_CORR_A,
+    P_IRR_LEFT, P_IRR_RIGHT, P_REACH, P_HALF,
+) = range(43)  # fmt: skip
+N_PAR = 43
+IRR_GRID = 81  # grid points of the running-direction section (providers._running_irregularity)
+IRR_NEWTON = 3  # Newton steps after the grid (same as providers._running_irregularity)
+MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
 
 
 @njit(cache=True)
@@ -57,7 +78,109 @@ def _uniform(x, x0, step, n):
 
 
 @njit(cache=True)
-def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record):
+def _irr_parts(par, radius, x0, spin, beta, res):
+    """providers._running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
+    (q, q', q'', r, r', r'', x offset, N_irr', N_irr'').
+    """
+    rv, r1, r2 = 0.0, 0.0, 0.0
+    alpha = 0.5 * math.pi + beta - spin
+    if par[P_POLY_N] > 0 and par[P_POLY_A] > 0:
+        n, amp = par[P_POLY_N], par[P_POLY_A]
+        arg = n * alpha + par[P_POLY_PH]
+        rv += amp * math.cos(arg)
+        r1 += -amp * n * math.sin(arg)
+        r2 += -amp * n * n * math.cos(arg)
+    if par[P_FLAT_L] > 0:
+        length, depth, r0 = par[P_FLAT_L], par[P_FLAT_D], par[P_R0]
+        u = alpha - par[P_FLAT_ANG] + math.pi
+        s = r0 * ((u - 2 * math.pi * math.floor(u / (2 * math.pi))) - math.pi)
+        if abs(s) < 0.5 * length:
+            k = 2 * math.pi / length
+            rv += -0.5 * depth * (1 + math.cos(k * s))
+            r1 += 0.5 * depth * k * math.sin(k * s) * r0
+            r2 += 0.5 * depth * k * k * math.cos(k * s) * r0 * r0
+    r = radius + rv
+    sb, cb = math.sin(beta), math.cos(beta)
+    xo = -r * sb
+    x1 = -(r1 * sb + r * cb)
+    x2 = -(r2 * sb + 2 * r1 * cb - r * sb)
+    n0, n1, n2 = 0.0, 0.0, 0.0
+    if par[P_CORR_A] > 0:
+        kc, amp = 2 * math.pi / par[P_CORR_W], par[P_CORR_A]
+        xx = x0 + xo
+        n0, n1, n2 = amp * math.cos(kc * xx), -amp * kc * math.sin(kc * xx), -amp * kc * kc * math.cos(kc * xx)
+    res[0] = r * cb - radius - n0
+    res[1] = r1 * cb - r * sb - n1 * x1
+    res[2] = r2 * cb - 2 * r1 * sb - r * cb - n2 * x1 * x1 - n1 * x2
+    res[3], res[4], res[5], res[6], res[7], res[8] = r, r1, r2, xo, n1, n2
+
+
+@njit(cache=True)
+def _irregularity(par, work, c, q, x0, spin, res, geo):
+    """Running-direction irregularity of one candidate (providers._running_irregularity, same steps: a grid of
+    IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
+    rolling radius, A) for the candidate.
+    """
+    half = par[P_HALF]
+    radius = work[8, c]
+    best, beta = -np.inf, 0.0
+    for g in range(IRR_GRID):
+        b = -half + 2.0 * half * g / (IRR_GRID - 1)
+        _irr_parts(par, radius, x0, spin, b, res)
+        if res[0] > best:
+            best, beta = res[0], b
+    step_size = 2 * half / (IRR_GRID - 1)
+    for _ in range(IRR_NEWTON):
+        _irr_parts(par, radius, x0, spin, beta, res)
+        step = -res[1] / res[2] if res[2] < 0 else 0.0
+        beta = min(max(beta + min(max(step, -step_size), step_size), -half), half)
+    _irr_parts(par, radius, x0, spin, beta, res)
+    qv, r, r1, r2, xo, n1, n2 = res[0], res[3], res[4], res[5], res[6], res[7], res[8]
+    kappa_w = (r * r + 2 * r1 * r1 - r * r2) / (r * r + r1 * r1) ** 1.5
+    scale = 2.0 * work[6, c] * radius
+    a_long = 0.5 * (kappa_w * scale + n2 / (1 + n1 * n1) ** 1.5)
+    ny_, nz_ = work[4, c], work[5, c]
+    nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
+    slope_y = (ny_ / nn) / (-nz_ / nn)
+    norm = math.sqrt(n1 * n1 + slope_y * slope_y + 1.0)
+    geo[0] = q + qv * (-nz_ / nn)
+    geo[1] = xo
+    geo[2] = r * math.cos(beta) - radius
+    geo[3], geo[4], geo[5] = n1 / norm, slope_y / norm, -1.0 / norm
+    geo[6] = r
+    geo[7] = max(a_long, MIN_LONG_CURV_FRACTION * 0.5 / par[P_R0])
+
+
+@njit(cache=True)
+def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
+    """fastsim.effective_flexibilities for one patch (variants three / single / three-unblended)."""
+    g = par[P_SHEAR]
+    l1 = 8.0 * a / (3.0 * c11 * g)
+    l2 = 8.0 * a / (3.0 * c22 * g)
+    l3 = math.pi * a * math.sqrt(a / b) / (4.0 * c23 * g)
+    flex = par[P_FLEX]
+    if flex == 2:
+        return l1, l2, l3
+    ab = a * b
+    if flex == 1:
+        num = l1 * abs(xi) + l2 * abs(eta) + l3 * abs(spin) * math.sqrt(ab)
+        den = math.sqrt(xi**2 + eta**2 + ab * spin**2)
+        single = num / den if den > 0 else l1
+        return single, single, single
+    cc = 3.0 * math.pi * a / 32.0
+    cp2 = (cc * spin) ** 2
+    num = xi**2 + eta**2 + cp2
+    den = xi**2 / l1 + eta**2 / l2 + cp2 / l3
+    l_comb = num / den if den > 0 else l1
+    force = par[P_MU] * normal
+    ch2 = (force / (g * ab * c11)) ** 2 + (force / (g * ab * c22)) ** 2 + (force / (g * ab**1.5 * c23)) ** 2
+    f_crp = math.sqrt((xi**2 + eta**2 + spin**2) / ch2) if ch2 > 0 else np.inf
+    w = min(max(f_crp / 3.0, 0.0), 1.0)
+    return (1 - w) * l1 + w * l_comb, (1 - w) * l2 + w * l_comb, (1 - w) * l3 + w * l_comb
+
+
+@njit(cache=True)
+def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy):
     """d/dt of the 14-state; fills rec (ncand, N_FIELDS) and the side forces when ``record``. Returns status."""
     out = np.zeros(14)
     xc, yc, zc = y[0], y[1], y[2]
@@ -82,6 +205,14 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record):
         nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
         n = np.array([0.0, ny_ / nn, nz_ / nn])
         lever = np.array([-sps * work[10, c], work[2, c], work[3, c]])
+        ca, cb, radius = work[6, c], work[7, c], work[8, c]
+        if par[P_IRR] > 0 and q > -par[P_REACH] and par[P_IRR_LEFT + sides[c]] > 0:
+            _irregularity(par, work, c, q, xc + lever[0], y[5], res, geo)
+            q = geo[0]
+            lever[0] += geo[1]
+            lever[2] += geo[2]
+            n[0], n[1], n[2] = geo[3], geo[4], geo[5]
+            radius, ca = geo[6], geo[7]
         if record:
             for f in range(N_FIELDS):
                 rec[c, f] = np.nan
@@ -89,7 +220,7 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record):
             rec[c, 7] = q
             rec[c, 8] = yc + work[2, c]
             rec[c, 9] = work[10, c]
-            rec[c, 10] = work[8, c]
+            rec[c, 10] = radius
             rec[c, 11] = work[9, c]
         if q <= 0.0:
             continue
@@ -110,7 +241,6 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record):
         eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
         spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
         # Hertz, approach control (tables of the axial function)
-        ca, cb = work[6, c], work[7, c]
         amin, amax = min(ca, cb), max(ca, cb)
         i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
         pp = hz[1, i] * (1 - w) + hz[1, i + 1] * w
@@ -130,9 +260,17 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record):
             ab = sa * sb
             gab = par[P_SHEAR] * ab
             gab15 = gab * math.sqrt(ab)
-            tx = -gab * c11 * xi
-            ty = -gab * c22 * eta - gab15 * c23 * spin
-            mz = gab15 * c23 * eta - gab * ab * c33 * spin
+            if par[P_MODEL] == 3:
+                l1, l2, l3 = _flexibilities(par, sa, sb, normal, xi, eta, spin, c11, c22, c23)
+                fs = _fastsim_one(
+                    sa, sb, par[P_MU], normal, xi, eta, spin, l1, l2, l3, int(par[P_NX]), int(par[P_NY]),
+                    par[P_PARAB] > 0, dummy, dummy, dummy, dummy, False,
+                )  # fmt: skip
+                tx, ty, mz = fs[0], fs[1], fs[2]
+            else:
+                tx = -gab * c11 * xi
+                ty = -gab * c22 * eta - gab15 * c23 * spin
+                mz = gab15 * c23 * eta - gab * ab * c33 * spin
             if par[P_MODEL] == 2:
                 tt = math.hypot(tx, ty)
                 limit = par[P_MU] * normal
@@ -240,21 +378,28 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
     ncand = table.shape[1]
     work = np.empty((table.shape[0], ncand))
     rec = np.empty((ncand + 2, N_FIELDS))
+    res = np.empty(9)
+    geo = np.empty(8)
+    dummy = np.zeros((1, 1))
     t = t0
     k_out = out_start
     evals = 0
     fmax, ymax = par[P_FMAX], par[P_YMAX]
     for step in range(n_steps):
-        st, k1 = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        st, k1 = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy)
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k2 = _rhs(t + 0.5 * h, y + 0.5 * h * k1, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        st, k2 = _rhs(
+            t + 0.5 * h, y + 0.5 * h * k1, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy
+        )
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k3 = _rhs(t + 0.5 * h, y + 0.5 * h * k2, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        st, k3 = _rhs(
+            t + 0.5 * h, y + 0.5 * h * k2, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy
+        )
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k4 = _rhs(t + h, y + h * k3, par, table, grid, slots, sides, hz, kk, work, rec, False)
+        st, k4 = _rhs(t + h, y + h * k3, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy)
         evals += 4
         if st != 0:
             return st, step, k_out, t, y, evals
@@ -265,7 +410,7 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
         y = y_new
         t = t0 + (step + 1) * h
         if (step + 1) % out_every == 0 and k_out < states.shape[0]:
-            st, _ = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True)
+            st, _ = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy)
             evals += 1
             if st != 0:
                 return st, step + 1, k_out, t, y, evals
@@ -285,19 +430,20 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
 
 
 def supported(scene, provider, model) -> bool:
-    """Whether the compiled path can run this combination (RK4, TableProvider without irregularities, model)."""
+    """Whether the compiled path can run this combination: RK4, a TableProvider (with or without running-direction
+    irregularities: polygon, rounded flat, corrugation) and one of the registry's models in MODEL_CODES.
+    """
     from rigid_dynamics.wheelset.providers import TableProvider
 
     return (
         scene.integrator.method == "RK4"
         and type(provider) is TableProvider
-        and provider.irregularities is None
         and getattr(model, "name", None) in MODEL_CODES
         and type(model).__module__ == "rigid_dynamics.contact.models"
     )
 
 
-def pack(model_wheelset, provider, tables, model_name):
+def pack(model_wheelset, provider, tables, model_name, options=None):
     """Parameter vector and arrays of the compiled RHS from a WheelsetModel, its TableProvider and tables."""
     m = model_wheelset
     scene = m.scene
@@ -316,6 +462,31 @@ def pack(model_wheelset, provider, tables, model_name):
     par[P_ZREF] = provider.z_ref
     par[P_FMAX] = scene.integrator.max_force_factor * scene.static_wheel_load_N
     par[P_YMAX] = scene.integrator.max_lateral_displacement_m
+    opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
+    opts.update(options or {})
+    par[P_NX], par[P_NY] = int(opts["nx"]), int(opts["ny"])
+    par[P_PARAB] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
+    par[P_FLEX] = FLEX_CODES[opts["flexibility"]]
+    par[P_R0] = provider.r0
+    irr = provider.irregularities
+    if irr is not None:
+        from rigid_dynamics.wheelset.irregular import flat_depth_m
+
+        # the same selection constants as providers._running_irregularity
+        par[P_IRR] = 1.0
+        par[P_IRR_LEFT], par[P_IRR_RIGHT] = (float(v) for v in provider._irr_sides)
+        par[P_POLY_N], par[P_POLY_A], par[P_POLY_PH] = irr.polygon_order, irr.polygon_amplitude_m, irr.polygon_phase_rad
+        reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
+        half = 0.02
+        if irr.flat_length_m > 0:
+            depth = flat_depth_m(irr, provider.r0)
+            par[P_FLAT_L], par[P_FLAT_D], par[P_FLAT_ANG] = irr.flat_length_m, depth, irr.flat_angle_rad
+            reach += 2.0 * depth
+            half = max(half, 1.5 * irr.flat_length_m / provider.r0)
+        if irr.corrugation_amplitude_m > 0:
+            par[P_CORR_W], par[P_CORR_A] = irr.corrugation_wavelength_m, irr.corrugation_amplitude_m
+            half = max(half, 0.6 * irr.corrugation_wavelength_m / provider.r0)
+        par[P_REACH], par[P_HALF] = reach, half
     yg, rg = provider.y_grid, provider.roll_grid
     grid = np.array([yg[0], yg[1] - yg[0], len(yg), rg[0], rg[1] - rg[0], len(rg)], float)
     hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])

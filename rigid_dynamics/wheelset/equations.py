@@ -274,6 +274,7 @@ def batch_contact_function(name: str, material, options=None):
         return normal, np.asarray(t_x, float), np.asarray(t_y, float), np.asarray(m_z, float), semi_a, semi_b
 
     solve.tables = tables
+    solve.options = dict(opts)
     return solve
 
 

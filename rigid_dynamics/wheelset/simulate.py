@@ -469,7 +469,7 @@ def simulate(
     can_compile = _compiled.supported(scene, provider, model_obj) and model.batch is not None
     if compiled and not can_compile:
         raise ValueError(
-            "compiled = True: the compiled path needs method RK4, a TableProvider without irregularities and one of "
+            "compiled = True: the compiled path needs method RK4, a TableProvider and one of "
             f"the models {', '.join(_compiled.MODEL_CODES)}"
         )
     use_compiled = can_compile and compiled is not False
@@ -640,7 +640,9 @@ def _run_compiled(model, provider, y0, duration, settings, recorder, report, sta
     """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
     from rigid_dynamics.wheelset import compiled
 
-    par, table, grid, slots, sides, hz, kk = compiled.pack(model, provider, model.batch.tables, model.model.name)
+    par, table, grid, slots, sides, hz, kk = compiled.pack(
+        model, provider, model.batch.tables, model.model.name, model.batch.options
+    )
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
     out_every = max(1, int(round(settings.output_step_s / h)))
