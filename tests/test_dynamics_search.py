@@ -95,3 +95,38 @@ def test_profile_section_agrees_with_search_on_s1002_uic60():
                 assert a.approach_m[ka] == pytest.approx(b.approach_m[kb], rel=1e-3, abs=5e-8)
                 assert a.rolling_radius_m[ka] == pytest.approx(b.rolling_radius_m[kb], abs=2e-5)
                 assert a.contact_angle_rad[ka] == pytest.approx(b.contact_angle_rad[kb], abs=5e-4)
+
+
+def test_search_reuse_first_order():
+    """Reuse of the last search with the rigid-body correction (profiles module docstring) against a fresh search
+    at the moved pose (the independent reference): a small pose change, including spin on a polygonal wheel, is
+    captured to second order; an identical pose returns the last patches themselves."""
+    ws = WheelsetParameters()
+    polygon = Irregularities(polygon_order=3, polygon_amplitude_m=3e-4)
+    fresh = SearchProvider(ws, TRACK, polygon)
+    reusing = SearchProvider(ws, TRACK, surfaces=fresh.surfaces, reuse_m=1e-4)
+    centre = np.array([0.1, 0.001, -ws.nominal_radius_m + 5e-4])
+    pose = (0.001, 1e-4, 0.3)
+    first = reusing.patches(centre, *pose)
+    assert np.all(first.approach_m > 1e-5)
+    assert reusing.patches(centre, *pose) is first
+    errors = []
+    for delta in (2e-5, 1e-5, 5e-6):
+        moved = centre + np.array([delta, delta, delta])
+        turned = (pose[0] + delta, pose[1] + 0.2 * delta, pose[2] + 2 * delta)
+        reused = reusing.patches(moved, *turned)
+        exact = fresh.patches(moved, *turned)
+        change = np.max(np.abs(exact.approach_m - first.approach_m))
+        error = np.max(np.abs(reused.approach_m - exact.approach_m))
+        assert change > 0.5 * delta
+        errors.append(error)
+        np.testing.assert_allclose(reused.point_m, exact.point_m, rtol=0, atol=3 * delta)
+    assert reusing.reused == 4 and reusing.searches == 2
+    # second order: the error falls at least ~3.5x per halving (search tolerance 1e-9 m as the floor)
+    assert errors[1] < max(errors[0] / 3.5, 3e-9) and errors[2] < max(errors[1] / 3.5, 3e-9)
+    assert errors[0] < 1e-2 * 2e-5
+
+
+def test_search_reuse_bad_input():
+    with pytest.raises(ValueError, match="reuse_m = -1.0: expected a finite number >= 0"):
+        SearchProvider(WheelsetParameters(), TRACK, reuse_m=-1.0)

@@ -26,6 +26,16 @@ conformal contacts are not Hertzian; the floor keeps the ellipse finite).
 SearchProvider: the 3-D contact search (rigid_dynamics.contact.search, eq 5-11) per side and pose, with
 irregularities; patches ordered by contact angle (slot 0 the tread side), at most two per side; a side with
 no patch gets a gap candidate (approach = -smallest gap) so that wheel lift is seen.
+
+Reuse of the last search (SearchProvider ``reuse_m``): a pose identical to the last one searched (the RK4 output
+sample and the next step's first stage) returns the last patches unchanged (exact). With ``reuse_m`` > 0 a pose
+within ``reuse_m`` of the last one (max of |delta centre| and r0 |delta angle|; e.g. the two RK4 stages at
+t + h/2, which differ by h^2/4 times the accelerations) reuses the last patches with the rigid-body correction
+of first order: the contact point moves with the wheel as a material point, p' = c' + C' C^T (p - c), and the
+approach changes by the normal component of that displacement, q' = q - n . (p' - p) (n from rail into wheel).
+For a polygonal wheel the tilt of the normal by the irregularity's slope makes this first-order exact for the
+spin too. Normal, curvatures and the other patch data are kept (their change is of the order of the pose
+change). The error is second order in the pose change; benchmarks/bench_dynamics.py measures it.
 """
 
 from __future__ import annotations
@@ -315,6 +325,8 @@ class SearchProvider:
         surfaces: optional prebuilt WheelsetTrack (then ``irregularities`` is ignored).
         options: contact-search options (search.DEFAULT_OPTIONS); by default the undeformed-distance
             field is not sampled (``field=False``) unless a model needs it.
+        reuse_m: pose change (m; angles times r0) up to which the last search is reused with the first-order
+            rigid-body correction (module docstring); 0 = only an identical pose reuses it (exact).
     """
 
     name = "search"
@@ -326,7 +338,13 @@ class SearchProvider:
         irregularities: Irregularities | None = None,
         surfaces=None,
         options: dict | None = None,
+        reuse_m: float = 0.0,
     ):
+        if not math.isfinite(reuse_m) or reuse_m < 0:
+            raise ValueError(f"reuse_m = {reuse_m!r}: expected a finite number >= 0")
+        self.reuse_m = float(reuse_m)
+        self._last = None
+        self.reused = 0
         self.surfaces = surfaces if surfaces is not None else build_surfaces(wheelset, track, irregularities)
         self.options = {"field": False}
         if options:
@@ -335,6 +353,50 @@ class SearchProvider:
         self.searches = 0
 
     def patches(self, centre_m, yaw_rad, roll_rad, spin_rad=0.0) -> PatchSet:
+        key = np.array([*np.asarray(centre_m, float)[:3], yaw_rad, roll_rad, spin_rad], float)
+        if self._last is not None:
+            last_key, last = self._last
+            if np.array_equal(key, last_key):
+                self.reused += 1
+                return last
+            change = np.abs(key - last_key)
+            if self.reuse_m > 0 and max(change[:3].max(), self.r0 * change[3:].max()) <= self.reuse_m:
+                self.reused += 1
+                return self._moved(last_key, last, key)
+        found = self._search(centre_m, yaw_rad, roll_rad, spin_rad)
+        self._last = (key, found)
+        return found
+
+    def _moved(self, old_key, old: PatchSet, key) -> PatchSet:
+        """The patches of the pose ``old_key`` carried to the pose ``key`` to first order (module docstring)."""
+        from dataclasses import replace
+
+        from rigid_dynamics.kinematics import wheelset_rotation
+
+        turn = wheelset_rotation(*key[3:6]) @ wheelset_rotation(*old_key[3:6]).T
+        point = key[:3] + (old.point_m - old_key[:3]) @ turn.T
+        approach = old.approach_m - np.einsum("ij,ij->i", old.normal, point - old.point_m)
+        geometries = None
+        if old.geometries is not None:
+            geometries = [
+                replace(g, approach_m=float(q), point_m=p)
+                for g, q, p in zip(old.geometries, approach, point, strict=True)
+            ]
+        return PatchSet(
+            side=old.side,
+            slot=old.slot,
+            point_m=point,
+            normal=old.normal,
+            curvature_long_1_per_m=old.curvature_long_1_per_m,
+            curvature_lat_1_per_m=old.curvature_lat_1_per_m,
+            approach_m=approach,
+            rolling_radius_m=old.rolling_radius_m,
+            contact_angle_rad=old.contact_angle_rad,
+            wheel_lateral_m=old.wheel_lateral_m,
+            geometries=geometries,
+        )
+
+    def _search(self, centre_m, yaw_rad, roll_rad, spin_rad) -> PatchSet:
         from rigid_dynamics.contact.search import WheelsetPose
 
         pose = WheelsetPose(
