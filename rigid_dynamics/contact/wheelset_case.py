@@ -13,14 +13,33 @@ with the patch forces N_k from Hertz's theory (eq 32-38) for the patch's curvatu
 wheels), residuals phi_i = (F_i / W)^(2/3) - 1 in contact (nearly linear in the approach, Hertz: F ~ q^1.5)
 and -gap_i / q_W - 1 out of contact (q_W ~ the Hertz approach at load W), with a finite-difference Jacobian.
 
-Each patch is then solved with the requested contact model (``registry.get_model``) under force control with
-its Hertz share of the wheel load (so every model carries the same load), with the creepages of a freely
+Load sharing between the patches (option ``load_sharing``):
+
+* ``"hertz"``: each patch is solved with the requested contact model (``registry.get_model``) under force
+  control with its Hertz share N_k of the wheel load (so every model carries the same load per patch). Right
+  for the analytic models, whose normal part IS Hertz.
+* ``"model"`` (CONTACT's way for non-Hertzian contact, Vollebregt's CONTACT user guide, wheel-rail module):
+  the patch forces come from the model itself under approach control. At a pose the search gives every patch's
+  rigid approach q_k (and, for ``bem``, its sampled undeformed distance h_k(x, y) - q_k), so all patches of a
+  wheel share the one rigid displacement of the wheelset; the model's normal problem then gives N_k(pose), and
+  the same two equations above are solved with these N_k. Start: the Hertz equilibrium; then Broyden's method
+  (quasi-Newton, "good" rank-one update; Dennis & Schnabel 1983, sec. 8.1) on (s_L, s_R) starting from the Hertz
+  Jacobian (finite differences at the Hertz equilibrium), each step one normal solve per patch (zero
+  creepage: the normal problem does not depend on the tangential one for quasi-identical materials; with
+  Kalker's difference parameter K != 0 in the model options the real creepages are used). The tangential
+  problem is solved once at the end under approach control at the converged pose (so the normal forces are
+  those of the equilibrium). Default (None): ``"model"`` when the model is ``bem`` and some patch is not
+  elliptic or a wheel has several patches, else ``"hertz"``. Elastic interaction between patches of one
+  wheel is neglected (each patch is its own half-space problem), as the patches are solved one by one.
+
+Each patch is solved with the creepages of a freely
 rolling wheelset (eq 39-49, creepage.py): centre velocity (V, 0, 0), yaw psi with zero yaw rate, roll theta,
 spin rate phi' = V / r0 (option ``spin_rate = "mean-rolling-radius"``: V over the mean rolling radius of the two
 wheels' main patches, the choice of CONTACT's A-2.2 example input, mbench_a22_right.inp, where the longitudinal
 creepages of the two wheels are equal and opposite).
 
-``approach_m`` instead of ``wheel_load_N`` prescribes the deepest approach on each wheel (approach control).
+``approach_m`` instead of ``wheel_load_N`` prescribes the deepest approach on each wheel (approach control);
+every patch is then solved under approach control (``load_sharing`` is "approach").
 """
 
 from __future__ import annotations
@@ -44,7 +63,10 @@ DEFAULT_CASE_OPTIONS: dict = {
     "spin_rate": "nominal",  # "nominal": phi' = V/r0; "mean-rolling-radius": V / mean of the wheels' radii
     "search": None,  # options passed to search.search_side
     "model": None,  # options passed to the contact model
+    "load_sharing": None,  # "hertz", "model" or None (auto: "model" for bem on non-elliptic/multi-patch wheels)
+    "model_max_iterations": 20,  # iterations of the "model" load-sharing phase (one normal solve per patch each)
 }
+LOAD_SHARING = ("hertz", "model")
 
 
 @dataclass(frozen=True)
@@ -149,8 +171,14 @@ class WheelsetCaseSolution:
         vertical_position_m: z of the wheelset centre (main frame, z down), m.
         roll_rad: theta, rad.
         patches: all patches, left first, deepest first per side.
-        wheel_vertical_load_N: {"left": ..., "right": ...} vertical load carried (Hertz, equilibrium), N.
-        iterations: equilibrium iterations.
+        wheel_vertical_load_N: {"left": ..., "right": ...} vertical load carried at the equilibrium, N: sum of
+            N_k (-n_z,k) with Hertz's N_k ("hertz" sharing) or the model's ("model" sharing, approach control).
+        iterations: equilibrium iterations in all (rigid contact + Hertz + model phase).
+        load_sharing: "hertz", "model" or "approach" (approach-controlled case).
+        model_iterations: iterations of the model phase ("model" sharing; 0 otherwise), each one normal solve
+            per patch.
+        equilibrium_residual: max over the wheels of |vertical load / wheel_load_N - 1| at the final pose (with
+            the forces of the chosen sharing); nan for approach-controlled cases.
         pose: the final :class:`WheelsetPose`.
     """
 
@@ -163,6 +191,9 @@ class WheelsetCaseSolution:
     patches: list[PatchSolution]
     wheel_vertical_load_N: dict
     iterations: int
+    load_sharing: str = "hertz"
+    model_iterations: int = 0
+    equilibrium_residual: float = math.nan
     pose: WheelsetPose | None = None
     extra: dict = field(default_factory=dict)
 
@@ -282,6 +313,56 @@ def rigid_contact(
     return RigidContact(status == "ok", status, pose, gap, radius, point, iterations)
 
 
+def _model_is_bem(contact_model) -> bool:
+    return getattr(contact_model, "name", "") == "bem"
+
+
+def _vertical_loads(searches: dict[str, SideSearch], forces: dict[str, np.ndarray]) -> dict[str, float]:
+    """Per side: sum over its patches of N_k (-n_z,k), N (main z points down, n_k from the rail into the wheel)."""
+    return {
+        side: float(sum(f * -p.frame[2, 2] for f, p in zip(forces[side], searches[side].patches, strict=True)))
+        for side in SIDES
+    }
+
+
+def _spin_rate(case: WheelsetCase, searches: dict[str, SideSearch], forces, spin_rate: str) -> float:
+    """Spin rate phi' (rad/s): V/r0 ("nominal") or V over the mean rolling radius of each wheel's most loaded patch."""
+    if spin_rate == "nominal":
+        return case.rolling_speed_m_per_s / case.nominal_radius_m
+    radii = []
+    for side in SIDES:
+        if searches[side].patches:
+            k = int(np.argmax(forces[side])) if len(forces[side]) else 0
+            radii.append(searches[side].patches[k].rolling_radius_m)
+    mean_radius = float(np.mean(radii)) if radii else case.nominal_radius_m
+    return case.rolling_speed_m_per_s / mean_radius
+
+
+def _creepage(case: WheelsetCase, pose: WheelsetPose, geometry: ContactGeometry, omega_spin: float) -> Creepage:
+    """Creepages of the freely rolling wheelset at the patch (eq 39-49, creepage.py)."""
+    x_d = pose.rotation.T @ (geometry.point_m - pose.centre_m)
+    kin = wheelset_creepage(
+        x_d,
+        geometry.frame[:, 2],
+        yaw_rad=case.yaw_rad,
+        roll_rad=pose.roll_rad,
+        centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
+        spin_rate_rad_per_s=omega_spin,
+    )
+    return kin.creepage()
+
+
+def _load_residual(searches, loads, target, q_ref) -> np.ndarray:
+    """phi_i = (F_i/W)^(2/3) - 1 on a wheel in contact, -gap_i/q_W - 1 on a wheel without a patch."""
+    out = np.zeros(2)
+    for i, side in enumerate(SIDES):
+        if searches[side].patches:
+            out[i] = (max(loads[side], 0.0) / target) ** (2.0 / 3.0) - 1.0
+        else:
+            out[i] = -searches[side].min_gap_m / q_ref - 1.0
+    return out
+
+
 def solve_wheelset_case(
     case: WheelsetCase,
     material: Material,
@@ -295,12 +376,14 @@ def solve_wheelset_case(
     Args:
         case: the case.
         material: elastic constants and friction of the pair.
-        model: contact model name (registry) or instance, used for the final patch solutions.
-        options: ``DEFAULT_CASE_OPTIONS`` keys.
+        model: contact model name (registry) or instance, used for the final patch solutions (and for the
+            normal forces of the equilibrium with ``load_sharing = "model"``, module docstring).
+        options: ``DEFAULT_CASE_OPTIONS`` keys; ``load_sharing`` "hertz", "model" or None (automatic).
         track: optional pre-built :class:`~rigid_dynamics.contact.track.WheelsetTrack` (else built from the case).
 
     Returns:
-        :class:`WheelsetCaseSolution` (never raises for non-convergence).
+        :class:`WheelsetCaseSolution` (never raises for non-convergence: ``success`` False, status
+        "not-converged", "search-failed" or "model-failed").
 
     Raises:
         ValueError: bad case, option or model name; unreadable profile.
@@ -316,11 +399,17 @@ def solve_wheelset_case(
         opts[key] = value
     if opts["spin_rate"] not in ("nominal", "mean-rolling-radius"):
         raise ValueError(f"spin_rate = {opts['spin_rate']!r}: expected 'nominal' or 'mean-rolling-radius'")
+    value = opts["model_max_iterations"]
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"model_max_iterations = {value!r}: expected an integer >= 1")
+    if opts["load_sharing"] is not None and opts["load_sharing"] not in LOAD_SHARING:
+        raise ValueError(f"load_sharing = {opts['load_sharing']!r}: expected 'hertz', 'model' or None (automatic)")
     contact_model = get_model(model)
     if track is None:
         track = build_track(case)
     search_options = dict(opts["search"] or {})
     search_options.setdefault("field", False)
+    field_sampling = bool((opts["search"] or {}).get("field", True))
 
     def run(sinks, field_sampling=False):
         so = dict(search_options, field=field_sampling)
@@ -330,16 +419,13 @@ def solve_wheelset_case(
     target = case.wheel_load_N
 
     def residual(searches):
-        out = np.zeros(2)
         if target is not None:
-            loads, _ = _hertz_loads(searches, material)
+            return _load_residual(searches, _hertz_loads(searches, material)[0], target, q_ref)
+        out = np.zeros(2)
         for i, side in enumerate(SIDES):
             result = searches[side]
             if result.patches:
-                if target is not None:
-                    out[i] = (max(loads[side], 0.0) / target) ** (2.0 / 3.0) - 1.0
-                else:
-                    out[i] = max(p.approach_m for p in result.patches) / case.approach_m - 1.0
+                out[i] = max(p.approach_m for p in result.patches) / case.approach_m - 1.0
             else:
                 out[i] = -result.min_gap_m / q_ref - 1.0
         return out
@@ -352,7 +438,7 @@ def solve_wheelset_case(
 
     # Phase 1: rigid contact, both wheels just touching (smallest gap 0 on each side).
     sinks, it1, status = newton(gaps, np.zeros(2), 1e-4, 2.0e-3, opts["max_iterations"])
-    # Phase 2: sink into the rails until each wheel carries its load (or the prescribed approach).
+    # Phase 2: sink into the rails until each wheel carries its load by Hertz (or the prescribed approach).
     iterations = it1
     if status == "ok":
         tolerance = opts["force_tolerance"] if target is not None else opts["approach_tolerance_m"] / case.approach_m
@@ -364,34 +450,116 @@ def solve_wheelset_case(
         "not-converged": "equilibrium iteration did not converge",
     }
     message = messages[status]
-    pose, searches = run(sinks, field_sampling=bool((opts["search"] or {}).get("field", True)))
+    pose, searches = run(sinks, field_sampling=field_sampling)
     loads, forces = _hertz_loads(searches, material)
+
+    # Which load sharing.
+    if target is None:
+        sharing = "approach"
+    elif opts["load_sharing"] is not None:
+        sharing = opts["load_sharing"]
+    else:
+        several = any(len(searches[side].patches) > 1 for side in SIDES)
+        non_elliptic = any(not p.is_elliptic for side in SIDES for p in searches[side].patches)
+        sharing = "model" if _model_is_bem(contact_model) and (several or non_elliptic) else "hertz"
+
+    # Phase 3 ("model" sharing): Broyden iteration with the model's normal forces under approach control.
+    model_iterations = 0
+    normal_results: dict | None = None  # side -> results of the last normal solves (at `searches`)
+    coupled = bool((opts["model"] or {}).get("difference_parameter", 0.0))
+    failed: list[str] = []
+    if sharing == "model" and status == "ok":
+        jac = np.zeros((2, 2))
+        base = residual(searches)
+        step = 2.0e-7
+        for j in range(2):
+            ds = np.zeros(2)
+            ds[j] = step
+            jac[:, j] = (residual(run(sinks + ds)[1]) - base) / step
+        limit = 5.0 * q_ref
+        previous = None
+        status = "not-converged"
+        for model_iterations in range(1, opts["model_max_iterations"] + 1):  # noqa: B007 (reported)
+            if model_iterations > 1:
+                pose, searches = run(sinks, field_sampling=field_sampling)
+            if not all(np.isfinite(s.min_gap_m) for s in searches.values()):
+                status = "search-failed"
+                break
+            if coupled:
+                omega = _spin_rate(case, searches, _hertz_loads(searches, material)[1], opts["spin_rate"])
+            normal_results, forces, failed = {}, {}, []
+            for side in SIDES:
+                normal_results[side] = []
+                for k, geometry in enumerate(searches[side].patches):
+                    if coupled:
+                        creepage = _creepage(case, pose, geometry, omega)
+                    else:
+                        creepage = Creepage(rolling_speed_m_per_s=case.rolling_speed_m_per_s)
+                    result = contact_model.solve(
+                        geometry, creepage, material, normal_force_N=None, options=opts["model"]
+                    )
+                    if not result.success:
+                        failed.append(f"{side} patch {k}: {result.message}")
+                    normal_results[side].append(result)
+                forces[side] = np.array([r.normal_force_N for r in normal_results[side]], float)
+            loads = _vertical_loads(searches, forces)
+            if failed:
+                status = "model-failed"
+                break
+            r = _load_residual(searches, loads, target, q_ref)
+            if not np.all(np.isfinite(r)):
+                break
+            # converged when each wheel's vertical load is within force_tolerance of W (relative)
+            error = [abs(loads[side] / target - 1.0) if searches[side].patches else math.inf for side in SIDES]
+            if max(error) < opts["force_tolerance"]:
+                status = "ok"
+                break
+            if previous is not None:
+                d_s, d_r = sinks - previous[0], r - previous[1]
+                denom = float(d_s @ d_s)
+                if denom > 0:
+                    jac = jac + np.outer(d_r - jac @ d_s, d_s) / denom
+            try:
+                delta = np.linalg.solve(jac, -r)
+            except np.linalg.LinAlgError:
+                delta = -r * limit
+            previous = (sinks.copy(), r)
+            sinks = sinks + np.clip(np.nan_to_num(delta), -limit, limit)
+        iterations += model_iterations
+        model_name = getattr(contact_model, "name", type(contact_model).__name__)
+        if status == "ok":
+            message = (
+                f"equilibrium found in {iterations} iterations ({model_iterations} with the {model_name} "
+                "model's normal forces, load sharing 'model')"
+            )
+        elif status == "model-failed":
+            message = "load sharing 'model': normal solve failed: " + "; ".join(failed)
+        elif status == "search-failed":
+            message = messages["search-failed"] + " (load sharing 'model')"
+        else:
+            message = (
+                f"load sharing 'model': equilibrium with the {model_name} model's normal forces did not "
+                f"converge in {model_iterations} iterations (force tolerance {opts['force_tolerance']:g})"
+            )
+    if target is not None:
+        if sharing == "hertz":
+            loads = _hertz_loads(searches, material)[0]
+        equilibrium_residual = float(max(abs(loads[side] / target - 1.0) for side in SIDES))
+    else:
+        equilibrium_residual = math.nan
+
+    # Final patch solutions (tangential problem at the final pose).
     patches: list[PatchSolution] = []
     failed = []
-    if opts["spin_rate"] == "nominal":
-        omega_spin = case.rolling_speed_m_per_s / case.nominal_radius_m
-    else:  # "mean-rolling-radius" (validated above)
-        radii = []
-        for side in SIDES:
-            if searches[side].patches:
-                k = int(np.argmax(forces[side])) if len(forces[side]) else 0
-                radii.append(searches[side].patches[k].rolling_radius_m)
-        mean_radius = float(np.mean(radii)) if radii else case.nominal_radius_m
-        omega_spin = case.rolling_speed_m_per_s / mean_radius
+    omega_spin = _spin_rate(case, searches, forces, opts["spin_rate"])
     for side in SIDES:
         for k, geometry in enumerate(searches[side].patches):
-            x_d = pose.rotation.T @ (geometry.point_m - pose.centre_m)
-            kin = wheelset_creepage(
-                x_d,
-                geometry.frame[:, 2],
-                yaw_rad=case.yaw_rad,
-                roll_rad=pose.roll_rad,
-                centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
-                spin_rate_rad_per_s=omega_spin,
-            )
-            creepage = kin.creepage()
-            force = float(forces[side][k]) if target is not None else None
-            result = contact_model.solve(geometry, creepage, material, normal_force_N=force, options=opts["model"])
+            creepage = _creepage(case, pose, geometry, omega_spin)
+            if sharing == "model" and normal_results is not None and coupled:
+                result = normal_results[side][k]  # solved with the real creepages already
+            else:
+                force = float(forces[side][k]) if sharing == "hertz" else None
+                result = contact_model.solve(geometry, creepage, material, normal_force_N=force, options=opts["model"])
             if not result.success:
                 failed.append(f"{side} patch {k}: {result.message}")
             patches.append(PatchSolution(side, geometry, creepage, result))
@@ -409,5 +577,8 @@ def solve_wheelset_case(
         patches=patches,
         wheel_vertical_load_N=loads,
         iterations=iterations,
+        load_sharing=sharing,
+        model_iterations=model_iterations,
+        equilibrium_residual=equilibrium_residual,
         pose=pose,
     )
