@@ -120,7 +120,8 @@ def write_bem_report(out_dir: str | Path, steps=DEFAULT_STEPS, bem_options: dict
         track = build_track(case)
         solutions = {}
         for name in MODELS:
-            options = {"search": SEARCH_OPTIONS}
+            # Hertz load sharing for every model: the report compares models at the same normal force per patch
+            options = {"search": SEARCH_OPTIONS, "load_sharing": "hertz"}
             if name == "bem":
                 options["model"] = bem_options
             solutions[name] = solve_wheelset_case(case, MATERIAL, model=name, options=options, track=track)
