@@ -18,25 +18,28 @@ Load sharing between the patches (option ``load_sharing``):
 * ``"hertz"``: each patch is solved with the requested contact model (``registry.get_model``) under force
   control with its Hertz share N_k of the wheel load (so every model carries the same load per patch). Right
   for the analytic models, whose normal part IS Hertz.
-* ``"model"`` (CONTACT's way for non-Hertzian contact, Vollebregt's CONTACT user guide, wheel-rail module):
-  the patch forces come from the model itself under approach control. At a pose the search gives every patch's
+* ``"model"`` (the way of the CONTACT program's wheel-rail module, E.A.H. Vollebregt, open source: with the
+  total vertical force prescribed it solves the wheel's patches for a wheelset position and iterates that
+  position by Newton/secant steps until the force is met, its m_wr_brentmeth/m_wr_solvecp modules): the patch
+  forces come from the model itself under approach control. At a pose the search gives every patch's
   rigid approach q_k (and, for ``bem``, its sampled undeformed distance h_k(x, y) - q_k), so all patches of a
   wheel share the one rigid displacement of the wheelset; the model's normal problem then gives N_k(pose), and
   the same two equations above are solved with these N_k. Start: the Hertz equilibrium; then Broyden's method
   (quasi-Newton, "good" rank-one update; Dennis & Schnabel 1983, sec. 8.1) on (s_L, s_R) starting from the Hertz
   Jacobian (finite differences at the Hertz equilibrium), each step one normal solve per patch (zero
   creepage: the normal problem does not depend on the tangential one for quasi-identical materials; with
-  Kalker's difference parameter K != 0 in the model options the real creepages are used). The tangential
+  Kalker's difference parameter K != 0 in the model options the real creepages are used), until
+  |F_i / W - 1| < ``force_tolerance`` on both wheels (``model_max_iterations``). The tangential
   problem is solved once at the end under approach control at the converged pose (so the normal forces are
   those of the equilibrium). Default (None): ``"model"`` when the model is ``bem`` and some patch is not
   elliptic or a wheel has several patches, else ``"hertz"``. Elastic interaction between patches of one
   wheel is neglected (each patch is its own half-space problem), as the patches are solved one by one.
 
-Each patch is solved with the creepages of a freely
-rolling wheelset (eq 39-49, creepage.py): centre velocity (V, 0, 0), yaw psi with zero yaw rate, roll theta,
-spin rate phi' = V / r0 (option ``spin_rate = "mean-rolling-radius"``: V over the mean rolling radius of the two
-wheels' main patches, the choice of CONTACT's A-2.2 example input, mbench_a22_right.inp, where the longitudinal
-creepages of the two wheels are equal and opposite).
+Each patch is solved with the creepages of a freely rolling wheelset (eq 39-49, creepage.py): centre velocity
+(V, 0, 0), yaw psi with zero yaw rate, roll theta, spin rate phi' = V / r0 (option
+``spin_rate = "mean-rolling-radius"``: V over the mean rolling radius of the two wheels' main patches, the choice
+of CONTACT's A-2.2 example input, mbench_a22_right.inp, where the longitudinal creepages of the two wheels are
+equal and opposite).
 
 ``approach_m`` instead of ``wheel_load_N`` prescribes the deepest approach on each wheel (approach control);
 every patch is then solved under approach control (``load_sharing`` is "approach").
