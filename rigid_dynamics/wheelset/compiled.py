@@ -116,6 +116,26 @@ def _irr_parts(par, radius, x0, spin, beta, res):
 
 
 @njit(cache=True)
+def _irr_q(par, radius, x0, spin, beta):
+    """The extra overlap q(beta) of _irr_parts alone (the same arithmetic; for the grid stage)."""
+    rv = 0.0
+    alpha = 0.5 * math.pi + beta - spin
+    if par[P_POLY_N] > 0 and par[P_POLY_A] > 0:
+        rv += par[P_POLY_A] * math.cos(par[P_POLY_N] * alpha + par[P_POLY_PH])
+    if par[P_FLAT_L] > 0:
+        length, depth, r0 = par[P_FLAT_L], par[P_FLAT_D], par[P_R0]
+        u = alpha - par[P_FLAT_ANG] + math.pi
+        s = r0 * ((u - 2 * math.pi * math.floor(u / (2 * math.pi))) - math.pi)
+        if abs(s) < 0.5 * length:
+            rv += -0.5 * depth * (1 + math.cos(2 * math.pi / length * s))
+    r = radius + rv
+    n0 = 0.0
+    if par[P_CORR_A] > 0:
+        n0 = par[P_CORR_A] * math.cos(2 * math.pi / par[P_CORR_W] * (x0 - r * math.sin(beta)))
+    return r * math.cos(beta) - radius - n0
+
+
+@njit(cache=True)
 def _irregularity(par, work, c, q, x0, spin, res, geo):
     """Running-direction irregularity of one candidate (providers._running_irregularity, same steps: a grid of
     IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
@@ -126,9 +146,9 @@ def _irregularity(par, work, c, q, x0, spin, res, geo):
     best, beta = -np.inf, 0.0
     for g in range(IRR_GRID):
         b = -half + 2.0 * half * g / (IRR_GRID - 1)
-        _irr_parts(par, radius, x0, spin, b, res)
-        if res[0] > best:
-            best, beta = res[0], b
+        qb = _irr_q(par, radius, x0, spin, b)
+        if qb > best:
+            best, beta = qb, b
     step_size = 2 * half / (IRR_GRID - 1)
     for _ in range(IRR_NEWTON):
         _irr_parts(par, radius, x0, spin, beta, res)
@@ -344,18 +364,27 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
         p_ext += mt[0] * om[0] + mt[1] * om[1] + mt[2] * om[2]
     acc = (force + fext) / par[P_MASS]
     acc[2] += par[P_G]
-    jb = np.array([par[P_JT], par[P_JA], par[P_JT]])
-    jm = np.zeros((3, 3))
-    for a in range(3):
-        for b in range(3):
-            jm[a, b] = rzx[a, 0] * jb[0] * rzx[b, 0] + rzx[a, 1] * jb[1] * rzx[b, 1] + rzx[a, 2] * jb[2] * rzx[b, 2]
-    jw = jm @ om
-    tq = (
-        moment
-        + mext
-        - np.array([om[1] * jw[2] - om[2] * jw[1], om[2] * jw[0] - om[0] * jw[2], om[0] * jw[1] - om[1] * jw[0]])
+    # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
+    jb0, jb1, jb2 = par[P_JT], par[P_JA], par[P_JT]
+    b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
+    b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
+    b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
+    jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
+    jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
+    jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
+    t0 = moment[0] + mext[0] - (om[1] * jw2 - om[2] * jw1)
+    t1 = moment[1] + mext[1] - (om[2] * jw0 - om[0] * jw2)
+    t2 = moment[2] + mext[2] - (om[0] * jw1 - om[1] * jw0)
+    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
+    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
+    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
+    al = np.array(
+        [
+            rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2,
+            rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2,
+            rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2,
+        ]
     )
-    al = np.linalg.solve(jm, tq)
     out[0], out[1], out[2] = vx, vy, vz
     out[3], out[4], out[5] = yr, rr, sr
     out[6], out[7], out[8] = acc[0], acc[1], acc[2]
