@@ -200,9 +200,16 @@ def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
 
 
 @njit(cache=True)
-def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy):
+def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy, sc):
     """d/dt of the 14-state; fills rec (ncand, N_FIELDS) and the side forces when ``record``. Returns status."""
     out = np.zeros(14)
+    # scratch rows (no allocation per candidate): normal, lever, point velocity, e_x, e_y, force, moment,
+    # total force, total moment, side forces (2)
+    n, lever, vel, ex, ey, fc, mc = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6]
+    force, moment, side_force = sc[7], sc[8], sc[9:11]
+    force[:] = 0.0
+    moment[:] = 0.0
+    side_force[:, :] = 0.0
     xc, yc, zc = y[0], y[1], y[2]
     yaw, roll = y[3], y[4]
     vx, vy, vz = y[6], y[7], y[8]
@@ -212,10 +219,7 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
     om = np.array([rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth])
     _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, roll, work)
     zref = par[P_ZREF]
-    force = np.zeros(3)
-    moment = np.zeros(3)
     p_con = 0.0
-    side_force = np.zeros((2, 3))
     ncand = table.shape[1]
     for c in range(ncand):
         q = work[0, c] + (zc - zref) * work[1, c]
@@ -223,8 +227,8 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
             q = -0.01
         ny_, nz_ = work[4, c], work[5, c]
         nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
-        n = np.array([0.0, ny_ / nn, nz_ / nn])
-        lever = np.array([-sps * work[10, c], work[2, c], work[3, c]])
+        n[0], n[1], n[2] = 0.0, ny_ / nn, nz_ / nn
+        lever[0], lever[1], lever[2] = -sps * work[10, c], work[2, c], work[3, c]
         ca, cb, radius = work[6, c], work[7, c], work[8, c]
         if par[P_IRR] > 0 and q > -par[P_REACH] and par[P_IRR_LEFT + sides[c]] > 0:
             _irregularity(par, work, c, q, xc + lever[0], y[5], res, geo)
@@ -244,19 +248,18 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
             rec[c, 11] = work[9, c]
         if q <= 0.0:
             continue
-        vel = np.array(
-            [
-                vx + om[1] * lever[2] - om[2] * lever[1],
-                vy + om[2] * lever[0] - om[0] * lever[2],
-                vz + om[0] * lever[1] - om[1] * lever[0],
-            ]
-        )
-        vp = np.array([vx, 0.0, 0.0]) - (n[0] * vx) * n
-        speed = math.sqrt(vp[0] ** 2 + vp[1] ** 2 + vp[2] ** 2)
+        vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
+        vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
+        vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
+        nv = n[0] * vx
+        vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
+        speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
         if not speed > 0.0:
             return 4, out
-        ex = vp / speed
-        ey = np.array([n[1] * ex[2] - n[2] * ex[1], n[2] * ex[0] - n[0] * ex[2], n[0] * ex[1] - n[1] * ex[0]])
+        ex[0], ex[1], ex[2] = vp0 / speed, vp1 / speed, vp2 / speed
+        ey[0] = n[1] * ex[2] - n[2] * ex[1]
+        ey[1] = n[2] * ex[0] - n[0] * ex[2]
+        ey[2] = n[0] * ex[1] - n[1] * ex[0]
         xi = (vel[0] * ex[0] + vel[1] * ex[1] + vel[2] * ex[2]) / speed
         eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
         spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
@@ -301,22 +304,17 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
                     tx *= scale
                     ty *= scale
                 mz = 0.0
-        f = ex * tx + ey * ty + n * normal
-        m = n * mz
-        force += f
-        moment += (
-            np.array(
-                [
-                    lever[1] * f[2] - lever[2] * f[1],
-                    lever[2] * f[0] - lever[0] * f[2],
-                    lever[0] * f[1] - lever[1] * f[0],
-                ]
-            )
-            + m
-        )
-        p_con += f[0] * vel[0] + f[1] * vel[1] + f[2] * vel[2] + m[0] * om[0] + m[1] * om[1] + m[2] * om[2]
+        for k in range(3):
+            fc[k] = ex[k] * tx + ey[k] * ty + n[k] * normal
+            mc[k] = n[k] * mz
+            force[k] += fc[k]
+        moment[0] += lever[1] * fc[2] - lever[2] * fc[1] + mc[0]
+        moment[1] += lever[2] * fc[0] - lever[0] * fc[2] + mc[1]
+        moment[2] += lever[0] * fc[1] - lever[1] * fc[0] + mc[2]
+        p_con += fc[0] * vel[0] + fc[1] * vel[1] + fc[2] * vel[2] + mc[0] * om[0] + mc[1] * om[1] + mc[2] * om[2]
         if record:
-            side_force[sides[c]] += f
+            for k in range(3):
+                side_force[sides[c], k] += fc[k]
             rec[c, 0] = normal
             rec[c, 1] = tx
             rec[c, 2] = ty
@@ -326,42 +324,39 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
             rec[c, 6] = spin
             rec[c, 12] = sa
             rec[c, 13] = sb
-    # exterior forces (equations.WheelsetModel.exterior)
-    fext = np.array([0.0, 0.0, par[P_AXLE]])
-    mext = np.zeros(3)
+    # exterior forces (equations.WheelsetModel.exterior), scalar arithmetic
+    fe0, fe1, fe2 = 0.0, 0.0, par[P_AXLE]
+    me0, me1, me2 = 0.0, 0.0, 0.0
     p_ext = par[P_AXLE] * vz
-    axle = np.array([-sps * cth, cps * cth, sth])
+    ax0, ax1, ax2 = -sps * cth, cps * cth, sth
+    x_frame = par[P_XF0] + par[P_V] * t
     for s in (-1.0, 1.0):
-        arm = axle * (s * par[P_BS])
-        pt = np.array([xc, yc, zc]) + arm
-        vel = np.array(
-            [
-                vx + om[1] * arm[2] - om[2] * arm[1],
-                vy + om[2] * arm[0] - om[0] * arm[2],
-                vz + om[0] * arm[1] - om[1] * arm[0],
-            ]
-        )
-        rel = pt - np.array([par[P_XF0] + par[P_V] * t, s * par[P_BS], par[P_ZF]])
-        relv = vel - np.array([par[P_V], 0.0, 0.0])
-        fs = np.array(
-            [
-                -par[P_KX] * rel[0] - par[P_CX] * relv[0],
-                -par[P_KY] * rel[1] - par[P_CY] * relv[1],
-                -par[P_KZ] * rel[2] - par[P_CZ] * relv[2],
-            ]
-        )
-        fext += fs
-        mext += np.array(
-            [arm[1] * fs[2] - arm[2] * fs[1], arm[2] * fs[0] - arm[0] * fs[2], arm[0] * fs[1] - arm[1] * fs[0]]
-        )
-        p_ext += fs[0] * vel[0] + fs[1] * vel[1] + fs[2] * vel[2]
+        sb_ = s * par[P_BS]
+        a0, a1, a2 = ax0 * sb_, ax1 * sb_, ax2 * sb_
+        v0 = vx + om[1] * a2 - om[2] * a1
+        v1 = vy + om[2] * a0 - om[0] * a2
+        v2 = vz + om[0] * a1 - om[1] * a0
+        f0 = -par[P_KX] * (xc + a0 - x_frame) - par[P_CX] * (v0 - par[P_V])
+        f1 = -par[P_KY] * (yc + a1 - sb_) - par[P_CY] * (v1 - 0.0)
+        f2 = -par[P_KZ] * (zc + a2 - par[P_ZF]) - par[P_CZ] * (v2 - 0.0)
+        fe0 += f0
+        fe1 += f1
+        fe2 += f2
+        me0 += a1 * f2 - a2 * f1
+        me1 += a2 * f0 - a0 * f2
+        me2 += a0 * f1 - a1 * f0
+        p_ext += f0 * v0 + f1 * v1 + f2 * v2
     myaw = -2.0 * (par[P_KYAW] * yaw + par[P_CYAW] * yr)
-    mext[2] += myaw
+    me2 += myaw
     p_ext += myaw * om[2]
     if par[P_TORQUE] != 0.0:
-        mt = -par[P_TORQUE] * axle
-        mext += mt
-        p_ext += mt[0] * om[0] + mt[1] * om[1] + mt[2] * om[2]
+        mt0, mt1, mt2 = -par[P_TORQUE] * ax0, -par[P_TORQUE] * ax1, -par[P_TORQUE] * ax2
+        me0 += mt0
+        me1 += mt1
+        me2 += mt2
+        p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
+    mext = np.array([me0, me1, me2])
+    fext = np.array([fe0, fe1, fe2])
     acc = (force + fext) / par[P_MASS]
     acc[2] += par[P_G]
     # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
@@ -410,25 +405,26 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
     res = np.empty(9)
     geo = np.empty(8)
     dummy = np.zeros((1, 1))
+    sc = np.zeros((11, 3))
     t = t0
     k_out = out_start
     evals = 0
     fmax, ymax = par[P_FMAX], par[P_YMAX]
     for step in range(n_steps):
-        st, k1 = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy)
+        st, k1 = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc)
         if st != 0:
             return st, step, k_out, t, y, evals
         st, k2 = _rhs(
-            t + 0.5 * h, y + 0.5 * h * k1, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy
+            t + 0.5 * h, y + 0.5 * h * k1, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc
         )
         if st != 0:
             return st, step, k_out, t, y, evals
         st, k3 = _rhs(
-            t + 0.5 * h, y + 0.5 * h * k2, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy
+            t + 0.5 * h, y + 0.5 * h * k2, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc
         )
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k4 = _rhs(t + h, y + h * k3, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy)
+        st, k4 = _rhs(t + h, y + h * k3, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc)
         evals += 4
         if st != 0:
             return st, step, k_out, t, y, evals
@@ -439,7 +435,7 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
         y = y_new
         t = t0 + (step + 1) * h
         if (step + 1) % out_every == 0 and k_out < states.shape[0]:
-            st, _ = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy)
+            st, _ = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy, sc)
             evals += 1
             if st != 0:
                 return st, step + 1, k_out, t, y, evals
