@@ -200,13 +200,15 @@ def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
 
 
 @njit(cache=True)
-def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy, sc):
-    """d/dt of the 14-state; fills rec (ncand, N_FIELDS) and the side forces when ``record``. Returns status."""
-    out = np.zeros(14)
-    # scratch rows (no allocation per candidate): normal, lever, point velocity, e_x, e_y, force, moment,
-    # total force, total moment, side forces (2)
+def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy, sc, out):
+    """d/dt of the 14-state into ``out``; fills rec (ncand, N_FIELDS) and the side forces when ``record``.
+    Returns the status.
+    """
+    # scratch rows (no allocation in the loop): normal, lever, point velocity, e_x, e_y, force, moment,
+    # total force, total moment, side forces (2), omega, R_z R_x (3 rows)
     n, lever, vel, ex, ey, fc, mc = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6]
     force, moment, side_force = sc[7], sc[8], sc[9:11]
+    om, rzx = sc[11], sc[12:15]
     force[:] = 0.0
     moment[:] = 0.0
     side_force[:, :] = 0.0
@@ -215,8 +217,10 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
     vx, vy, vz = y[6], y[7], y[8]
     yr, rr, sr = y[9], y[10], y[11]
     cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
-    rzx = np.array([[cps, -sps * cth, sps * sth], [sps, cps * cth, -cps * sth], [0.0, sth, cth]])
-    om = np.array([rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth])
+    rzx[0, 0], rzx[0, 1], rzx[0, 2] = cps, -sps * cth, sps * sth
+    rzx[1, 0], rzx[1, 1], rzx[1, 2] = sps, cps * cth, -cps * sth
+    rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
+    om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
     _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, roll, work)
     zref = par[P_ZREF]
     p_con = 0.0
@@ -255,7 +259,7 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
         vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
         speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
         if not speed > 0.0:
-            return 4, out
+            return 4
         ex[0], ex[1], ex[2] = vp0 / speed, vp1 / speed, vp2 / speed
         ey[0] = n[1] * ex[2] - n[2] * ex[1]
         ey[1] = n[2] * ex[0] - n[0] * ex[2]
@@ -355,10 +359,9 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
         me1 += mt1
         me2 += mt2
         p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
-    mext = np.array([me0, me1, me2])
-    fext = np.array([fe0, fe1, fe2])
-    acc = (force + fext) / par[P_MASS]
-    acc[2] += par[P_G]
+    acc0 = (force[0] + fe0) / par[P_MASS]
+    acc1 = (force[1] + fe1) / par[P_MASS]
+    acc2 = (force[2] + fe2) / par[P_MASS] + par[P_G]
     # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
     jb0, jb1, jb2 = par[P_JT], par[P_JA], par[P_JT]
     b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
@@ -367,31 +370,27 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
     jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
     jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
     jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
-    t0 = moment[0] + mext[0] - (om[1] * jw2 - om[2] * jw1)
-    t1 = moment[1] + mext[1] - (om[2] * jw0 - om[0] * jw2)
-    t2 = moment[2] + mext[2] - (om[0] * jw1 - om[1] * jw0)
+    t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
+    t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
+    t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
     c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
     c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
     c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
-    al = np.array(
-        [
-            rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2,
-            rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2,
-            rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2,
-        ]
-    )
+    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
+    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
+    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
     out[0], out[1], out[2] = vx, vy, vz
     out[3], out[4], out[5] = yr, rr, sr
-    out[6], out[7], out[8] = acc[0], acc[1], acc[2]
-    out[9] = (al[0] * sps * sth - al[1] * cps * sth + al[2] * cth + yr * rr * sth + rr * sr) / cth
-    out[11] = (al[0] * sps - al[1] * cps + yr * rr + rr * sr * sth) / cth
-    out[10] = al[0] * cps + al[1] * sps - yr * sr * cth
+    out[6], out[7], out[8] = acc0, acc1, acc2
+    out[9] = (al0 * sps * sth - al1 * cps * sth + al2 * cth + yr * rr * sth + rr * sr) / cth
+    out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
+    out[10] = al0 * cps + al1 * sps - yr * sr * cth
     out[12], out[13] = p_con, p_ext
     if record:
         for sd in range(2):
             for k in range(3):
                 rec[ncand + sd, k] = side_force[sd, k]
-    return 0, out
+    return 0
 
 
 @njit(cache=True)
@@ -405,37 +404,46 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
     res = np.empty(9)
     geo = np.empty(8)
     dummy = np.zeros((1, 1))
-    sc = np.zeros((11, 3))
+    sc = np.zeros((15, 3))
+    nst = y.shape[0]
+    y = y.copy()
+    k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
+    ys, y_new, d_rec = np.empty(nst), np.empty(nst), np.empty(nst)
     t = t0
     k_out = out_start
     evals = 0
     fmax, ymax = par[P_FMAX], par[P_YMAX]
     for step in range(n_steps):
-        st, k1 = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc)
+        st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k1)
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k2 = _rhs(
-            t + 0.5 * h, y + 0.5 * h * k1, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc
-        )
+        for i in range(nst):
+            ys[i] = y[i] + 0.5 * h * k1[i]
+        st = _rhs(t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k2)
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k3 = _rhs(
-            t + 0.5 * h, y + 0.5 * h * k2, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc
-        )
+        for i in range(nst):
+            ys[i] = y[i] + 0.5 * h * k2[i]
+        st = _rhs(t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k3)
         if st != 0:
             return st, step, k_out, t, y, evals
-        st, k4 = _rhs(t + h, y + h * k3, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc)
+        for i in range(nst):
+            ys[i] = y[i] + h * k3[i]
+        st = _rhs(t + h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k4)
         evals += 4
         if st != 0:
             return st, step, k_out, t, y, evals
-        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        for v in y_new:
-            if not np.isfinite(v):
-                return 1, step, k_out, t, y, evals
-        y = y_new
+        finite = True
+        for i in range(nst):
+            y_new[i] = y[i] + (h / 6.0) * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            if not np.isfinite(y_new[i]):
+                finite = False
+        if not finite:
+            return 1, step, k_out, t, y, evals
+        y, y_new = y_new, y
         t = t0 + (step + 1) * h
         if (step + 1) % out_every == 0 and k_out < states.shape[0]:
-            st, _ = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy, sc)
+            st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy, sc, d_rec)
             evals += 1
             if st != 0:
                 return st, step + 1, k_out, t, y, evals
