@@ -116,8 +116,10 @@ def _irr_parts(par, radius, x0, spin, beta, res):
 
 
 @njit(cache=True)
-def _irr_q(par, radius, x0, spin, beta):
-    """The extra overlap q(beta) of _irr_parts alone (the same arithmetic; for the grid stage)."""
+def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
+    """The extra overlap q(beta) of _irr_parts alone (the same arithmetic; for the grid stage, whose sin and cos
+    of beta are tabulated once).
+    """
     rv = 0.0
     alpha = 0.5 * math.pi + beta - spin
     if par[P_POLY_N] > 0 and par[P_POLY_A] > 0:
@@ -131,24 +133,24 @@ def _irr_q(par, radius, x0, spin, beta):
     r = radius + rv
     n0 = 0.0
     if par[P_CORR_A] > 0:
-        n0 = par[P_CORR_A] * math.cos(2 * math.pi / par[P_CORR_W] * (x0 - r * math.sin(beta)))
-    return r * math.cos(beta) - radius - n0
+        n0 = par[P_CORR_A] * math.cos(2 * math.pi / par[P_CORR_W] * (x0 - r * sin_beta))
+    return r * cos_beta - radius - n0
 
 
 @njit(cache=True)
-def _irregularity(par, work, c, q, x0, spin, res, geo):
+def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
     """Running-direction irregularity of one candidate (providers._running_irregularity, same steps: a grid of
     IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
-    rolling radius, A) for the candidate.
+    rolling radius, A) for the candidate. bg: the grid angles (as np.linspace(-half, half, IRR_GRID)), their sines
+    and cosines (3, IRR_GRID).
     """
     half = par[P_HALF]
     radius = work[8, c]
     best, beta = -np.inf, 0.0
     for g in range(IRR_GRID):
-        b = -half + 2.0 * half * g / (IRR_GRID - 1)
-        qb = _irr_q(par, radius, x0, spin, b)
+        qb = _irr_q(par, radius, x0, spin, bg[0, g], bg[1, g], bg[2, g])
         if qb > best:
-            best, beta = qb, b
+            best, beta = qb, bg[0, g]
     step_size = 2 * half / (IRR_GRID - 1)
     for _ in range(IRR_NEWTON):
         _irr_parts(par, radius, x0, spin, beta, res)
@@ -200,7 +202,7 @@ def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
 
 
 @njit(cache=True)
-def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy, sc, out):
+def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy, sc, out, bg):
     """d/dt of the 14-state into ``out``; fills rec (ncand, N_FIELDS) and the side forces when ``record``.
     Returns the status.
     """
@@ -235,7 +237,7 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
         lever[0], lever[1], lever[2] = -sps * work[10, c], work[2, c], work[3, c]
         ca, cb, radius = work[6, c], work[7, c], work[8, c]
         if par[P_IRR] > 0 and q > -par[P_REACH] and par[P_IRR_LEFT + sides[c]] > 0:
-            _irregularity(par, work, c, q, xc + lever[0], y[5], res, geo)
+            _irregularity(par, work, c, q, xc + lever[0], y[5], res, geo, bg)
             q = geo[0]
             lever[0] += geo[1]
             lever[2] += geo[2]
@@ -405,6 +407,12 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
     geo = np.empty(8)
     dummy = np.zeros((1, 1))
     sc = np.zeros((15, 3))
+    bg = np.empty((3, IRR_GRID))
+    step_b = 2.0 * par[P_HALF] / (IRR_GRID - 1)
+    for g in range(IRR_GRID):
+        bg[0, g] = g * step_b - par[P_HALF]
+        bg[1, g] = math.sin(bg[0, g])
+        bg[2, g] = math.cos(bg[0, g])
     nst = y.shape[0]
     y = y.copy()
     k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
@@ -414,22 +422,26 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
     evals = 0
     fmax, ymax = par[P_FMAX], par[P_YMAX]
     for step in range(n_steps):
-        st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k1)
+        st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k1, bg)
         if st != 0:
             return st, step, k_out, t, y, evals
         for i in range(nst):
             ys[i] = y[i] + 0.5 * h * k1[i]
-        st = _rhs(t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k2)
+        st = _rhs(
+            t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k2, bg
+        )
         if st != 0:
             return st, step, k_out, t, y, evals
         for i in range(nst):
             ys[i] = y[i] + 0.5 * h * k2[i]
-        st = _rhs(t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k3)
+        st = _rhs(
+            t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k3, bg
+        )
         if st != 0:
             return st, step, k_out, t, y, evals
         for i in range(nst):
             ys[i] = y[i] + h * k3[i]
-        st = _rhs(t + h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k4)
+        st = _rhs(t + h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k4, bg)
         evals += 4
         if st != 0:
             return st, step, k_out, t, y, evals
@@ -443,7 +455,7 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
         y, y_new = y_new, y
         t = t0 + (step + 1) * h
         if (step + 1) % out_every == 0 and k_out < states.shape[0]:
-            st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy, sc, d_rec)
+            st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy, sc, d_rec, bg)
             evals += 1
             if st != 0:
                 return st, step + 1, k_out, t, y, evals
