@@ -68,7 +68,7 @@ Notes.
   change, falling 4x per halving).
 * The tables: the Python right-hand side costs 0.35-0.6 ms per call (numpy on 2-4 candidates); the compiled loop
   about 1.2 us (Vermeulen-Johnson), 6-8 us (FASTSIM 20 x 20, of which the strip kernel for the two patches is
-  about 5 us) and 14-16 us (FASTSIM with the polygon: the running-direction section, an 81-angle grid and 3 Newton
+  about 5 us) and 12-14 us (FASTSIM with the polygon: the running-direction section, an 81-angle grid and 3 Newton
   steps per candidate). The compiled path equals the Python path to ~1e-14 (tests/test_dynamics_compiled.py).
 * Time-step error of the compiled cases against a 1/16 ms run: on ideal geometry 0.4 % (0.5 ms) and 4.5 % (1 ms)
   of the static wheel load at most. With the polygon the maximum stays large at every step size (a separate step-
@@ -77,12 +77,12 @@ Notes.
   switch between one and two patches per wheel near the centre (the same double minimum), and the switching
   instants move with the step.
 * Targets. Tables >= 100x: reached on ideal geometry with Vermeulen-Johnson at a 1 ms step (4.5 % largest wheel-
-  load error against the fine step; 90-100x at the scene's 0.5 ms, 0.4 %), not with FASTSIM (about 17x at 0.5 ms
-  and 28x at 1 ms on ideal geometry, about 8x / 13x with the polygon; see the table): an RK4 step of 0.5 ms costs
+  load error against the fine step; 90-100x at the scene's 0.5 ms, 0.4 %), not with FASTSIM (about 18x at 0.5 ms
+  and 30x at 1 ms on ideal geometry, about 9x / 15x with the polygon; see the table): an RK4 step of 0.5 ms costs
   4.5 RHS calls (with the output sample), so 100x asks for ~1.1 us per call, below the cost of FASTSIM's 2 x 400
   strip elements alone. The 3-D search (about 0.01x, 0.02x with reuse) is three orders of magnitude short of 10x:
   that needs a compiled search on irregular surfaces (the contact search's owners) or the tables with the polygon
-  by the running-direction section (tables-polygon-compiled, 8-13x, the geometry differing from the search as
+  by the running-direction section (tables-polygon-compiled, 9-15x, the geometry differing from the search as
   described above).
 """
 
