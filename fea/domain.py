@@ -31,36 +31,50 @@ class Domain:
         return 4.0 if self.symmetry == "quarter" else 1.0
 
 
+def mesh_on_rank0(name: str, build, comm=None, limits: QualityLimits | None = None):
+    """Build a gmsh model on rank 0 with ``build(model)``, check its quality, and distribute it.
+
+    Every rank gets the same outcome: the DOLFINx mesh data and the quality report, or the same
+    exception (MeshQualityError for a bad mesh, ValueError for a failing builder).
+
+    Returns:
+        (mesh data of ``dolfinx.io.gmsh.model_to_mesh``, MeshQuality, {group name: tag}).
+    """
+    import dolfinx_solver  # noqa: F401  (must precede dolfinx/petsc4py/mpi4py)
+    from dolfinx.io import gmsh as gmsh_io
+    from mpi4py import MPI
+
+    from meshing.quality import mesh_quality
+    from meshing.session import generate, gmsh_model
+
+    comm = MPI.COMM_WORLD if comm is None else comm
+    limits = QualityLimits() if limits is None else limits
+    error, quality = None, None
+    with gmsh_model(name) as model:
+        if comm.rank == 0:
+            try:
+                build(model)
+                generate(model)
+                quality = check_quality(mesh_quality(model), limits)
+            except (MeshQualityError, ValueError) as exc:
+                error = (type(exc).__name__, str(exc))
+        error = comm.bcast(error, root=0)
+        if error is not None:
+            kind, message = error
+            raise MeshQualityError(message) if kind == "MeshQualityError" else ValueError(message)
+        quality = comm.bcast(quality, root=0)
+        data = gmsh_io.model_to_mesh(model, comm, 0, gdim=3)
+    groups = {group_name: group.tag for group_name, group in data.physical_groups.items()}
+    return data, quality, groups
+
+
 def hertz_block_domain(spec, comm=None, limits: QualityLimits | None = None) -> Domain:
     """Mesh a :class:`meshing.hertz.HertzBlockSpec` on rank 0 and distribute it.
 
     Raises:
         MeshQualityError: (on every rank) the mesh fails ``limits``.
     """
-    import dolfinx_solver  # noqa: F401  (must precede dolfinx/petsc4py/mpi4py)
-    from dolfinx.io import gmsh as gmsh_io
-    from mpi4py import MPI
-
     from meshing.hertz import build_hertz_block
-    from meshing.quality import mesh_quality
-    from meshing.session import generate, gmsh_model
 
-    comm = MPI.COMM_WORLD if comm is None else comm
-    limits = QualityLimits() if limits is None else limits
-    error = None
-    quality = None
-    with gmsh_model("hertz-block") as model:
-        if comm.rank == 0:
-            try:
-                build_hertz_block(model, spec)
-                generate(model)
-                quality = check_quality(mesh_quality(model), limits)
-            except (MeshQualityError, ValueError) as exc:
-                error = f"{type(exc).__name__}: {exc}"
-        error = comm.bcast(error, root=0)
-        if error is not None:
-            raise MeshQualityError(error)
-        quality = comm.bcast(quality, root=0)
-        data = gmsh_io.model_to_mesh(model, comm, 0, gdim=3)
-    groups = {name: group.tag for name, group in data.physical_groups.items()}
+    data, quality, groups = mesh_on_rank0("hertz-block", lambda model: build_hertz_block(model, spec), comm, limits)
     return Domain(data.mesh, data.facet_tags, groups, quality, spec.symmetry)

@@ -62,31 +62,10 @@ def hertz_pair_domain(spec, lower_curvatures, upper_curvatures, comm=None, limit
         spec: :class:`meshing.hertz.HertzBlockSpec`.
         lower_curvatures, upper_curvatures: (A_i, B_i) in 1/m (>= 0).
     """
-    import dolfinx_solver  # noqa: F401
-    from dolfinx.io import gmsh as gmsh_io
-    from mpi4py import MPI
-
+    from fea.domain import mesh_on_rank0
     from meshing.hertz import build_hertz_pair
-    from meshing.quality import MeshQualityError, QualityLimits, check_quality, mesh_quality
-    from meshing.session import generate, gmsh_model
 
-    comm = MPI.COMM_WORLD if comm is None else comm
-    limits = QualityLimits() if limits is None else limits
-    error, quality = None, None
-    with gmsh_model("hertz-pair") as model:
-        if comm.rank == 0:
-            try:
-                build_hertz_pair(model, spec)
-                generate(model)
-                quality = check_quality(mesh_quality(model), limits)
-            except (MeshQualityError, ValueError) as exc:
-                error = f"{type(exc).__name__}: {exc}"
-        error = comm.bcast(error, root=0)
-        if error is not None:
-            raise MeshQualityError(error)
-        quality = comm.bcast(quality, root=0)
-        data = gmsh_io.model_to_mesh(model, comm, 0, gdim=3)
-    groups = {name: group.tag for name, group in data.physical_groups.items()}
+    data, quality, groups = mesh_on_rank0("hertz-pair", lambda model: build_hertz_pair(model, spec), comm, limits)
     msh = data.mesh
     x = msh.geometry.x
     depth = spec.half_width_m
@@ -366,30 +345,12 @@ def profile_pair_domain(rail_curve, wheel_curve, rail_spec, wheel_spec, comm=Non
     contact points are at the origin with the common normal along +Z (the contact frame, yaw
     neglected); the undeformed distance is then the distance of the two real surfaces.
     """
-    import dolfinx_solver  # noqa: F401
-    from dolfinx.io import gmsh as gmsh_io
-    from mpi4py import MPI
-
+    from fea.domain import mesh_on_rank0
     from meshing.profile_sections import build_profile_section
-    from meshing.quality import MeshQualityError, QualityLimits, check_quality, mesh_quality
-    from meshing.session import generate, gmsh_model
 
-    comm = MPI.COMM_WORLD if comm is None else comm
-    limits = QualityLimits() if limits is None else limits
-    error, quality = None, None
-    with gmsh_model("profile-pair") as model:
-        if comm.rank == 0:
-            try:
-                build_profile_section(model, rail_curve, rail_spec, prefix="lower")
-                build_profile_section(model, wheel_curve, wheel_spec, prefix="upper", size_field=False)
-                generate(model)
-                quality = check_quality(mesh_quality(model), limits)
-            except (MeshQualityError, ValueError) as exc:
-                error = f"{type(exc).__name__}: {exc}"
-        error = comm.bcast(error, root=0)
-        if error is not None:
-            raise MeshQualityError(error) if error.startswith("MeshQualityError") else ValueError(error)
-        quality = comm.bcast(quality, root=0)
-        data = gmsh_io.model_to_mesh(model, comm, 0, gdim=3)
-    groups = {name: group.tag for name, group in data.physical_groups.items()}
+    def build(model):
+        build_profile_section(model, rail_curve, rail_spec, prefix="lower")
+        build_profile_section(model, wheel_curve, wheel_spec, prefix="upper", size_field=False)
+
+    data, quality, groups = mesh_on_rank0("profile-pair", build, comm, limits)
     return PairDomain(data.mesh, data.cell_tags, data.facet_tags, groups, quality, "full")
