@@ -173,6 +173,19 @@ class HertzModel:
         )
 
 
+def _linear_forces(hertz, creepage, material):
+    """Kalker's linear-theory (Fx, Fy, Mz) on the Hertz ellipse of one patch (eq 50-52)."""
+    return linear_creep_forces(
+        hertz.semi_axis_long_m,
+        hertz.semi_axis_lat_m,
+        creepage.longitudinal,
+        creepage.lateral,
+        creepage.spin_1_per_m,
+        shear_modulus_Pa=material.shear_modulus_Pa,
+        poisson_ratio=material.poisson_ratio,
+    )
+
+
 class LinearModel:
     """Hertz + Kalker's linear theory (full adhesion; seed eq 50-52)."""
 
@@ -186,15 +199,7 @@ class LinearModel:
         hertz, reason = _hertz(geometry, material, normal_force_N)
         if hertz is None:
             return _base_result(self.name, geometry, creepage, None, reason, start)
-        fx, fy, mz = linear_creep_forces(
-            hertz.semi_axis_long_m,
-            hertz.semi_axis_lat_m,
-            creepage.longitudinal,
-            creepage.lateral,
-            creepage.spin_1_per_m,
-            shear_modulus_Pa=material.shear_modulus_Pa,
-            poisson_ratio=material.poisson_ratio,
-        )
+        fx, fy, mz = _linear_forces(hertz, creepage, material)
         return _base_result(
             self.name,
             geometry,
@@ -221,15 +226,7 @@ class VermeulenJohnsonModel:
         hertz, reason = _hertz(geometry, material, normal_force_N)
         if hertz is None:
             return _base_result(self.name, geometry, creepage, None, reason, start)
-        tx, ty, _ = linear_creep_forces(
-            hertz.semi_axis_long_m,
-            hertz.semi_axis_lat_m,
-            creepage.longitudinal,
-            creepage.lateral,
-            creepage.spin_1_per_m,
-            shear_modulus_Pa=material.shear_modulus_Pa,
-            poisson_ratio=material.poisson_ratio,
-        )
+        tx, ty, _ = _linear_forces(hertz, creepage, material)
         fx, fy = vermeulen_johnson_saturation(tx, ty, hertz.normal_force_N, material.friction_coefficient)
         return _base_result(
             self.name,
