@@ -244,29 +244,14 @@ class FeaModel:
         settings = SolverSettings(
             degree=opts.degree, linear_solver=opts.linear_solver, max_iterations=opts.max_iterations
         )
-        if opts.formulation == "profiles":
-            from fea.two_body import solve_two_body
-
-            domain, sections = _profile_domain(geometry, opts, semi, spec.contact_size_m, comm, limits)
-            t_mesh = time.perf_counter() - t_mesh
-            young_body = material.young_modulus_Pa
-            sol = solve_two_body(
-                domain,
-                young_body,
-                nu,
-                normal_force_N=normal_force_N,
-                approach_m=None if normal_force_N is not None else geometry.approach_m,
-                initial_approach_m=q0,
-                contact_size_m=spec.contact_size_m,
-                settings=settings,
-            )
-            sol.node_xy_m[:, 1] *= _lateral_sign(geometry)
-            quadric = False
-        elif opts.formulation == "two-body":
+        if opts.formulation in ("profiles", "two-body"):
             from fea.two_body import hertz_pair_domain, solve_two_body
 
-            half_curv = (0.5 * a_curv, 0.5 * b_curv)
-            domain = hertz_pair_domain(spec, half_curv, half_curv, comm, limits)
+            if opts.formulation == "profiles":
+                domain, _ = _profile_domain(geometry, opts, semi, spec.contact_size_m, comm, limits)
+            else:
+                half_curv = (0.5 * a_curv, 0.5 * b_curv)
+                domain = hertz_pair_domain(spec, half_curv, half_curv, comm, limits)
             t_mesh = time.perf_counter() - t_mesh
             young_body = material.young_modulus_Pa
             sol = solve_two_body(
@@ -279,6 +264,9 @@ class FeaModel:
                 contact_size_m=spec.contact_size_m,
                 settings=settings,
             )
+            if opts.formulation == "profiles":
+                sol.node_xy_m[:, 1] *= _lateral_sign(geometry)
+                quadric = False
         else:
             domain = hertz_block_domain(spec, comm, limits)
             t_mesh = time.perf_counter() - t_mesh
