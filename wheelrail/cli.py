@@ -28,9 +28,17 @@ from wheelrail.config import ConfigError
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
 
+MPI_RANK_VARIABLES = ("PMI_RANK", "OMPI_COMM_WORLD_RANK", "PMIX_RANK")
+
+
+def _under_mpi() -> bool:
+    """Whether this process was started by mpiexec (MPICH, Open MPI or PMIx launchers)."""
+    return any(var in os.environ for var in MPI_RANK_VARIABLES)
+
+
 def _mpi_rank() -> int:
     """Rank of this process under mpiexec (0 when not under MPI), from the launcher's environment."""
-    for var in ("PMI_RANK", "OMPI_COMM_WORLD_RANK", "PMIX_RANK"):
+    for var in MPI_RANK_VARIABLES:
         if var in os.environ:
             try:
                 return int(os.environ[var])
@@ -114,7 +122,7 @@ def _with_fea_output(case, args):
     """Ask the FEA model to write its XDMF and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
     import dataclasses
 
-    if args.out is None and _mpi_rank() != 0 or args.out is None and "PMI_RANK" in os.environ:
+    if args.out is None and _under_mpi():
         raise ConfigError("--method fea with --plot under mpiexec: give --out DIR so every rank writes to one folder")
     if args.out is None:
         args.out = new_output_dir_for(case)
