@@ -1,9 +1,23 @@
-"""Compiled (numba) kernels of the contact search for ideal surfaces given as lateral Hermite tables.
+"""Compiled (numba) kernels of the contact search: ideal surfaces as lateral Hermite tables plus closed-form
+irregularities.
 
 Same mathematics as search.py (eq 7-11): wheel point x_w = C_D x_d + x_t with x_d = [R cos a, y, R sin a],
-outward normal n_w = t_y x t_a / |.|, distance h along n_w to the rail z = N(y) by Newton's method, and a
-damped Newton minimisation of h(a, y) with central-difference derivatives. Tables: (lower, step, values,
-slopes * step, curvatures) as built by search._LateralTable; R depends on y_d only, N on y only.
+tangents t_a = [R_a cos a - R sin a, 0, R_a sin a + R cos a], t_y = [R_y cos a, 1, R_y sin a] (eq 9), outward
+normal n_w = t_y x t_a / |.|, distance h along n_w to the rail z = N(x, y) by Newton's method
+(f'(h) = n_z - N_x n_x - N_y n_y), and a damped Newton minimisation of h(a, y) with central-difference
+derivatives. Tables: (lower, step, values, slopes * step, curvatures) as built by search._LateralTable.
+
+Surfaces (eq 5-6): R(a, y_d) = R_id(y_d) + R_irr(a) and N(x, y) = N_id(y) + N_irr(x, y_r), y_r = s y - e_r.
+The irregularities are rows of a (k, 7) float array, evaluated in closed form (the same formulas as
+rigid_dynamics.geometry.irregularities; an empty array is the ideal surface):
+
+* wheel, code 0, harmonic out-of-roundness: [0, n, A, phi, -, -, -]: R_irr = A cos(n a + phi);
+* wheel, code 1, rounded flat: [1, a0, r_w, L, d, -, -]: s = r_w wrap(a - a0),
+  R_irr = -(d/2)(1 + cos(2 pi s / L)) for |s| <= L/2;
+* wheel, code 2, new (chord) flat: [2, a0, r_w, d, theta/2, -, -]: R_irr = (r_w - d)/cos(a - a0) - r_w for
+  |wrap(a - a0)| <= theta/2;
+* rail, code 0, corrugation: [0, k = 2 pi / lambda, A, phi, y_c, b, t]: N_irr = A cos(k x + phi) w(y_r), w the
+  C2 lateral band (1 - quintic smooth step of (|y_r - y_c| - b) / t).
 """
 
 from __future__ import annotations
@@ -34,17 +48,90 @@ def _table(y, lower, step, value, slope, curvature):
 
 
 @njit(cache=True)
-def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations):
+def _wrap_pi(angle):
+    """Angle wrapped to [-pi, pi) (Python's float modulo, as numpy's)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def wheel_irregularity(alpha, irr):
+    """(R_irr, dR_irr/da) of the rows of ``irr`` at the angle alpha (module docstring)."""
+    v, va = 0.0, 0.0
+    for k in range(irr.shape[0]):
+        code = irr[k, 0]
+        if code == 0.0:
+            n, amp = irr[k, 1], irr[k, 2]
+            arg = n * alpha + irr[k, 3]
+            v += amp * math.cos(arg)
+            va -= amp * n * math.sin(arg)
+        elif code == 1.0:
+            da = _wrap_pi(alpha - irr[k, 1])
+            r_w, length, depth = irr[k, 2], irr[k, 3], irr[k, 4]
+            s = r_w * da
+            if abs(s) <= 0.5 * length:
+                wave = 2.0 * math.pi / length
+                v -= 0.5 * depth * (1.0 + math.cos(wave * s))
+                va += 0.5 * depth * wave * r_w * math.sin(wave * s)
+        else:
+            da = _wrap_pi(alpha - irr[k, 1])
+            r_w, depth, half = irr[k, 2], irr[k, 3], irr[k, 4]
+            if abs(da) <= half:
+                f = (r_w - depth) / math.cos(da)
+                v += f - r_w
+                va += f * math.tan(da)
+    return v, va
+
+
+@njit(cache=True)
+def rail_irregularity(x, y, irr, sign, offset):
+    """(N_irr, dN_irr/dx, dN_irr/dy) of the rows of ``irr`` at main-frame (x, y); y_r = sign y - offset."""
+    v, vx, vy = 0.0, 0.0, 0.0
+    y_r = sign * y - offset
+    for k in range(irr.shape[0]):
+        wave, amp, phase, y_c, half, taper = irr[k, 1], irr[k, 2], irr[k, 3], irr[k, 4], irr[k, 5], irr[k, 6]
+        u = y_r - y_c
+        xi = (abs(u) - half) / taper
+        if xi <= 0.0:
+            w, dw = 1.0, 0.0
+        elif xi >= 1.0:
+            continue
+        else:
+            w = 1.0 - xi**3 * (10.0 - 15.0 * xi + 6.0 * xi * xi)
+            dw = -(1.0 if u >= 0 else -1.0) * 30.0 * xi * xi * (1.0 - xi) ** 2 / taper
+        c, s = math.cos(wave * x + phase), math.sin(wave * x + phase)
+        v += amp * c * w
+        vx -= amp * wave * s * w
+        vy += sign * amp * c * dw
+    return v, vx, vy
+
+
+@njit(cache=True)
+def _rail(x, y, rail, rail_irr, rail_map):
+    big_n, n_y, _ = _table(y, rail[0], rail[1], rail[2], rail[3], rail[4])
+    n_x = 0.0
+    if rail_irr.shape[0] > 0:
+        v, vx, vy = rail_irregularity(x, y, rail_irr, rail_map[0], rail_map[1])
+        big_n, n_x, n_y = big_n + v, vx, n_y + vy
+    return big_n, n_x, n_y
+
+
+@njit(cache=True)
+def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map):
     """h(alpha, y) for one wheel point; +inf outside the surfaces or beyond _FAR."""
     if y < y_range[0] or y > y_range[1]:
         return math.inf
     r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
     if not math.isfinite(r):
         return math.inf
+    r_a = 0.0
+    if wheel_irr.shape[0] > 0:
+        v, r_a = wheel_irregularity(alpha, wheel_irr)
+        r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
     xd0, xd1, xd2 = r * ca, y, r * sa
-    ta0, ta2 = -r * sa, r * ca  # R_a = 0 for an ideal wheel
+    ta0, ta2 = r_a * ca - r * sa, r_a * sa + r * ca
     ty0, ty1, ty2 = r_y * ca, 1.0, r_y * sa
+    p0 = rot[0, 0] * xd0 + rot[0, 1] * xd1 + rot[0, 2] * xd2 + centre[0]
     p1 = rot[1, 0] * xd0 + rot[1, 1] * xd1 + rot[1, 2] * xd2 + centre[1]
     p2 = rot[2, 0] * xd0 + rot[2, 1] * xd1 + rot[2, 2] * xd2 + centre[2]
     a0 = rot[0, 0] * ta0 + rot[0, 2] * ta2
@@ -65,9 +152,9 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
             py = rail_range[0]
         elif py > rail_range[1]:
             py = rail_range[1]
-        big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
+        big_n, n_x, n_y = _rail(p0 + h * n0, py, rail, rail_irr, rail_map)
         f = p2 + h * n2 - big_n
-        slope = n2 - n_y * n1
+        slope = n2 - n_x * n0 - n_y * n1
         if abs(slope) < 1e-3:
             slope = math.copysign(1e-3, slope)
         step = f / slope
@@ -77,33 +164,53 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
     py = p1 + h * n1
     if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
         return math.inf
-    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
+    big_n = _rail(p0 + h * n0, py, rail, rail_irr, rail_map)[0]
     if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
         return math.inf
     return h
 
 
 @njit(cache=True)
-def distance_grid(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations):
+def distance_grid(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations):
     """H on the grid alphas x ys, shape (len(alphas), len(ys))."""
     out = np.empty((alphas.shape[0], ys.shape[0]))
     for i in range(alphas.shape[0]):
         for j in range(ys.shape[0]):
-            out[i, j] = _distance(alphas[i], ys[j], rot, centre, wheel, rail, y_range, rail_range, iterations)
+            out[i, j] = _distance(
+                alphas[i],
+                ys[j],
+                rot,
+                centre,
+                wheel,
+                rail,
+                y_range,
+                rail_range,
+                iterations,
+                wheel_irr,
+                rail_irr,
+                rail_map,
+            )
     return out
 
 
 @njit(cache=True)
-def distance_points(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations):
+def distance_points(
+    alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations
+):
     """H at the points (alphas[k], ys[k])."""
     out = np.empty(alphas.shape[0])
     for k in range(alphas.shape[0]):
-        out[k] = _distance(alphas[k], ys[k], rot, centre, wheel, rail, y_range, rail_range, iterations)
+        out[k] = _distance(
+            alphas[k], ys[k], rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
+        )
     return out
 
 
 @njit(cache=True)
-def refine(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations, radius, max_iter, tol, fixed_alpha):
+def refine(
+    alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
+    max_iter, tol, fixed_alpha,
+):  # fmt: skip
     """Damped Newton on h(alpha, y) from each start; returns (alpha, y, h, converged)."""
     k_max = alphas.shape[0]
     out_a, out_y, out_h = alphas.copy(), ys.copy(), np.empty(k_max)
@@ -117,7 +224,20 @@ def refine(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations
         a, y = out_a[k], out_y[k]
         for _ in range(max_iter):
             for s in range(9):
-                v = _distance(a + oa[s] * da, y + oy[s] * d, rot, centre, wheel, rail, y_range, rail_range, iterations)
+                v = _distance(
+                    a + oa[s] * da,
+                    y + oy[s] * d,
+                    rot,
+                    centre,
+                    wheel,
+                    rail,
+                    y_range,
+                    rail_range,
+                    iterations,
+                    wheel_irr,
+                    rail_irr,
+                    rail_map,
+                )
                 hs[s] = v if math.isfinite(v) else 1.0
             g_a = (hs[1] - hs[2]) / (2 * d)
             g_y = (hs[3] - hs[4]) / (2 * d)
@@ -143,5 +263,7 @@ def refine(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, iterations
                 converged[k] = True
                 break
         out_a[k], out_y[k] = a, y
-        out_h[k] = _distance(a, y, rot, centre, wheel, rail, y_range, rail_range, iterations)
+        out_h[k] = _distance(
+            a, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
+        )
     return out_a, out_y, out_h, converged

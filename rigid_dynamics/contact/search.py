@@ -200,11 +200,59 @@ class _LateralTable:
         return value, slope, curvature
 
 
+def compiled_wheel_irregularities(irregularities) -> np.ndarray | None:
+    """Rows of the compiled kernels (_search_kernels module docstring) for wheel irregularities, or None.
+
+    Supported (closed forms evaluated in numba): rigid_dynamics.geometry's ``HarmonicOutOfRoundness`` and
+    ``WheelFlat`` (both shapes): irregularities of the rolling angle a alone. Any other irregularity (e.g. a
+    measured grid R_irr(a, y)) gives None: the search then takes the general numpy path.
+    """
+    from rigid_dynamics.geometry.irregularities import HarmonicOutOfRoundness, WheelFlat
+
+    rows = []
+    for irr in irregularities:
+        if type(irr) is HarmonicOutOfRoundness:
+            rows.append([0.0, float(irr.order), irr.amplitude_m, irr.phase_rad, 0.0, 0.0, 0.0])
+        elif type(irr) is WheelFlat and irr.shape == "rounded":
+            rows.append([1.0, irr.centre_angle_rad, irr.wheel_radius_m, irr.length_m, irr.depth, 0.0, 0.0])
+        elif type(irr) is WheelFlat and irr.shape == "new":
+            r, d = irr.wheel_radius_m, irr.depth
+            rows.append([2.0, irr.centre_angle_rad, r, d, math.acos((r - d) / r), 0.0, 0.0])
+        else:
+            return None
+    return np.array(rows, float).reshape(-1, 7)
+
+
+def compiled_rail_irregularities(irregularities) -> np.ndarray | None:
+    """Rows of the compiled kernels for rail irregularities (``RailCorrugation`` only), or None (numpy path)."""
+    from rigid_dynamics.geometry.irregularities import RailCorrugation
+
+    rows = []
+    for irr in irregularities:
+        if type(irr) is not RailCorrugation:
+            return None
+        rows.append(
+            [0.0, 2.0 * math.pi / irr.wavelength_m, irr.amplitude_m, irr.phase_rad, irr.centre_y_m]
+            + [irr.half_width_m, irr.taper_m]
+        )
+    return np.array(rows, float).reshape(-1, 7)
+
+
+def _irregularity_sum(irregularities, u, v):
+    total = [np.zeros(np.broadcast(u, v).shape) for _ in range(6)]
+    for irr in irregularities:
+        for k, value in enumerate(irr.evaluate(u, v)):
+            total[k] = total[k] + value
+    return total
+
+
 class TabulatedWheel:
-    """Fast stand-in for an ideal wheel surface (no irregularities): R(y_d) from a fine Hermite table.
+    """Fast stand-in for a wheel surface R(a, y_d) = R_id(y_d) + R_irr(a): R_id from a fine Hermite table.
 
     ``exact`` is the surface it was built from; the contact search uses the table to find the minima and the
-    exact surface for each patch's geometry.
+    exact surface for each patch's geometry. Irregularities (``exact.irregularities``) must be of the rolling
+    angle alone (:func:`compiled_wheel_irregularities`); ``evaluate`` adds their exact values, the compiled
+    kernels the same closed forms (``irregularity_rows``).
     """
 
     def __init__(self, surface, spacing_m: float = 2.0e-5):
@@ -212,41 +260,72 @@ class TabulatedWheel:
         self.y_range_m = tuple(float(v) for v in surface.y_range_m)
         self._table = _LateralTable(surface.ideal_radius, *self.y_range_m, spacing_m)
         self.table_tuple = self._table.as_tuple()
+        self.irregularities = tuple(getattr(surface, "irregularities", ()))
+        rows = compiled_wheel_irregularities(self.irregularities)
+        if rows is None:
+            raise ValueError(f"irregularities = {self.irregularities!r}: expected HarmonicOutOfRoundness/WheelFlat")
+        self.irregularity_rows = rows
 
     def evaluate(self, angle_rad, y_d_m):
         angle_rad, y_d_m = np.broadcast_arrays(np.asarray(angle_rad, float), np.asarray(y_d_m, float))
         r, r_y, r_yy = self._table(y_d_m)
         zero = np.zeros_like(r)
-        return (r, zero, r_y, zero, zero, r_yy)
+        if not self.irregularities:
+            return (r, zero, r_y, zero, zero, r_yy)
+        v, va, _, vaa, _, _ = _irregularity_sum(self.irregularities, angle_rad, zero)  # no y dependence
+        return (r + v, va, r_y, vaa, zero, r_yy)
 
 
 class TabulatedRail:
-    """Fast stand-in for an ideal rail surface (no irregularities, no deflection): N(y) from a Hermite table."""
+    """Fast stand-in for a rail surface N(x, y) = N_id(y) + N_irr(x, y_r) (no deflection): N_id from a Hermite
+    table, corrugation (:func:`compiled_rail_irregularities`) added exactly; y_r = s y - e_r (placement.py).
+    """
 
     def __init__(self, surface, spacing_m: float = 2.0e-5):
         self.exact = surface
         self.y_range_m = tuple(float(v) for v in surface.y_range_m)
         self._table = _LateralTable(surface.ideal_height, *self.y_range_m, spacing_m)
         self.table_tuple = self._table.as_tuple()
+        self.irregularities = tuple(getattr(surface, "irregularities", ()))
+        rows = compiled_rail_irregularities(self.irregularities)
+        if rows is None:
+            raise ValueError(f"irregularities = {self.irregularities!r}: expected RailCorrugation")
+        self.irregularity_rows = rows
+        self.lateral_map = np.array(
+            [float(getattr(surface, "sign", 1.0)), float(getattr(surface, "lateral_offset_m", 0.0))]
+        )
 
     def evaluate(self, x_m, y_m):
         x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
         n, n_y, n_yy = self._table(y_m)
         zero = np.zeros_like(n)
-        return (n, zero, n_y, zero, zero, n_yy)
+        if not self.irregularities:
+            return (n, zero, n_y, zero, zero, n_yy)
+        s = self.lateral_map[0]
+        v, vx, vy, vxx, vxy, vyy = _irregularity_sum(self.irregularities, x_m, s * y_m - self.lateral_map[1])
+        return (n + v, vx, n_y + s * vy, vxx, s * vxy, n_yy + vyy)
 
 
 def fast_surfaces(wheel, rail):
-    """Tabulated stand-ins for surfaces without irregularities (``ideal_radius``/``ideal_height`` methods).
+    """Tabulated stand-ins (compiled search) for rigid_dynamics.geometry surfaces.
 
-    A surface with irregularities, a rail deflection or without those methods is returned unchanged.
+    A wheel is tabulated when it has ``ideal_radius`` and its irregularities are all of the rolling angle alone
+    (harmonic out-of-roundness, wheel flats; none: ideal); a rail when it has ``ideal_height``, no deflection and
+    only corrugation irregularities (or none). Any other surface is returned unchanged (numpy path). The
+    compiled search runs only when both stand-ins of a side are tabulated.
     """
-    if getattr(wheel, "irregularities", None) == () and hasattr(wheel, "ideal_radius"):
+    from rigid_dynamics.geometry.placement import RailSurface, WheelSurface
+
+    wheel_irr = getattr(wheel, "irregularities", None)
+    if hasattr(wheel, "ideal_radius") and (
+        wheel_irr == () or (isinstance(wheel, WheelSurface) and compiled_wheel_irregularities(wheel_irr) is not None)
+    ):
         wheel = TabulatedWheel(wheel)
+    rail_irr = getattr(rail, "irregularities", None)
     if (
-        getattr(rail, "irregularities", None) == ()
+        hasattr(rail, "ideal_height")
         and getattr(rail, "deflection", 0) is None
-        and hasattr(rail, "ideal_height")
+        and (rail_irr == () or (isinstance(rail, RailSurface) and compiled_rail_irregularities(rail_irr) is not None))
     ):
         rail = TabulatedRail(rail)
     return wheel, rail
@@ -515,6 +594,9 @@ def search_side(
             rail.table_tuple,
             np.array(geo.y_range),
             np.array(geo.rail_range),
+            wheel.irregularity_rows,
+            rail.irregularity_rows,
+            rail.lateral_map,
         )
 
         def points(a, y, n_iter=iters):
