@@ -106,27 +106,67 @@ def rail_irregularity(x, y, irr, sign, offset):
 
 
 @njit(cache=True)
-def _rail(x, y, rail, rail_irr, rail_map):
-    big_n, n_y, _ = _table(y, rail[0], rail[1], rail[2], rail[3], rail[4])
-    n_x = 0.0
-    if rail_irr.shape[0] > 0:
-        v, vx, vy = rail_irregularity(x, y, rail_irr, rail_map[0], rail_map[1])
-        big_n, n_x, n_y = big_n + v, vx, n_y + vy
-    return big_n, n_x, n_y
+def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations):
+    """h(alpha, y) on ideal surfaces (no irregularity rows): the irregular kernel's arithmetic with R_a = N_x = 0."""
+    if y < y_range[0] or y > y_range[1]:
+        return math.inf
+    r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
+    if not math.isfinite(r):
+        return math.inf
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    xd0, xd1, xd2 = r * ca, y, r * sa
+    ta0, ta2 = -r * sa, r * ca  # R_a = 0 for an ideal wheel
+    ty0, ty1, ty2 = r_y * ca, 1.0, r_y * sa
+    p1 = rot[1, 0] * xd0 + rot[1, 1] * xd1 + rot[1, 2] * xd2 + centre[1]
+    p2 = rot[2, 0] * xd0 + rot[2, 1] * xd1 + rot[2, 2] * xd2 + centre[2]
+    a0 = rot[0, 0] * ta0 + rot[0, 2] * ta2
+    a1 = rot[1, 0] * ta0 + rot[1, 2] * ta2
+    a2 = rot[2, 0] * ta0 + rot[2, 2] * ta2
+    b0 = rot[0, 0] * ty0 + rot[0, 1] * ty1 + rot[0, 2] * ty2
+    b1 = rot[1, 0] * ty0 + rot[1, 1] * ty1 + rot[1, 2] * ty2
+    b2 = rot[2, 0] * ty0 + rot[2, 1] * ty1 + rot[2, 2] * ty2
+    n0 = b1 * a2 - b2 * a1  # t_y x t_a: outward
+    n1 = b2 * a0 - b0 * a2
+    n2 = b0 * a1 - b1 * a0
+    norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    n0, n1, n2 = n0 / norm, n1 / norm, n2 / norm
+    h = 0.0
+    for _ in range(iterations):
+        py = p1 + h * n1
+        if py < rail_range[0]:
+            py = rail_range[0]
+        elif py > rail_range[1]:
+            py = rail_range[1]
+        big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
+        f = p2 + h * n2 - big_n
+        slope = n2 - n_y * n1
+        if abs(slope) < 1e-3:
+            slope = math.copysign(1e-3, slope)
+        step = f / slope
+        h -= step
+        if abs(step) < 1e-13:
+            break
+    py = p1 + h * n1
+    if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
+        return math.inf
+    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
+    if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
+        return math.inf
+    return h
 
 
 @njit(cache=True)
-def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map):
+def _distance_irregular(
+    alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
+):
     """h(alpha, y) for one wheel point; +inf outside the surfaces or beyond _FAR."""
     if y < y_range[0] or y > y_range[1]:
         return math.inf
     r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
     if not math.isfinite(r):
         return math.inf
-    r_a = 0.0
-    if wheel_irr.shape[0] > 0:
-        v, r_a = wheel_irregularity(alpha, wheel_irr)
-        r += v
+    v, r_a = wheel_irregularity(alpha, wheel_irr)
+    r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
     xd0, xd1, xd2 = r * ca, y, r * sa
     ta0, ta2 = r_a * ca - r * sa, r_a * sa + r * ca
@@ -152,7 +192,9 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
             py = rail_range[0]
         elif py > rail_range[1]:
             py = rail_range[1]
-        big_n, n_x, n_y = _rail(p0 + h * n0, py, rail, rail_irr, rail_map)
+        big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
+        v, n_x, vy = rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])
+        big_n, n_y = big_n + v, n_y + vy
         f = p2 + h * n2 - big_n
         slope = n2 - n_x * n0 - n_y * n1
         if abs(slope) < 1e-3:
@@ -164,7 +206,8 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
     py = p1 + h * n1
     if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
         return math.inf
-    big_n = _rail(p0 + h * n0, py, rail, rail_irr, rail_map)[0]
+    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
+    big_n += rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])[0]
     if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
         return math.inf
     return h
@@ -174,11 +217,43 @@ def _distance(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iteration
 def distance_grid(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations):
     """H on the grid alphas x ys, shape (len(alphas), len(ys))."""
     out = np.empty((alphas.shape[0], ys.shape[0]))
+    ideal = wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0
     for i in range(alphas.shape[0]):
         for j in range(ys.shape[0]):
-            out[i, j] = _distance(
-                alphas[i],
-                ys[j],
+            if ideal:
+                out[i, j] = _distance_ideal(alphas[i], ys[j], rot, centre, wheel, rail, y_range, rail_range, iterations)
+            else:
+                out[i, j] = _distance_irregular(
+                    alphas[i],
+                    ys[j],
+                    rot,
+                    centre,
+                    wheel,
+                    rail,
+                    y_range,
+                    rail_range,
+                    iterations,
+                    wheel_irr,
+                    rail_irr,
+                    rail_map,
+                )
+    return out
+
+
+@njit(cache=True)
+def distance_points(
+    alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations
+):
+    """H at the points (alphas[k], ys[k])."""
+    out = np.empty(alphas.shape[0])
+    ideal = wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0
+    for k in range(alphas.shape[0]):
+        if ideal:
+            out[k] = _distance_ideal(alphas[k], ys[k], rot, centre, wheel, rail, y_range, rail_range, iterations)
+        else:
+            out[k] = _distance_irregular(
+                alphas[k],
+                ys[k],
                 rot,
                 centre,
                 wheel,
@@ -194,25 +269,13 @@ def distance_grid(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, whe
 
 
 @njit(cache=True)
-def distance_points(
-    alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations
-):
-    """H at the points (alphas[k], ys[k])."""
-    out = np.empty(alphas.shape[0])
-    for k in range(alphas.shape[0]):
-        out[k] = _distance(
-            alphas[k], ys[k], rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
-        )
-    return out
-
-
-@njit(cache=True)
 def refine(
     alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
     max_iter, tol, fixed_alpha,
 ):  # fmt: skip
     """Damped Newton on h(alpha, y) from each start; returns (alpha, y, h, converged)."""
     k_max = alphas.shape[0]
+    ideal = wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0
     out_a, out_y, out_h = alphas.copy(), ys.copy(), np.empty(k_max)
     converged = np.zeros(k_max, dtype=np.bool_)
     d = 1.0e-5  # m, difference step in arc length
@@ -224,20 +287,25 @@ def refine(
         a, y = out_a[k], out_y[k]
         for _ in range(max_iter):
             for s in range(9):
-                v = _distance(
-                    a + oa[s] * da,
-                    y + oy[s] * d,
-                    rot,
-                    centre,
-                    wheel,
-                    rail,
-                    y_range,
-                    rail_range,
-                    iterations,
-                    wheel_irr,
-                    rail_irr,
-                    rail_map,
-                )
+                if ideal:
+                    v = _distance_ideal(
+                        a + oa[s] * da, y + oy[s] * d, rot, centre, wheel, rail, y_range, rail_range, iterations
+                    )
+                else:
+                    v = _distance_irregular(
+                        a + oa[s] * da,
+                        y + oy[s] * d,
+                        rot,
+                        centre,
+                        wheel,
+                        rail,
+                        y_range,
+                        rail_range,
+                        iterations,
+                        wheel_irr,
+                        rail_irr,
+                        rail_map,
+                    )
                 hs[s] = v if math.isfinite(v) else 1.0
             g_a = (hs[1] - hs[2]) / (2 * d)
             g_y = (hs[3] - hs[4]) / (2 * d)
@@ -263,7 +331,10 @@ def refine(
                 converged[k] = True
                 break
         out_a[k], out_y[k] = a, y
-        out_h[k] = _distance(
-            a, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
-        )
+        if ideal:
+            out_h[k] = _distance_ideal(a, y, rot, centre, wheel, rail, y_range, rail_range, iterations)
+        else:
+            out_h[k] = _distance_irregular(
+                a, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
+            )
     return out_a, out_y, out_h, converged
