@@ -27,11 +27,15 @@ twice. At each patch:
   nothing: it is h(x, y) - q, negative where the undeformed bodies overlap) and the Hertz-validity test
   ``is_elliptic`` (see :func:`ellipticity_error`).
 
-Speed. Surfaces without irregularities (the ideal geometry of eq 5-6: R = R_id(y_d), N = N_id(y)) are replaced
-for the search by fine cubic-Hermite tables (:func:`fast_surfaces`, 20 um spacing, value error ~1e-14 m) and the
-grid evaluation and the refinement then run in compiled numba kernels (_search_kernels.py): about 1 ms per side
-for the S1002/UIC60 pair (benchmarks/results/search.md). Surfaces with irregularities take the general numpy path
-with their own ``evaluate``. The patch's point, normal and curvatures always come from the exact surfaces.
+Speed. The ideal profiles of rigid_dynamics.geometry's surfaces (R_id(y_d), N_id(y)) are replaced for the search
+by fine cubic-Hermite tables (:func:`fast_surfaces`, 20 um spacing, value error ~1e-14 m) and the grid evaluation
+and the refinement then run in compiled numba kernels (_search_kernels.py): about 1 ms per side for the
+S1002/UIC60 pair (benchmarks/results/search.md). The irregularities of the rolling angle (harmonic
+out-of-roundness, wheel flats) and rail corrugation are added in the kernels in closed form (the formulas of
+rigid_dynamics.geometry.irregularities), about 1.3 ms per side, equal to the numpy path on the exact surfaces
+to ~1e-12 m in the approach (tests/test_search_irregular.py). Other surfaces (measured irregularity grids, rail
+deflection, duck-typed surfaces) take the general numpy path with their own ``evaluate`` (6-10 ms per side).
+The patch's point, normal and curvatures always come from the exact surfaces.
 Option ``profile_only`` is the fast path for tables of ideal geometry without yaw: alpha is fixed at the lowest
 point and only y_d is searched (the problem reduces to the two profiles).
 
