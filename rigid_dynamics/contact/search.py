@@ -338,9 +338,9 @@ def fast_surfaces(wheel, rail):
 class _SideGeometry:
     """Wheel and rail surfaces of one side at one pose: vectorised point / normal / distance evaluation."""
 
-    def __init__(self, wheel, rail, pose: WheelsetPose, side: str, lateral_range_m, rail_lateral_range_m):
+    def __init__(self, wheel, rail, pose: WheelsetPose, side: str, lateral_range_m, rail_lateral_range_m, rot=None):
         self.wheel, self.rail, self.side = wheel, rail, side
-        self.rot = pose.rotation
+        self.rot = pose.rotation if rot is None else rot
         self.centre = pose.centre_m
         self.pose = pose
         self.y_range = lateral_range_m
@@ -573,7 +573,7 @@ def search_side(
     if exact_wheel is wheel and exact_rail is rail:
         geo_exact = geo
     else:
-        geo_exact = _SideGeometry(exact_wheel, exact_rail, pose, side, geo.y_range, geo.rail_range)
+        geo_exact = _SideGeometry(exact_wheel, exact_rail, pose, side, geo.y_range, geo.rail_range, geo.rot)
 
     # Grid around the lowest point alpha = pi/2 - phi (spin angle, see kinematics: R_y(-phi)).
     alpha_mid = 0.5 * np.pi - pose.spin_rad
