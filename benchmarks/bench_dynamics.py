@@ -51,13 +51,12 @@ from wheelrail.config import build_dataclass  # noqa: E402
 NOTES = """\
 Notes.
 
-* What the search path spends its time on (cProfile, 0.01 s of the polygonal scene, 12 ms per RHS): the 3-D search
-  is ~95 % (two sides, ~6 ms each: the grid of distances over (alpha, y_d), eq 11 Newton per point, the refinement
-  of each minimum, all in numpy on the exact irregular surfaces, whose profile splines scipy evaluates point by
-  point); the FASTSIM contact solve and the equations of motion are < 5 %. The search's compiled kernels
-  (contact/_search_kernels.py) serve only ideal surfaces (tabulated wheel and rail); with a polygon the wheel
-  surface is not tabulated, so the numpy path runs. The gap field is already off (``field=False``) for the
-  dynamics.
+* What the search path spends its time on: before the compiled irregular search (cProfile, 0.01 s of the
+  polygonal scene, 12 ms per RHS) the 3-D search was ~95 % (two sides, ~6 ms each, numpy on the exact irregular
+  surfaces). The search now runs polygon, rounded flat and corrugation through its numba kernels (Hermite table of
+  the ideal profile + closed-form irregularities; benchmarks/results/search.md: ~1.3 ms per side), and ~0.6 ms
+  per side goes to evaluating each patch on the exact surfaces with scipy; RHS ~3.6 ms. The FASTSIM contact solve
+  and the equations of motion are a small part. The gap field is off (``field=False``) for the dynamics.
 * search-reuse halves the searches (RK4's two stages at t + h/2 differ by h^2/4 times the accelerations, and the
   last stage of a step and the first of the next by the same order; the output sample is the next step's first
   stage exactly). Its difference to the unmodified search is of the size of the unmodified search's own step-size
