@@ -291,9 +291,7 @@ class BemModel:
         )
         semi_long = semi_lat = None
         if geometry.is_elliptic:
-            jj, ii = np.nonzero(contact)
-            semi_long = float(0.5 * (x[ii].max() - x[ii].min() + dx))
-            semi_lat = float(0.5 * (y[jj].max() - y[jj].min() + dy))
+            semi_long, semi_lat = _elliptic_semi_axes(x, y, p, contact, dx, dy)
         success = bool(norm.converged and tang.converged)
         if success:
             status, message = "ok", "NORM and TANG converged"
@@ -343,3 +341,26 @@ class BemModel:
                 "potential_area_enlargements": grown,
             },
         )
+
+
+def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
+    """Semi-axes (along x, y) of an elliptic patch from a least-squares fit of the pressure field.
+
+    For Hertzian pressure p^2 = p0^2 (1 - (x - xc)^2/a^2 - (y - yc)^2/b^2) (Johnson 1985, eq 4.22), so
+    p^2 is linear in (x - xc)^2 and (y - yc)^2 over the contact elements; a = sqrt(-c0/c1), b = sqrt(-c0/c2)
+    for the fitted p^2 = c0 + c1 (x - xc)^2 + c2 (y - yc)^2, with (xc, yc) the pressure centroid. This is
+    not quantised by the element size as the extent of the contact elements is; the extents (outer edges of
+    the elements in contact) are the fall-back when the fit is degenerate (fewer than 6 elements).
+    """
+    jj, ii = np.nonzero(contact)
+    extents = (float(0.5 * (x[ii].max() - x[ii].min() + dx)), float(0.5 * (y[jj].max() - y[jj].min() + dy)))
+    if len(ii) < 6:
+        return extents
+    weights = pressure[jj, ii]
+    xc = float(np.sum(weights * x[ii]) / np.sum(weights))
+    yc = float(np.sum(weights * y[jj]) / np.sum(weights))
+    design = np.stack([np.ones(len(ii)), (x[ii] - xc) ** 2, (y[jj] - yc) ** 2], axis=1)
+    c0, c1, c2 = np.linalg.lstsq(design, weights**2, rcond=None)[0]
+    if not (c0 > 0 and c1 < 0 and c2 < 0):
+        return extents
+    return float(np.sqrt(-c0 / c1)), float(np.sqrt(-c0 / c2))
