@@ -155,6 +155,11 @@ def rectangle_influence(
         prim = _primitives(x + sx * hx, y + sy * hy)
         for key, val in prim.items():
             acc[key] = acc.get(key, 0.0) + sign * val
+    return _kernels_from_primitives(acc, shear_modulus_Pa, poisson_ratio, difference_parameter)
+
+
+def _kernels_from_primitives(acc, shear_modulus_Pa, poisson_ratio, difference_parameter) -> dict[str, np.ndarray]:
+    """The eight influence kernels from the corner-differenced primitives ``acc`` of one rectangle."""
     c = 1.0 / (math.pi * shear_modulus_Pa)
     nu, k = poisson_ratio, difference_parameter
     out = {
@@ -188,19 +193,7 @@ def _lattice_rectangle_influence(
     cy = (np.arange(dj[0], dj[-1] + 2) - 0.5) * dy_m
     prim = _primitives(*np.meshgrid(cx, cy))
     acc = {k: v[1:, 1:] - v[1:, :-1] - v[:-1, 1:] + v[:-1, :-1] for k, v in prim.items()}
-    c = 1.0 / (math.pi * shear_modulus_Pa)
-    nu, k = poisson_ratio, difference_parameter
-    out = {
-        "zz": c * (1.0 - nu) * acc["inv_r"],
-        "xx": c * ((1.0 - nu) * acc["inv_r"] + nu * acc["xx_r3"]),
-        "yy": c * ((1.0 - nu) * acc["inv_r"] + nu * acc["yy_r3"]),
-        "xy": c * nu * acc["xy_r3"],
-        "zx": c * k * acc["x_r2"],
-        "zy": c * k * acc["y_r2"],
-    }
-    out["xz"] = -out["zx"]
-    out["yz"] = -out["zy"]
-    return out
+    return _kernels_from_primitives(acc, shear_modulus_Pa, poisson_ratio, difference_parameter)
 
 
 def strip_influence(
