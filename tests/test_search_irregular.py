@@ -93,8 +93,8 @@ def test_polygon_shifts_the_approach_by_the_out_of_roundness():
 
 
 def test_closed_forms_equal_the_geometry_package():
-    """The numba closed forms (value, first derivatives) against rigid_dynamics.geometry's numpy evaluate, over
-    a full turn (wrap-around) and across the corrugation band's tapers on both rails."""
+    """The numba closed forms (value, first and second derivatives) against rigid_dynamics.geometry's numpy
+    evaluate, over a full turn (wrap-around) and across the corrugation band's tapers on both rails."""
     wheel_irr = (
         HarmonicOutOfRoundness(3, 3e-4, 0.4), HarmonicOutOfRoundness(7, 1e-5),
         WheelFlat(0.05, R0, centre_angle_rad=3.0),
@@ -102,10 +102,11 @@ def test_closed_forms_equal_the_geometry_package():
     )  # fmt: skip
     rows = compiled_wheel_irregularities(wheel_irr)
     angles = np.linspace(-7.0, 7.0, 4001)
-    ref = [sum(irr.evaluate(angles, 0.0)[k] for irr in wheel_irr) for k in (0, 1)]
+    ref = [sum(irr.evaluate(angles, 0.0)[k] for irr in wheel_irr) for k in (0, 1, 3)]
     got = np.array([kern.wheel_irregularity(a, rows) for a in angles])
     np.testing.assert_allclose(got[:, 0], ref[0], atol=1e-15)
     np.testing.assert_allclose(got[:, 1], ref[1], atol=1e-13)
+    np.testing.assert_allclose(got[:, 2], ref[2], atol=1e-11, rtol=1e-12)
     rail_irr = (RailCorrugation(0.05, 3e-5, 0.3, centre_y_m=0.002, half_width_m=0.01, taper_m=0.004),)
     rows = compiled_rail_irregularities(rail_irr)
     track = build_track(CASE, rail_irregularities={s: rail_irr for s in SIDES})
@@ -124,6 +125,9 @@ def test_closed_forms_equal_the_geometry_package():
         np.testing.assert_allclose(got[:, 0], (exact[0] - ideal[0]).ravel(), atol=1e-15)
         np.testing.assert_allclose(got[:, 1], exact[1].ravel(), atol=1e-13)
         np.testing.assert_allclose(got[:, 2], (exact[2] - ideal[1]).ravel(), atol=1e-12)
+        np.testing.assert_allclose(got[:, 3], exact[3].ravel(), atol=1e-11)
+        np.testing.assert_allclose(got[:, 4], exact[4].ravel(), atol=1e-11)
+        np.testing.assert_allclose(got[:, 5], (exact[5] - ideal[2]).ravel(), atol=1e-9)
 
 
 def test_dense_scan_finds_the_compiled_patches_on_a_polygonal_wheel():

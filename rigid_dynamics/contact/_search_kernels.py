@@ -30,7 +30,7 @@ from numba import njit
 _FAR = 0.05  # |h| beyond this (m) is not a contact candidate (another branch of the rail, or far away)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _table(y, lower, step, value, slope, curvature):
     u = (y - lower) / step
     n = value.shape[0]
@@ -47,23 +47,25 @@ def _table(y, lower, step, value, slope, curvature):
     return val, der, cur
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _wrap_pi(angle):
     """Angle wrapped to [-pi, pi) (Python's float modulo, as numpy's)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def wheel_irregularity(alpha, irr):
-    """(R_irr, dR_irr/da) of the rows of ``irr`` at the angle alpha (module docstring)."""
-    v, va = 0.0, 0.0
+    """(R_irr, dR_irr/da, d2R_irr/da2) of the rows of ``irr`` at the angle alpha (module docstring)."""
+    v, va, vaa = 0.0, 0.0, 0.0
     for k in range(irr.shape[0]):
         code = irr[k, 0]
         if code == 0.0:
             n, amp = irr[k, 1], irr[k, 2]
             arg = n * alpha + irr[k, 3]
-            v += amp * math.cos(arg)
+            c = amp * math.cos(arg)
+            v += c
             va -= amp * n * math.sin(arg)
+            vaa -= n * n * c
         elif code == 1.0:
             da = _wrap_pi(alpha - irr[k, 1])
             r_w, length, depth = irr[k, 2], irr[k, 3], irr[k, 4]
@@ -72,41 +74,48 @@ def wheel_irregularity(alpha, irr):
                 wave = 2.0 * math.pi / length
                 v -= 0.5 * depth * (1.0 + math.cos(wave * s))
                 va += 0.5 * depth * wave * r_w * math.sin(wave * s)
+                vaa += 0.5 * depth * (wave * r_w) ** 2 * math.cos(wave * s)
         else:
             da = _wrap_pi(alpha - irr[k, 1])
             r_w, depth, half = irr[k, 2], irr[k, 3], irr[k, 4]
             if abs(da) <= half:
                 f = (r_w - depth) / math.cos(da)
+                t = math.tan(da)
                 v += f - r_w
-                va += f * math.tan(da)
-    return v, va
+                va += f * t
+                vaa += f * (1.0 + 2.0 * t * t)
+    return v, va, vaa
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rail_irregularity(x, y, irr, sign, offset):
-    """(N_irr, dN_irr/dx, dN_irr/dy) of the rows of ``irr`` at main-frame (x, y); y_r = sign y - offset."""
-    v, vx, vy = 0.0, 0.0, 0.0
+    """(N_irr, N_x, N_y, N_xx, N_xy, N_yy) of the rows of ``irr`` at main-frame (x, y); y_r = sign y - offset."""
+    v, vx, vy, vxx, vxy, vyy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     y_r = sign * y - offset
     for k in range(irr.shape[0]):
         wave, amp, phase, y_c, half, taper = irr[k, 1], irr[k, 2], irr[k, 3], irr[k, 4], irr[k, 5], irr[k, 6]
         u = y_r - y_c
         xi = (abs(u) - half) / taper
         if xi <= 0.0:
-            w, dw = 1.0, 0.0
+            w, dw, d2w = 1.0, 0.0, 0.0
         elif xi >= 1.0:
             continue
         else:
             w = 1.0 - xi**3 * (10.0 - 15.0 * xi + 6.0 * xi * xi)
             dw = -(1.0 if u >= 0 else -1.0) * 30.0 * xi * xi * (1.0 - xi) ** 2 / taper
+            d2w = -60.0 * xi * (1.0 - xi) * (1.0 - 2.0 * xi) / (taper * taper)
         c, s = math.cos(wave * x + phase), math.sin(wave * x + phase)
         v += amp * c * w
         vx -= amp * wave * s * w
         vy += sign * amp * c * dw
-    return v, vx, vy
+        vxx -= amp * wave * wave * c * w
+        vxy -= sign * amp * wave * s * dw
+        vyy += amp * c * d2w
+    return v, vx, vy, vxx, vxy, vyy
 
 
-@njit(cache=True)
-def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations):
+@njit(cache=True, _nrt=False)
+def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, h_start=0.0):
     """h(alpha, y) on ideal surfaces (no irregularity rows): the irregular kernel's arithmetic with R_a = N_x = 0."""
     if y < y_range[0] or y > y_range[1]:
         return math.inf
@@ -130,7 +139,7 @@ def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, ite
     n2 = b0 * a1 - b1 * a0
     norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
     n0, n1, n2 = n0 / norm, n1 / norm, n2 / norm
-    h = 0.0
+    h = h_start
     for _ in range(iterations):
         py = p1 + h * n1
         if py < rail_range[0]:
@@ -155,17 +164,19 @@ def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, ite
     return h
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _distance_irregular(
-    alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
+    alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map, h_start=0.0
 ):
-    """h(alpha, y) for one wheel point; +inf outside the surfaces or beyond _FAR."""
+    """h(alpha, y) for one wheel point; +inf outside the surfaces or beyond _FAR. Newton's method on h starts
+    from h_start (a nearby point's h saves iterations; the converged root is the same).
+    """
     if y < y_range[0] or y > y_range[1]:
         return math.inf
     r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
     if not math.isfinite(r):
         return math.inf
-    v, r_a = wheel_irregularity(alpha, wheel_irr)
+    v, r_a, _ = wheel_irregularity(alpha, wheel_irr)
     r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
     xd0, xd1, xd2 = r * ca, y, r * sa
@@ -185,7 +196,7 @@ def _distance_irregular(
     n2 = b0 * a1 - b1 * a0
     norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
     n0, n1, n2 = n0 / norm, n1 / norm, n2 / norm
-    h = 0.0
+    h = h_start
     for _ in range(iterations):
         py = p1 + h * n1
         if py < rail_range[0]:
@@ -193,7 +204,7 @@ def _distance_irregular(
         elif py > rail_range[1]:
             py = rail_range[1]
         big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
-        v, n_x, vy = rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])
+        v, n_x, vy, _, _, _ = rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])
         big_n, n_y = big_n + v, n_y + vy
         f = p2 + h * n2 - big_n
         slope = n2 - n_x * n0 - n_y * n1
@@ -211,6 +222,18 @@ def _distance_irregular(
     if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
         return math.inf
     return h
+
+
+@njit(cache=True, _nrt=False)
+def distance(
+    alpha, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, h_start=0.0
+):
+    """h(alpha, y): the ideal kernel when there are no irregularity rows, else the irregular one."""
+    if wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0:
+        return _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, h_start)
+    return _distance_irregular(
+        alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map, h_start
+    )
 
 
 @njit(cache=True)
@@ -268,73 +291,78 @@ def distance_points(
     return out
 
 
+@njit(cache=True, _nrt=False)
+def _finite_distance(a, y, args, h_start):
+    """distance(a, y, *args, h_start), with 1 m standing for +inf (outside the surfaces) in the difference
+    quotients.
+    """
+    v = distance(a, y, *args, h_start)
+    return v if math.isfinite(v) else 1.0
+
+
+@njit(cache=True, _nrt=False)
+def refine_point(
+    a, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
+    max_iter, tol, fixed_alpha,
+):  # fmt: skip
+    """Damped Newton on h(alpha, y) from one start (central differences, 9 points).
+
+    Returns (alpha, y, converged, h near the point (a start for its distance), and the last difference Hessian
+    h_aa, h_yy, h_ay in m/m^2, derivatives by arc length a r and y).
+    """
+    d = 1.0e-5  # m, difference step in arc length
+    da = d / radius
+    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations)
+    h_aa = h_yy = h_ay = math.nan
+    hs = 0.0
+    for _ in range(max_iter):
+        h0 = _finite_distance(a, y, args, hs)
+        hs = h0 if abs(h0) < _FAR else 0.0  # start of the neighbours' Newton iterations
+        h1, h2 = _finite_distance(a + da, y, args, hs), _finite_distance(a - da, y, args, hs)
+        h3, h4 = _finite_distance(a, y + d, args, hs), _finite_distance(a, y - d, args, hs)
+        h5, h6 = _finite_distance(a + da, y + d, args, hs), _finite_distance(a + da, y - d, args, hs)
+        h7, h8 = _finite_distance(a - da, y + d, args, hs), _finite_distance(a - da, y - d, args, hs)
+        g_a = (h1 - h2) / (2 * d)
+        g_y = (h3 - h4) / (2 * d)
+        h_aa = (h1 - 2 * h0 + h2) / (d * d)
+        h_yy = (h3 - 2 * h0 + h4) / (d * d)
+        h_ay = (h5 - h6 - h7 + h8) / (4 * d * d)
+        if fixed_alpha:
+            g_a, h_aa, h_ay = 0.0, 1.0, 0.0
+        det = h_aa * h_yy - h_ay * h_ay
+        if h_aa > 0 and det > 0:
+            s_a = -(h_yy * g_a - h_ay * g_y) / det
+            s_y = -(h_aa * g_y - h_ay * g_a) / det
+            ok = True
+        else:
+            s_a, s_y, ok = -g_a * 1e-3, -g_y * 1e-3, False
+        norm = math.sqrt(s_a * s_a + s_y * s_y)
+        if norm > 3.0e-3:
+            s_a *= 3.0e-3 / norm
+            s_y *= 3.0e-3 / norm
+        a += s_a / radius
+        y = min(max(y + s_y, y_range[0]), y_range[1])
+        if ok and norm < tol:
+            return a, y, True, hs, h_aa, h_yy, h_ay
+    return a, y, False, hs, h_aa, h_yy, h_ay
+
+
 @njit(cache=True)
 def refine(
     alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
     max_iter, tol, fixed_alpha,
 ):  # fmt: skip
-    """Damped Newton on h(alpha, y) from each start; returns (alpha, y, h, converged)."""
+    """refine_point from each start; returns (alpha, y, h, converged)."""
     k_max = alphas.shape[0]
-    ideal = wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0
     out_a, out_y, out_h = alphas.copy(), ys.copy(), np.empty(k_max)
     converged = np.zeros(k_max, dtype=np.bool_)
-    d = 1.0e-5  # m, difference step in arc length
-    da = d / radius
-    hs = np.empty(9)
-    oa = (0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 1.0, -1.0, -1.0)
-    oy = (0.0, 0.0, 0.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0)
     for k in range(k_max):
-        a, y = out_a[k], out_y[k]
-        for _ in range(max_iter):
-            for s in range(9):
-                if ideal:
-                    v = _distance_ideal(
-                        a + oa[s] * da, y + oy[s] * d, rot, centre, wheel, rail, y_range, rail_range, iterations
-                    )
-                else:
-                    v = _distance_irregular(
-                        a + oa[s] * da,
-                        y + oy[s] * d,
-                        rot,
-                        centre,
-                        wheel,
-                        rail,
-                        y_range,
-                        rail_range,
-                        iterations,
-                        wheel_irr,
-                        rail_irr,
-                        rail_map,
-                    )
-                hs[s] = v if math.isfinite(v) else 1.0
-            g_a = (hs[1] - hs[2]) / (2 * d)
-            g_y = (hs[3] - hs[4]) / (2 * d)
-            h_aa = (hs[1] - 2 * hs[0] + hs[2]) / (d * d)
-            h_yy = (hs[3] - 2 * hs[0] + hs[4]) / (d * d)
-            h_ay = (hs[5] - hs[6] - hs[7] + hs[8]) / (4 * d * d)
-            if fixed_alpha:
-                g_a, h_aa, h_ay = 0.0, 1.0, 0.0
-            det = h_aa * h_yy - h_ay * h_ay
-            if h_aa > 0 and det > 0:
-                s_a = -(h_yy * g_a - h_ay * g_y) / det
-                s_y = -(h_aa * g_y - h_ay * g_a) / det
-                ok = True
-            else:
-                s_a, s_y, ok = -g_a * 1e-3, -g_y * 1e-3, False
-            norm = math.sqrt(s_a * s_a + s_y * s_y)
-            if norm > 3.0e-3:
-                s_a *= 3.0e-3 / norm
-                s_y *= 3.0e-3 / norm
-            a += s_a / radius
-            y = min(max(y + s_y, y_range[0]), y_range[1])
-            if ok and norm < tol:
-                converged[k] = True
-                break
-        out_a[k], out_y[k] = a, y
-        if ideal:
-            out_h[k] = _distance_ideal(a, y, rot, centre, wheel, rail, y_range, rail_range, iterations)
-        else:
-            out_h[k] = _distance_irregular(
-                a, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map
-            )
+        a, y, ok, hs, _, _, _ = refine_point(
+            out_a[k], out_y[k], rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map,
+            iterations, radius, max_iter, tol, fixed_alpha,
+        )  # fmt: skip
+        out_a[k], out_y[k], converged[k] = a, y, ok
+        out_h[k] = distance(
+            a, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations
+        )
     return out_a, out_y, out_h, converged

@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact.fastsim import _fastsim_one
+from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
@@ -50,7 +51,7 @@ IRR_NEWTON = 3  # Newton steps after the grid (same as providers._running_irregu
 MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _lookup(table, y0, dy, ny, r0, dr, nr, y, roll, out):
     fy = (min(max(y, y0), y0 + (ny - 1) * dy) - y0) / dy
     j = min(int(fy), ny - 2)
@@ -66,7 +67,7 @@ def _lookup(table, y0, dy, ny, r0, dr, nr, y, roll, out):
             )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _uniform(x, x0, step, n):
     f = (x - x0) / step
     if f < 0.0:
@@ -77,7 +78,7 @@ def _uniform(x, x0, step, n):
     return i, f - i
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _irr_parts(par, radius, x0, spin, beta, res):
     """providers._running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
     (q, q', q'', r, r', r'', x offset, N_irr', N_irr'').
@@ -115,7 +116,7 @@ def _irr_parts(par, radius, x0, spin, beta, res):
     res[3], res[4], res[5], res[6], res[7], res[8] = r, r1, r2, xo, n1, n2
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
     """The extra overlap q(beta) of _irr_parts alone (the same arithmetic; for the grid stage, whose sin and cos
     of beta are tabulated once).
@@ -137,7 +138,7 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
     return r * cos_beta - radius - n0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
     """Running-direction irregularity of one candidate (providers._running_irregularity, same steps: a grid of
     IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
@@ -173,7 +174,7 @@ def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
     geo[7] = max(a_long, MIN_LONG_CURV_FRACTION * 0.5 / par[P_R0])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
     """fastsim.effective_flexibilities for one patch (variants three / single / three-unblended)."""
     g = par[P_SHEAR]
@@ -201,10 +202,41 @@ def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
     return (1 - w) * l1 + w * l_comb, (1 - w) * l2 + w * l_comb, (1 - w) * l3 + w * l_comb
 
 
-@njit(cache=True)
-def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, geo, dummy, sc, out, bg):
-    """d/dt of the 14-state into ``out``; fills rec (ncand, N_FIELDS) and the side forces when ``record``.
-    Returns the status.
+@njit(cache=True, _nrt=False)
+def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
+    """Candidate geometry from the tables (providers.TableProvider) and the running-direction irregularities,
+    into cg (ncand, N_GEO) (q, lever, normal, A, B, rolling radius, wheel lateral, contact angle).
+    """
+    xc, yc, zc = y[0], y[1], y[2]
+    sps = math.sin(y[3])
+    _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, y[4], work)
+    zref = par[P_ZREF]
+    for c in range(table.shape[1]):
+        q = work[0, c] + (zc - zref) * work[1, c]
+        if slots[c] > 0 and work[11, c] + (zc - zref) * work[1, c] > 0:
+            q = -0.01
+        ny_, nz_ = work[4, c], work[5, c]
+        nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
+        g = cg[c]
+        g[4], g[5], g[6] = 0.0, ny_ / nn, nz_ / nn
+        g[1], g[2], g[3] = -sps * work[10, c], work[2, c], work[3, c]
+        g[7], g[8], g[9] = work[6, c], work[7, c], work[8, c]
+        g[10], g[11] = work[10, c], work[9, c]
+        if par[P_IRR] > 0 and q > -par[P_REACH] and par[P_IRR_LEFT + sides[c]] > 0:
+            _irregularity(par, work, c, q, xc + g[1], y[5], res, geo, bg)
+            q = geo[0]
+            g[1] += geo[1]
+            g[3] += geo[2]
+            g[4], g[5], g[6] = geo[3], geo[4], geo[5]
+            g[9], g[7] = geo[6], geo[7]
+        g[0] = q
+
+
+@njit(cache=True, _nrt=False)
+def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
+    """d/dt of the 14-state into ``out`` from the candidate geometry cg (ncand, N_GEO) (see _table_geometry;
+    a candidate with q = NaN is absent: recorded as NaN); fills rec (ncand + 2, N_FIELDS) and the side forces
+    when ``record``. Returns the status.
     """
     # scratch rows (no allocation in the loop): normal, lever, point velocity, e_x, e_y, force, moment,
     # total force, total moment, side forces (2), omega, R_z R_x (3 rows)
@@ -223,36 +255,25 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
     rzx[1, 0], rzx[1, 1], rzx[1, 2] = sps, cps * cth, -cps * sth
     rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
     om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
-    _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, roll, work)
-    zref = par[P_ZREF]
     p_con = 0.0
-    ncand = table.shape[1]
+    ncand = cg.shape[0]
     for c in range(ncand):
-        q = work[0, c] + (zc - zref) * work[1, c]
-        if slots[c] > 0 and work[11, c] + (zc - zref) * work[1, c] > 0:
-            q = -0.01
-        ny_, nz_ = work[4, c], work[5, c]
-        nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
-        n[0], n[1], n[2] = 0.0, ny_ / nn, nz_ / nn
-        lever[0], lever[1], lever[2] = -sps * work[10, c], work[2, c], work[3, c]
-        ca, cb, radius = work[6, c], work[7, c], work[8, c]
-        if par[P_IRR] > 0 and q > -par[P_REACH] and par[P_IRR_LEFT + sides[c]] > 0:
-            _irregularity(par, work, c, q, xc + lever[0], y[5], res, geo, bg)
-            q = geo[0]
-            lever[0] += geo[1]
-            lever[2] += geo[2]
-            n[0], n[1], n[2] = geo[3], geo[4], geo[5]
-            radius, ca = geo[6], geo[7]
+        g = cg[c]
+        q = g[0]
+        lever[0], lever[1], lever[2] = g[1], g[2], g[3]
+        n[0], n[1], n[2] = g[4], g[5], g[6]
+        ca, cb, radius = g[7], g[8], g[9]
         if record:
             for f in range(N_FIELDS):
                 rec[c, f] = np.nan
-            rec[c, 0] = 0.0
-            rec[c, 7] = q
-            rec[c, 8] = yc + work[2, c]
-            rec[c, 9] = work[10, c]
-            rec[c, 10] = radius
-            rec[c, 11] = work[9, c]
-        if q <= 0.0:
+            if not math.isnan(q):
+                rec[c, 0] = 0.0
+                rec[c, 7] = q
+                rec[c, 8] = yc + lever[1]
+                rec[c, 9] = g[10]
+                rec[c, 10] = radius
+                rec[c, 11] = g[11]
+        if not q > 0.0:
             continue
         vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
         vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
@@ -395,19 +416,36 @@ def _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, record, res, g
     return 0
 
 
-@njit(cache=True)
-def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk, states, recs, out_start):
-    """Advance ``n_steps`` RK4 steps from (t0, y); record every ``out_every`` steps into states/recs from
-    index ``out_start``. Returns (status, steps done, next output index, t, y, rhs evaluations).
+@njit(cache=True, _nrt=False)
+def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
+    """d/dt of the 14-state: the candidate geometry from the tables (mode 0, _table_geometry) or the 3-D search
+    (mode 1, compiled_search.search_geometry; ``full``: with the lateral scan), then _forces. Returns the status.
     """
-    ncand = table.shape[1]
-    work = np.empty((table.shape[0], ncand))
-    rec = np.empty((ncand + 2, N_FIELDS))
-    res = np.empty(9)
-    geo = np.empty(8)
-    dummy = np.zeros((1, 1))
-    sc = np.zeros((15, 3))
-    bg = np.empty((3, IRR_GRID))
+    work, rec, res, geo, dummy, sc, bg, cg = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
+    if mode == 0:
+        table, grid, slots = targs
+        _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg)
+    else:
+        sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = sargs
+        search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
+    return _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out)
+
+
+@njit(cache=True)
+def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs, states, recs, out_start):
+    """Advance ``n_steps`` RK4 steps from (t0, y); record every ``out_every`` steps into states/recs from
+    index ``out_start``. mode 0: tables (targs = (table, grid, slots)); mode 1: 3-D search (sargs =
+    compiled_search's (sp, tabs, irrs) + workspace, whose memory carries over between calls; the lateral scan
+    runs at each step's first stage and at the recorded samples). Returns (status, steps done, next output
+    index, t, y, rhs evaluations).
+    """
+    ncand = sides.shape[0]
+    n_rows = targs[0].shape[0]
+    ws = (
+        np.empty((n_rows, ncand)), np.empty((ncand + 2, N_FIELDS)), np.empty(9), np.empty(8), np.zeros((1, 1)),
+        np.zeros((15, 3)), np.empty((3, IRR_GRID)), np.zeros((ncand, N_GEO)),
+    )  # fmt: skip
+    rec, bg = ws[1], ws[6]
     step_b = 2.0 * par[P_HALF] / (IRR_GRID - 1)
     for g in range(IRR_GRID):
         bg[0, g] = g * step_b - par[P_HALF]
@@ -416,33 +454,33 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
     nst = y.shape[0]
     y = y.copy()
     k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
-    ys, y_new, d_rec = np.empty(nst), np.empty(nst), np.empty(nst)
+    ys, y_new = np.empty(nst), np.empty(nst)
     t = t0
     k_out = out_start
     evals = 0
     fmax, ymax = par[P_FMAX], par[P_YMAX]
+    have_k1 = False  # k1 of the next step is the recorded sample's derivative (same t and y)
     for step in range(n_steps):
-        st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k1, bg)
-        if st != 0:
-            return st, step, k_out, t, y, evals
+        if not have_k1:
+            st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, False, True, k1)
+            evals += 1
+            if st != 0:
+                return st, step, k_out, t, y, evals
+        have_k1 = False
         for i in range(nst):
             ys[i] = y[i] + 0.5 * h * k1[i]
-        st = _rhs(
-            t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k2, bg
-        )
+        st = _rhs(t + 0.5 * h, ys, par, hz, kk, sides, mode, targs, sargs, ws, False, False, k2)
         if st != 0:
             return st, step, k_out, t, y, evals
         for i in range(nst):
             ys[i] = y[i] + 0.5 * h * k2[i]
-        st = _rhs(
-            t + 0.5 * h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k3, bg
-        )
+        st = _rhs(t + 0.5 * h, ys, par, hz, kk, sides, mode, targs, sargs, ws, False, False, k3)
         if st != 0:
             return st, step, k_out, t, y, evals
         for i in range(nst):
             ys[i] = y[i] + h * k3[i]
-        st = _rhs(t + h, ys, par, table, grid, slots, sides, hz, kk, work, rec, False, res, geo, dummy, sc, k4, bg)
-        evals += 4
+        st = _rhs(t + h, ys, par, hz, kk, sides, mode, targs, sargs, ws, False, False, k4)
+        evals += 3
         if st != 0:
             return st, step, k_out, t, y, evals
         finite = True
@@ -455,17 +493,18 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
         y, y_new = y_new, y
         t = t0 + (step + 1) * h
         if (step + 1) % out_every == 0 and k_out < states.shape[0]:
-            st = _rhs(t, y, par, table, grid, slots, sides, hz, kk, work, rec, True, res, geo, dummy, sc, d_rec, bg)
+            st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, k1)
             evals += 1
             if st != 0:
                 return st, step + 1, k_out, t, y, evals
+            have_k1 = True
             states[k_out, :] = y
             recs[k_out, :, :] = rec
             k_out += 1
             for sd in range(2):
                 total = 0.0
                 for c in range(ncand):
-                    if sides[c] == sd:
+                    if sides[c] == sd and rec[c, 0] > 0:
                         total += rec[c, 0]
                 if total > fmax:
                     return 2, step + 1, k_out, t, y, evals
@@ -475,21 +514,37 @@ def rk4_run(y, t0, h, n_steps, out_every, par, table, grid, slots, sides, hz, kk
 
 
 def supported(scene, provider, model) -> bool:
-    """Whether the compiled path can run this combination: RK4, a TableProvider (with or without running-direction
-    irregularities: polygon, rounded flat, corrugation) and one of the registry's models in MODEL_CODES.
+    """Whether the compiled path can run this combination: RK4, one of the registry's models in MODEL_CODES, and
+    a TableProvider (with or without running-direction irregularities: polygon, rounded flat, corrugation) or a
+    SearchProvider on tabulated surfaces (ideal profiles with polygon, flats or corrugation).
     """
+    from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
+    from rigid_dynamics.wheelset.profiles import SearchProvider
     from rigid_dynamics.wheelset.providers import TableProvider
 
-    return (
+    if not (
         scene.integrator.method == "RK4"
-        and type(provider) is TableProvider
         and getattr(model, "name", None) in MODEL_CODES
         and type(model).__module__ == "rigid_dynamics.contact.models"
-    )
+    ):
+        return False
+    if type(provider) is TableProvider:
+        return True
+    if type(provider) is SearchProvider:
+        fast = getattr(provider.surfaces, "fast", None)
+        return fast is not None and all(
+            isinstance(w, TabulatedWheel) and isinstance(r, TabulatedRail) for w, r in fast.values()
+        )
+    return False
 
 
 def pack(model_wheelset, provider, tables, model_name, options=None):
-    """Parameter vector and arrays of the compiled RHS from a WheelsetModel, its TableProvider and tables."""
+    """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
+    Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
+    """
+    from rigid_dynamics.wheelset.profiles import SearchProvider
+
+    search = type(provider) is SearchProvider
     m = model_wheelset
     scene = m.scene
     par = np.zeros(N_PAR)
@@ -504,7 +559,7 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
     par[P_ESTAR] = tables.e_star
     par[P_MU] = scene.material.friction_coefficient
     par[P_MODEL] = MODEL_CODES[model_name]
-    par[P_ZREF] = provider.z_ref
+    par[P_ZREF] = 0.0 if search else provider.z_ref
     par[P_FMAX] = scene.integrator.max_force_factor * scene.static_wheel_load_N
     par[P_YMAX] = scene.integrator.max_lateral_displacement_m
     opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
@@ -513,7 +568,7 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
     par[P_PARAB] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
     par[P_FLEX] = FLEX_CODES[opts["flexibility"]]
     par[P_R0] = provider.r0
-    irr = provider.irregularities
+    irr = None if search else provider.irregularities
     if irr is not None:
         from rigid_dynamics.wheelset.irregular import flat_depth_m
 
@@ -532,11 +587,30 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
             par[P_CORR_W], par[P_CORR_A] = irr.corrugation_wavelength_m, irr.corrugation_amplitude_m
             half = max(half, 0.6 * irr.corrugation_wavelength_m / provider.r0)
         par[P_REACH], par[P_HALF] = reach, half
-    yg, rg = provider.y_grid, provider.roll_grid
-    grid = np.array([yg[0], yg[1] - yg[0], len(yg), rg[0], rg[1] - rg[0], len(rg)], float)
     hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
     hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
     kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
     kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
+    if search:
+        from rigid_dynamics.wheelset import compiled_search as cs
+
+        sides = np.array([0, 0, 1, 1], np.int64)
+        slots = np.array([0, 1, 0, 1], np.int64)
+        targs = (np.zeros((1, 4, 2, 2)), np.zeros(6), slots)
+        sargs = (*cs.pack_search(provider, provider.options), *cs.workspace())
+        return par, hz, kk, sides, slots, 1, targs, sargs
+    yg, rg = provider.y_grid, provider.roll_grid
+    grid = np.array([yg[0], yg[1] - yg[0], len(yg), rg[0], rg[1] - rg[0], len(rg)], float)
     table = np.ascontiguousarray(provider.table)
-    return par, table, grid, np.asarray(provider.slot, np.int64), np.asarray(provider.side, np.int64), hz, kk
+    slots = np.asarray(provider.slot, np.int64)
+    sides = np.asarray(provider.side, np.int64)
+    return par, hz, kk, sides, slots, 0, (table, grid, slots), _dummy_search()
+
+
+def _dummy_search():
+    """The search arguments of the tables mode (never read; of the search mode's types)."""
+    from rigid_dynamics.wheelset import compiled_search as cs
+
+    tab = np.zeros((3, 2))
+    irr = np.zeros((0, 7))
+    return (np.zeros((2, cs.SP_LEN)), (tab, tab, tab, tab), (irr, irr, irr, irr), *cs.workspace())

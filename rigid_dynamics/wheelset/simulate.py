@@ -469,7 +469,8 @@ def simulate(
     can_compile = _compiled.supported(scene, provider, model_obj) and model.batch is not None
     if compiled and not can_compile:
         raise ValueError(
-            "compiled = True: the compiled path needs method RK4, a TableProvider and one of "
+            "compiled = True: the compiled path needs method RK4, a TableProvider or a SearchProvider on tabulated "
+            "surfaces, and one of "
             f"the models {', '.join(_compiled.MODEL_CODES)}"
         )
     use_compiled = can_compile and compiled is not False
@@ -640,14 +641,14 @@ def _run_compiled(model, provider, y0, duration, settings, recorder, report, sta
     """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
     from rigid_dynamics.wheelset import compiled
 
-    par, table, grid, slots, sides, hz, kk = compiled.pack(
+    par, hz, kk, sides, slots, mode, targs, sargs = compiled.pack(
         model, provider, model.batch.tables, model.model.name, model.batch.options
     )
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
     out_every = max(1, int(round(settings.output_step_s / h)))
     n_out = n_steps // out_every
-    ncand = table.shape[1]
+    ncand = len(sides)
     states = np.zeros((n_out, 14))
     recs = np.zeros((n_out, ncand + 2, compiled.N_FIELDS))
     y, t, done, k_out = y0.copy(), 0.0, 0, 0
@@ -656,7 +657,7 @@ def _run_compiled(model, provider, y0, duration, settings, recorder, report, sta
     while done < n_steps:
         todo = min(chunk, n_steps - done)
         status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
-            y, t, h, todo, out_every, par, table, grid, slots, sides, hz, kk, states, recs, k_out
+            y, t, h, todo, out_every, par, hz, kk, sides, mode, targs, sargs, states, recs, k_out
         )
         model.rhs_evaluations += int(evals)
         if k_new > k_out:

@@ -1,0 +1,458 @@
+"""Compiled (numba) 3-D contact search for the compiled RK4 loop: the patches of both wheels at one pose.
+
+The same search as rigid_dynamics.contact.search.search_side with the SearchProvider of profiles.py, on the
+same surfaces (the TabulatedWheel/TabulatedRail stand-ins: Hermite tables of the ideal profiles plus the closed-
+form irregularities of contact._search_kernels), with two changes that make it cheap enough to run at every
+right-hand side:
+
+* Candidates. search_side refines every minimum of h(alpha, y_d) on an (alpha, y_d) grid. Here a *full*
+  evaluation (the first stage of each RK4 step and every recorded sample) scans the vertical gap
+  N(p_x, p_y) - p_z of the wheel points at the lowest angle alpha = pi/2 - phi along y_d (step
+  ``scan_step_m``); every local minimum of that gap below ``candidate_gap_m / cos(75 deg)`` is a start (a
+  vertical gap is the normal gap divided by the cosine of the contact angle to first order, and its minima
+  sit where the profile slopes are equal, the 2-D condition of a minimum of h). The start is the nearest
+  candidate of the previous evaluation within ``memory_radius_m`` when there is one (warm start), else the scan
+  point. The other RK4 stages start from the previous evaluation's candidates alone (the pose moves by
+  O(h v) within a step; a new minimum appears at the next step's scan at the latest).
+* Patch geometry. Point, normal and curvatures (eq 12-33: curvature tensors of both surfaces in the rolling-
+  direction basis, D = (K_w - K_r)/2, principal A nearest the rolling direction) are evaluated on the same
+  tabulated surfaces (the second derivative of each profile interpolated linearly between nodes 2e-5 m apart)
+  instead of search_side's exact surfaces.
+
+Each start is refined by contact._search_kernels.refine_point (the damped Newton of search_side), candidates
+are deduplicated as in search_side (the same point, or one interpenetration region: h < 0 along the joining
+segment), and the two deepest patches of a side, ordered by contact angle, fill slots 0 and 1 (SearchProvider).
+A side without contact gets SearchProvider's placeholder in slot 0 (q = -smallest gap) and an absent slot 1
+(q = NaN). tests/test_dynamics_compiled_search.py compares the geometry with SearchProvider's.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rigid_dynamics.contact._search_kernels import (
+    _table,
+    distance,
+    rail_irregularity,
+    refine_point,
+    wheel_irregularity,
+)
+
+N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
+MAX_START = 8  # starts refined per side and evaluation
+MAX_MEMORY = 4  # candidates kept per side for the next evaluation
+ABSENT_GAP_M = 0.01  # profiles.ABSENT_GAP_M
+COS_STEEPEST = math.cos(math.radians(75.0))
+
+# layout of the per-side rows of ``sp`` (search parameters), shape (2, SP_LEN)
+(
+    S_YLO, S_YHI, S_RLO, S_RHI, S_RSIGN, S_ROFF, S_WLOW, S_WSTEP, S_RLOW, S_RSTEP, S_SIGN,
+    S_SCAN, S_GAP, S_NEWTON, S_ITER, S_TOL, S_RADIUS, S_MEMR, S_TRACK,
+) = range(19)  # fmt: skip
+SP_LEN = 19
+
+
+@njit(cache=True, _nrt=False)
+def rotation(yaw, roll, spin, rot):
+    """C_D = R_z(psi) R_x(theta) R_y(-phi) (kinematics.wheelset_rotation) into rot (3, 3)."""
+    cps, sps, cth, sth, cph, sph = (
+        math.cos(yaw),
+        math.sin(yaw),
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(spin),
+        math.sin(spin),
+    )
+    # R_z R_x
+    a00, a01, a02 = cps, -sps * cth, sps * sth
+    a10, a11, a12 = sps, cps * cth, -cps * sth
+    a20, a21, a22 = 0.0, sth, cth
+    # times R_y(-phi) = [[c, 0, -s], [0, 1, 0], [s, 0, c]]
+    rot[0, 0], rot[0, 1], rot[0, 2] = a00 * cph + a02 * sph, a01, -a00 * sph + a02 * cph
+    rot[1, 0], rot[1, 1], rot[1, 2] = a10 * cph + a12 * sph, a11, -a10 * sph + a12 * cph
+    rot[2, 0], rot[2, 1], rot[2, 2] = a20 * cph + a22 * sph, a21, -a20 * sph + a22 * cph
+
+
+@njit(cache=True, _nrt=False)
+def _vertical_gap(cos_a, sin_a, r_irr, y_d, rot, centre, wheel, rail, rail_range, rail_irr, rail_map):
+    """N(p_x, p_y) - p_z of the wheel point (alpha, y_d) (cos, sin of alpha and R_irr(alpha) given); +inf where
+    the wheel or the rail is not defined.
+    """
+    r = _table(y_d, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])[0]
+    if not math.isfinite(r):
+        return math.inf
+    r += r_irr
+    x0, x2 = r * cos_a, r * sin_a
+    py = rot[1, 0] * x0 + rot[1, 1] * y_d + rot[1, 2] * x2 + centre[1]
+    if not (py >= rail_range[0] and py <= rail_range[1]):
+        return math.inf
+    pz = rot[2, 0] * x0 + rot[2, 1] * y_d + rot[2, 2] * x2 + centre[2]
+    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
+    if rail_irr.shape[0] > 0:
+        px = rot[0, 0] * x0 + rot[0, 1] * y_d + rot[0, 2] * x2 + centre[0]
+        big_n += rail_irregularity(px, py, rail_irr, rail_map[0], rail_map[1])[0]
+    return big_n - pz
+
+
+@njit(cache=True, _nrt=False)
+def _tensor(du, dv, duu, duv, dvv, n, e1, e2):
+    """Curvature tensor (k11, k12, k22) of a parametric surface in the basis (e1, e2) (curvature.curvature_tensor)."""
+    h11 = n[0] * duu[0] + n[1] * duu[1] + n[2] * duu[2]
+    h12 = n[0] * duv[0] + n[1] * duv[1] + n[2] * duv[2]
+    h22 = n[0] * dvv[0] + n[1] * dvv[1] + n[2] * dvv[2]
+    a11 = e1[0] * du[0] + e1[1] * du[1] + e1[2] * du[2]
+    a12 = e1[0] * dv[0] + e1[1] * dv[1] + e1[2] * dv[2]
+    a21 = e2[0] * du[0] + e2[1] * du[1] + e2[2] * du[2]
+    a22 = e2[0] * dv[0] + e2[1] * dv[1] + e2[2] * dv[2]
+    det = a11 * a22 - a12 * a21
+    b11, b12, b21, b22 = a22 / det, -a12 / det, -a21 / det, a11 / det
+    k11 = b11 * (h11 * b11 + h12 * b21) + b21 * (h12 * b11 + h22 * b21)
+    k12 = b11 * (h11 * b12 + h12 * b22) + b21 * (h12 * b12 + h22 * b22)
+    k22 = b12 * (h11 * b12 + h12 * b22) + b22 * (h12 * b12 + h22 * b22)
+    return k11, k12, k22
+
+
+@njit(cache=True, _nrt=False)
+def _rot(rot, v, out):
+    for i in range(3):
+        out[i] = rot[i, 0] * v[0] + rot[i, 1] * v[1] + rot[i, 2] * v[2]
+
+
+@njit(cache=True, _nrt=False)
+def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr, rail_map, right, vb, g):
+    """Geometry of the patch at the refined minimum (alpha, y_d) with distance h into g (N_GEO): search._patch's
+    point, normal and principal relative curvatures, on the tabulated surfaces. vb: scratch (12, 3).
+    """
+    r, r_y, r_yy = _table(y_d, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
+    v, r_a, r_aa = wheel_irregularity(alpha, wheel_irr)
+    r += v
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    loc = vb[11]
+    p, t_a, t_y, x_aa, x_ay, x_yy = vb[0], vb[1], vb[2], vb[3], vb[4], vb[5]
+    loc[0], loc[1], loc[2] = r * ca, y_d, r * sa
+    _rot(rot, loc, p)
+    loc[0], loc[1], loc[2] = r_a * ca - r * sa, 0.0, r_a * sa + r * ca
+    _rot(rot, loc, t_a)
+    loc[0], loc[1], loc[2] = r_y * ca, 1.0, r_y * sa
+    _rot(rot, loc, t_y)
+    loc[0], loc[1], loc[2] = r_aa * ca - 2.0 * r_a * sa - r * ca, 0.0, r_aa * sa + 2.0 * r_a * ca - r * sa
+    _rot(rot, loc, x_aa)
+    loc[0], loc[1], loc[2] = -r_y * sa, 0.0, r_y * ca
+    _rot(rot, loc, x_ay)
+    loc[0], loc[1], loc[2] = r_yy * ca, 0.0, r_yy * sa
+    _rot(rot, loc, x_yy)
+    for i in range(3):
+        p[i] += centre[i]
+    n, e1, e2 = vb[6], vb[7], vb[8]
+    # n = -(t_y x t_a)/|.|: from the rail into the wheel
+    n[0] = -(t_y[1] * t_a[2] - t_y[2] * t_a[1])
+    n[1] = -(t_y[2] * t_a[0] - t_y[0] * t_a[2])
+    n[2] = -(t_y[0] * t_a[1] - t_y[1] * t_a[0])
+    norm = math.sqrt(n[0] ** 2 + n[1] ** 2 + n[2] ** 2)
+    for i in range(3):
+        n[i] /= norm
+    # rail point = p + h * outward normal
+    qx, qy, qz = p[0] - h * n[0], p[1] - h * n[1], p[2] - h * n[2]
+    # rolling-direction basis (search option rolling_direction = main x)
+    e1[0], e1[1], e1[2] = 1.0 - n[0] * n[0], -n[0] * n[1], -n[0] * n[2]
+    norm = math.sqrt(e1[0] ** 2 + e1[1] ** 2 + e1[2] ** 2)
+    for i in range(3):
+        e1[i] /= norm
+    e2[0] = n[1] * e1[2] - n[2] * e1[1]
+    e2[1] = n[2] * e1[0] - n[0] * e1[2]
+    e2[2] = n[0] * e1[1] - n[1] * e1[0]
+    w11, w12, w22 = _tensor(t_a, t_y, x_aa, x_ay, x_yy, n, e1, e2)
+    big_n, n_y, n_yy = _table(qy, rail[0], rail[1], rail[2], rail[3], rail[4])
+    _, n_x, vy, n_xx, n_xy, vyy = rail_irregularity(qx, qy, rail_irr, rail_map[0], rail_map[1])
+    n_y += vy
+    n_yy += vyy
+    du, dv, duu, duv, dvv = vb[1], vb[2], vb[3], vb[4], vb[5]  # reused for the rail
+    du[0], du[1], du[2] = 1.0, 0.0, n_x
+    dv[0], dv[1], dv[2] = 0.0, 1.0, n_y
+    duu[0], duu[1], duu[2] = 0.0, 0.0, n_xx
+    duv[0], duv[1], duv[2] = 0.0, 0.0, n_xy
+    dvv[0], dvv[1], dvv[2] = 0.0, 0.0, n_yy
+    r11, r12, r22 = _tensor(du, dv, duu, duv, dvv, n, e1, e2)
+    d11, d12, d22 = 0.5 * (w11 - r11), 0.5 * (w12 - r12), 0.5 * (w22 - r22)
+    # principal values; A belongs to the direction within +-pi/4 of e1 (curvature.principal_relative_curvature)
+    mean, half = 0.5 * (d11 + d22), math.sqrt(0.25 * (d11 - d22) ** 2 + d12 * d12)
+    angle = 0.5 * math.atan2(2.0 * d12, d11 - d22)  # direction of mean + half
+    if abs(angle) <= 0.25 * math.pi:
+        big_a, big_b = mean + half, mean - half
+    else:
+        big_a, big_b = mean - half, mean + half
+    g[0] = -h
+    g[1], g[2], g[3] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1], 0.5 * (p[2] + qz) - centre[2]
+    g[4], g[5], g[6] = n[0], n[1], n[2]
+    g[7], g[8] = max(big_a, 1e-6), max(big_b, 1e-6)
+    g[9] = r
+    g[10] = y_d
+    tilt = -n[1] if right else n[1]
+    g[11] = math.atan2(tilt, -n[2])
+
+
+@njit(cache=True, _nrt=False)
+def _side_args(sp, tabs, irrs, s):
+    wheel = (sp[s, S_WLOW], sp[s, S_WSTEP], tabs[2 * s][0], tabs[2 * s][1], tabs[2 * s][2])
+    rail = (sp[s, S_RLOW], sp[s, S_RSTEP], tabs[2 * s + 1][0], tabs[2 * s + 1][1], tabs[2 * s + 1][2])
+    return wheel, rail, irrs[2 * s], irrs[2 * s + 1]
+
+
+@njit(cache=True, _nrt=False)
+def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg):
+    """Candidates and patches of side s (0 left, 1 right) into cg rows 2 s, 2 s + 1; updates the memory
+    mem[s] (MAX_MEMORY, 6: angle from the lowest point alpha - (pi/2 - phi), y_d, h, h_aa, h_yy, h_ay) / n_mem[s]:
+    the angle is kept relative to the lowest point, so that a warm start follows the wheel's rotation; the
+    Hessian is the last refinement's. cand: scratch (MAX_START, 7: alpha, y_d, h, mark, Hessian),
+    order: scratch (MAX_START,) int. Returns the number of starts that did not converge.
+    """
+    wheel, rail, wheel_irr, rail_irr = _side_args(sp, tabs, irrs, s)
+    y_range, rail_range, rail_map = sp[s, S_YLO : S_YHI + 1], sp[s, S_RLO : S_RHI + 1], sp[s, S_RSIGN : S_ROFF + 1]
+    iters, radius = int(sp[s, S_NEWTON]), sp[s, S_RADIUS]
+    alpha_mid = 0.5 * math.pi - spin
+    n_start = 0
+    if full:
+        step = sp[s, S_SCAN]
+        # y_d whose lowest point can lie over the rail: p_y = rot[1, 1] y_d + rot[1, 0] x + rot[1, 2] z + c_y with
+        # |x|, |z| <= 1.2 r0 (a margin of 0.2 r0 on the radius)
+        reach = 1.2 * radius * (abs(rot[1, 0]) + abs(rot[1, 2]))
+        lo = (rail_range[0] - centre[1] - reach) / rot[1, 1]
+        hi = (rail_range[1] - centre[1] + reach) / rot[1, 1]
+        y0 = max(y_range[0], min(lo, hi) - step)
+        n_scan = int((min(y_range[1], max(lo, hi) + step) - y0) / step) + 1
+        limit = sp[s, S_GAP] / COS_STEEPEST
+        cos_a, sin_a, r_irr = math.cos(alpha_mid), math.sin(alpha_mid), wheel_irregularity(alpha_mid, wheel_irr)[0]
+        g_prev2, g_prev = math.inf, math.inf
+        for k in range(n_scan + 1):
+            if k < n_scan:
+                yk = y0 + k * step
+                gk = _vertical_gap(cos_a, sin_a, r_irr, yk, rot, centre, wheel, rail, rail_range, rail_irr, rail_map)
+            else:
+                gk = math.inf
+            # the previous sample is a minimum: below its left neighbour, not above its right one
+            if k >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < limit:
+                y_s = y0 + (k - 1) * step
+                if n_start < MAX_START:
+                    cand[n_start, 0], cand[n_start, 1], cand[n_start, 3] = alpha_mid, y_s, g_prev
+                    n_start += 1
+                else:  # keep the lowest
+                    worst = 0
+                    for j in range(1, MAX_START):
+                        if cand[j, 3] > cand[worst, 3]:
+                            worst = j
+                    if g_prev < cand[worst, 3]:
+                        cand[worst, 0], cand[worst, 1], cand[worst, 3] = alpha_mid, y_s, g_prev
+            g_prev2, g_prev = g_prev, gk
+        # warm starts from the memory
+        for j in range(n_start):
+            best, dist = -1, sp[s, S_MEMR]
+            for m in range(n_mem[s]):
+                d = abs(mem[s, m, 1] - cand[j, 1])
+                if d < dist:
+                    best, dist = m, d
+            if best >= 0:
+                cand[j, 0], cand[j, 1] = alpha_mid + mem[s, best, 0], mem[s, best, 1]
+    failed = 0
+    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
+    if not full:
+        # track the last candidates: one Newton step with central-difference gradient and the Hessian of their
+        # last refinement (the pose moved by O(h v) since)
+        d = 1.0e-5
+        da = d / radius
+        for m in range(n_mem[s]):
+            a, yd, h_m = alpha_mid + mem[s, m, 0], mem[s, m, 1], mem[s, m, 2]
+            h_aa, h_yy, h_ay = mem[s, m, 3], mem[s, m, 4], mem[s, m, 5]
+            h0 = distance(a, yd, *args, h_m)
+            det = h_aa * h_yy - h_ay * h_ay
+            tracked = False
+            if math.isfinite(h0) and h_aa > 0 and det > 0:
+                hs = h0
+                g_a = (distance(a + da, yd, *args, hs) - distance(a - da, yd, *args, hs)) / (2 * d)
+                g_y = (distance(a, yd + d, *args, hs) - distance(a, yd - d, *args, hs)) / (2 * d)
+                s_a = -(h_yy * g_a - h_ay * g_y) / det
+                s_y = -(h_aa * g_y - h_ay * g_a) / det
+                if math.isfinite(s_a) and math.isfinite(s_y) and s_a * s_a + s_y * s_y < sp[s, S_TRACK] ** 2:
+                    a += s_a / radius
+                    yd = min(max(yd + s_y, y_range[0]), y_range[1])
+                    cand[n_start, 2] = distance(a, yd, *args, hs)
+                    cand[n_start, 4], cand[n_start, 5], cand[n_start, 6] = h_aa, h_yy, h_ay
+                    tracked = True
+            if not tracked:
+                a, yd, ok, hs, h_aa, h_yy, h_ay = refine_point(
+                    a, yd, *args, radius, int(sp[s, S_ITER]), sp[s, S_TOL], False
+                )
+                cand[n_start, 2] = distance(a, yd, *args, hs)
+                cand[n_start, 4], cand[n_start, 5], cand[n_start, 6] = h_aa, h_yy, h_ay
+                if not ok:
+                    failed += 1
+            cand[n_start, 0], cand[n_start, 1], cand[n_start, 3] = a, yd, 0.0
+            n_start += 1
+    else:
+        for j in range(n_start):
+            a, yd, ok, hs, h_aa, h_yy, h_ay = refine_point(
+                cand[j, 0], cand[j, 1], *args, radius, int(sp[s, S_ITER]), sp[s, S_TOL], False
+            )
+            cand[j, 0], cand[j, 1] = a, yd
+            cand[j, 2] = distance(a, yd, *args, hs)
+            cand[j, 3] = 0.0  # not taken yet (the deduplication marks taken starts with -1)
+            cand[j, 4], cand[j, 5], cand[j, 6] = h_aa, h_yy, h_ay
+            if not ok:
+                failed += 1
+    # deduplicate, deepest first (search_side): the same point, or one interpenetration region
+    n_kept = 0
+    for _ in range(n_start):
+        best = -1
+        for j in range(n_start):
+            if math.isfinite(cand[j, 2]) and cand[j, 3] != -1.0 and (best < 0 or cand[j, 2] < cand[best, 2]):
+                best = j
+        if best < 0:
+            break
+        cand[best, 3] = -1.0  # taken
+        duplicate = False
+        for i in range(n_kept):
+            k = order[i]
+            if abs(cand[best, 1] - cand[k, 1]) < 1e-6 and abs(cand[best, 0] - cand[k, 0]) * radius < 1e-6:
+                duplicate = True
+                break
+            if cand[best, 2] < 0:
+                inside = True
+                for q in range(25):
+                    t = q / 24.0
+                    hv = distance(
+                        cand[k, 0] + t * (cand[best, 0] - cand[k, 0]), cand[k, 1] + t * (cand[best, 1] - cand[k, 1]),
+                        *args, cand[k, 2],
+                    )  # fmt: skip
+                    if not hv < 0:
+                        inside = False
+                        break
+                if inside:
+                    duplicate = True
+                    break
+        if not duplicate:
+            order[n_kept] = best
+            n_kept += 1
+    # memory for the next evaluation
+    n_mem[s] = 0
+    for i in range(n_kept):
+        k = order[i]
+        if cand[k, 2] < sp[s, S_GAP] and n_mem[s] < MAX_MEMORY:
+            mem[s, n_mem[s], 0], mem[s, n_mem[s], 1] = cand[k, 0] - alpha_mid, cand[k, 1]
+            mem[s, n_mem[s], 2] = cand[k, 2]
+            mem[s, n_mem[s], 3], mem[s, n_mem[s], 4], mem[s, n_mem[s], 5] = cand[k, 4], cand[k, 5], cand[k, 6]
+            n_mem[s] += 1
+    # patches: the two deepest (order is by depth), then by contact angle
+    right = s == 1
+    c0, c1 = 2 * s, 2 * s + 1
+    n_patch = 0
+    for i in range(min(n_kept, 2)):
+        k = order[i]
+        if cand[k, 2] < 0:
+            patch_geometry(
+                cand[k, 0],
+                cand[k, 1],
+                cand[k, 2],
+                rot,
+                centre,
+                wheel,
+                rail,
+                wheel_irr,
+                rail_irr,
+                rail_map,
+                right,
+                vb,
+                cg[c0 + n_patch],
+            )
+            n_patch += 1
+    if n_patch == 2 and cg[c1, 11] < cg[c0, 11]:
+        for f in range(N_GEO):
+            cg[c0, f], cg[c1, f] = cg[c1, f], cg[c0, f]
+    if n_patch == 0:
+        gap = cand[order[0], 2] if n_kept > 0 else ABSENT_GAP_M
+        sign = sp[s, S_SIGN]
+        g = cg[c0]
+        g[0] = -gap
+        g[1], g[2], g[3] = 0.0, sign * 0.75, radius
+        g[4], g[5], g[6] = 0.0, 0.0, -1.0
+        g[7], g[8], g[9] = 0.5 / radius, 0.5 / 0.3, radius
+        g[10], g[11] = sign * 0.75, 0.0
+    if n_patch < 2:
+        cg[c1, 0] = math.nan
+    return failed
+
+
+@njit(cache=True, _nrt=False)
+def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg):
+    """Both sides' patches at the state y into cg (4, N_GEO). Returns the number of unconverged refinements."""
+    rotation(y[3], y[4], y[5], rot)
+    failed = 0
+    for s in range(2):
+        failed += search_side(s, y[0:3], rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
+    return failed
+
+
+def pack_search(provider, options=None):
+    """(sp, tabs, irrs) of search_geometry from a SearchProvider (its surfaces' fast stand-ins).
+
+    Options (all optional): ``scan_step_m`` (1e-3), ``memory_radius_m`` (2e-3), ``track_step_m`` (1e-4: a
+    tracking step longer than this is replaced by a full refinement), and the contact-search options
+    candidate_gap_m, newton_iterations, refine_iterations, refine_tolerance_m (search.DEFAULT_OPTIONS).
+
+    Raises:
+        ValueError: a side's surfaces are not tabulated (an irregularity the compiled kernels do not evaluate:
+            measured grids, rail deflection).
+    """
+    from rigid_dynamics.contact.search import DEFAULT_OPTIONS, TabulatedRail, TabulatedWheel
+
+    opts = {k: DEFAULT_OPTIONS[k] for k in ("candidate_gap_m", "newton_iterations", "refine_iterations")}
+    # The contact point after a Newton step of size s is off by O(s^2 / profile radius): a 1e-7 m last step leaves
+    # ~1e-12 m, as search_side's 1e-9 m, at fewer refinement iterations.
+    opts["refine_tolerance_m"] = 1.0e-7
+    opts.update({"scan_step_m": 1.0e-3, "memory_radius_m": 2.0e-3, "track_step_m": 1.0e-4})
+    for key, value in (options or {}).items():
+        if key in opts:
+            opts[key] = value
+    sp = np.zeros((2, SP_LEN))
+    tabs, irrs = [], []
+    for s, side in enumerate(("left", "right")):
+        wheel, rail = provider.surfaces.fast[side]
+        if not (isinstance(wheel, TabulatedWheel) and isinstance(rail, TabulatedRail)):
+            raise ValueError(
+                f"{side} side: the compiled search needs tabulated surfaces (ideal profiles with polygon, flat or "
+                "corrugation); this scene's irregularities need the Python search"
+            )
+        w_low, w_step = wheel.table_tuple[:2]
+        r_low, r_step = rail.table_tuple[:2]
+        sp[s, S_YLO : S_YHI + 1] = wheel.y_range_m
+        sp[s, S_RLO : S_RHI + 1] = rail.y_range_m
+        sp[s, S_RSIGN : S_ROFF + 1] = rail.lateral_map
+        sp[s, S_WLOW], sp[s, S_WSTEP], sp[s, S_RLOW], sp[s, S_RSTEP] = w_low, w_step, r_low, r_step
+        sp[s, S_SIGN] = -1.0 if side == "left" else 1.0
+        sp[s, S_SCAN], sp[s, S_GAP] = opts["scan_step_m"], opts["candidate_gap_m"]
+        sp[s, S_NEWTON], sp[s, S_ITER], sp[s, S_TOL] = (
+            opts["newton_iterations"],
+            opts["refine_iterations"],
+            opts["refine_tolerance_m"],
+        )
+        sp[s, S_RADIUS] = provider.r0
+        sp[s, S_MEMR] = opts["memory_radius_m"]
+        sp[s, S_TRACK] = opts["track_step_m"]
+        tabs.append(np.ascontiguousarray(np.stack(wheel.table_tuple[2:])))
+        tabs.append(np.ascontiguousarray(np.stack(rail.table_tuple[2:])))
+        irrs.append(np.ascontiguousarray(wheel.irregularity_rows, float).reshape(-1, 7))
+        irrs.append(np.ascontiguousarray(rail.irregularity_rows, float).reshape(-1, 7))
+    return sp, tuple(tabs), tuple(irrs)
+
+
+def workspace():
+    """Scratch and memory arrays of search_geometry: (mem, n_mem, cand, order, vb, rot)."""
+    return (
+        np.zeros((2, MAX_MEMORY, 6)),
+        np.zeros(2, np.int64),
+        np.zeros((MAX_START, 7)),
+        np.zeros(MAX_START, np.int64),
+        np.zeros((12, 3)),
+        np.zeros((3, 3)),
+    )
