@@ -3,8 +3,10 @@
 ``simulate(scene, progress=None) -> SimulationResult``. The adaptive methods are scipy's
 ``OdeSolver`` classes (RK45, DOP853, Radau, BDF, LSODA) stepped one step at a time, so that the run
 can be watched: output samples are taken from each step's dense output at the fixed output times,
-and after every step the state is checked. ``RK4`` is the classical fourth-order Runge-Kutta method
-with a fixed step (Butcher 1987 tableau: c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)).
+and after every step the state is checked. The implicit Radau and BDF get the Jacobian of
+``_state_jacobian`` (exact kinematic rows, fixed finite-difference steps) instead of scipy's own.
+``RK4`` is the classical fourth-order Runge-Kutta method with a fixed step (Butcher 1987 tableau:
+c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)).
 
 Safety (a run never hangs and never writes NaN silently): the run ends with a status
 (``SimulationResult.status``) and the time and state where it happened when
@@ -572,7 +574,13 @@ def simulate(
 
 
 def _tolerances(settings, scene):
-    """Absolute tolerances per state: positions/angles atol, rates 10 atol x speed scale, work 1e-6 m g r0."""
+    """Absolute tolerances per state (atol = ``absolute_tolerance``).
+
+    atol for x, y, z, yaw and roll; 100 atol for the spin angle and the rates; 1000 atol for the spin rate;
+    1e-3 J for the two work integrals (diagnostics that do not enter the right-hand side; loosening their
+    tolerance 1e4-fold or tightening it to atol (m g + axle load) changes the steps of RK45, BDF, Radau and
+    LSODA on hunting-conical by under 2 %: the mechanical states set the steps).
+    """
     atol = np.full(14, settings.absolute_tolerance)
     atol[6:12] = settings.absolute_tolerance * 100.0
     atol[5] = settings.absolute_tolerance * 100.0
@@ -581,10 +589,75 @@ def _tolerances(settings, scene):
     return atol
 
 
+_JACOBIAN_RELATIVE_STEP = math.sqrt(np.finfo(float).eps)
+
+
+def _state_jacobian(fun: Callable) -> Callable:
+    """Jacobian d f / d y of the 14-state function ``fun`` for the implicit methods Radau and BDF.
+
+    scipy's own finite-difference Jacobian (``num_jac``) perturbs column j by ``factor_j max(atol_j, |y_j|)``
+    and multiplies ``factor_j`` by 10 at every evaluation where the column's difference is negligible, with no
+    upper bound. The right-hand side does not depend on the two work integrals at all, nor on the spin angle
+    without wheel irregularities, so their factors grow tenfold per Jacobian until the step overflows to inf
+    after about 300 Jacobians; the perturbed state is then not finite and the Jacobian NaN (BDF on the scene
+    hunting-conical stopped at t = 1.58 s with "array must not contain infs or NaNs").
+
+    This Jacobian uses the structure of the equations and steps that do not adapt:
+
+    * rows 0-5 are exact: d/dt (x, y, z, psi, theta, phi) = (x', y', z', psi', theta', phi'), so [0 I 0];
+    * columns 12-13 are zero: the work integrals do not enter the right-hand side;
+    * columns 0-11 by forward differences with the step sqrt(eps) max(|y_j|, 1) in SI units (1 m, 1 rad,
+      1 m/s, 1 rad/s). The step grows with |y_j| for the states that grow without bound (x, spin angle), so
+      that (y_j + h) - y_j keeps about half the digits, and does not depend on the tolerances.
+
+    A perturbed state that ``fun`` rejects (NaN, see ``trouble`` in :func:`simulate`) is retried with the
+    step reversed. When ``fun`` rejects the state itself (BDF asks for the Jacobian at its predicted state,
+    which can be wild after a failed Newton iteration) the last Jacobian is returned: the Newton iteration
+    then fails at that state too and the solver halves its step.
+
+    Raises:
+        _Stop: "solver-failed" when a column cannot be differenced in either direction.
+    """
+    last = [None]
+
+    def jac(t, y):
+        y = np.asarray(y, float)
+        n = len(y)
+        f0 = fun(t, y)
+        if not np.all(np.isfinite(f0)):
+            if last[0] is not None:
+                return last[0]
+            raise _Stop("solver-failed", f"no Jacobian: the state function is not finite at t = {t:.6g} s", t, y)
+        jac_matrix = np.zeros((n, n))
+        jac_matrix[0:6, 6:12] = np.eye(6)
+        for j in range(12):
+            for sign in (1.0, -1.0):
+                trial = y.copy()
+                trial[j] += sign * _JACOBIAN_RELATIVE_STEP * max(abs(y[j]), 1.0)
+                step = trial[j] - y[j]
+                f1 = fun(t, trial)
+                if np.all(np.isfinite(f1)):
+                    break
+            else:
+                raise _Stop(
+                    "solver-failed",
+                    f"no Jacobian: the state function is not finite next to the state at t = {t:.6g} s "
+                    f"(column {j}, {STATE_NAMES[j]})",
+                    t,
+                    y,
+                )
+            jac_matrix[6:, j] = (f1[6:] - f0[6:]) / step
+        last[0] = jac_matrix
+        return jac_matrix
+
+    return jac
+
+
 def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
     from scipy import integrate
 
     cls = getattr(integrate, settings.method)
+    options = {"jac": _state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
     solver = cls(
         fun,
         0.0,
@@ -593,6 +666,7 @@ def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scen
         rtol=settings.relative_tolerance,
         atol=_tolerances(settings, scene),
         max_step=settings.max_step_s,
+        **options,
     )
     steps = 0
     next_out = 1
