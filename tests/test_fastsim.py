@@ -16,7 +16,13 @@ import math
 import numpy as np
 import pytest
 
-from rigid_dynamics.contact.fastsim import fastsim_batch, fastsim_fields, kalker_flexibilities
+from rigid_dynamics.contact.fastsim import (
+    _fastsim_one,
+    _fastsim_reference,
+    fastsim_batch,
+    fastsim_fields,
+    kalker_flexibilities,
+)
 from rigid_dynamics.contact.kalker import kalker_coefficients
 
 G, NU, MU = 82.0e9, 0.28, 0.3
@@ -230,3 +236,30 @@ def test_spin_moment_slopes_known_deviation():
         lin = linear_creep_forces(a, b, *creep, shear_modulus_Pa=G, poisson_ratio=NU)[2]
         ratios.append(float(r.spin_moment_Nm / lin))
     assert 0.7 < ratios[0] < 0.76 and 0.82 < ratios[1] < 0.88, ratios
+
+
+@pytest.mark.parametrize("parabolic", [False, True])
+def test_fast_kernel_equals_plain_strip_loop(parabolic):
+    """Second implementation: the fast kernel (mirrored strip pairs sharing the bound, two pairs at a time,
+    squared comparison, hoisted constants) must give the plain one-strip-at-a-time loop's results to round-off.
+
+    Random patches and creepages from full adhesion to full slip, odd and even grids down to one element and
+    one strip. Forces to 1e-12 of mu N (moment: of mu N a); the slip count exactly (a tie |t| = g to the last bit
+    is not expected).
+    """
+    rng = np.random.default_rng(11)
+    d = np.zeros((1, 1))
+    for _ in range(40):
+        a, b = rng.uniform(2e-3, 10e-3, 2)
+        fn, mu = rng.uniform(1e4, 1e5), rng.uniform(0.1, 0.5)
+        scale = 10.0 ** rng.uniform(-6, -1.5)
+        xi, eta = rng.uniform(-1, 1, 2) * scale
+        phi = rng.uniform(-1, 1) * scale * 1e3 * rng.choice([0.0, 1.0])
+        l1, l2, l3 = rng.uniform(0.5, 2.0, 3) * kalker_flexibilities(a, b, G, kalker_coefficients(a / b, NU))
+        for nx, ny in [(1, 1), (1, 6), (7, 1), (5, 4), (13, 9), (20, 20), (8, 15)]:
+            args = (a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic)
+            fast = _fastsim_one(*args, d, d, d, d, False)
+            ref = _fastsim_reference(*args, d, d, d, d, False)
+            np.testing.assert_allclose(fast[:2], ref[:2], rtol=1e-12, atol=1e-12 * mu * fn, err_msg=str(args))
+            np.testing.assert_allclose(fast[2], ref[2], rtol=1e-12, atol=1e-12 * mu * fn * a, err_msg=str(args))
+            assert fast[3] == ref[3], args
