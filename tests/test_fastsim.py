@@ -263,3 +263,45 @@ def test_fast_kernel_equals_plain_strip_loop(parabolic):
             np.testing.assert_allclose(fast[:2], ref[:2], rtol=1e-12, atol=1e-12 * mu * fn, err_msg=str(args))
             np.testing.assert_allclose(fast[2], ref[2], rtol=1e-12, atol=1e-12 * mu * fn * a, err_msg=str(args))
             assert fast[3] == ref[3], args
+
+
+def test_observed_convergence_rate_per_direction():
+    """Convergence verification of the strip grid, one direction at a time (benchmarks/results/fastsim_grid.md).
+
+    Patch a = 6 mm, b = 4 mm, N = 80 kN. Each error is taken against a fine grid that shares the other
+    direction's resolution (40), so that only the refined direction's error remains.
+
+    * Across strips (ny): the strip force is a polynomial in y (a(y)^2 in adhesion, a(y) g(y) on the bound), so
+      the midpoint sum over strips is second order: halving dy quarters the error (observed 4.02-4.06) in the
+      linear range and at half saturation.
+    * Along strips (nx) at half saturation the adhesion/slip boundary cuts elements; the observed order is
+      1.5 (error ratio 2.75-2.9 per halving for F, 2.4-2.55 for Mz), between the first order of a cut element
+      and the second order of the midpoint rule. Bands: ratio 2.4-3.3 for F (order 1.26-1.72), 2.1-2.9 for Mz.
+    """
+    a, b, fn = 6e-3, 4e-3, 80e3
+
+    def forces(creep, nx, ny):
+        r = fastsim_batch(
+            a, b, fn, *creep, shear_modulus_Pa=G, poisson_ratio=NU, friction_coefficient=MU, nx=nx, ny=ny
+        )  # fmt: skip
+        return np.array([r.creep_force_long_N, r.creep_force_lat_N, r.spin_moment_Nm], dtype=float)
+
+    def errors(creep, grids, ref):
+        f_ref = forces(creep, *ref)
+        fs = [forces(creep, *g) for g in grids]
+        ef = np.array([np.hypot(*(f[:2] - f_ref[:2])) for f in fs]) / np.hypot(*f_ref[:2])
+        em = np.array([abs(f[2] - f_ref[2]) for f in fs]) / abs(f_ref[2])
+        return ef, em
+
+    ns = [10, 20, 40, 80]
+    linear, half = (1e-4, 1e-4, 0.01), (1e-3, 1e-3, 0.1)
+    for creep in (linear, half):
+        ef, _ = errors(creep, [(40, n) for n in ns], (40, 3200))
+        ratios = ef[:-1] / ef[1:]
+        assert np.all((ratios > 3.6) & (ratios < 4.4)), (creep, ratios)
+        assert ef[-1] > 1e-6  # far above round-off: the ratios measure discretisation error
+    ef, em = errors(half, [(n, 40) for n in ns], (3200, 40))
+    rf, rm = ef[:-1] / ef[1:], em[:-1] / em[1:]
+    assert np.all((rf > 2.4) & (rf < 3.3)), rf
+    assert np.all((rm > 2.1) & (rm < 2.9)), rm
+    assert ef[-1] > 1e-5 and em[-1] > 1e-5
