@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 _FAR = 0.05  # |h| beyond this (m) is not a contact candidate (another branch of the rail, or far away)
+_ROOT_RESIDUAL = 1.0e-15  # m: a vertical residual this small ends Newton's iterations on h (round-off ~1e-16 m)
 
 
 @njit(cache=True, _nrt=False)
@@ -115,6 +116,19 @@ def rail_irregularity(x, y, irr, sign, offset):
 
 
 @njit(cache=True, _nrt=False)
+def _checked_root(h, py, pz, rail, rail_range, rail_irr_value):
+    """Return h after Newton's iterations on the rail, or +inf: outside the rail, beyond _FAR, or not converged (the
+    normal leaves the rail before meeting it: residual above 1e-10 m).
+    """
+    if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
+        return math.inf
+    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0] + rail_irr_value
+    if not abs(pz - big_n) < 1e-10:
+        return math.inf
+    return h
+
+
+@njit(cache=True, _nrt=False)
 def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, h_start=0.0):
     """h(alpha, y) on ideal surfaces (no irregularity rows): the irregular kernel's arithmetic with R_a = N_x = 0."""
     if y < y_range[0] or y > y_range[1]:
@@ -142,12 +156,15 @@ def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, ite
     h = h_start
     for _ in range(iterations):
         py = p1 + h * n1
+        inside = py >= rail_range[0] and py <= rail_range[1]
         if py < rail_range[0]:
             py = rail_range[0]
         elif py > rail_range[1]:
             py = rail_range[1]
         big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
         f = p2 + h * n2 - big_n
+        if inside and abs(f) < _ROOT_RESIDUAL:  # h exact to round-off already
+            return h if abs(h) <= _FAR else math.inf
         slope = n2 - n_y * n1
         if abs(slope) < 1e-3:
             slope = math.copysign(1e-3, slope)
@@ -155,13 +172,7 @@ def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, ite
         h -= step
         if abs(step) < 1e-13:
             break
-    py = p1 + h * n1
-    if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
-        return math.inf
-    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
-    if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
-        return math.inf
-    return h
+    return _checked_root(h, p1 + h * n1, p2 + h * n2, rail, rail_range, 0.0)
 
 
 @njit(cache=True, _nrt=False)
@@ -199,6 +210,7 @@ def _distance_irregular(
     h = h_start
     for _ in range(iterations):
         py = p1 + h * n1
+        inside = py >= rail_range[0] and py <= rail_range[1]
         if py < rail_range[0]:
             py = rail_range[0]
         elif py > rail_range[1]:
@@ -207,6 +219,8 @@ def _distance_irregular(
         v, n_x, vy, _, _, _ = rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])
         big_n, n_y = big_n + v, n_y + vy
         f = p2 + h * n2 - big_n
+        if inside and abs(f) < _ROOT_RESIDUAL:  # h exact to round-off already
+            return h if abs(h) <= _FAR else math.inf
         slope = n2 - n_x * n0 - n_y * n1
         if abs(slope) < 1e-3:
             slope = math.copysign(1e-3, slope)
@@ -214,14 +228,16 @@ def _distance_irregular(
         h -= step
         if abs(step) < 1e-13:
             break
+    x = p0 + h * n0
     py = p1 + h * n1
-    if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
-        return math.inf
-    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
-    big_n += rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])[0]
-    if not abs(p2 + h * n2 - big_n) < 1e-10:  # not converged: the normal leaves the rail before meeting it
-        return math.inf
-    return h
+    return _checked_root(
+        h,
+        py,
+        p2 + h * n2,
+        rail,
+        rail_range,
+        rail_irregularity(x, py, rail_irr, rail_map[0], rail_map[1])[0] if rail_irr.shape[0] > 0 else 0.0,
+    )
 
 
 @njit(cache=True, _nrt=False)

@@ -195,21 +195,44 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
 
 
 @njit(cache=True, _nrt=False)
-def _side_args(sp, tabs, irrs, s):
-    wheel = (sp[s, S_WLOW], sp[s, S_WSTEP], tabs[2 * s][0], tabs[2 * s][1], tabs[2 * s][2])
-    rail = (sp[s, S_RLOW], sp[s, S_RSTEP], tabs[2 * s + 1][0], tabs[2 * s + 1][1], tabs[2 * s + 1][2])
-    return wheel, rail, irrs[2 * s], irrs[2 * s + 1]
+def _track(a, yd, memory, args, radius, limit, y_range):
+    """One Newton step on h(alpha, y_d) from a last candidate with central-difference gradient and the Hessian of
+    its last refinement (memory = (angle, y_d, h, h_aa, h_yy, h_ay)). Returns (alpha, y_d, h, tracked); not
+    tracked when the Hessian is not positive definite, h is undefined or the step is longer than ``limit``.
+    """
+    d = 1.0e-5
+    da = d / radius
+    h_aa, h_yy, h_ay = memory[3], memory[4], memory[5]
+    det = h_aa * h_yy - h_ay * h_ay
+    h0 = distance(a, yd, *args, memory[2])
+    if not (math.isfinite(h0) and h_aa > 0 and det > 0):
+        return a, yd, h0, False
+    g_a = (distance(a + da, yd, *args, h0) - distance(a - da, yd, *args, h0)) / (2 * d)
+    g_y = (distance(a, yd + d, *args, h0) - distance(a, yd - d, *args, h0)) / (2 * d)
+    s_a = -(h_yy * g_a - h_ay * g_y) / det
+    s_y = -(h_aa * g_y - h_ay * g_a) / det
+    if not (math.isfinite(s_a) and math.isfinite(s_y) and s_a * s_a + s_y * s_y < limit * limit):
+        return a, yd, h0, False
+    a += s_a / radius
+    yd = min(max(yd + s_y, y_range[0]), y_range[1])
+    return a, yd, distance(a, yd, *args, h0), True
 
 
 @njit(cache=True, _nrt=False)
 def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg):
     """Candidates and patches of side s (0 left, 1 right) into cg rows 2 s, 2 s + 1; updates the memory
-    mem[s] (MAX_MEMORY, 6: angle from the lowest point alpha - (pi/2 - phi), y_d, h, h_aa, h_yy, h_ay) / n_mem[s]:
-    the angle is kept relative to the lowest point, so that a warm start follows the wheel's rotation; the
-    Hessian is the last refinement's. cand: scratch (MAX_START, 7: alpha, y_d, h, mark, Hessian),
+    mem[s] (MAX_MEMORY, 7: angle from the lowest point alpha - (pi/2 - phi), y_d, h, h_aa, h_yy, h_ay, merged) /
+    n_mem[s]: the angle is kept relative to the lowest point, so that a warm start follows the wheel's rotation;
+    the Hessian is the last refinement's; merged candidates (one interpenetration region with a deeper one) are
+    kept as warm starts of the next scan, not tracked. cand: scratch (MAX_START, 8: alpha, y_d, h, mark, Hessian,
+    merged),
     order: scratch (MAX_START,) int. Returns the number of starts that did not converge.
     """
-    wheel, rail, wheel_irr, rail_irr = _side_args(sp, tabs, irrs, s)
+    # (built here, not returned from a helper: these functions run without NRT reference counting, so no array may
+    # be handed back to a caller that counts references)
+    wheel = (sp[s, S_WLOW], sp[s, S_WSTEP], tabs[2 * s][0], tabs[2 * s][1], tabs[2 * s][2])
+    rail = (sp[s, S_RLOW], sp[s, S_RSTEP], tabs[2 * s + 1][0], tabs[2 * s + 1][1], tabs[2 * s + 1][2])
+    wheel_irr, rail_irr = irrs[2 * s], irrs[2 * s + 1]
     y_range, rail_range, rail_map = sp[s, S_YLO : S_YHI + 1], sp[s, S_RLO : S_RHI + 1], sp[s, S_RSIGN : S_ROFF + 1]
     iters, radius = int(sp[s, S_NEWTON]), sp[s, S_RADIUS]
     alpha_mid = 0.5 * math.pi - spin
@@ -246,61 +269,48 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
                     if g_prev < cand[worst, 3]:
                         cand[worst, 0], cand[worst, 1], cand[worst, 3] = alpha_mid, y_s, g_prev
             g_prev2, g_prev = g_prev, gk
-        # warm starts from the memory
+        # warm starts from the memory: a scan minimum within memory_radius_m of a last candidate is tracked from it
         for j in range(n_start):
             best, dist = -1, sp[s, S_MEMR]
             for m in range(n_mem[s]):
                 d = abs(mem[s, m, 1] - cand[j, 1])
                 if d < dist:
                     best, dist = m, d
-            if best >= 0:
-                cand[j, 0], cand[j, 1] = alpha_mid + mem[s, best, 0], mem[s, best, 1]
+            cand[j, 3] = best
+    else:
+        for m in range(n_mem[s]):
+            cand[n_start, 3] = m
+            n_start += 1
     failed = 0
     args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
-    if not full:
-        # track the last candidates: one Newton step with central-difference gradient and the Hessian of their
-        # last refinement (the pose moved by O(h v) since)
-        d = 1.0e-5
-        da = d / radius
-        for m in range(n_mem[s]):
-            a, yd, h_m = alpha_mid + mem[s, m, 0], mem[s, m, 1], mem[s, m, 2]
-            h_aa, h_yy, h_ay = mem[s, m, 3], mem[s, m, 4], mem[s, m, 5]
-            h0 = distance(a, yd, *args, h_m)
-            det = h_aa * h_yy - h_ay * h_ay
-            tracked = False
-            if math.isfinite(h0) and h_aa > 0 and det > 0:
-                hs = h0
-                g_a = (distance(a + da, yd, *args, hs) - distance(a - da, yd, *args, hs)) / (2 * d)
-                g_y = (distance(a, yd + d, *args, hs) - distance(a, yd - d, *args, hs)) / (2 * d)
-                s_a = -(h_yy * g_a - h_ay * g_y) / det
-                s_y = -(h_aa * g_y - h_ay * g_a) / det
-                if math.isfinite(s_a) and math.isfinite(s_y) and s_a * s_a + s_y * s_y < sp[s, S_TRACK] ** 2:
-                    a += s_a / radius
-                    yd = min(max(yd + s_y, y_range[0]), y_range[1])
-                    cand[n_start, 2] = distance(a, yd, *args, hs)
-                    cand[n_start, 4], cand[n_start, 5], cand[n_start, 6] = h_aa, h_yy, h_ay
-                    tracked = True
-            if not tracked:
-                a, yd, ok, hs, h_aa, h_yy, h_ay = refine_point(
-                    a, yd, *args, radius, int(sp[s, S_ITER]), sp[s, S_TOL], False
-                )
-                cand[n_start, 2] = distance(a, yd, *args, hs)
-                cand[n_start, 4], cand[n_start, 5], cand[n_start, 6] = h_aa, h_yy, h_ay
-                if not ok:
-                    failed += 1
-            cand[n_start, 0], cand[n_start, 1], cand[n_start, 3] = a, yd, 0.0
-            n_start += 1
-    else:
-        for j in range(n_start):
+    for j in range(n_start):
+        m = int(cand[j, 3])
+        cand[j, 7] = 0.0
+        if not full and mem[s, m, 6] > 0:
+            # merged into a deeper candidate's region at the last scan: carried to the next scan as a warm start
+            for f in range(6):
+                cand[j, f if f < 3 else f + 1] = mem[s, m, f]
+            cand[j, 0] += alpha_mid
+            cand[j, 3], cand[j, 7] = -1.0, 1.0  # not a candidate of this evaluation
+            continue
+        tracked = False
+        if m >= 0:
+            a, yd = alpha_mid + mem[s, m, 0], mem[s, m, 1]
+            a, yd, h, tracked = _track(a, yd, mem[s, m], args, radius, sp[s, S_TRACK], y_range)
+            if tracked:
+                cand[j, 4], cand[j, 5], cand[j, 6] = mem[s, m, 3], mem[s, m, 4], mem[s, m, 5]
+        else:
+            a, yd = cand[j, 0], cand[j, 1]
+        if not tracked:
             a, yd, ok, hs, h_aa, h_yy, h_ay = refine_point(
-                cand[j, 0], cand[j, 1], *args, radius, int(sp[s, S_ITER]), sp[s, S_TOL], False
+                a, yd, *args, radius, int(sp[s, S_ITER]), sp[s, S_TOL], False
             )
-            cand[j, 0], cand[j, 1] = a, yd
-            cand[j, 2] = distance(a, yd, *args, hs)
-            cand[j, 3] = 0.0  # not taken yet (the deduplication marks taken starts with -1)
+            h = distance(a, yd, *args, hs)
             cand[j, 4], cand[j, 5], cand[j, 6] = h_aa, h_yy, h_ay
             if not ok:
                 failed += 1
+        cand[j, 0], cand[j, 1], cand[j, 2] = a, yd, h
+        cand[j, 3] = 0.0  # not taken yet (the deduplication marks taken starts with -1)
     # deduplicate, deepest first (search_side): the same point, or one interpenetration region
     n_kept = 0
     for _ in range(n_start):
@@ -317,31 +327,40 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
             if abs(cand[best, 1] - cand[k, 1]) < 1e-6 and abs(cand[best, 0] - cand[k, 0]) * radius < 1e-6:
                 duplicate = True
                 break
-            if cand[best, 2] < 0:
+            if full and cand[best, 2] < 0:  # (tracked candidates were separate regions at the last scan)
+                # one interpenetration region when every wheel point of the joining segment (25 points, the middle
+                # first: the likeliest to show a gap) lies inside the rail: its vertical gap, which has the sign of
+                # its distance h along the normal, is negative (search_side tests h itself)
                 inside = True
-                for q in range(25):
-                    t = q / 24.0
-                    hv = distance(
-                        cand[k, 0] + t * (cand[best, 0] - cand[k, 0]), cand[k, 1] + t * (cand[best, 1] - cand[k, 1]),
-                        *args, cand[k, 2],
+                for q in range(-1, 25):
+                    t = 0.5 if q < 0 else q / 24.0
+                    a_t = cand[k, 0] + t * (cand[best, 0] - cand[k, 0])
+                    gap = _vertical_gap(
+                        math.cos(a_t), math.sin(a_t), wheel_irregularity(a_t, wheel_irr)[0],
+                        cand[k, 1] + t * (cand[best, 1] - cand[k, 1]), rot, centre, wheel, rail, rail_range, rail_irr,
+                        rail_map,
                     )  # fmt: skip
-                    if not hv < 0:
+                    if not gap < 0:
                         inside = False
                         break
                 if inside:
                     duplicate = True
+                    cand[best, 7] = 1.0  # merged: kept in the memory as a warm start only
                     break
         if not duplicate:
             order[n_kept] = best
             n_kept += 1
-    # memory for the next evaluation
+    # memory for the next evaluation: the kept candidates, then the merged ones (warm starts only)
     n_mem[s] = 0
-    for i in range(n_kept):
-        k = order[i]
+    for i in range(n_kept + n_start):
+        k = order[i] if i < n_kept else i - n_kept
+        if i >= n_kept and cand[k, 7] != 1.0:
+            continue
         if cand[k, 2] < sp[s, S_GAP] and n_mem[s] < MAX_MEMORY:
             mem[s, n_mem[s], 0], mem[s, n_mem[s], 1] = cand[k, 0] - alpha_mid, cand[k, 1]
             mem[s, n_mem[s], 2] = cand[k, 2]
             mem[s, n_mem[s], 3], mem[s, n_mem[s], 4], mem[s, n_mem[s], 5] = cand[k, 4], cand[k, 5], cand[k, 6]
+            mem[s, n_mem[s], 6] = cand[k, 7]
             n_mem[s] += 1
     # patches: the two deepest (order is by depth), then by contact angle
     right = s == 1
@@ -449,9 +468,9 @@ def pack_search(provider, options=None):
 def workspace():
     """Scratch and memory arrays of search_geometry: (mem, n_mem, cand, order, vb, rot)."""
     return (
-        np.zeros((2, MAX_MEMORY, 6)),
+        np.zeros((2, MAX_MEMORY, 7)),
         np.zeros(2, np.int64),
-        np.zeros((MAX_START, 7)),
+        np.zeros((MAX_START, 8)),
         np.zeros(MAX_START, np.int64),
         np.zeros((12, 3)),
         np.zeros((3, 3)),
