@@ -58,6 +58,8 @@ SCENE_ERRORS = [
     ("poisson_ratio = 0.28", "poisson_ratio = 0.5", r"poisson_ratio"),
     ("nominal_radius_m = 0.46", "nominal_radius_m = -0.46", r"nominal_radius_m"),
     ("duration_s = 3.0", "duration_s = nan", r"'duration_s' = nan: expected a finite number"),
+    ("speed_m_per_s = 20.0", "speed_m_per_s = 20.0\nfastsim_strips = 0", r"fastsim_strips = 0: expected an integer"),
+    ("speed_m_per_s = 20.0", "speed_m_per_s = 20.0\nfastsim_strips = 2.5", r"'fastsim_strips' = 2.5"),
     (
         'wheel_profile = "conical"',
         'wheel_profile = "/no/such/wheel.prw"',

@@ -48,6 +48,7 @@ IRREGULARITIES = {
         ("linear", "none"),
         ("vermeulen-johnson", "none"),
         ("fastsim", "none"),
+        ("fastsim-10x6", "none"),
         ("fastsim", "polygon"),
         ("vermeulen-johnson", "flat"),
         ("linear", "corrugation-right"),
@@ -57,6 +58,8 @@ def test_compiled_equals_python(model, irregularity):
     """FASTSIM (the contact package's strip kernel) and the running-direction irregularities (polygon, rounded flat,
     corrugation on one side) evaluated in the compiled loop must equal the Python path (providers and batch kernels)."""
     scene = replace(SCENE, contact_model=model, irregularities=IRREGULARITIES[irregularity])
+    if model == "fastsim-10x6":  # the scene's FASTSIM grid reaches both paths
+        scene = replace(scene, contact_model="fastsim", fastsim_elements_per_strip=10, fastsim_strips=6)
     provider = build_provider(scene)
     fast = simulate(scene, provider=provider, compiled=True)
     slow = simulate(scene, provider=provider, compiled=False)
@@ -72,6 +75,9 @@ def test_compiled_equals_python(model, irregularity):
     for name in ("approach_m", "rolling_radius_m", "semi_axis_long_m", "creepage_lat", "spin_creepage_1_per_m"):
         np.testing.assert_allclose(fast.patches[name], slow.patches[name], rtol=1e-9, atol=1e-15, err_msg=name)
     np.testing.assert_allclose(fast.patches["creep_force_lat_N"], slow.patches["creep_force_lat_N"], rtol=0, atol=1e-3)
+    if model == "fastsim-10x6":
+        fine = simulate(replace(scene, fastsim_elements_per_strip=20, fastsim_strips=20), provider=provider)
+        assert np.nanmax(np.abs(fine.patches["creep_force_lat_N"] - fast.patches["creep_force_lat_N"])) > 1.0
 
 
 def test_compiled_stops_and_refuses():

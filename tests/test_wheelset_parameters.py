@@ -50,6 +50,8 @@ def test_defaults_are_valid_and_frozen():
         (DynamicsScene, {"duration_s": -1.0}, "duration_s = -1.0"),
         (DynamicsScene, {"contact_provider": "magic"}, "contact_provider = 'magic': expected one of auto"),
         (DynamicsScene, {"contact_model": ""}, "contact_model = '': expected a registered model name"),
+        (DynamicsScene, {"fastsim_strips": 0}, "fastsim_strips = 0: expected an integer from 1 to 1000"),
+        (DynamicsScene, {"fastsim_elements_per_strip": 12.0}, "fastsim_elements_per_strip = 12.0: expected an int"),
         (DynamicsScene, {"wheelset": {"mass_kg": 1.0}}, "wheelset = .*: expected a WheelsetParameters"),
     ],
 )

@@ -323,6 +323,9 @@ class DynamicsScene:
         contact_provider: "auto" (conical analytic for conical wheels, tables for ideal geometry,
             3-D search with irregularities), "conical", "tables" or "search".
         contact_tolerance: relative force tolerance handed to the "auto" contact model.
+        fastsim_elements_per_strip, fastsim_strips: FASTSIM's grid (nx, ny) when the model is "fastsim" or "auto"
+            picks it. 20 x 20 keeps the creep forces within ~0.5 % of a 200 x 200 grid, 15 x 10 within 1 %,
+            9 x 8 within 2 % (benchmarks/results/fastsim_grid.md) at 1/2, 1/3 and 1/9 of the cost.
     """
 
     name: str = "scene"
@@ -338,6 +341,8 @@ class DynamicsScene:
     contact_model: str = "linear"
     contact_provider: str = "auto"
     contact_tolerance: float = 0.05
+    fastsim_elements_per_strip: int = 20
+    fastsim_strips: int = 20
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
 
@@ -349,6 +354,10 @@ class DynamicsScene:
             )
         if not isinstance(self.contact_model, str) or not self.contact_model:
             raise ValueError(f"contact_model = {self.contact_model!r}: expected a registered model name")
+        for name in ("fastsim_elements_per_strip", "fastsim_strips"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1000:
+                raise ValueError(f"{name} = {value!r}: expected an integer from 1 to 1000")
         for name, cls in (
             ("wheelset", WheelsetParameters),
             ("suspension", SuspensionParameters),
