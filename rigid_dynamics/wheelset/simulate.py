@@ -286,19 +286,21 @@ def initial_state(scene: DynamicsScene) -> np.ndarray:
 
 
 class _Recorder:
-    """Collects output samples and detects events and anomalies on them."""
+    """Collects output samples and detects events and anomalies on them. Samples are kept as blocks of rows (one
+    row from :meth:`append`, many from :meth:`append_many`), joined by :meth:`arrays`.
+    """
 
     def __init__(self, model: WheelsetModel, scene: DynamicsScene):
         self.model = model
         self.scene = scene
-        self.t: list[float] = []
+        self.t: list[np.ndarray] = []
         self.states: list[np.ndarray] = []
         self.patches = {name: [] for name in PATCH_FIELDS}
         self.forces: list[np.ndarray] = []
-        self.kinetic: list[float] = []
-        self.potential: list[float] = []
-        self.work_contact: list[float] = []
-        self.work_exterior: list[float] = []
+        self.kinetic: list[np.ndarray] = []
+        self.potential: list[np.ndarray] = []
+        self.work_contact: list[np.ndarray] = []
+        self.work_exterior: list[np.ndarray] = []
         self.events: list[tuple] = []
         self.in_contact = None
         self.flange = None
@@ -356,15 +358,15 @@ class _Recorder:
                 if flange[i] and not self.flange[i]:
                     self.events.append(("flange-contact", side, t))
         self.in_contact, self.flange = touching, flange
-        self.t.append(t)
-        self.states.append(state.copy())
+        self.t.append(np.array([t], float))
+        self.states.append(state[None].copy())
         for name in PATCH_FIELDS:
-            self.patches[name].append(table[name])
-        self.forces.append(forces)
-        self.kinetic.append(self.model.kinetic_energy_J(state))
-        self.potential.append(self.model.potential_energy_J(state))
-        self.work_contact.append(float(full_state[12]))
-        self.work_exterior.append(float(full_state[13]))
+            self.patches[name].append(np.asarray(table[name], float)[None])
+        self.forces.append(np.asarray(forces, float)[None])
+        self.kinetic.append(np.array([self.model.kinetic_energy_J(state)], float))
+        self.potential.append(np.array([self.model.potential_energy_J(state)], float))
+        self.work_contact.append(np.array([full_state[12]], float))
+        self.work_exterior.append(np.array([full_state[13]], float))
         if self.scene.integrator.stop_at_wheel_lift and not np.all(touching):
             side = SIDES[int(np.argmin(touching))]
             raise _Stop("wheel-lift", f"the {side} wheel lost contact at t = {t:.6g} s", t, state)
@@ -403,11 +405,11 @@ class _Recorder:
         self.events.sort(key=lambda e: e[2])
         self.in_contact, self.flange = touching[-1], flange[-1]
         states = full_states[:, :12]
-        self.t.extend(float(v) for v in times)
-        self.states.extend(states.copy())
+        self.t.append(np.asarray(times, float).copy())
+        self.states.append(states.copy())
         for name in PATCH_FIELDS:
-            self.patches[name].extend(tables[name])
-        self.forces.extend(np.asarray(forces))
+            self.patches[name].append(np.asarray(tables[name], float).copy())
+        self.forces.append(np.asarray(forces, float).copy())
         # kinetic energy m|v|^2/2 + omega.J omega/2, J = R diag(Jt, Ja, Jt) R^T (R = R_z R_x), vectorised
         psi, theta = states[:, 3], states[:, 4]
         yr, rr, sr = states[:, 9], states[:, 10], states[:, 11]
@@ -424,23 +426,25 @@ class _Recorder:
         body = np.einsum("nji,nj->ni", rzx, omega)
         j_diag = np.diag(self.model.j_body)
         kinetic = 0.5 * self.model.mass * np.sum(states[:, 6:9] ** 2, axis=1) + 0.5 * np.sum(j_diag * body**2, axis=1)
-        self.kinetic.extend(kinetic)
-        self.potential.extend(-self.model.mass * self.model.gravity * states[:, 2])
-        self.work_contact.extend(full_states[:, 12])
-        self.work_exterior.extend(full_states[:, 13])
+        self.kinetic.append(kinetic)
+        self.potential.append(-self.model.mass * self.model.gravity * states[:, 2])
+        self.work_contact.append(full_states[:, 12].copy())
+        self.work_exterior.append(full_states[:, 13].copy())
 
     def arrays(self):
-        n = len(self.t)
-        patches = {name: (np.array(v) if n else np.zeros((0, 2, MAX_SLOTS))) for name, v in self.patches.items()}
+        def joined(blocks, empty_shape):
+            return np.concatenate(blocks) if blocks else np.zeros(empty_shape)
+
+        patches = {name: joined(v, (0, 2, MAX_SLOTS)) for name, v in self.patches.items()}
         return (
-            np.array(self.t),
-            np.array(self.states) if n else np.zeros((0, 12)),
+            joined(self.t, (0,)),
+            joined(self.states, (0, 12)),
             patches,
-            np.array(self.forces) if n else np.zeros((0, 2, 3)),
-            np.array(self.kinetic),
-            np.array(self.potential),
-            np.array(self.work_contact),
-            np.array(self.work_exterior),
+            joined(self.forces, (0, 2, 3)),
+            joined(self.kinetic, (0,)),
+            joined(self.potential, (0,)),
+            joined(self.work_contact, (0,)),
+            joined(self.work_exterior, (0,)),
         )
 
 
