@@ -124,6 +124,7 @@ def test_compiled_search_run_equals_the_python_search_run(polygon_scene):
     fast = simulate(scene, compiled=True)
     slow = simulate(scene, compiled=False)
     assert fast.status == slow.status == "ok"
+    assert fast.summary()["compiled"] is True and slow.summary()["compiled"] is False
     n0 = scene.static_wheel_load_N
     d_force = np.nanmax(
         np.abs(np.nan_to_num(fast.patches["normal_force_N"]) - np.nan_to_num(slow.patches["normal_force_N"]))

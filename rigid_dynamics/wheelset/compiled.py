@@ -431,6 +431,31 @@ def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
     return _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out)
 
 
+@njit(cache=True, _nrt=False)
+def _beta_grid(par, bg):
+    """The running-direction section's angles (np.linspace(-half, half, IRR_GRID)), their sines and cosines."""
+    step_b = 2.0 * par[P_HALF] / (IRR_GRID - 1)
+    for g in range(IRR_GRID):
+        bg[0, g] = g * step_b - par[P_HALF]
+        bg[1, g] = math.sin(bg[0, g])
+        bg[2, g] = math.cos(bg[0, g])
+
+
+@njit(cache=True)
+def rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec):
+    """One right-hand side (with the lateral scan in the search mode) into out (14), its candidates into rec
+    (ncand + 2, N_FIELDS). Returns the status (for the static equilibrium before a compiled run).
+    """
+    ncand = sides.shape[0]
+    ws = (
+        np.empty((targs[0].shape[0], ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((15, 3)),
+        np.empty((3, IRR_GRID)), np.zeros((ncand, N_GEO)),
+    )  # fmt: skip
+    bg = ws[6]
+    _beta_grid(par, bg)
+    return _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
+
+
 @njit(cache=True)
 def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs, states, recs, out_start):
     """Advance ``n_steps`` RK4 steps from (t0, y); record every ``out_every`` steps into states/recs from
@@ -446,11 +471,7 @@ def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs
         np.zeros((15, 3)), np.empty((3, IRR_GRID)), np.zeros((ncand, N_GEO)),
     )  # fmt: skip
     rec, bg = ws[1], ws[6]
-    step_b = 2.0 * par[P_HALF] / (IRR_GRID - 1)
-    for g in range(IRR_GRID):
-        bg[0, g] = g * step_b - par[P_HALF]
-        bg[1, g] = math.sin(bg[0, g])
-        bg[2, g] = math.cos(bg[0, g])
+    _beta_grid(par, bg)
     nst = y.shape[0]
     y = y.copy()
     k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)

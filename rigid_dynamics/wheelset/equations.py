@@ -496,8 +496,14 @@ class WheelsetModel:
         """Gravity potential V_g = -m g z (z down), J."""
         return -self.mass * self.gravity * float(state[2])
 
-    def static_state(self, state: np.ndarray) -> tuple[np.ndarray, bool, str]:
+    def static_state(self, state: np.ndarray, derivative=None, deepest_approach=None) -> tuple[np.ndarray, bool, str]:
         """Adjust z and theta of ``state`` so that vertical force and roll moment balance (t = 0).
+
+        Args:
+            state: the 12-state to adjust.
+            derivative: optional (t, 14-state) -> d/dt replacing :meth:`derivative` (the compiled loop's RHS).
+            deepest_approach: optional 12-state -> (left, right) deepest approach of each wheel, m, replacing the
+                provider's patches.
 
         Returns:
             (state, success, message).
@@ -505,13 +511,14 @@ class WheelsetModel:
         from scipy.optimize import root
 
         work = np.array(state, float)
+        derivative = self.derivative if derivative is None else derivative
 
         def residual(v):
             trial = work.copy()
             trial[2], trial[4] = v
             full = np.concatenate([trial, [0.0, 0.0]])
             try:
-                d = self.derivative(0.0, full)
+                d = derivative(0.0, full)
             except ContactFailure:
                 return np.array([1e3, 1e3])
             return np.array([d[8], d[10] * 0.1])
@@ -520,10 +527,13 @@ class WheelsetModel:
         # (a roll theta lowers the right wheel by about e0 theta and lifts the left one: level them first)
         e0 = self.scene.wheelset.contact_half_distance_m
         for _ in range(6):
-            patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
-            deepest = [
-                np.max(patches.approach_m[patches.side == i]) if np.any(patches.side == i) else 0.0 for i in (0, 1)
-            ]
+            if deepest_approach is not None:
+                deepest = deepest_approach(work)
+            else:
+                patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
+                deepest = [
+                    np.max(patches.approach_m[patches.side == i]) if np.any(patches.side == i) else 0.0 for i in (0, 1)
+                ]
             work[4] += (deepest[0] - deepest[1]) / (2.0 * e0)
             shift = 1e-4 - 0.5 * (deepest[0] + deepest[1])
             work[2] += shift

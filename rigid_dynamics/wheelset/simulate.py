@@ -84,7 +84,7 @@ class SimulationResult:
         events: tuples (kind, side, time_s): "wheel-lift", "contact-restored", "flange-contact".
         rhs_evaluations, steps: counters. wall_time_s: wall time of the integration, s.
         failure_time_s, failure_state: where the run ended abnormally (None when it did not).
-        provider, contact_model, method: what was used.
+        provider, contact_model, method: what was used; compiled: whether the compiled RK4 loop ran it.
         scene: the scene that ran.
     """
 
@@ -107,6 +107,7 @@ class SimulationResult:
     provider: str = ""
     contact_model: str = ""
     method: str = ""
+    compiled: bool = False
     scene: DynamicsScene | None = field(default=None, repr=False)
 
     @property
@@ -171,6 +172,7 @@ class SimulationResult:
             "provider": self.provider,
             "contact_model": self.contact_model,
             "method": self.method,
+            "compiled": self.compiled,
         }
 
 
@@ -490,8 +492,15 @@ def simulate(
     status, message, fail_t, fail_state = "ok", "", None, None
     steps = 0
 
-    state0, ok, why = model.static_state(initial_state(scene))
+    packed = None
+    if use_compiled:
+        packed = _compiled.pack(model, provider, model.batch.tables, model.model.name, model.batch.options)
+        state0, ok, why = model.static_state(initial_state(scene), *_compiled_static_functions(packed))
+    else:
+        state0, ok, why = model.static_state(initial_state(scene))
     model.frame_x0 = float(state0[0])
+    if packed is not None:
+        packed[0][_compiled.P_XF0] = model.frame_x0  # the suspension frame starts where the wheelset does
     model.rhs_evaluations = 0
     full0 = np.concatenate([state0, [0.0, 0.0]])
     last_fraction = [-1.0]
@@ -542,7 +551,7 @@ def simulate(
         recorder.record(0.0, full0)
         next_out = 1
         if use_compiled:
-            steps = _run_compiled(model, provider, full0, duration, settings, recorder, report, start)
+            steps = _run_compiled(model, packed, full0, duration, settings, recorder, report, start)
         elif settings.method == "RK4":
             steps = _run_rk4(fun, full0, duration, settings, out_times, recorder, report)
         else:
@@ -576,6 +585,7 @@ def simulate(
         provider=getattr(provider, "name", type(provider).__name__),
         contact_model=getattr(model_obj, "name", type(model_obj).__name__),
         method=settings.method,
+        compiled=use_compiled,
         scene=scene,
     )
 
@@ -718,13 +728,36 @@ def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scen
 _COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed"}
 
 
-def _run_compiled(model, provider, y0, duration, settings, recorder, report, start) -> int:
+def _compiled_static_functions(packed):
+    """(derivative, deepest approach per wheel) by the compiled right-hand side, for WheelsetModel.static_state."""
+    from rigid_dynamics.wheelset import compiled
+
+    par, hz, kk, sides, _, mode, targs, sargs = packed
+    ncand = len(sides)
+    rec = np.zeros((ncand + 2, compiled.N_FIELDS))
+
+    def derivative(t, full_state):
+        out = np.zeros(14)
+        status = compiled.rhs_once(
+            float(t), np.asarray(full_state, float), par, hz, kk, sides, mode, targs, sargs, out, rec
+        )
+        if status != 0:
+            raise ContactFailure(f"compiled right-hand side: {_COMPILED_STATUS[int(status)]}")
+        return out
+
+    def deepest(state):
+        derivative(0.0, np.concatenate([state, [0.0, 0.0]]))
+        approach = np.nan_to_num(rec[:ncand, 7], nan=-np.inf)
+        return [float(np.max(approach[sides == i])) if np.any(sides == i) else 0.0 for i in (0, 1)]
+
+    return derivative, deepest
+
+
+def _run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
     """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
     from rigid_dynamics.wheelset import compiled
 
-    par, hz, kk, sides, slots, mode, targs, sargs = compiled.pack(
-        model, provider, model.batch.tables, model.model.name, model.batch.options
-    )
+    par, hz, kk, sides, slots, mode, targs, sargs = packed
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
     out_every = max(1, int(round(settings.output_step_s / h)))
