@@ -15,11 +15,20 @@ good sample with status and failure state). Per run the record holds:
 * ``max_approach_m``: the deepest interpenetration (the constraint measure of an elastic contact);
 * ``max_abs_lateral_displacement_m``, ``real_time_factor``, ``rhs_evaluations``, ``wall_time_s``.
 
+Besides the statuses of ``simulate``, a record can end as ``"error"`` (the run raised; ``message`` holds the
+exception) or, on dask, ``"worker-lost"`` (the worker process running it died): one bad run never stops the sweep.
+
 Entry points: :func:`run_stress_sweep` (the CLI's: default sweep, files, summary), :func:`stress_sweep`
 (records as a list of dicts), :func:`write_records` (CSV and JSON,
 written atomically), :func:`default_sweeps` (the standard set for a scene), :func:`nonlinear_critical_speed`
-(bisection over speed with short runs: decaying or growing lateral oscillation). Runs are serial by default;
-with a ``dask.distributed`` client (``client=``) they are mapped on its workers (dask is imported only then).
+(bisection over speed with short runs: decaying or growing lateral oscillation), :func:`local_dask_client`
+(a ``dask.distributed`` cluster of single-threaded worker processes on this machine).
+
+Runs are serial by default; with a ``dask.distributed`` client (``client=``, or ``workers >= 2`` in
+:func:`run_stress_sweep`) they are mapped on its workers. dask is imported only then. The runs are
+deterministic, so the records of both paths are identical except the timings (``wall_time_s``,
+``real_time_factor``, and a ``budget-exceeded`` status if a run hits its wall-time cap); they come back in task
+order either way.
 """
 
 from __future__ import annotations
@@ -30,7 +39,8 @@ import json
 import math
 import os
 import tempfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager, suppress
 from dataclasses import replace
 from pathlib import Path
 
@@ -155,10 +165,89 @@ def run_record(result: SimulationResult, parameter: str = "", value: float = mat
     }
 
 
-def _run_one(task):
-    """Run one (scene, parameter, value) task and return its record (module-level: picklable for dask)."""
+def _failure_record(scene: DynamicsScene, parameter: str, value: float, status: str, message: str) -> dict:
+    """The record of a run that produced no result (it raised, or its worker died): no measures."""
+    record = dict.fromkeys(RECORD_FIELDS)
+    record.update(
+        parameter=parameter,
+        value=value if math.isfinite(value) else None,
+        status=status,
+        success=False,
+        message=message,
+        method=scene.integrator.method,
+        provider=scene.contact_provider,
+        contact_model=scene.contact_model,
+    )
+    return record
+
+
+def _run_one(task) -> dict:
+    """Run one (scene, parameter, value) task and return its record (module-level: picklable for dask).
+
+    ``simulate`` reports numerical trouble as a status; anything it raises all the same becomes an ``"error"``
+    record, so that one run cannot end the sweep (serially or on a dask worker).
+    """
     scene, parameter, value = task
-    return run_record(simulate(scene), parameter, value)
+    try:
+        return run_record(simulate(scene), parameter, value)
+    except Exception as exc:
+        return _failure_record(scene, parameter, value, "error", f"{type(exc).__name__}: {exc}")
+
+
+def _map_on_client(client, tasks: list, progress: Callable[[float], None] | None, function=None) -> list[dict]:
+    """Run the tasks on a dask.distributed client; records in task order, progress as runs finish.
+
+    ``function`` replaces :func:`_run_one` (for tests of a worker that dies).
+    """
+    from distributed import as_completed
+
+    futures = client.map(function or _run_one, tasks, pure=False)
+    position = {future.key: i for i, future in enumerate(futures)}
+    records: list[dict | None] = [None] * len(tasks)
+    try:
+        for done, future in enumerate(as_completed(futures), start=1):
+            i = position[future.key]
+            try:
+                records[i] = future.result()
+            except Exception as exc:  # the task itself never raises (_run_one): its worker died or it was lost
+                scene, parameter, value = tasks[i]
+                records[i] = _failure_record(scene, parameter, value, "worker-lost", f"{type(exc).__name__}: {exc}")
+            future.release()
+            if progress is not None:
+                progress(done / len(tasks))
+    except BaseException:  # interrupted (Ctrl-C) or the client failed: do not leave the runs going
+        with suppress(Exception):
+            client.cancel(futures)
+        raise
+    return records
+
+
+@contextmanager
+def local_dask_client(workers: int) -> Iterator:
+    """A ``dask.distributed`` Client of a LocalCluster of ``workers`` single-threaded worker processes.
+
+    The cluster and client are closed on exit. No dashboard is started, and the scheduler's small HTTP server
+    listens on a free port of 127.0.0.1 (not dask's default 8787, which a second cluster would contend for).
+
+    Raises:
+        ValueError: ``workers`` is not an integer >= 1.
+        ImportError: dask.distributed is not installed.
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers = {workers!r}: expected an integer >= 1")
+    from distributed import Client, LocalCluster
+
+    with (
+        LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        yield client
 
 
 def default_sweeps(base: DynamicsScene, critical_speed_m_per_s: float | None = None) -> dict[str, tuple]:
@@ -196,8 +285,9 @@ def stress_sweep(
         sweeps: parameter -> values (SWEEP_PARAMETERS); default :func:`default_sweeps`.
         duration_s: shorter simulated time for every run (default: the scene's).
         max_wall_time_s: wall-time cap per run (status "budget-exceeded" beyond), s; None keeps the scene's.
-        progress: callable(fraction) after every finished run.
-        client: optional ``dask.distributed.Client``; the runs are mapped on its workers.
+        progress: callable(fraction) after every finished run (on dask: in the order the runs finish).
+        client: optional ``dask.distributed.Client``; the runs are mapped on its workers (records still in task
+            order, identical to the serial ones except the timings).
 
     Raises:
         ValueError: unknown parameter or invalid value (before any run).
@@ -209,11 +299,7 @@ def stress_sweep(
         base = replace(base, integrator=replace(base.integrator, max_wall_time_s=float(max_wall_time_s)))
     tasks = [(scene_variant(base, p, v), p, float(v)) for p, values in sweeps.items() for v in values]
     if client is not None:
-        futures = client.map(_run_one, tasks, pure=False)
-        records = client.gather(futures)
-        if progress is not None:
-            progress(1.0)
-        return list(records)
+        return _map_on_client(client, tasks, progress)
     records = []
     for i, task in enumerate(tasks):
         records.append(_run_one(task))
@@ -281,19 +367,44 @@ def nonlinear_critical_speed(
     }
 
 
-def run_stress_sweep(scene: DynamicsScene, out_dir: str | Path | None = None, *, quick: bool = False, client=None):
+def run_stress_sweep(
+    scene: DynamicsScene,
+    out_dir: str | Path | None = None,
+    *,
+    quick: bool = False,
+    client=None,
+    workers: int = 1,
+    progress: Callable[[float], None] | None = None,
+):
     """The standard stress sweep of a scene (the entry of ``wheelrail stress``).
 
     Runs :func:`default_sweeps` (``quick``: three values per parameter and at most 0.2 s simulated per run;
     otherwise the scene's duration capped at 2 s), writes ``stress.csv``, ``stress.json`` and ``stress.png`` into
     ``out_dir`` when given, and returns a summary dict: ``runs`` (the records), ``finished``, ``stopped``,
-    ``statuses`` (status -> count), ``max_energy_balance_relative`` of the finished runs, ``files``.
+    ``statuses`` (status -> count), ``max_energy_balance_relative`` of the finished runs, ``workers``, ``files``.
+
+    Args:
+        scene: the base scene.
+        out_dir: folder for the files (none written when None).
+        quick: the small sweep.
+        client: a ``dask.distributed.Client`` to run on (``workers`` is then ignored).
+        workers: 1 runs serially; N >= 2 runs on a :func:`local_dask_client` of N worker processes, closed after.
+        progress: callable(fraction) as runs finish.
+
+    Raises:
+        ValueError: ``workers`` is not an integer >= 1.
     """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers = {workers!r}: expected an integer >= 1")
     sweeps = default_sweeps(scene)
     if quick:
         sweeps = {k: tuple(v)[:: max(1, len(v) // 3)][:3] for k, v in sweeps.items()}
     duration = min(scene.duration_s, 0.2 if quick else 2.0)
-    records = stress_sweep(scene, sweeps, duration_s=duration, client=client)
+    if client is None and workers >= 2:
+        with local_dask_client(workers) as local:
+            records = stress_sweep(scene, sweeps, duration_s=duration, client=local, progress=progress)
+    else:
+        records = stress_sweep(scene, sweeps, duration_s=duration, client=client, progress=progress)
     files = []
     if out_dir is not None:
         paths = write_records(records, out_dir)
@@ -316,6 +427,7 @@ def run_stress_sweep(scene: DynamicsScene, out_dir: str | Path | None = None, *,
         "stopped": len(records) - len(finished),
         "statuses": statuses,
         "max_energy_balance_relative": max(energies) if energies else None,
+        "workers": len(client.nthreads()) if client is not None else workers,
         "files": files,
     }
 
@@ -351,6 +463,7 @@ __all__ = [
     "RECORD_FIELDS",
     "SWEEP_PARAMETERS",
     "default_sweeps",
+    "local_dask_client",
     "nonlinear_critical_speed",
     "run_record",
     "run_stress_sweep",

@@ -2,16 +2,30 @@
 
 The harness must finish every run with a status (an oversized fixed step must stop as a force anomaly or blow-up,
 not hang or write NaN), report a small energy residual for the accurate runs, and write its records atomically.
+On a dask.distributed cluster of worker processes the records must equal the serial ones (the runs are
+deterministic; only the timings differ), come back in task order, report progress as runs finish, and a run that
+raises or whose worker dies must end as a record, not end the sweep.
 """
 
 import csv
 import json
+import os
+from dataclasses import replace
 
 import pytest
 
 from comparisons.dynamics_plots import plot_dynamics, plot_stress
-from comparisons.stress import scene_variant, stress_sweep, write_records
+from comparisons.stress import (
+    RECORD_FIELDS,
+    _map_on_client,
+    _run_one,
+    local_dask_client,
+    scene_variant,
+    stress_sweep,
+    write_records,
+)
 from rigid_dynamics.wheelset.parameters import DynamicsScene, InitialConditions, SuspensionParameters, TrackGeometry
+from wheelrail.cli import main
 
 BASE = DynamicsScene(
     track=TrackGeometry(rail_head_radius_m=0.05),
@@ -77,3 +91,108 @@ def test_cli_entry_points(tmp_path):
     report = run_stress_sweep(quick, out_dir=tmp_path / "stress", quick=True)
     assert report["finished"] + report["stopped"] == len(report["runs"]) > 5
     assert sorted(report["files"]) == ["stress.csv", "stress.json", "stress.png"]
+
+
+# --- dask.distributed ---------------------------------------------------------------------------
+
+TIMINGS = ("wall_time_s", "real_time_factor")
+
+
+def untimed(records):
+    return [{k: v for k, v in r.items() if k not in TIMINGS} for r in records]
+
+
+@pytest.fixture(scope="module")
+def dask_client():
+    """Two single-threaded worker processes (about 1 s to start and close)."""
+    with local_dask_client(2) as client:
+        yield client
+
+
+def test_dask_sweep_equals_serial(dask_client):
+    sweeps = {"fixed_step_s": (2e-4, 2e-2), "relative_tolerance": (1e-7,)}
+    serial = stress_sweep(BASE, sweeps)
+    seen = []
+    parallel = stress_sweep(BASE, sweeps, client=dask_client, progress=seen.append)
+    workers = dask_client.run(os.getpid)
+    assert len(set(workers.values())) == 2 and os.getpid() not in workers.values()  # really other processes
+    assert [list(r) for r in parallel] == [list(r) for r in serial] == [list(RECORD_FIELDS)] * 3
+    assert [(r["parameter"], r["value"]) for r in parallel] == [
+        ("fixed_step_s", 2e-4),
+        ("fixed_step_s", 2e-2),
+        ("relative_tolerance", 1e-7),
+    ]
+    assert untimed(parallel) == untimed(serial)
+    assert seen == pytest.approx([1 / 3, 2 / 3, 1.0])
+    assert parallel[0]["success"] and not parallel[1]["success"] and parallel[1]["failure_time_s"] is not None
+
+
+def test_raising_run_is_a_record_serially_and_on_dask(dask_client):
+    bad = replace(BASE, contact_model="nonexistent")
+    tasks = [(BASE, "speed_m_per_s", 20.0), (bad, "speed_m_per_s", 20.0), (BASE, "speed_m_per_s", 20.0)]
+    serial = [_run_one(task) for task in tasks]
+    parallel = _map_on_client(dask_client, tasks, None)
+    assert untimed(parallel) == untimed(serial)
+    error = parallel[1]
+    assert list(error) == list(RECORD_FIELDS)
+    assert error["status"] == "error" and error["success"] is False
+    assert error["message"].startswith("ValueError: contact model = 'nonexistent'")
+    assert error["contact_model"] == "nonexistent" and error["energy_balance_relative"] is None
+    assert parallel[0]["status"] == parallel[2]["status"] == "ok"
+
+
+def _exit_on_nan(task):
+    """A task function that kills its worker process when the value is NaN (runs in the worker)."""
+    import math
+    import os
+
+    from comparisons.stress import _run_one
+
+    if math.isnan(task[2]):
+        os._exit(3)
+    return _run_one(task)
+
+
+def test_dead_worker_is_a_record_not_the_end_of_the_sweep():
+    import dask
+
+    tasks = [(BASE, "speed_m_per_s", 20.0), (BASE, "speed_m_per_s", float("nan"))]
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), local_dask_client(1) as client:
+        records = _map_on_client(client, tasks, None, function=_exit_on_nan)
+    # the task that was on the worker when it died may be lost too (allowed-failures 0): either way, a record
+    assert records[0]["status"] in ("ok", "worker-lost") and records[0]["value"] == 20.0
+    assert records[1]["status"] == "worker-lost" and "KilledWorker" in records[1]["message"]
+    assert records[1]["value"] is None and list(records[1]) == list(RECORD_FIELDS)
+
+
+def short_scene(tmp_path):
+    from wheelrail.scenes import resolve_scene_path
+
+    text = resolve_scene_path("hunting-conical").read_text()
+    assert "duration_s = 3.0" in text
+    path = tmp_path / "short.toml"
+    path.write_text(text.replace("duration_s = 3.0", "duration_s = 0.02"))
+    return path
+
+
+def test_cli_stress_workers_2_equals_serial(tmp_path, capsys):
+    from comparisons.stress import run_stress_sweep
+    from wheelrail.scenes import load_scene
+
+    scene = short_scene(tmp_path)
+    assert main(["stress", str(scene), "--quick", "--out", str(tmp_path / "two"), "--workers", "2"]) == 0
+    assert " runs (" in capsys.readouterr().out.splitlines()[0].partition("on 2 workers")[0]
+    two = json.loads((tmp_path / "two" / "summary.json").read_text())
+    one = run_stress_sweep(load_scene(scene), quick=True)
+    assert (one["workers"], two["workers"]) == (1, 2)
+    assert len(two["runs"]) > 5 and untimed(two["runs"]) == untimed(one["runs"])
+    assert sorted(two["files"]) == ["stress.csv", "stress.json", "stress.png"]
+
+
+@pytest.mark.parametrize("value", ["0", "-2", "two", "2.5", ""])
+def test_cli_stress_bad_workers(tmp_path, capsys, value):
+    code = main(["stress", "--quick", "--workers", value, "--out", str(tmp_path / "out")])
+    captured = capsys.readouterr()
+    assert code == 2 and "Traceback" not in captured.err
+    assert captured.err == f"wheelrail: error: --workers {value!r}: expected an integer >= 1\n"
+    assert not (tmp_path / "out").exists()  # fails before any work

@@ -222,17 +222,35 @@ def _progress_bar(quiet: bool, label: str):
 
 
 def cmd_stress(args) -> int:
+    import importlib.util
+
     from wheelrail.output import copy_input, new_output_dir, write_json
     from wheelrail.scenes import DEFAULT_STRESS_SCENE, load_scene, resolve_scene_path
 
+    try:
+        workers = int(args.workers)
+    except ValueError:
+        workers = 0
+    if workers < 1:
+        raise ConfigError(f"--workers {args.workers!r}: expected an integer >= 1")
+    if workers > 1 and importlib.util.find_spec("distributed") is None:
+        raise ConfigError(f"--workers {args.workers!r}: needs dask.distributed (pip install 'dask[distributed]')")
     source = resolve_scene_path(args.scene or DEFAULT_STRESS_SCENE)
     scene = load_scene(source)
     from comparisons.stress import run_stress_sweep
 
     out_dir = new_output_dir(args.out, f"stress-{source.stem}")
     copy_input(source, out_dir, "scene.toml")
-    report = run_stress_sweep(scene, out_dir=out_dir, quick=args.quick)
+    update, close = _progress_bar(False, f"stress {source.stem}")
+    try:
+        report = run_stress_sweep(scene, out_dir=out_dir, quick=args.quick, workers=workers, progress=update)
+    finally:
+        close()
     write_json(out_dir / "summary.json", report if isinstance(report, dict) else {"runs": report})
+    _print(
+        f"stress sweep of {source.stem}: {len(report['runs'])} runs ({report['finished']} finished, "
+        f"{report['stopped']} stopped) on {workers} worker{'s' if workers > 1 else ''}"
+    )
     _print(f"stress sweep of {source.stem}: output written to {out_dir}")
     return EXIT_OK
 
@@ -334,9 +352,15 @@ def build_parser() -> argparse.ArgumentParser:
     manchester.set_defaults(func=cmd_manchester)
 
     stress = sub.add_parser("stress", help="numerical-stability stress sweep")
-    stress.add_argument("scene", nargs="?")
-    stress.add_argument("--out", type=Path)
+    stress.add_argument("scene", nargs="?", help="embedded scene name or TOML file (default: hunting-conical)")
+    stress.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/stress-<scene>-<time>)")
     stress.add_argument("--quick", action="store_true", help="a small sweep")
+    stress.add_argument(
+        "--workers",
+        default="1",
+        metavar="N",
+        help="1: run serially (default); N >= 2: on a local dask.distributed cluster of N single-threaded processes",
+    )
     stress.set_defaults(func=cmd_stress)
     return parser
 
