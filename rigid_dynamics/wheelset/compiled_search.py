@@ -10,7 +10,9 @@ right-hand side:
   N(p_x, p_y) - p_z of the wheel points at the lowest angle alpha = pi/2 - phi along y_d (step
   ``scan_step_m``); every local minimum of that gap below ``candidate_gap_m / cos(75 deg)`` is a start (a
   vertical gap is the normal gap divided by the cosine of the contact angle to first order, and its minima
-  sit where the profile slopes are equal, the 2-D condition of a minimum of h). The start is the nearest
+  sit where the profile slopes are equal, the 2-D condition of a minimum of h); at each such y_d the gap is scanned
+  over search_side's angles (``alpha_points`` over +-``alpha_half_range_rad``), and every minimum over the angle
+  (e.g. both edges of a wheel flat) is a start. The start is the nearest
   candidate of the previous evaluation within ``memory_radius_m`` when there is one (warm start), else the scan
   point. The other RK4 stages start from the previous evaluation's candidates alone (the pose moves by
   O(h v) within a step; a new minimum appears at the next step's scan at the latest).
@@ -50,9 +52,9 @@ COS_STEEPEST = math.cos(math.radians(75.0))
 # layout of the per-side rows of ``sp`` (search parameters), shape (2, SP_LEN)
 (
     S_YLO, S_YHI, S_RLO, S_RHI, S_RSIGN, S_ROFF, S_WLOW, S_WSTEP, S_RLOW, S_RSTEP, S_SIGN,
-    S_SCAN, S_GAP, S_NEWTON, S_ITER, S_TOL, S_RADIUS, S_MEMR, S_TRACK,
-) = range(19)  # fmt: skip
-SP_LEN = 19
+    S_SCAN, S_GAP, S_NEWTON, S_ITER, S_TOL, S_RADIUS, S_MEMR, S_TRACK, S_AHALF, S_APTS,
+) = range(21)  # fmt: skip
+SP_LEN = 21
 
 
 @njit(cache=True, _nrt=False)
@@ -195,6 +197,23 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
 
 
 @njit(cache=True, _nrt=False)
+def _keep_lowest(cand, first, n, alpha, y_d, gap):
+    """Add the start (alpha, y_d) with gap to cand[first : first + MAX_START] holding n starts (replacing the
+    highest gap when full). Returns the new n.
+    """
+    if n < MAX_START:
+        cand[first + n, 0], cand[first + n, 1], cand[first + n, 3] = alpha, y_d, gap
+        return n + 1
+    worst = first
+    for j in range(first + 1, first + MAX_START):
+        if cand[j, 3] > cand[worst, 3]:
+            worst = j
+    if gap < cand[worst, 3]:
+        cand[worst, 0], cand[worst, 1], cand[worst, 3] = alpha, y_d, gap
+    return n
+
+
+@njit(cache=True, _nrt=False)
 def _track(a, yd, memory, args, radius, limit, y_range):
     """One Newton step on h(alpha, y_d) from a last candidate with central-difference gradient and the Hessian of
     its last refinement (memory = (angle, y_d, h, h_aa, h_yy, h_ay)). Returns (alpha, y_d, h, tracked); not
@@ -224,8 +243,8 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
     mem[s] (MAX_MEMORY, 7: angle from the lowest point alpha - (pi/2 - phi), y_d, h, h_aa, h_yy, h_ay, merged) /
     n_mem[s]: the angle is kept relative to the lowest point, so that a warm start follows the wheel's rotation;
     the Hessian is the last refinement's; merged candidates (one interpenetration region with a deeper one) are
-    kept as warm starts of the next scan, not tracked. cand: scratch (MAX_START, 8: alpha, y_d, h, mark, Hessian,
-    merged),
+    kept as warm starts of the next scan, not tracked. cand: scratch (2 MAX_START, 8: alpha, y_d, h, mark,
+    Hessian, merged; the second half holds the lateral scan's minima),
     order: scratch (MAX_START,) int. Returns the number of starts that did not converge.
     """
     # (built here, not returned from a helper: these functions run without NRT reference counting, so no array may
@@ -249,6 +268,7 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
         limit = sp[s, S_GAP] / COS_STEEPEST
         cos_a, sin_a, r_irr = math.cos(alpha_mid), math.sin(alpha_mid), wheel_irregularity(alpha_mid, wheel_irr)[0]
         g_prev2, g_prev = math.inf, math.inf
+        n_y = 0  # lateral minima, kept in cand[MAX_START:]
         for k in range(n_scan + 1):
             if k < n_scan:
                 yk = y0 + k * step
@@ -257,23 +277,32 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
                 gk = math.inf
             # the previous sample is a minimum: below its left neighbour, not above its right one
             if k >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < limit:
-                y_s = y0 + (k - 1) * step
-                if n_start < MAX_START:
-                    cand[n_start, 0], cand[n_start, 1], cand[n_start, 3] = alpha_mid, y_s, g_prev
-                    n_start += 1
-                else:  # keep the lowest
-                    worst = 0
-                    for j in range(1, MAX_START):
-                        if cand[j, 3] > cand[worst, 3]:
-                            worst = j
-                    if g_prev < cand[worst, 3]:
-                        cand[worst, 0], cand[worst, 1], cand[worst, 3] = alpha_mid, y_s, g_prev
+                n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, y0 + (k - 1) * step, g_prev)
             g_prev2, g_prev = g_prev, gk
-        # warm starts from the memory: a scan minimum within memory_radius_m of a last candidate is tracked from it
+        # at each lateral minimum, the minima over the angle (search_side's alpha grid: e.g. both edges of a flat)
+        n_a, half = int(sp[s, S_APTS]), sp[s, S_AHALF]
+        for j in range(MAX_START, MAX_START + n_y):
+            y_s = cand[j, 1]
+            g_prev2, g_prev = math.inf, math.inf
+            for i in range(n_a + 1):
+                if i < n_a:
+                    a_i = alpha_mid + (2.0 * i / (n_a - 1) - 1.0) * half if n_a > 1 else alpha_mid
+                    gk = _vertical_gap(
+                        math.cos(a_i), math.sin(a_i), wheel_irregularity(a_i, wheel_irr)[0], y_s, rot, centre, wheel,
+                        rail, rail_range, rail_irr, rail_map,
+                    )  # fmt: skip
+                else:
+                    gk = math.inf
+                if i >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < limit:
+                    a_prev = alpha_mid + (2.0 * (i - 1) / (n_a - 1) - 1.0) * half if n_a > 1 else alpha_mid
+                    n_start = _keep_lowest(cand, 0, n_start, a_prev, y_s, g_prev)
+                g_prev2, g_prev = g_prev, gk
+        # warm starts from the memory: a scan minimum within memory_radius_m of a last candidate (in y_d and in
+        # arc length along the wheel) is tracked from it
         for j in range(n_start):
             best, dist = -1, sp[s, S_MEMR]
             for m in range(n_mem[s]):
-                d = abs(mem[s, m, 1] - cand[j, 1])
+                d = max(abs(mem[s, m, 1] - cand[j, 1]), radius * abs(alpha_mid + mem[s, m, 0] - cand[j, 0]))
                 if d < dist:
                     best, dist = m, d
             cand[j, 3] = best
@@ -417,7 +446,8 @@ def pack_search(provider, options=None):
 
     Options (all optional): ``scan_step_m`` (1e-3), ``memory_radius_m`` (2e-3), ``track_step_m`` (1e-4: a
     tracking step longer than this is replaced by a full refinement), and the contact-search options
-    candidate_gap_m, newton_iterations, refine_iterations, refine_tolerance_m (search.DEFAULT_OPTIONS).
+    candidate_gap_m, newton_iterations, refine_iterations, refine_tolerance_m, alpha_half_range_rad,
+    alpha_points (search.DEFAULT_OPTIONS).
 
     Raises:
         ValueError: a side's surfaces are not tabulated (an irregularity the compiled kernels do not evaluate:
@@ -425,7 +455,10 @@ def pack_search(provider, options=None):
     """
     from rigid_dynamics.contact.search import DEFAULT_OPTIONS, TabulatedRail, TabulatedWheel
 
-    opts = {k: DEFAULT_OPTIONS[k] for k in ("candidate_gap_m", "newton_iterations", "refine_iterations")}
+    opts = {
+        k: DEFAULT_OPTIONS[k]
+        for k in ("candidate_gap_m", "newton_iterations", "refine_iterations", "alpha_half_range_rad", "alpha_points")
+    }
     # The contact point after a Newton step of size s is off by O(s^2 / profile radius): a 1e-7 m last step leaves
     # ~1e-12 m, as search_side's 1e-9 m, at fewer refinement iterations.
     opts["refine_tolerance_m"] = 1.0e-7
@@ -458,6 +491,7 @@ def pack_search(provider, options=None):
         sp[s, S_RADIUS] = provider.r0
         sp[s, S_MEMR] = opts["memory_radius_m"]
         sp[s, S_TRACK] = opts["track_step_m"]
+        sp[s, S_AHALF], sp[s, S_APTS] = opts["alpha_half_range_rad"], opts["alpha_points"]
         tabs.append(np.ascontiguousarray(np.stack(wheel.table_tuple[2:])))
         tabs.append(np.ascontiguousarray(np.stack(rail.table_tuple[2:])))
         irrs.append(np.ascontiguousarray(wheel.irregularity_rows, float).reshape(-1, 7))
@@ -470,7 +504,7 @@ def workspace():
     return (
         np.zeros((2, MAX_MEMORY, 7)),
         np.zeros(2, np.int64),
-        np.zeros((MAX_START, 8)),
+        np.zeros((2 * MAX_START, 8)),
         np.zeros(MAX_START, np.int64),
         np.zeros((12, 3)),
         np.zeros((3, 3)),
