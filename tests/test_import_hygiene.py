@@ -3,7 +3,19 @@
 import subprocess
 import sys
 
-HEAVY = ("gmsh", "dolfinx", "petsc4py", "mpi4py", "pyvista", "matplotlib", "ufl", "basix", "meshio")
+HEAVY = (
+    "gmsh",
+    "dolfinx",
+    "petsc4py",
+    "mpi4py",
+    "pyvista",
+    "matplotlib",
+    "ufl",
+    "basix",
+    "meshio",
+    "dask",
+    "distributed",
+)
 
 CODE = """
 import sys, importlib, pkgutil
