@@ -12,7 +12,12 @@ classical RK4 with a 0.5 ms step as in the scene file unless the case name gives
 * ``tables-ideal``, ``tables-polygon``: contact-geometry tables over lateral shift and roll (ideal geometry; with
   the polygon by the running-direction section of providers.py), the Python right-hand side;
 * ``*-compiled-*``: the same tables in the compiled RK4 loop (rigid_dynamics.wheelset.compiled; FASTSIM by the
-  contact package's strip kernel, the polygon evaluated in the loop), 2 s simulated;
+  contact package's strip kernel, the polygon evaluated in the loop), 2 s simulated; ``-vj``: Vermeulen-Johnson,
+  ``-fastsim15x10``: FASTSIM on 15 x 10 elements (creep forces within 1 % of a 200 x 200 grid,
+  benchmarks/results/fastsim_grid.md) instead of 20 x 20 (0.5 %);
+* ``search-compiled-*``: the 3-D search compiled into the RK4 loop (rigid_dynamics.wheelset.compiled_search:
+  lateral scan at each step's first stage, tracking at the others), with the polygon, 2 s; ``-short`` is the same
+  over the search case's interval against the Python search (``search``);
 * ``hunting-conical``: the analytic conical provider, Kalker linear creep, RK45.
 
 Error beside the time (largest difference of the wheel normal forces relative to the static wheel load, and of
@@ -51,38 +56,34 @@ from wheelrail.config import build_dataclass  # noqa: E402
 NOTES = """\
 Notes.
 
-* What the search path spends its time on: before the compiled irregular search (cProfile, 0.01 s of the
-  polygonal scene, 12 ms per RHS) the 3-D search was ~95 % (two sides, ~6 ms each, numpy on the exact irregular
-  surfaces). The search now runs polygon, rounded flat and corrugation through its numba kernels (Hermite table of
-  the ideal profile + closed-form irregularities; benchmarks/results/search.md: ~1.3 ms per side), and ~0.6 ms
-  per side goes to evaluating each patch on the exact surfaces with scipy; RHS ~3.6 ms. The FASTSIM contact solve
-  and the equations of motion are a small part. The gap field is off (``field=False``) for the dynamics.
-* search-reuse halves the searches (RK4's two stages at t + h/2 differ by h^2/4 times the accelerations, and the
-  last stage of a step and the first of the next by the same order; the output sample is the next step's first
-  stage exactly). Its difference to the unmodified search is of the size of the unmodified search's own step-size
-  sensitivity (search-0.25ms against search): the largest wheel-load differences of both come from the S1002/UIC60
-  double gap minimum near the centred position, where the search's deepest point, and with it the Hertz patch,
-  jumps between two places 10 mm apart, so that any small perturbation shifts the jump instants
-  (tests/test_dynamics_search.py checks the reuse's approach against a fresh search: error 3e-10 m for a 2e-5 pose
-  change, falling 4x per halving).
-* The tables: the Python right-hand side costs 0.35-0.6 ms per call (numpy on 2-4 candidates); the compiled loop
-  about 1.2 us (Vermeulen-Johnson), 6-8 us (FASTSIM 20 x 20, of which the strip kernel for the two patches is
-  about 5 us) and 12-14 us (FASTSIM with the polygon: the running-direction section, an 81-angle grid and 3 Newton
-  steps per candidate). The compiled path equals the Python path to ~1e-14 (tests/test_dynamics_compiled.py).
-* Time-step error of the compiled cases against a 1/16 ms run: on ideal geometry 0.4 % (0.5 ms) and 4.5 % (1 ms)
-  of the static wheel load at most. With the polygon the maximum stays large at every step size (a separate step-
-  halving study of the compiled polygon case, 1 ms ... 1/16 ms against 1/32 ms, not run by this script: 0.77,
-  0.58, 0.14, 0.30, 0.47) while the median converges (0.045, 0.013, 0.005, 0.0024, 0.0020): the table candidates
-  switch between one and two patches per wheel near the centre (the same double minimum), and the switching
-  instants move with the step.
-* Targets. Tables >= 100x: reached on ideal geometry with Vermeulen-Johnson at a 1 ms step (4.5 % largest wheel-
-  load error against the fine step; 90-100x at the scene's 0.5 ms, 0.4 %), not with FASTSIM (about 18x at 0.5 ms
-  and 30x at 1 ms on ideal geometry, about 9x / 15x with the polygon; see the table): an RK4 step of 0.5 ms costs
-  4.5 RHS calls (with the output sample), so 100x asks for ~1.1 us per call, below the cost of FASTSIM's 2 x 400
-  strip elements alone. The 3-D search (about 0.01x, 0.02x with reuse) is three orders of magnitude short of 10x:
-  that needs a compiled search on irregular surfaces (the contact search's owners) or the tables with the polygon
-  by the running-direction section (tables-polygon-compiled, 9-15x, the geometry differing from the search as
-  described above).
+* Targets. With the 3-D search (search-compiled, Hertz + FASTSIM 20 x 20, 2 s of the polygonal-wheel scene):
+  about 12x real time at the scene's 0.5 ms step and 21x at 1 ms. With tables on ideal geometry: FASTSIM 20 x 20
+  about 54x (0.5 ms) and 95x (1 ms); FASTSIM 15 x 10 (creep forces within 1 % of a 200 x 200 grid,
+  benchmarks/results/fastsim_grid.md) about 87x and 154x; Vermeulen-Johnson about 150x and 250x. So >= 100x with
+  tables and FASTSIM needs the 1 ms step with the 15 x 10 grid; at 1 ms the largest wheel-load error against the
+  1/16 ms run is 4.6 % of the static load (a short transient; median 2e-5), at 0.5 ms 0.4 %. Real-time factors
+  include the run's fixed cost (static equilibrium by the compiled RHS, packing, recording: a few ms).
+  Machines here are shared: repeated runs of this script scatter by ~10-20 %.
+* The compiled search (rigid_dynamics.wheelset.compiled_search) runs inside the compiled RK4 loop: at each
+  step's first stage a lateral scan of the vertical gap (1 mm) seeds Newton refinements (warm-started and, near
+  a last candidate, a single quasi-Newton step), and the other three stages track the last candidates; patch
+  geometry (curvature tensors, principal relative curvatures) is evaluated on the tabulated surfaces. About
+  10 us per RHS on average (2 x 0.8 us of it FASTSIM). It reproduces the Python search loop: 2e-4 N0 and 1e-8 m
+  over 0.03 s (tests/test_dynamics_compiled_search.py); patches at random poses within 1e-11 m in approach.
+* Largest errors are switching instants. S1002/UIC60 1:40 has two near-equal gap minima on each wheel near the
+  centred position (10 mm apart); whether they form one patch or two, and which is deeper, flips with tiny
+  changes of the pose, so any perturbation (the step size, the search method) moves the flip instants and the
+  largest wheel-load difference at such an instant is O(1) of the static load while the median converges
+  (search-compiled against its 1/16 ms run: median 2e-4 at 0.5 ms, 3e-3 at 1 ms; the Python search against
+  itself at 0.25 ms: max 1.07, median 0.016; search-compiled-0.5ms-short against the Python search: max 1.28 at
+  one flip, median 0.004). A genuinely non-Hertzian (conformal, two-point) contact: the BEM or FEA rungs are the
+  tools to judge it, not a Hertz dynamics run.
+* The Python paths, for reference: the search at every RHS (search) costs ~3.5 ms per call (search-reuse halves
+  the searches by the first-order rigid-body update between close stages), the Python table RHS 0.35-0.6 ms.
+  tables-polygon-compiled treats the polygon by a running-direction section of the table candidates
+  (providers.py) instead of the 3-D search (22x / 38x).
+* Compiled table path: ~1 us per RHS with Vermeulen-Johnson, ~2.5 us with FASTSIM 20 x 20 (the strip kernel
+  ~0.8 us per patch), ~1.6 us with 15 x 10. It equals the Python path to ~1e-14 (tests/test_dynamics_compiled.py).
 """
 
 
@@ -150,17 +151,21 @@ def main(argv=None):
     short = replace(polygon, duration_s=args.search_time)
     plain = SearchProvider(polygon.wheelset, polygon.track, polygon.irregularities)
     plain.patches = plain._search  # the unmodified path: a search at every call
-    search_rec, search_res = run_case("search", short, "search", provider=plain)
+    simulate(replace(short, duration_s=0.002), provider=plain, compiled=False)  # load the numba kernels
+    # the Python RK4 loop (compiled=False: SearchProvider scenes run the compiled search by default)
+    search_rec, search_res = run_case("search", short, "search", False, provider=plain)
     add(search_rec)
     reusing = SearchProvider(polygon.wheelset, polygon.track, surfaces=plain.surfaces, reuse_m=1e-5)
-    rec, res = run_case("search-reuse", short, "search", provider=reusing)
+    rec, res = run_case("search-reuse", short, "search", False, provider=reusing)
     rec["searches_reused"] = reusing.reused
     add(rec, res, search_res, "search")
     half = replace(short, integrator=replace(short.integrator, fixed_step_s=2.5e-4))
-    rec, res = run_case("search-0.25ms", half, "search", provider=plain)
+    rec, res = run_case("search-0.25ms", half, "search", False, provider=plain)
     add(rec, res, search_res, "search")
     ideal = replace(polygon, irregularities=Irregularities(), duration_s=args.tables_time)
-    rec_ideal_search, res_ideal_search = run_case("search-ideal", replace(ideal, duration_s=args.search_time), "search")
+    rec_ideal_search, res_ideal_search = run_case(
+        "search-ideal", replace(ideal, duration_s=args.search_time), "search", False
+    )
     add(rec_ideal_search)
     ideal_tables = build_provider(replace(ideal, contact_provider="tables"))
     polygon_tables = build_provider(replace(polygon, contact_provider="tables"))
@@ -178,6 +183,11 @@ def main(argv=None):
         ("tables-ideal", replace(ideal, duration_s=2.0), ideal_tables),
         ("tables-polygon", replace(polygon, duration_s=2.0), polygon_tables),
         ("tables-ideal-vj", replace(ideal, contact_model="vermeulen-johnson", duration_s=2.0), ideal_tables),
+        (
+            "tables-ideal-fastsim15x10",
+            replace(ideal, duration_s=2.0, fastsim_elements_per_strip=15, fastsim_strips=10),
+            ideal_tables,
+        ),
     ):
         simulate(replace(base, duration_s=0.01), provider=provider, compiled=True)  # load the compiled code
         fine = replace(base, integrator=replace(base.integrator, fixed_step_s=fine_step))
@@ -186,6 +196,19 @@ def main(argv=None):
             scene = replace(base, integrator=replace(base.integrator, fixed_step_s=step))
             rec, res = run_case(f"{label}-compiled-{step * 1e3:g}ms", scene, "tables", True, provider)
             add(rec, res, reference, f"fine-{label} ({fine_step * 1e3:g} ms)")
+
+    # the compiled 3-D search (rigid_dynamics.wheelset.compiled_search) on the polygonal-wheel scene, 2 s
+    search_provider = build_provider(polygon)
+    simulate(replace(polygon, duration_s=0.01), provider=search_provider, compiled=True)  # load the compiled code
+    rec, res = run_case("search-compiled-0.5ms-short", short, "search", True, search_provider)
+    add(rec, res, search_res, "search")
+    base = replace(polygon, duration_s=2.0)
+    fine = replace(base, integrator=replace(base.integrator, fixed_step_s=fine_step))
+    _, reference = run_case("fine-search-compiled", fine, "search", True, search_provider)
+    for step in (5e-4, 1e-3):
+        scene = replace(base, integrator=replace(base.integrator, fixed_step_s=step))
+        rec, res = run_case(f"search-compiled-{step * 1e3:g}ms", scene, "search", True, search_provider)
+        add(rec, res, reference, f"fine-search-compiled ({fine_step * 1e3:g} ms)")
 
     machine = {
         "platform": platform.platform(),
