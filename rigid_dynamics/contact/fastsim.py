@@ -65,6 +65,17 @@ FLEXIBILITIES = ("single", "three", "three-unblended")
 
 
 @njit(cache=True)
+def _strip_constants(a, b, mu, fn, xi, eta, phi, l1, l2, l3, ny, parabolic):
+    """(strip width dy, traction bound at the centre g0, xi/L1, eta/L2, phi/L3) of both strip loops."""
+    dy = 2.0 * b / ny
+    if parabolic:
+        g0 = mu * 2.0 * fn / (math.pi * a * b)
+    else:
+        g0 = mu * 3.0 * fn / (2.0 * math.pi * a * b)
+    return dy, g0, xi / l1, eta / l2, phi / l3
+
+
+@njit(cache=True)
 def _fastsim_reference(
     a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, px_out, py_out, sx_out, sy_out, store
 ):
@@ -79,14 +90,7 @@ def _fastsim_reference(
     n_slip = 0
     if fn <= 0.0 or a <= 0.0 or b <= 0.0:
         return fx, fy, mz, 0.0
-    dy = 2.0 * b / ny
-    if parabolic:
-        g0 = mu * 2.0 * fn / (math.pi * a * b)
-    else:
-        g0 = mu * 3.0 * fn / (2.0 * math.pi * a * b)
-    cx = xi / l1
-    cy = eta / l2
-    cs = phi / l3
+    dy, g0, cx, cy, cs = _strip_constants(a, b, mu, fn, xi, eta, phi, l1, l2, l3, ny, parabolic)
     for j in range(ny):
         y = -b + (j + 0.5) * dy
         ay = a * math.sqrt(max(0.0, 1.0 - (y / b) ** 2))
@@ -202,16 +206,9 @@ def _fastsim_fast(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic):
     n_slip = 0
     if fn <= 0.0 or a <= 0.0 or b <= 0.0:
         return fx, fy, mz, 0.0
-    dy = 2.0 * b / ny
-    if parabolic:
-        g0 = mu * 2.0 * fn / (math.pi * a * b)
-    else:
-        g0 = mu * 3.0 * fn / (2.0 * math.pi * a * b)
+    dy, g0, cx, cy, cs = _strip_constants(a, b, mu, fn, xi, eta, phi, l1, l2, l3, ny, parabolic)
     g0sq = g0 * g0
     inv_a2 = 1.0 / (a * a)
-    cx = xi / l1
-    cy = eta / l2
-    cs = phi / l3
     dyb = 2.0 / ny
     dxa = 2.0 / nx
     n_units = (ny + 1) // 2
