@@ -431,14 +431,22 @@ def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
     return _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out)
 
 
-@njit(cache=True, _nrt=False)
-def _beta_grid(par, bg):
-    """The running-direction section's angles (np.linspace(-half, half, IRR_GRID)), their sines and cosines."""
+@njit(cache=True)
+def _workspace(par, n_rows, ncand, rec):
+    """Scratch arrays of _rhs: (table work, rec, res, geo, dummy, scratch rows, beta grid, candidate geometry).
+    The beta grid holds the running-direction section's angles (np.linspace(-half, half, IRR_GRID)), their sines
+    and cosines.
+    """
+    bg = np.empty((3, IRR_GRID))
     step_b = 2.0 * par[P_HALF] / (IRR_GRID - 1)
     for g in range(IRR_GRID):
         bg[0, g] = g * step_b - par[P_HALF]
         bg[1, g] = math.sin(bg[0, g])
         bg[2, g] = math.cos(bg[0, g])
+    return (
+        np.empty((n_rows, ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((15, 3)), bg,
+        np.zeros((ncand, N_GEO)),
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -446,13 +454,7 @@ def rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec):
     """One right-hand side (with the lateral scan in the search mode) into out (14), its candidates into rec
     (ncand + 2, N_FIELDS). Returns the status (for the static equilibrium before a compiled run).
     """
-    ncand = sides.shape[0]
-    ws = (
-        np.empty((targs[0].shape[0], ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((15, 3)),
-        np.empty((3, IRR_GRID)), np.zeros((ncand, N_GEO)),
-    )  # fmt: skip
-    bg = ws[6]
-    _beta_grid(par, bg)
+    ws = _workspace(par, targs[0].shape[0], sides.shape[0], rec)
     return _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
 
 
@@ -465,13 +467,8 @@ def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs
     index, t, y, rhs evaluations).
     """
     ncand = sides.shape[0]
-    n_rows = targs[0].shape[0]
-    ws = (
-        np.empty((n_rows, ncand)), np.empty((ncand + 2, N_FIELDS)), np.empty(9), np.empty(8), np.zeros((1, 1)),
-        np.zeros((15, 3)), np.empty((3, IRR_GRID)), np.zeros((ncand, N_GEO)),
-    )  # fmt: skip
-    rec, bg = ws[1], ws[6]
-    _beta_grid(par, bg)
+    ws = _workspace(par, targs[0].shape[0], ncand, np.empty((ncand + 2, N_FIELDS)))
+    rec = ws[1]
     nst = y.shape[0]
     y = y.copy()
     k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
