@@ -531,6 +531,34 @@ def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs
     return 0, n_steps, k_out, t, y, evals
 
 
+def load(packed) -> None:
+    """Load (from numba's cache, or compile) rk4_run and rhs_once for the types of ``packed`` (pack's result):
+    zero steps, and one right-hand side at the zero state (no wheel near a rail there: no candidate enters the
+    search memory, whose warm starts are its only state).
+    """
+    par, hz, kk, sides, _, mode, targs, sargs = packed
+    y = np.zeros(14)
+    rec = np.zeros((len(sides) + 2, N_FIELDS))
+    rk4_run(
+        y,
+        0.0,
+        1e-3,
+        0,
+        1,
+        par,
+        hz,
+        kk,
+        sides,
+        mode,
+        targs,
+        sargs,
+        np.zeros((0, 14)),
+        np.zeros((0, len(sides) + 2, N_FIELDS)),
+        0,
+    )
+    rhs_once(0.0, y, par, hz, kk, sides, mode, targs, sargs, np.zeros(14), rec)
+
+
 def supported(scene, provider, model) -> bool:
     """Whether the compiled path can run this combination: RK4, one of the registry's models in MODEL_CODES, and
     a TableProvider (with or without running-direction irregularities: polygon, rounded flat, corrugation) or a
