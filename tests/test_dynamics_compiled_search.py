@@ -134,3 +134,14 @@ def test_compiled_search_run_equals_the_python_search_run(polygon_scene):
     assert d_force < 5e-4 * n0
     assert d_pos < 5e-8
     np.testing.assert_array_equal(np.isnan(fast.patches["normal_force_N"]), np.isnan(slow.patches["normal_force_N"]))
+
+
+def test_angle_scan_only_where_the_rolling_direction_can_hold_two_minima():
+    """The angle scan (both edges of a flat) is skipped on wheels whose gap stays convex along the rail: the
+    embedded polygon (n^2 A / r^2 = 0.013 1/m against 1/r = 2.2 1/m) and corrugation (A k^2 = 0.47 1/m)."""
+    r0 = 0.46
+    assert cs._convex_along_the_rail(np.array([[0.0, 3, 3e-4, 0, 0, 0, 0]]), np.zeros((0, 7)), r0)
+    corrugation = np.array([[0.0, 2 * np.pi / 0.05, 3e-5, 0, 0, 0.01, 0.004]])
+    assert cs._convex_along_the_rail(np.zeros((0, 7)), corrugation, r0)
+    assert not cs._convex_along_the_rail(np.array([[1.0, 1.1, r0, 0.05, 1e-3, 0, 0]]), np.zeros((0, 7)), r0)
+    assert not cs._convex_along_the_rail(np.array([[0.0, 20, 3e-3, 0, 0, 0, 0]]), np.zeros((0, 7)), r0)

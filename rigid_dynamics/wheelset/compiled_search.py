@@ -441,6 +441,20 @@ def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, c
     return failed
 
 
+def _convex_along_the_rail(wheel_rows, rail_rows, radius) -> bool:
+    """Whether the gap along the rolling direction stays convex (one minimum over the wheel angle): no flat, and
+    the curvature the polygons (n^2 A / r^2) and corrugations (A k^2) add stays below half the wheel's 1/r.
+    """
+    extra = 0.0
+    for row in wheel_rows:
+        if row[0] != 0.0:  # a flat: concave, two edges
+            return False
+        extra += row[1] ** 2 * abs(row[2]) / radius**2
+    for row in rail_rows:
+        extra += abs(row[2]) * row[1] ** 2
+    return extra < 0.5 / radius
+
+
 def pack_search(provider, options=None):
     """(sp, tabs, irrs) of search_geometry from a SearchProvider (its surfaces' fast stand-ins).
 
@@ -492,6 +506,8 @@ def pack_search(provider, options=None):
         sp[s, S_MEMR] = opts["memory_radius_m"]
         sp[s, S_TRACK] = opts["track_step_m"]
         sp[s, S_AHALF], sp[s, S_APTS] = opts["alpha_half_range_rad"], opts["alpha_points"]
+        if _convex_along_the_rail(wheel.irregularity_rows, rail.irregularity_rows, provider.r0):
+            sp[s, S_APTS] = 1  # one minimum over the angle: the lowest angle seeds it
         tabs.append(np.ascontiguousarray(np.stack(wheel.table_tuple[2:])))
         tabs.append(np.ascontiguousarray(np.stack(rail.table_tuple[2:])))
         irrs.append(np.ascontiguousarray(wheel.irregularity_rows, float).reshape(-1, 7))
