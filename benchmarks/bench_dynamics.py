@@ -57,9 +57,9 @@ NOTES = """\
 Notes.
 
 * Targets. With the 3-D search (search-compiled, Hertz + FASTSIM 20 x 20, 2 s of the polygonal-wheel scene):
-  about 12x real time at the scene's 0.5 ms step and 21x at 1 ms. With tables on ideal geometry: FASTSIM 20 x 20
-  about 54x (0.5 ms) and 95x (1 ms); FASTSIM 15 x 10 (creep forces within 1 % of a 200 x 200 grid,
-  benchmarks/results/fastsim_grid.md) about 87x and 154x; Vermeulen-Johnson about 150x and 250x. So >= 100x with
+  about 13x real time at the scene's 0.5 ms step and 23x at 1 ms. With tables on ideal geometry: FASTSIM 20 x 20
+  about 56x (0.5 ms) and 99x (1 ms); FASTSIM 15 x 10 (creep forces within 1 % of a 200 x 200 grid,
+  benchmarks/results/fastsim_grid.md) about 90x and 160x; Vermeulen-Johnson about 150x and 270x. So >= 100x with
   tables and FASTSIM needs the 1 ms step with the 15 x 10 grid; at 1 ms the largest wheel-load error against the
   1/16 ms run is 4.6 % of the static load (a short transient; median 2e-5), at 0.5 ms 0.4 %. Real-time factors
   include the run's fixed cost (static equilibrium by the compiled RHS, packing, recording: a few ms).
@@ -68,7 +68,7 @@ Notes.
   step's first stage a lateral scan of the vertical gap (1 mm) seeds Newton refinements (warm-started and, near
   a last candidate, a single quasi-Newton step), and the other three stages track the last candidates; patch
   geometry (curvature tensors, principal relative curvatures) is evaluated on the tabulated surfaces. About
-  10 us per RHS on average (2 x 0.8 us of it FASTSIM). It reproduces the Python search loop: 2e-4 N0 and 1e-8 m
+  9.5 us per RHS on average (2 x 0.8 us of it FASTSIM). It reproduces the Python search loop: 2e-4 N0 and 1e-8 m
   over 0.03 s (tests/test_dynamics_compiled_search.py); patches at random poses within 1e-11 m in approach.
 * Largest errors are switching instants. S1002/UIC60 1:40 has two near-equal gap minima on each wheel near the
   centred position (10 mm apart); whether they form one patch or two, and which is deeper, flips with tiny
