@@ -61,6 +61,25 @@ def test_sweep_statuses_and_files(tmp_path):
     assert plot_stress(records, tmp_path / "stress.png").exists()
 
 
+def test_summary_lists_finished_runs_whose_energy_does_not_balance():
+    from comparisons.stress import ENERGY_SUSPECT_RELATIVE, summarize
+
+    def record(parameter, value, success, energy):
+        return {"parameter": parameter, "value": value, "status": "ok" if success else "blow-up", "success": success,
+                "energy_balance_relative": energy}  # fmt: skip
+
+    records = [
+        record("fixed_step_s", 2e-3, True, 0.99),
+        record("fixed_step_s", 5e-4, True, 2e-4),
+        record("fixed_step_s", 2e-2, False, 0.9),  # stopped: reported by its status, not as suspect
+        record("relative_tolerance", 1e-3, True, None),
+    ]
+    report = summarize(records)
+    assert report["energy_suspect"] == [{"parameter": "fixed_step_s", "value": 2e-3, "energy_balance_relative": 0.99}]
+    assert report["statuses"] == {"ok": 3, "blow-up": 1} and report["finished"] == 3
+    assert report["max_energy_balance_relative"] == 0.99 and ENERGY_SUSPECT_RELATIVE == 0.01
+
+
 def test_variants_and_bad_parameter():
     assert scene_variant(BASE, "fixed_step_s", 1e-4).integrator.method == "RK4"
     assert scene_variant(BASE, "friction_coefficient", 0.1).material.friction_coefficient == 0.1
@@ -80,7 +99,7 @@ def test_plot_dynamics_writes_png(tmp_path):
 def test_cli_entry_points(tmp_path):
     """The functions ``wheelrail run`` / ``wheelrail stress`` call (regression of their contract)."""
     from comparisons.dynamics_plots import plot_simulation
-    from comparisons.stress import run_stress_sweep
+    from comparisons.stress import ENERGY_SUSPECT_RELATIVE, run_stress_sweep
     from rigid_dynamics.wheelset import simulate, timeseries_arrays
 
     result = simulate(BASE)
@@ -91,6 +110,15 @@ def test_cli_entry_points(tmp_path):
     report = run_stress_sweep(quick, out_dir=tmp_path / "stress", quick=True)
     assert report["finished"] + report["stopped"] == len(report["runs"]) > 5
     assert sorted(report["files"]) == ["stress.csv", "stress.json", "stress.png"]
+    # finished runs whose energy does not balance are listed, and only those
+    limit = ENERGY_SUSPECT_RELATIVE
+    listed = {(r["parameter"], r["value"]) for r in report["energy_suspect"]}
+    expected = {
+        (r["parameter"], r["value"])
+        for r in report["runs"]
+        if r["success"] and r["energy_balance_relative"] is not None and r["energy_balance_relative"] > limit
+    }
+    assert listed == expected
 
 
 # --- dask.distributed ---------------------------------------------------------------------------

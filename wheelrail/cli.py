@@ -237,7 +237,7 @@ def cmd_stress(args) -> int:
         raise ConfigError(f"--workers {args.workers!r}: needs dask.distributed (pip install 'dask[distributed]')")
     source = resolve_scene_path(args.scene or DEFAULT_STRESS_SCENE)
     scene = load_scene(source)
-    from comparisons.stress import run_stress_sweep
+    from comparisons.stress import ENERGY_SUSPECT_RELATIVE, run_stress_sweep
 
     out_dir = new_output_dir(args.out, f"stress-{source.stem}")
     copy_input(source, out_dir, "scene.toml")
@@ -251,6 +251,11 @@ def cmd_stress(args) -> int:
         f"stress sweep of {source.stem}: {len(report['runs'])} runs ({report['finished']} finished, "
         f"{report['stopped']} stopped) on {workers} worker{'s' if workers > 1 else ''}"
     )
+    for run in report.get("energy_suspect", []):
+        _print(
+            f"stress sweep of {source.stem}: {run['parameter']} = {run['value']:g} finished with an energy balance "
+            f"of {run['energy_balance_relative']:.3g} (above {ENERGY_SUSPECT_RELATIVE:g}: check the step or tolerance)"
+        )
     _print(f"stress sweep of {source.stem}: output written to {out_dir}")
     return EXIT_OK
 
