@@ -3,7 +3,7 @@ VENV := .venv
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: demo test lint setup clean
+.PHONY: demo test lint setup clean clean-numba
 
 $(STAMP): pyproject.toml tools/setup_venv.sh
 	bash tools/setup_venv.sh
@@ -21,3 +21,8 @@ lint: $(STAMP)
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
+
+# numba's on-disk cache is keyed on each function's own file: after editing a jitted function that another
+# module's cached function calls (e.g. the FASTSIM kernel inside the compiled RK4 loop), drop the cache
+clean-numba:
+	find rigid_dynamics -name '*.nbi' -delete -o -name '*.nbc' -delete
