@@ -30,7 +30,8 @@ Residuals phi_i = (F_i / W)^(2/3) - 1 (nearly linear in the sink: F ~ q^1.5); th
 Pitch rate: the case's ``pitch_rate_rad_per_s`` (the wheelset's angular velocity about its axle, with CONTACT's
 sign: negative for forward rolling; spin rate phi' = -pitch rate), else option ``spin_rate``:
 ``"zero-axle-moment"`` (default; a freely rolling wheelset without traction torque settles where the moments of
-all contact forces about the axle cancel: secant iteration on phi', each step a full equilibrium),
+all contact forces about the axle cancel: secant iteration on phi', each step a full equilibrium; a model without
+creep forces, ``hertz``, has no moment and keeps V / r0),
 ``"nominal"`` (V / r0) or ``"mean-rolling-radius"`` (V over the mean rolling radius of the wheels' main patches).
 Creepages (eq 39-49, creepage.py) at each patch's reference point; centre velocity (V, 0, 0), yaw and roll rates 0.
 
@@ -62,6 +63,7 @@ DEFAULT_CASE_OPTIONS: dict = {
     "patch": None,  # options of wheelset_patches.wheel_patches (angle_separation_rad, distance_*_m, ...)
     "search": None,  # options passed to search.search_side ("search" patches)
     "model": None,  # options passed to the contact model
+    "sides": SIDES,  # per-wheel kinematics: the wheels to solve (CONTACT's A-2.2 deck solves the right one)
 }
 SPIN_RATES = ("zero-axle-moment", "nominal", "mean-rolling-radius")
 PATCH_MODES = ("contact", "search")
@@ -220,7 +222,8 @@ class WheelsetCaseSolution:
         spin_rate_rad_per_s: phi' used, rad/s. spin_rate_mode: "prescribed" or the ``spin_rate`` option.
         axle_moment_Nm: moment of all contact forces on the wheelset about its axle (y_d), N m.
         equilibrium_residual: max over the wheels of |vertical load / wheel_load_N - 1|; nan under approach control.
-        pose: the final :class:`WheelsetPose` (per-wheel kinematics: the right wheel's).
+        pose: the final :class:`WheelsetPose` (per-wheel kinematics: the last solved wheel's).
+        Per-wheel kinematics with option ``sides`` solves only those wheels: the dicts hold only them.
     """
 
     success: bool
@@ -431,6 +434,11 @@ def solve_wheelset_case(
         value = opts[name]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
             raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+    sides = tuple(opts["sides"]) if isinstance(opts["sides"], (tuple, list)) else (opts["sides"],)
+    if not sides or any(side not in SIDES for side in sides) or len(set(sides)) != len(sides):
+        raise ValueError(f"sides = {opts['sides']!r}: expected a non-empty selection of 'left', 'right'")
+    if case.roll_rad is None and len(sides) != 2:
+        raise ValueError(f"sides = {opts['sides']!r}: the whole-wheelset equilibrium (roll_rad None) needs both wheels")
     contact_model = get_model(model)
     if track is None:
         track = build_track(case)
@@ -448,7 +456,7 @@ def solve_wheelset_case(
         """Equilibrium at spin rate omega: (states per side, warm-start data, iterations, status)."""
         if per_wheel:
             states, starts, total, status = {}, {}, 0, "ok"
-            for side in SIDES:
+            for side in sides:
 
                 def pose_of(s):
                     return WheelsetPose(
@@ -506,8 +514,8 @@ def solve_wheelset_case(
             False, status, messages.get(status, status), time.perf_counter() - started, math.nan, math.nan, [], {},
             iterations, "per-wheel" if per_wheel else "equilibrium", omega, mode,
         )  # fmt: skip
-    patches = [p for side in SIDES for p in states[side].patches]
-    failed = [f for side in SIDES for f in states[side].failed]
+    patches = [p for side in sides for p in states[side].patches]
+    failed = [f for side in sides for f in states[side].failed]
     message = messages.get(status, status)
     if failed:
         status, message = "model-failed", "; ".join(failed)
@@ -516,10 +524,10 @@ def solve_wheelset_case(
     elif status == "ok":
         message = f"equilibrium found in {iterations} wheel evaluations"
     target = case.wheel_load_N
-    loads = {side: states[side].vertical_load_N for side in SIDES}
-    residual = max(abs(loads[side] / target - 1.0) for side in SIDES) if target is not None else math.nan
-    z = {side: states[side].pose.z_m for side in SIDES}
-    pose = states["right"].pose
+    loads = {side: states[side].vertical_load_N for side in sides}
+    residual = max(abs(loads[side] / target - 1.0) for side in sides) if target is not None else math.nan
+    z = {side: states[side].pose.z_m for side in sides}
+    pose = states[sides[-1]].pose
     return WheelsetCaseSolution(
         success=status == "ok",
         status=status,
@@ -535,7 +543,7 @@ def solve_wheelset_case(
         spin_rate_mode=mode,
         axle_moment_Nm=float(sum(s.axle_moment_Nm for s in states.values())),
         equilibrium_residual=float(residual),
-        wheel_force_N={side: states[side].force_N.copy() for side in SIDES},
+        wheel_force_N={side: states[side].force_N.copy() for side in sides},
         wheel_vertical_position_m=z,
         pose=pose,
     )
