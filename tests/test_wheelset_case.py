@@ -59,8 +59,10 @@ def test_centred_wheelset_is_symmetric_and_carries_the_load():
     assert nominal.spin_rate_rad_per_s == pytest.approx(2.0 / 0.46, rel=1e-12)
     for patch, sign in ((p, -1 if p.side == "left" else 1) for p in nominal.patches):
         g = patch.geometry
-        assert patch.creepage.longitudinal == pytest.approx(1 - g.rolling_radius_m / 0.46, abs=1e-9)
-        assert patch.creepage.spin_1_per_m == pytest.approx(sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6)
+        xi = 1 - g.rolling_radius_m / 0.46  # relative to V (eq 41); the case divides by the mean rolling speed:
+        mean = 2.0 / (2.0 - xi)  # V (2 - xi)/2 (Kalker, CONTACT)
+        assert patch.creepage.longitudinal == pytest.approx(xi * mean, abs=1e-9)
+        assert patch.creepage.spin_1_per_m == pytest.approx(mean * sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6)
         assert patch.creepage.lateral == pytest.approx(0.0, abs=1e-12)
 
 

@@ -47,14 +47,16 @@ def test_summary_says_within_tolerance(rows):
 
 
 def test_creepages_and_contact_angle_equal_contacts_at_its_reference_point(rows):
-    """With the deck's roll and pitch rate the creepages at the reference point are CONTACT's (CKSI, CETA, CPHI).
+    """With the deck's roll and pitch rate the creepages at the reference point are CONTACT's (CKSI, CETA, CPHI),
+    relative to the bodies' mean rolling speed as CONTACT defines them: within 0.5 % or 2e-5 (recorded: 0.3 % at
+    the flange root, 0.04 % in flange contact, 1.6e-5 at the 0.5 mm shift where xi is 5e-4).
 
     Not on case 11, the blended patch, whose reference point lies 0.23 mm from CONTACT's (module docstring): the
     rolling radius changes by the flange-root slope over it (xi: 0.00403 against 0.00417)."""
     for r in (r for r in rows if r["combination"] == "single"):
-        assert r["creepage_long"] == pytest.approx(r["contact_creepage_long"], abs=2e-5), r["step"]
-        assert r["creepage_lat"] == pytest.approx(r["contact_creepage_lat"], abs=2e-5), r["step"]
-        assert r["spin_creepage_1_per_m"] == pytest.approx(r["contact_spin_creepage_1_per_m"], rel=0.02, abs=0.02)
+        assert r["creepage_long"] == pytest.approx(r["contact_creepage_long"], rel=0.005, abs=2e-5), r["step"]
+        assert r["creepage_lat"] == pytest.approx(r["contact_creepage_lat"], rel=0.005, abs=2e-5), r["step"]
+        assert r["spin_creepage_1_per_m"] == pytest.approx(r["contact_spin_creepage_1_per_m"], rel=0.005)
         assert r["contact_angle_rad"] == pytest.approx(r["contact_contact_angle_rad"], abs=0.02)
 
 

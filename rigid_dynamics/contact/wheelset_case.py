@@ -33,7 +33,9 @@ sign: negative for forward rolling; spin rate phi' = -pitch rate), else option `
 all contact forces about the axle cancel: secant iteration on phi', each step a full equilibrium; a model without
 creep forces, ``hertz``, has no moment and keeps V / r0),
 ``"nominal"`` (V / r0) or ``"mean-rolling-radius"`` (V over the mean rolling radius of the wheels' main patches).
-Creepages (eq 39-49, creepage.py) at each patch's reference point; centre velocity (V, 0, 0), yaw and roll rates 0.
+Creepages (eq 39-49, creepage.py) of the wheel's material point on the normal through each patch's reference
+point; centre velocity (V, 0, 0), yaw and roll rates 0; relative to the mean rolling speed of the two bodies as
+Kalker and CONTACT define them (option ``rolling_speed``, see ``_creepage``).
 
 ``approach_m`` instead of ``wheel_load_N`` prescribes the largest approach on each wheel (approach control).
 """
@@ -63,6 +65,8 @@ DEFAULT_CASE_OPTIONS: dict = {
     "patch": None,  # options of wheelset_patches.wheel_patches (angle_separation_rad, distance_*_m, ...)
     "search": None,  # options passed to search.search_side ("search" patches)
     "model": None,  # options passed to the contact model
+    "rolling_speed": "mean",  # creepages relative to the bodies' mean rolling speed ("mean", Kalker, CONTACT)
+    # or to the wheelset centre's speed ("centre", eq 41); see _creepage
     "sides": SIDES,  # per-wheel kinematics: the wheels to solve (CONTACT's A-2.2 deck solves the right one)
 }
 SPIN_RATES = ("zero-axle-moment", "nominal", "mean-rolling-radius")
@@ -261,8 +265,16 @@ class _WheelState:
     failed: list[str]
 
 
-def _creepage(case: WheelsetCase, pose: WheelsetPose, point_m, normal, omega_spin: float) -> Creepage:
-    """Creepages of the wheel's material point ``point_m`` (main frame) with the patch normal (eq 39-49)."""
+def _creepage(
+    case: WheelsetCase, pose: WheelsetPose, point_m, normal, omega_spin: float, rolling_speed: str = "mean"
+) -> Creepage:
+    """Creepages of the wheel's material point ``point_m`` (main frame) with the patch normal (eq 39-49).
+
+    ``rolling_speed = "centre"``: divided by V = |v_p| of the wheelset centre (eq 41). ``"mean"`` (Kalker's and
+    CONTACT's definition): divided by the mean of the two bodies' rolling speeds through the contact, the rail's V
+    and the wheel's V (1 - xi), i.e. V (2 - xi)/2 with xi the eq-41 creepage; the slip velocities are the same,
+    the creepages differ by the factor 2 / (2 - xi) (1.2 % at a flange contact that rolls 2.4 % faster than r0).
+    """
     x_d = pose.rotation.T @ (np.asarray(point_m, float) - pose.centre_m)
     kin = wheelset_creepage(
         x_d,
@@ -272,7 +284,16 @@ def _creepage(case: WheelsetCase, pose: WheelsetPose, point_m, normal, omega_spi
         centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
         spin_rate_rad_per_s=omega_spin,
     )
-    return kin.creepage()
+    creepage = kin.creepage()
+    if rolling_speed == "centre":
+        return creepage
+    factor = 2.0 / (2.0 - creepage.longitudinal)
+    return Creepage(
+        longitudinal=creepage.longitudinal * factor,
+        lateral=creepage.lateral * factor,
+        spin_1_per_m=creepage.spin_1_per_m * factor,
+        rolling_speed_m_per_s=creepage.rolling_speed_m_per_s / factor,
+    )
 
 
 class _Evaluator:
@@ -305,7 +326,9 @@ class _Evaluator:
         geometries, min_gap = self.geometry(pose, side)
         patches, failed = [], []
         for k, (geometry, how, deepest, material_point) in enumerate(geometries):
-            creepage = _creepage(self.case, pose, material_point, geometry.frame[:, 2], omega)
+            creepage = _creepage(
+                self.case, pose, material_point, geometry.frame[:, 2], omega, self.opts["rolling_speed"]
+            )
             result = self.model.solve(
                 geometry, creepage, self.material, normal_force_N=None, options=self.opts["model"]
             )
@@ -424,6 +447,8 @@ def solve_wheelset_case(
         opts[key] = value
     if opts["spin_rate"] not in SPIN_RATES:
         raise ValueError(f"spin_rate = {opts['spin_rate']!r}: expected one of {', '.join(map(repr, SPIN_RATES))}")
+    if opts["rolling_speed"] not in ("mean", "centre"):
+        raise ValueError(f"rolling_speed = {opts['rolling_speed']!r}: expected 'mean' or 'centre'")
     if opts["patches"] not in PATCH_MODES:
         raise ValueError(f"patches = {opts['patches']!r}: expected one of {', '.join(map(repr, PATCH_MODES))}")
     for name in ("max_iterations",):
