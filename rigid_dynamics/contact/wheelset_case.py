@@ -11,7 +11,9 @@ rail) and yawed by ``yaw_rad`` (psi of eq 1), and its vertical position is found
 Patches (option ``patches``): ``"contact"`` (default) forms them as CONTACT does, from the vertical gap under the
 wheel's contact locus, joining close interpenetration regions into one patch (A_SEP, D_SEP, D_COMB) with the
 contact plane at the weighted centre (rigid_dynamics.contact.wheelset_patches, where the undeformed distance is
-evaluated exactly at any point); ``"search"`` takes the 3-D search's patches (one per local minimum of the
+evaluated exactly at any point; regions are joined only for a model that solves the joined gap itself, ``bem``
+and ``fea``, or any model with ``solves_undeformed_distance = True``: the analytic rungs take each region as its
+own patch); ``"search"`` takes the 3-D search's patches (one per local minimum of the
 normal distance, plane at the deepest point; the geometry the dynamics uses). Every patch is solved by the
 requested model under approach control at the wheelset's pose, so all patches of a wheel share its rigid
 displacement and each model carries the load with its own normal forces (Hertz for the analytic rungs).
@@ -296,6 +298,14 @@ def _creepage(
     )
 
 
+FIELD_MODELS = ("bem", "fea")
+"""Models that solve the sampled undeformed distance itself (joined patches are theirs; module docstring)."""
+
+
+def _solves_undeformed_distance(model) -> bool:
+    return bool(getattr(model, "solves_undeformed_distance", getattr(model, "name", "") in FIELD_MODELS))
+
+
 class _Evaluator:
     """Patches, model solutions and sums of one wheel at a pose (counting the evaluations)."""
 
@@ -313,9 +323,14 @@ class _Evaluator:
         from rigid_dynamics.contact.wheelset_patches import wheel_patches
 
         wheel, rail = track.fast[side]
+        patch_options = dict(opts["patch"] or {})
+        if not _solves_undeformed_distance(self.model):
+            # regions are joined only for a model that solves the joined gap (bem, fea); the analytic rungs take
+            # each interpenetration region as its own patch (a joined patch is no ellipse)
+            patch_options["distance_separation_m"] = 0.0
         patches, locus = wheel_patches(
             wheel, rail, pose, side, wheel_lateral_range_m=wheel.y_range_m, rail_lateral_range_m=rail.y_range_m,
-            nominal_radius_m=track.nominal_radius_m, options=opts["patch"],
+            nominal_radius_m=track.nominal_radius_m, options=patch_options,
         )  # fmt: skip
         finite = locus.gap_m[np.isfinite(locus.gap_m)]
         min_gap = float(finite.min()) if finite.size else math.inf
@@ -369,7 +384,7 @@ def _solve_one_wheel(evaluator: _Evaluator, pose_of, side: str, omega: float, q_
         s = s_touch + (q_ref if target is not None else case.approach_m)
     else:
         s_touch, s = start
-    previous = None
+    previous = low = high = None
     state = None
     for iteration in range(1, opts["max_iterations"] + 1):
         state = evaluator.wheel(pose_of(s), side, omega)
@@ -387,6 +402,11 @@ def _solve_one_wheel(evaluator: _Evaluator, pose_of, side: str, omega: float, q_
             done = state.patches and abs(state.max_approach_m - case.approach_m) < opts["approach_tolerance_m"]
         if done:
             return (state, (s_touch, s)), iteration, "ok"
+        # bracket of the root (phi rises with the sink): safeguarded secant (bisection when it leaves the bracket)
+        if r < 0:
+            low = (s, r) if low is None or s > low[0] else low
+        else:
+            high = (s, r) if high is None or s < high[0] else high
         if previous is None or previous[1] == r:
             # phi ~ (s - s_touch)/(s* - s_touch) - 1 for a Hertzian wheel: scale the sink below the touch
             step = -r * max(s - s_touch, 0.2 * q_ref)
@@ -394,7 +414,10 @@ def _solve_one_wheel(evaluator: _Evaluator, pose_of, side: str, omega: float, q_
             step = -r * (s - previous[0]) / (r - previous[1])
         previous = (s, r)
         step = float(np.clip(step, -5.0 * q_ref, 5.0 * q_ref))
-        s = s + step
+        new = s + step
+        if low is not None and high is not None and not low[0] < new < high[0]:
+            new = 0.5 * (low[0] + high[0])
+        step, s = new - s, new
         if abs(step) < 1e-15:
             return (state, (s_touch, s)), iteration, "ok" if target is None else "not-converged"
     return (state, (s_touch, s)), opts["max_iterations"], "not-converged"

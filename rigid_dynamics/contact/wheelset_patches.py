@@ -283,6 +283,18 @@ def _curvatures(geo_exact: _SideGeometry, alpha0: float, y0: float, rail_xy, fra
     return float(a_rel), float(b_rel), float(angle), float(radius[0])
 
 
+def _overlap_ellipse(xs, ys, field, approach: float):
+    """Curvatures (A, B, 0) of the quadric A x^2 + B y^2 - q whose rigid overlap has the sampled overlap's extents
+    (an equivalent ellipse for joined or conformal patches); None when nothing overlaps."""
+    over = np.isfinite(field) & (field < 0)
+    if not over.any() or approach <= 0:
+        return None
+    cols, rows = np.flatnonzero(over.any(axis=0)), np.flatnonzero(over.any(axis=1))
+    hx = 0.5 * (xs[min(cols[-1] + 1, xs.size - 1)] - xs[max(cols[0] - 1, 0)])
+    hy = 0.5 * (ys[min(rows[-1] + 1, ys.size - 1)] - ys[max(rows[0] - 1, 0)])
+    return approach / hx**2, approach / hy**2, 0.0
+
+
 def _box_minimum(gap_of, x0, y0, hx, hy, points: int = 7, passes: int = 3):
     """Smallest gap near (x0, y0) by successively finer small grids, and where it is."""
     best = (math.inf, x0, y0)
@@ -380,6 +392,12 @@ def wheel_patches(
             area = None
         undeformed = UndeformedDistance(x_m=xs, y_m=ys, distance_m=field, exact=gap_of, potential_area_m=area)
         convex = a_rel > 0 and b_rel > 0
+        if not convex or len(group) > 1:
+            # the curvatures at one point do not describe a joined or conformal patch: the analytic rungs get the
+            # quadric with the same rigid-overlap extents (an equivalent ellipse; is_elliptic False)
+            fitted = _overlap_ellipse(xs, ys, field, approach)
+            if fitted is not None:
+                a_rel, b_rel, ell_angle = fitted
         a_use, b_use = max(a_rel, 1e-6), max(b_rel, 1e-6)
         elliptic = convex and len(group) == 1
         if elliptic:
