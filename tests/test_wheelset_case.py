@@ -62,7 +62,9 @@ def test_centred_wheelset_is_symmetric_and_carries_the_load():
         xi = 1 - g.rolling_radius_m / 0.46  # relative to V (eq 41); the case divides by the mean rolling speed:
         mean = 2.0 / (2.0 - xi)  # V (2 - xi)/2 (Kalker, CONTACT)
         assert patch.creepage.longitudinal == pytest.approx(xi * mean, abs=1e-9)
-        assert patch.creepage.spin_1_per_m == pytest.approx(mean * sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6)
+        assert patch.creepage.spin_1_per_m == pytest.approx(
+            mean * sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6
+        )
         assert patch.creepage.lateral == pytest.approx(0.0, abs=1e-12)
 
 
@@ -133,6 +135,47 @@ def test_canted_rail_file_is_not_canted_twice_and_flange_is_outside_r0():
     assert wheel.evaluate(np.pi / 2, 0.75)[0] == pytest.approx(0.46, abs=1e-9)
 
 
+def test_cant_is_data_of_the_profile_not_of_its_name(tmp_path):
+    """A byte-identical copy of the canted Manchester rail under another name: its cant is whatever the case states
+    (default 0, as for any file), never guessed from the name; stated, it places the rail as the built-in one."""
+    from rigid_dynamics.geometry.readers import BUILTIN_PROFILE_DIR
+
+    copy = tmp_path / "my_rail.prr"
+    copy.write_bytes((BUILTIN_PROFILE_DIR / "MBench_UIC60_v3.prr").read_bytes())
+    builtin = build_track(a22(0.0))
+    stated = build_track(a22(0.0, rail_profile=str(copy), rail_profile_cant_rad=CANT))
+    unstated = build_track(a22(0.0, rail_profile=str(copy)))
+    y = np.linspace(0.72, 0.79, 15)
+    np.testing.assert_allclose(stated.rails["right"].evaluate(0.0, y)[0], builtin.rails["right"].evaluate(0.0, y)[0])
+    assert unstated.rails["right"].cant_rad == pytest.approx(CANT)  # canted by the case's 1:40 on top of the file's
+    assert stated.rails["right"].cant_rad == pytest.approx(0.0, abs=1e-15)
+
+
+def test_a_wheel_file_with_z_up_is_an_error_that_names_the_fix():
+    with pytest.raises(ValueError, match="wheel_profile_mirror_z"):
+        build_track(a22(0.0, wheel_profile_mirror_z=True))  # z turned up: the flange points to the axle
+
+
+def test_left_and_right_profiles_may_differ():
+    """A worn left wheel on the new right one: each side gets its own surface; with equal profiles named on both
+    sides the result is the one-profile shorthand's."""
+    both = build_track(a22(0.0, wheel_profile_left="MBench_S1002_v3"))
+    one = build_track(a22(0.0))
+    y = np.linspace(-0.79, -0.70, 12)
+    np.testing.assert_allclose(
+        both.wheels["left"].evaluate(np.pi / 2, y)[0], one.wheels["left"].evaluate(np.pi / 2, y)[0]
+    )
+    worn = build_track(a22(0.0, wheel_profile_left="worn_high_mileage"))
+    y = np.linspace(-0.78, -0.71, 15)
+    r_worn, r_new = (t.wheels["left"].evaluate(np.pi / 2, y)[0] for t in (worn, one))
+    assert np.nanmax(np.abs(r_worn - r_new)) > 1e-4
+    right = (t.wheels["right"].evaluate(np.pi / 2, -y)[0] for t in (worn, one))
+    np.testing.assert_allclose(*right)
+    sol = solve_wheelset_case(a22(0.0, wheel_profile_left="worn_high_mileage"), STEEL, "hertz", NO_FIELD)
+    assert sol.success, sol.message
+    assert sol.roll_rad != pytest.approx(0.0, abs=1e-7)  # no longer symmetric
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
@@ -147,6 +190,10 @@ def test_canted_rail_file_is_not_canted_twice_and_flange_is_outside_r0():
         ({"gauge_height_m": -0.01}, "gauge_height_m = -0.01"),
         ({"rail_inclination_rad": 0.3}, "rail_inclination_rad = 0.3"),
         ({"rolling_speed_m_per_s": 0.0}, "rolling_speed_m_per_s = 0.0"),
+        ({"rail_profile_cant_rad": 0.3}, "rail_profile_cant_rad = 0.3"),
+        ({"profile_smoothing_m": -1e-3}, "profile_smoothing_m = -0.001"),
+        ({"wheel_profile_mirror_z": 1}, "wheel_profile_mirror_z = 1"),
+        ({"wheel_profile_left": ""}, "wheel_profile_left = ''"),
     ],
 )
 def test_bad_case_raises(kwargs, match):

@@ -40,6 +40,14 @@ WHEELSET_GEOMETRY_KEYS = {
     "flange_back_distance_m",
     "nominal_radius_m",
     "rail_inclination_rad",
+    "wheel_profile_left",
+    "rail_profile_left",
+    "rail_profile_cant_rad",
+    "profile_smoothing_m",
+    "wheel_profile_mirror_y",
+    "wheel_profile_mirror_z",
+    "rail_profile_mirror_y",
+    "rail_profile_mirror_z",
 }
 QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
 
@@ -130,7 +138,7 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
         return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
     if kind == "wheelset":
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
-        check_keys(kinematics, {"rolling_speed_m_per_s"}, "kinematics")
+        check_keys(kinematics, {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"}, "kinematics")
         force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
         wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics)
         return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
@@ -147,9 +155,13 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
         table["wheel_load_N"] = wheel_load_N
     if approach_m is not None:
         table["approach_m"] = approach_m
-    if "rolling_speed_m_per_s" in kinematics:
-        table["rolling_speed_m_per_s"] = kinematics["rolling_speed_m_per_s"]
-    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail")):
+    for key in ("rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"):
+        if key in kinematics:
+            table[key] = kinematics[key]
+    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail"), ("wheel_profile_left", "wheel"),
+                      ("rail_profile_left", "rail")):  # fmt: skip
+        if key not in table and key.endswith("_left"):
+            continue
         if key not in table:
             raise ConfigError(f"missing key 'geometry.{key}': expected a built-in profile name or a file path")
         value = table[key]

@@ -314,7 +314,8 @@ def cmd_manchester(args) -> int:
         _print(f"  patch count differs from CONTACT at steps {comparison['patch_count_mismatch_steps']}")
     verdict = "within" if comparison["within_tolerance"] else "NOT within"
     _print(
-        f"Manchester A-2.2 ({args.method}, {args.kinematics}): {verdict} the tolerances against CONTACT; output written to {out_dir}"
+        f"Manchester A-2.2 ({args.method}, {args.kinematics}): {verdict} the tolerances against CONTACT; "
+        f"output written to {out_dir}"
     )
     return EXIT_OK if summary["all_converged"] else EXIT_FAILED
 

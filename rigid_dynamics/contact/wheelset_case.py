@@ -80,22 +80,31 @@ class WheelsetCase:
     """A wheelset contact case (the ``[geometry] kind = "wheelset"`` contract of the contact-case files).
 
     Attributes:
-        wheel_profile: built-in profile name or file path (both wheels; the left one is mirrored).
-        rail_profile: built-in profile name or file path (both rails; mirrored on the left).
+        wheel_profile: built-in profile name or file path (the right wheel; also the left one, mirrored, unless
+            ``wheel_profile_left`` is given).
+        rail_profile: built-in profile name or file path (the right rail; also the left, mirrored).
         lateral_shift_m: wheelset lateral displacement towards main +y (the right rail), m.
         yaw_rad: psi (eq 1), rad.
         gauge_m: track gauge (distance between the gauge faces at gauge_height_m below the rail tops), m.
         gauge_height_m: depth below the top of the rail where the gauge is measured, m (14 mm in EN 13848-1).
         flange_back_distance_m: distance between the two wheels' inner (back) faces, m.
         nominal_radius_m: r0, wheel radius at the tape circle, m.
-        rail_inclination_rad: cant of the rails towards the track centre, rad (1:40 -> atan(1/40)). Set 0 when
-            the rail profile is already canted (MBench_UIC60_v3.prr): it is applied to the profile as read.
+        rail_inclination_rad: cant of the rails in the track towards the track centre, rad (1:40 -> atan(1/40));
+            only its difference to the profile's own cant (``rail_profile_cant_rad``) is applied to the points.
         wheel_load_N: vertical load per wheel, N (force control), or None.
         approach_m: deepest approach per wheel, m (approach control), or None. Exactly one of the two.
         rolling_speed_m_per_s: V, forward speed of the wheelset, m/s.
         roll_rad: prescribed roll angle theta (per-wheel kinematics, module docstring), rad; None: solved.
         pitch_rate_rad_per_s: prescribed angular velocity of the wheelset about its axle, rad/s, with CONTACT's
             sign (forward rolling is negative; phi' = -pitch rate); None: option ``spin_rate``.
+        wheel_profile_left, rail_profile_left: the left wheel's and rail's profiles when they differ from the
+            right ones (None: the right ones, mirrored).
+        rail_profile_cant_rad: cant already contained in the rail profile's points, rad; None: the profile's own
+            (built-in profiles know theirs, e.g. MBench_UIC60_v3 1:40; a file has 0 unless stated here).
+        profile_smoothing_m: smoothing wavelength L_filt of the profile splines, m (default 2 mm; 0 interpolates).
+        wheel_profile_mirror_y, wheel_profile_mirror_z, rail_profile_mirror_y, rail_profile_mirror_z: turn a
+            profile file of another orientation into the internal one (y towards the field side, z down), as
+            CONTACT's MIRRORY / MIRRORZ.
     """
 
     wheel_profile: str
@@ -112,6 +121,14 @@ class WheelsetCase:
     rolling_speed_m_per_s: float = 1.0
     roll_rad: float | None = None
     pitch_rate_rad_per_s: float | None = None
+    wheel_profile_left: str | None = None
+    rail_profile_left: str | None = None
+    rail_profile_cant_rad: float | None = None
+    profile_smoothing_m: float = 0.002
+    wheel_profile_mirror_y: bool = False
+    wheel_profile_mirror_z: bool = False
+    rail_profile_mirror_y: bool = False
+    rail_profile_mirror_z: bool = False
 
     def __post_init__(self) -> None:
         for name in ("wheel_profile", "rail_profile"):
@@ -150,6 +167,34 @@ class WheelsetCase:
             raise ValueError(
                 f"wheel_load_N = {self.wheel_load_N!r}, approach_m = {self.approach_m!r}: expected exactly one of them"
             )
+        for name in ("wheel_profile_left", "rail_profile_left"):
+            value = getattr(self, name)
+            if value is not None and (not isinstance(value, str) or not value):
+                raise ValueError(f"{name} = {value!r}: expected None, a built-in profile name or a file path")
+        for name in (
+            "wheel_profile_mirror_y",
+            "wheel_profile_mirror_z",
+            "rail_profile_mirror_y",
+            "rail_profile_mirror_z",
+        ):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name} = {getattr(self, name)!r}: expected true or false")
+        value = self.rail_profile_cant_rad
+        if value is not None and (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or abs(value) >= 0.2
+        ):
+            raise ValueError(f"rail_profile_cant_rad = {value!r}: expected None or an angle with |angle| < 0.2 rad")
+        value = self.profile_smoothing_m
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or not 0 <= value <= 0.05
+        ):
+            raise ValueError(f"profile_smoothing_m = {value!r}: expected a length in [0, 0.05] m")
         if self.roll_rad is not None and (
             isinstance(self.roll_rad, bool)
             or not isinstance(self.roll_rad, (int, float))
@@ -535,6 +580,9 @@ def solve_wheelset_case(
         scale = case.rolling_speed_m_per_s * (case.wheel_load_N or 1.0e4) * case.nominal_radius_m
         previous = None
         for _ in range(12):
+            creep = [p.result.creep_force_long_N for st in states.values() for p in st.patches]
+            if not any(c != 0.0 for c in creep):
+                break  # no creep forces (hertz): the pitch rate changes nothing; V / r0 is kept
             moment = sum(s.axle_moment_Nm for s in states.values())
             if abs(moment) <= opts["axle_moment_tolerance"] * scale / case.rolling_speed_m_per_s:
                 break

@@ -86,9 +86,24 @@ def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 
     point alpha = pi/2 - phi.
     """
     y_lo, y_hi = geo.y_range
+    # only the part of the wheel above its rail: y_d of the rail's ends (the wheelset frame's y at the axle height)
+    ends = (np.array(geo.rail_range)[:, None] - geo.centre[1]) / geo.rot[1, 1]
+    y_lo, y_hi = max(y_lo, float(ends.min()) - 5e-3), min(y_hi, float(ends.max()) + 5e-3)
     n = max(int(math.ceil((y_hi - y_lo) / step_m)) + 1, 3)
     lat = np.linspace(y_lo, y_hi, n)
-    alpha = np.full(n, 0.5 * math.pi - geo.pose.spin_rad)
+    alpha_start = 0.5 * math.pi - geo.pose.spin_rad
+    if _compiled(geo):
+        from rigid_dynamics.contact import _patch_kernels as kern
+
+        alpha, point = np.empty(n), np.empty((n, 3))
+        gap, rail_z, angle = np.empty(n), np.empty(n), np.empty(n)
+        kern.contact_locus(
+            lat, alpha_start, geo.rot, geo.centre, geo.wheel.table_tuple, geo.wheel.irregularity_rows,
+            geo.rail.table_tuple, geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range),
+            geo.side == "right", iterations, alpha, point, gap, rail_z, angle,
+        )  # fmt: skip
+        return ContactLocus(alpha, lat, point, gap, rail_z, angle)
+    alpha = np.full(n, alpha_start)
     for _ in range(iterations):
         _, _, _, (t_a, t_y, x_aa, x_ay, _), _ = geo.wheel_point(alpha, lat, second=True)
         f = t_a[:, 2] * t_y[:, 1] - t_y[:, 2] * t_a[:, 1]
@@ -108,6 +123,13 @@ def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 
     tilt = -normal_y if geo.side == "right" else normal_y
     angle = np.arctan2(tilt, -normal_z)
     return ContactLocus(alpha, lat, point, gap, np.where(on_rail, big_n, np.nan), angle)
+
+
+def _compiled(geo: _SideGeometry) -> bool:
+    """Whether both surfaces are search.py's tabulated stand-ins (the compiled kernels apply)."""
+    from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
+
+    return isinstance(geo.wheel, TabulatedWheel) and isinstance(geo.rail, TabulatedRail)
 
 
 @dataclass(frozen=True, eq=False)
@@ -215,7 +237,20 @@ def plane_gap(geo: _SideGeometry, locus: ContactLocus, origin, frame, x_m, y_m, 
     """
     x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
     shape = x_m.shape
-    x, y = x_m.ravel(), y_m.ravel()
+    x, y = np.ascontiguousarray(x_m.ravel()), np.ascontiguousarray(y_m.ravel())
+    if _compiled(geo):
+        from rigid_dynamics.contact import _patch_kernels as kern
+
+        order = np.argsort(locus.point_m[:, 1])
+        gap, alpha, lat = np.empty(x.size), np.empty(x.size), np.empty(x.size)
+        kern.plane_gap(
+            x, y, np.asarray(origin, float), np.ascontiguousarray(frame), np.ascontiguousarray(locus.point_m[order, 1]),
+            locus.lateral_m[order], locus.alpha_rad[order], np.ascontiguousarray(locus.point_m[order, 0]), geo.rot,
+            geo.centre, geo.wheel.table_tuple, geo.wheel.irregularity_rows, geo.rail.table_tuple,
+            geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range), np.array(geo.y_range),
+            iterations, gap, alpha, lat,
+        )  # fmt: skip
+        return gap.reshape(shape), alpha.reshape(shape), lat.reshape(shape)
     e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
     base = origin + x[:, None] * e_x + y[:, None] * e_y
     t_rail = geo._distance_along(base, n, iterations)
@@ -285,7 +320,8 @@ def _curvatures(geo_exact: _SideGeometry, alpha0: float, y0: float, rail_xy, fra
 
 def _overlap_ellipse(xs, ys, field, approach: float):
     """Curvatures (A, B, 0) of the quadric A x^2 + B y^2 - q whose rigid overlap has the sampled overlap's extents
-    (an equivalent ellipse for joined or conformal patches); None when nothing overlaps."""
+    (an equivalent ellipse for joined or conformal patches); None when nothing overlaps.
+    """
     over = np.isfinite(field) & (field < 0)
     if not over.any() or approach <= 0:
         return None
