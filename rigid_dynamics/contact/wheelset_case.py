@@ -381,6 +381,20 @@ class _Evaluator:
         min_gap = float(finite.min()) if finite.size else math.inf
         return [(p.geometry, p.combination, p.deepest_point_rail_m, p.wheel_point_m) for p in patches], min_gap
 
+    def min_gap(self, pose: WheelsetPose, side: str) -> float:
+        """Smallest gap of one wheel (vertical, from the contact locus; the search's normal gap for "search")."""
+        if self.opts["patches"] == "search":
+            return self.geometry(pose, side)[1]
+        from rigid_dynamics.contact.search import _SideGeometry
+        from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS, contact_locus
+
+        wheel, rail = self.track.fast[side]
+        geo = _SideGeometry(wheel, rail, pose, side, wheel.y_range_m, rail.y_range_m)
+        step = (self.opts["patch"] or {}).get("locus_step_m", DEFAULT_PATCH_OPTIONS["locus_step_m"])
+        gap = contact_locus(geo, step).gap_m
+        finite = gap[np.isfinite(gap)]
+        return float(finite.min()) if finite.size else math.inf
+
     def wheel(self, pose: WheelsetPose, side: str, omega: float) -> _WheelState:
         self.count += 1
         geometries, min_gap = self.geometry(pose, side)
@@ -419,7 +433,7 @@ def _solve_one_wheel(evaluator: _Evaluator, pose_of, side: str, omega: float, q_
     if start is None:
         s = 0.0
         for _ in range(6):
-            _, gap = evaluator.geometry(pose_of(s), side)
+            gap = evaluator.min_gap(pose_of(s), side)
             if not math.isfinite(gap):
                 return None, 0, "search-failed"
             s += gap
@@ -657,7 +671,7 @@ def _solve_whole(evaluator, track, case, omega, q_ref, warm, opts):
         # rigid touch of both wheels (smallest gap 0 per side): Newton with a finite-difference Jacobian
 
         def gaps(sinks):
-            return np.array([evaluator.geometry(pose_of(sinks), side)[1] for side in SIDES])
+            return np.array([evaluator.min_gap(pose_of(sinks), side) for side in SIDES])
 
         sinks = np.zeros(2)
         for _ in range(opts["max_iterations"]):
