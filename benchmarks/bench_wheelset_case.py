@@ -103,10 +103,10 @@ def geometry_cost():
         sol = solve_wheelset_case(a22_case(step), MATERIAL, "hertz", {"spin_rate": "nominal"}, track=track)
         pose = sol.pose
 
-        def old():
+        def old(pose=pose):
             return [track.search(pose, side, {"field": True}) for side in SIDES]
 
-        def new():
+        def new(pose=pose):
             result = []
             for side in SIDES:
                 wheel, rail = track.fast[side]
@@ -125,11 +125,11 @@ def geometry_cost():
         x = np.linspace(field_old.x_m[2], field_old.x_m[-3], 40)
         y = np.linspace(field_old.y_m[2], field_old.y_m[-3], 40)
         xx, yy = np.meshgrid(x, y)
-        t_interp = best_time(lambda f=field_old: f.evaluate(xx, yy))
+        t_interp = best_time(lambda f=field_old, xx=xx, yy=yy: f.evaluate(xx, yy))
         x = np.linspace(field_new.x_m[2], field_new.x_m[-3], 40)
         y = np.linspace(field_new.y_m[2], field_new.y_m[-3], 40)
         xx2, yy2 = np.meshgrid(x, y)
-        t_exact = best_time(lambda f=field_new: f.evaluate(xx2, yy2))
+        t_exact = best_time(lambda f=field_new, xx=xx2, yy=yy2: f.evaluate(xx, yy))
         out.append({
             "step": step, "lateral_shift_m": step * 0.5e-3,
             "search_with_sampled_field_s": t_old, "contact_patches_s": t_new,
@@ -212,7 +212,8 @@ def markdown(result) -> str:
         "",
         "## Geometry per wheelset pose (both sides)",
         "",
-        "| shift | 3-D search + sampled field 31x31 | CONTACT-style patches (exact gap) | gap at 40x40: bilinear | exact |",
+        "| shift | 3-D search + sampled field 31x31 | CONTACT-style patches (exact gap) | gap at 40x40: bilinear "
+        "| exact |",
         "|---|---|---|---|---|",
     ]
     for g in result["geometry"]:
