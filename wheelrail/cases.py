@@ -11,7 +11,13 @@ A case file has the tables
 * ``[kinematics]``: ``creepage_long``, ``creepage_lat``, ``spin_creepage_1_per_m``,
   ``rolling_speed_m_per_s`` (quadric); a wheelset case takes only ``rolling_speed_m_per_s`` and
   derives the creepages from its yaw and geometry;
-* ``[solver]``: options of the contact model (passed through; the model rejects unknown ones).
+* ``[solver]``: for a quadric case the options of the contact model; for a wheelset case the case's options
+  (``rigid_dynamics.contact.wheelset_case.DEFAULT_CASE_OPTIONS``) with the model's options in ``[solver.model]``.
+  Both are checked against their declarations before any work (:func:`check_solver_options`;
+  ``wheelrail models`` lists each model's options).
+
+Numbers are checked against physical ranges as well as types (:data:`PHYSICAL_RANGES`): a creepage of 1e9
+or a rolling speed of 1e6 m/s is bad input, not a case.
 """
 
 from __future__ import annotations
@@ -162,10 +168,128 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
     return build_dataclass(WheelsetCase, table, "geometry")
 
 
-def load_case(path: str | Path) -> ContactCase:
-    """Read and validate a case file (an embedded case name is accepted too)."""
+def load_case(path: str | Path, method: str | None = None) -> ContactCase:
+    """Read and validate a case file (an embedded case name is accepted too).
+
+    With ``method`` (a registered model name) the ``[solver]`` table is checked against that model's
+    declared options too (:func:`check_solver_options`).
+    """
     path = resolve_case_path(path)
-    return parse_case(read_toml(path, "case file"), name=Path(path).stem)
+    case = parse_case(read_toml(path, "case file"), name=Path(path).stem)
+    if method is not None:
+        check_solver_options(case, method)
+    return case
+
+
+def _wheelset_case_options(method: str) -> dict:
+    """Declaration of a wheelset case's ``[solver]`` options (defaults: DEFAULT_CASE_OPTIONS)."""
+    from rigid_dynamics.contact.options import Option, declare, validate_options
+    from rigid_dynamics.contact.registry import model_options
+    from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
+    from rigid_dynamics.contact.wheelset_case import DEFAULT_CASE_OPTIONS as D
+    from rigid_dynamics.contact.wheelset_case import LOAD_SHARING
+
+    def check_model(value, key):
+        validate_options(model_options(method), value, method, prefix=f"{key}.")
+        _check_joint_rules(method, value, f"solver.{key}")
+
+    def check_search(value, key):
+        declared = declare(
+            *(
+                Option(k, _python_type(v), v, "contact search option", allow_none=v is None)
+                for k, v in SEARCH_OPTIONS.items()
+            )
+        )
+        validate_options(declared, value, "contact search", prefix=f"{key}.")
+
+    return declare(
+        Option("max_iterations", int, D["max_iterations"], "equilibrium iterations", minimum=1),
+        Option(
+            "force_tolerance",
+            float,
+            D["force_tolerance"],
+            "relative, on each wheel's load",
+            minimum=0,
+            exclusive_minimum=True,
+        ),
+        Option("approach_tolerance_m", float, D["approach_tolerance_m"], "m", minimum=0, exclusive_minimum=True),
+        Option("spin_rate", str, D["spin_rate"], "spin rate", choices=("nominal", "mean-rolling-radius")),
+        Option("search", dict, D["search"], "contact search options", allow_none=True, check=check_search),
+        Option(
+            "model", dict, D["model"], f"options of the contact model {method!r}", allow_none=True, check=check_model
+        ),
+        Option("load_sharing", str, D["load_sharing"], "load sharing", choices=LOAD_SHARING, allow_none=True),
+        Option("model_max_iterations", int, D["model_max_iterations"], "load-sharing iterations", minimum=1),
+    )
+
+
+def _python_type(value) -> type:
+    """The option type of a default value (None: a number, as the search's ``field_scale``)."""
+    if value is None:
+        return float
+    if isinstance(value, (tuple, list)):
+        return tuple
+    if isinstance(value, bool):
+        return bool
+    if isinstance(value, int):
+        return int
+    if isinstance(value, float):
+        return float
+    if isinstance(value, str):
+        return str
+    return dict
+
+
+def _check_joint_rules(method: str, options: dict, key: str) -> None:
+    """Rules joining two options (a model's ``check_options``, e.g. FEA's degree 2 only with 'rigid')."""
+    from rigid_dynamics.contact.options import OptionError
+    from rigid_dynamics.contact.registry import model_class
+
+    check = getattr(model_class(method), "check_options", None)
+    if check is None:
+        return
+    try:
+        check(options)
+    except OptionError:
+        raise
+    except ValueError as exc:
+        raise ConfigError(f"table [{key}]: {exc}") from None
+
+
+def check_solver_options(case: ContactCase, method: str) -> None:
+    """Check a case's ``[solver]`` table against the declared options of the model ``method``.
+
+    Raises:
+        ConfigError: one line naming the key (``solver.nx``), the value and what was expected.
+    """
+    from rigid_dynamics.contact.options import OptionError, validate_options
+    from rigid_dynamics.contact.registry import MODELS, model_options
+
+    if method not in MODELS:
+        raise ConfigError(f"--method {method!r}: expected one of {', '.join(MODELS)}")
+    try:
+        if case.kind == "quadric":
+            validate_options(model_options(method), case.solver_options, method)
+            _check_joint_rules(method, case.solver_options, "solver")
+        else:
+            validate_options(_wheelset_case_options(method), case.solver_options, "wheelset case")
+    except OptionError as exc:
+        raise ConfigError(option_message(exc, "solver", method)) from None
+
+
+def option_message(exc, table: str, method: str) -> str:
+    """The one-line message for an OptionError met in the table ``table`` of a file."""
+    from rigid_dynamics.contact.registry import MODELS
+
+    key = f"{table}.{exc.key}"
+    owner = f"the contact model {exc.model!r}" if exc.model in MODELS else f"the {exc.model}"
+    if exc.model == "wheelset case" and exc.unknown:
+        owner += f" (options of {method!r} go in [{table}.model])"
+    if exc.unknown and exc.expected == "none":
+        return f"unknown key {key!r} = {exc.value!r}: {owner} takes no options"
+    if exc.unknown:
+        return f"unknown key {key!r} = {exc.value!r}: not an option of {owner}; expected one of {exc.expected}"
+    return f"key {key!r} = {exc.value!r}: expected {exc.expected} (option of {owner})"
 
 
 CASES_DIR = Path(__file__).parent / "cases"

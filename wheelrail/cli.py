@@ -56,11 +56,13 @@ def _print(*args, **kwargs) -> None:
 
 
 def cmd_models(args) -> int:
-    from rigid_dynamics.contact.registry import MODELS
+    from rigid_dynamics.contact.registry import MODELS, model_options
 
     width = max(len(n) for n in MODELS)
     for name, (_, description) in MODELS.items():
         _print(f"{name:<{width}}  {description}")
+        for option in model_options(name).values():
+            _print(f"{'':<{width}}    {option.describe()}")
     return EXIT_OK
 
 
@@ -95,7 +97,7 @@ def cmd_contact(args) -> int:
 
     if args.method not in MODELS:
         raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
-    case = load_case(args.case)
+    case = load_case(args.case, method=args.method)
     if args.method == "fea" and (args.out is not None or args.plot):
         case = _with_fea_output(case, args)
     solution = solve_case(case, args.method)

@@ -22,6 +22,36 @@ class ConfigError(ValueError):
     """A scene or case file is invalid. The message names the key, the value and what was expected."""
 
 
+PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
+    "creepage_long": (-1.0, 1.0, "a creepage is a slip velocity over the rolling speed"),
+    "creepage_lat": (-1.0, 1.0, "a creepage is a slip velocity over the rolling speed"),
+    "spin_creepage_1_per_m": (-20.0, 20.0, "1/m: sin(contact angle) / rolling radius"),
+    "rolling_speed_m_per_s": (0.0, 200.0, "m/s: the rail speed record is 160 m/s"),
+    "speed_m_per_s": (0.0, 200.0, "m/s: the rail speed record is 160 m/s"),
+    "normal_force_N": (0.0, 5.0e6, "N: a wheel load is at most a few hundred kN"),
+    "wheel_load_N": (0.0, 5.0e6, "N: a wheel load is at most a few hundred kN"),
+    "axle_load_N": (0.0, 1.0e7, "N: axle loads are at most a few hundred kN"),
+    "shear_modulus_Pa": (1.0e6, 1.0e12, "Pa: steel 8e10, rubber 1e6"),
+    "young_modulus_Pa": (3.0e6, 3.0e12, "Pa: steel 2.1e11, rubber 3e6"),
+    "friction_coefficient": (0.0, 2.0, "dry steel on steel about 0.3-0.6"),
+    "approach_m": (-1.0, 0.01, "m: Hertz approaches of wheels on rails are below 0.1 mm"),
+    "radius_long_m": (1.0e-4, 1.0e6, "m"),
+    "radius_lat_m": (1.0e-4, 1.0e6, "m"),
+}
+"""Key name -> (lowest, highest, why): numbers outside are bad input however well typed (the range and
+the reason are in the message). Applied to every key of that name in scene and case files."""
+
+
+def check_physical_range(key: str, value: float) -> float:
+    """``value`` if the last part of the dotted ``key`` has no physical range or it lies in it; else ConfigError."""
+    limits = PHYSICAL_RANGES.get(key.rsplit(".", 1)[-1])
+    if limits is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
+        low, high, why = limits
+        if not low <= value <= high:
+            raise ConfigError(f"key {key!r} = {value!r}: expected a number from {low:g} to {high:g} ({why})")
+    return value
+
+
 def read_toml(path: str | Path, what: str = "file") -> dict:
     """Read a TOML file, turning I/O and syntax errors into ConfigError."""
     path = Path(path)
@@ -154,7 +184,7 @@ def build_dataclass(cls: type, table: dict, prefix: str = "") -> Any:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise ConfigError(f"missing key {key!r}: expected {_type_name(hints[name])}")
             continue
-        kwargs[name] = convert_value(table[name], hints[name], key)
+        kwargs[name] = check_physical_range(key, convert_value(table[name], hints[name], key))
     try:
         return cls(**kwargs)
     except ConfigError:
@@ -196,4 +226,4 @@ def get_number(table: dict, name: str, prefix: str, *, positive: bool = False, d
     value = convert_value(table[name], float, key)
     if positive and value <= 0:
         raise ConfigError(f"key {key!r} = {value!r}: expected a number > 0")
-    return value
+    return check_physical_range(key, value)

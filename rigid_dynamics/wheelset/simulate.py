@@ -60,6 +60,11 @@ STATUSES = (
 )
 
 
+NUMERICAL_ERRORS = (ValueError, ArithmeticError, np.linalg.LinAlgError)
+"""Exceptions that the static equilibrium or the integration can raise from below for numerical trouble: turned
+into a status (``invalid-initial-state``, ``solver-failed``) at the driver, never a traceback."""
+
+
 class _Stop(Exception):
     def __init__(self, status: str, message: str, t: float | None = None, state=None):
         super().__init__(message)
@@ -497,10 +502,13 @@ def simulate(
     status, message, fail_t, fail_state = "ok", "", None, None
     steps = 0
 
-    if use_compiled:
-        state0, ok, why = model.static_state(initial_state(scene), *_compiled_static_functions(packed))
-    else:
-        state0, ok, why = model.static_state(initial_state(scene))
+    try:
+        if use_compiled:
+            state0, ok, why = model.static_state(initial_state(scene), *_compiled_static_functions(packed))
+        else:
+            state0, ok, why = model.static_state(initial_state(scene))
+    except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
+        state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
     if packed is not None:
         packed[0][_compiled.P_XF0] = model.frame_x0  # the suspension frame starts where the wheelset does
@@ -566,6 +574,8 @@ def simulate(
         steps = steps or getattr(stop, "steps", 0)
     except ContactFailure as exc:
         status, message = "contact-failed", str(exc)
+    except NUMERICAL_ERRORS as exc:  # raised below the driver (e.g. the curvature code for a huge stiffness with RK4)
+        status, message = "solver-failed", f"numerical failure: {type(exc).__name__}: {exc}"
     wall = time.perf_counter() - start
     t, states, patches, forces, kin, pot, wc, we = recorder.arrays()
     return SimulationResult(
