@@ -23,7 +23,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
 from pathlib import Path
 
 from rigid_dynamics.contact.track import build_track
@@ -134,9 +133,9 @@ def sweep(method: str = "fastsim", steps=STEPS, model_options=None) -> list[dict
 
 
 def _atomic_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    from rigid_dynamics.files import write_text
+
+    write_text(path, text)
 
 
 def write_table(rows: list[dict], path: Path) -> Path:
@@ -163,11 +162,13 @@ def write_plots(rows: list[dict], out_dir: Path) -> list[Path]:
     style = {"left": ("tab:blue", "o"), "right": ("tab:red", "s")}
 
     def save(fig, name):
+        from rigid_dynamics.files import save_figure
+
         path = out_dir / name
-        tmp = path.with_name(path.stem + ".tmp.png")
-        fig.savefig(tmp, dpi=120, bbox_inches="tight")
-        plt.close(fig)
-        os.replace(tmp, path)
+        try:
+            save_figure(fig, path, dpi=120, bbox_inches="tight")
+        finally:
+            plt.close(fig)
         out.append(path)
 
     def by_side(key, scale=1.0):
