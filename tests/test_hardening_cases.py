@@ -5,6 +5,7 @@ Coulomb's bound |F_t| <= mu N (exit status 1, a status that is not ok).
 """
 
 import math
+from pathlib import Path
 
 import pytest
 from hardening_helpers import QUADRIC, assert_error, run, write
@@ -13,6 +14,8 @@ from rigid_dynamics.contact.options import Option, OptionError, declare, declare
 from rigid_dynamics.contact.registry import MODELS, get_model, model_options
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STEEL
+
+PROFILES = Path(__file__).resolve().parents[1] / "rigid_dynamics" / "geometry" / "data" / "profiles"
 
 
 @pytest.mark.parametrize(
@@ -152,3 +155,19 @@ def test_a_dataclass_field_without_declared_details_is_refused():
     assert declare_dataclass(Toy, {"n": {"help": "n"}, "name": {"help": "a name"}})["name"].allow_none
     with pytest.raises(ValueError, match="Toy.name has no declared details"):
         declare_dataclass(Toy, {"n": {"help": "n"}})
+
+
+@pytest.mark.parametrize("name", ["MBench_S1002_v3.prw", "MBench_UIC60_v3.prr", "MBench_UIC60_v3.ban", "avg_wheel.whl"])
+def test_profile_file_with_a_byte_order_mark_reads_as_without(tmp_path, name):
+    """A UTF-8 BOM (as some Windows editors write) is dropped by every reader, SIMPACK .prw/.prr included."""
+    import numpy as np
+
+    from rigid_dynamics.geometry.readers import read_profile
+
+    source = PROFILES / name
+    copy = tmp_path / name
+    copy.write_bytes(b"\xef\xbb\xbf" + source.read_bytes())
+    plain, with_bom = read_profile(source), read_profile(copy)
+    assert with_bom.kind == plain.kind
+    np.testing.assert_array_equal(with_bom.y_m, plain.y_m)
+    np.testing.assert_array_equal(with_bom.z_m, plain.z_m)
