@@ -15,10 +15,12 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"force-anomaly"``: a normal force exceeds ``max_force_factor`` times the static wheel load;
 * ``"derailed"``: |y| exceeds ``max_lateral_displacement_m``;
 * ``"contact-failed"``: a contact model failed or the creepages became undefined (rolling speed 0);
-* ``"solver-failed"``: the adaptive solver could not continue (step size too small);
+* ``"solver-failed"``: the adaptive solver could not continue (step size too small), or a numerical exception
+  was raised below the driver (:data:`NUMERICAL_ERRORS`, e.g. the curvature code for a huge stiffness with RK4);
 * ``"budget-exceeded"``: more than ``max_rhs_evaluations`` evaluations or ``max_wall_time_s``;
 * ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
-* ``"invalid-initial-state"``: no static equilibrium was found for the initial state;
+* ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
+  raised one of :data:`NUMERICAL_ERRORS`, e.g. for a tiny shear modulus);
 
 and ``"ok"`` when it reaches the end. Events (wheel lift, contact restored, flange contact onset)
 are detected on the output samples, so their times are known to one output step.
