@@ -47,6 +47,13 @@ def scene_text(name: str, *replacements: tuple[str, str]) -> str:
         ),
         ("hunting-conical", [("speed_m_per_s = 20.0", "speed_m_per_s = 1e6")], ["'speed_m_per_s' = 1000000.0", "200"]),
         ("hunting-conical", [("duration_s = 3.0", "duration_s = -1.0")], ["duration_s", "-1.0"]),
+        ("wheel-flat", [("gauge_m = 1.435", "gauge_m = 1e30")], ["'track.gauge_m' = 1e+30", "0.1 to 3"]),
+        ("hunting-conical", [("output_step_s = 0.002", "output_step_s = 1e-30")], ["'integrator.output_step_s'"]),
+        (
+            "hunting-conical",
+            [("lateral_displacement_m = 0.003", "lateral_displacement_m = 1e30")],
+            ["'initial.lateral_displacement_m' = 1e+30", "flangeway"],
+        ),
     ],
 )
 def test_bad_scene_refused_before_work(capsys, tmp_path, scene, replacements, fragments):

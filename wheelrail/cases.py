@@ -118,6 +118,9 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
     geometry_table = get_table(doc, "geometry")
     kinematics = get_table(doc, "kinematics", required=False)
     solver = _read_solver(get_table(doc, "solver", required=False))
+    for key in ("name", "description"):
+        if key in doc and not isinstance(doc[key], str):
+            raise ConfigError(f"key {key!r} = {doc[key]!r}: expected a string")
     name = str(doc.get("name", name))
     kind = geometry_table.get("kind")
     if kind == "quadric":
