@@ -18,6 +18,8 @@ from hardening_helpers import assert_error, run
         (["conicity", "--amplitude-m", "nan"], ["--amplitude-m", "'nan'"]),
         (["conicity", "--amplitude-m", "-0.003"], ["--amplitude-m -0.003", "> 0"]),
         (["conicity", "--wheel", "no-such-profile"], ["--wheel 'no-such-profile'"]),
+        (["conicity", "--gauge-m", "1e30"], ["--gauge-m 1e+30", "from 0.1 to 3"]),  # was a ZeroDivisionError
+        (["conicity", "--rail-inclination-rad", "3"], ["--rail-inclination-rad 3.0", "-0.2 to 0.2"]),
         (["stress", "--workers", "0"], ["--workers '0': expected an integer >= 1"]),
         (["stress", "--workers", "two"], ["--workers 'two'"]),
         (["manchester", "--method", "kalker"], ["--method 'kalker'"]),

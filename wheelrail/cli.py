@@ -280,10 +280,16 @@ def cmd_conicity(args) -> int:
             profiles[kind] = load_profile(value, kind)
         except ValueError as exc:
             raise ConfigError(f"{option} {value!r}: {exc}") from None
+    from wheelrail.config import check_physical_range
+
     for option in ("gauge_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
         value = getattr(args, option)
         if not (value > 0 and value < float("inf")):
             raise ConfigError(f"--{option.replace('_', '-')} {value!r}: expected a finite number > 0")
+    for option in ("gauge_m", "gauge_height_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
+        check_physical_range(f"--{option.replace('_', '-')}", getattr(args, option), option)
+    if args.rail_inclination_rad is not None:
+        check_physical_range("--rail-inclination-rad", args.rail_inclination_rad, "rail_inclination_rad")
     result = equivalent_conicity_from_names(
         wheel_profile=profiles["wheel"],
         rail_profile=profiles["rail"],

@@ -62,18 +62,23 @@ PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
     "contact_tolerance": (0.0, 10.0, "relative creep-force error accepted by auto"),
     "traction_torque_N_m": (-1.0e6, 1.0e6, "N m: mu N r is about 25 kN m for a 100 kN wheel load"),
     "rail_head_radius_m": (1.0e-3, 10.0, "m"),
+    "amplitude_m": (1.0e-5, 0.02, "m: EN 15302 uses 3 mm; the flangeway clearance is about 10 mm"),
+    "rail_inclination_rad": (-0.2, 0.2, "rad: 1:40 is 0.025, 1:20 is 0.05"),
 }
 """Key name -> (lowest, highest, why): numbers outside are bad input however well typed (the range and
 the reason are in the message). Applied to every key of that name in scene and case files."""
 
 
-def check_physical_range(key: str, value: float) -> float:
-    """``value`` if the last part of the dotted ``key`` has no physical range or it lies in it; else ConfigError."""
-    limits = PHYSICAL_RANGES.get(key.rsplit(".", 1)[-1])
+def check_physical_range(key: str, value: float, name: str | None = None) -> float:
+    """``value`` if it lies in the physical range of ``name`` (default: the last part of the dotted ``key``) or
+    there is none; else ConfigError naming ``key`` (a file's key or a command-line option).
+    """
+    limits = PHYSICAL_RANGES.get(name or key.rsplit(".", 1)[-1])
     if limits is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
         low, high, why = limits
         if not low <= value <= high:
-            raise ConfigError(f"key {key!r} = {value!r}: expected a number from {low:g} to {high:g} ({why})")
+            what = key if key.startswith("-") else f"key {key!r} ="
+            raise ConfigError(f"{what} {value!r}: expected a number from {low:g} to {high:g} ({why})")
     return value
 
 
