@@ -32,6 +32,7 @@ from comparisons.manchester import MATERIAL, a22_case
 from rigid_dynamics.contact.registry import get_model
 from rigid_dynamics.contact.track import build_track
 from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+from rigid_dynamics.files import save_figure, write_text
 
 MODELS = ("hertz", "fastsim", "bem")
 DEFAULT_STEPS = (0, 12, 13, 14)
@@ -92,7 +93,7 @@ def _profiles_png(path: Path, bem, fastsim, hertz, title: str) -> None:
         ax.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -188,8 +189,8 @@ def write_bem_report(out_dir: str | Path, steps=DEFAULT_STEPS, bem_options: dict
                     row["profiles_png"] = prof.name
             entry["patches"].append(row)
         report["steps"].append(entry)
-    (out / "bem_report.json").write_text(json.dumps(report, indent=2, default=str))
-    (out / "bem_report.md").write_text(_markdown(report))
+    write_text(out / "bem_report.json", json.dumps(report, indent=2, default=str))
+    write_text(out / "bem_report.md", _markdown(report))
     return report
 
 

@@ -31,7 +31,6 @@ import dataclasses
 import io
 import json
 import math
-import os
 from functools import cache
 from pathlib import Path
 
@@ -232,9 +231,9 @@ def sweep(method: str = "bem", steps=STEPS, model_options=None, kinematics: str 
 
 
 def _atomic_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    from rigid_dynamics.files import write_text
+
+    write_text(path, text)
 
 
 def write_table(rows: list[dict], path: Path) -> Path:
@@ -261,11 +260,13 @@ def write_plots(rows: list[dict], out_dir: Path, method: str = "") -> list[Path]
     steps = sorted({r["step"] for r in rows})
 
     def save(fig, name):
+        from rigid_dynamics.files import save_figure
+
         path = out_dir / name
-        tmp = path.with_name(path.stem + ".tmp.png")
-        fig.savefig(tmp, dpi=120, bbox_inches="tight")
-        plt.close(fig)
-        os.replace(tmp, path)
+        try:
+            save_figure(fig, path, dpi=120, bbox_inches="tight")
+        finally:
+            plt.close(fig)
         out.append(path)
 
     def by_side(key, scale=1.0):

@@ -501,7 +501,7 @@ def read_profile(path, kind: str | None = None) -> Profile:
     if ext not in (".prw", ".prr", ".whl", ".ban", ".csv", ".txt"):
         raise _err(p, f"unknown extension {p.suffix!r}; expected .prw, .prr, .whl, .ban, .csv or .txt")
     try:
-        text = p.read_text(encoding="utf-8", errors="replace")
+        text = p.read_text(encoding="utf-8-sig", errors="replace")  # -sig: a UTF-8 byte-order mark is dropped
     except OSError as exc:
         raise _err(p, f"cannot be read ({exc.strerror or exc})") from None
     if ext in (".prw", ".prr"):
@@ -529,8 +529,9 @@ def write_profile_csv(path, profile: Profile) -> Path:
     """
     if not isinstance(profile, Profile):
         raise ValueError(f"profile must be a Profile, got {type(profile).__name__}")
+    from rigid_dynamics.files import write_text
+
     p = Path(path)
-    tmp = p.with_name(p.name + ".tmp")
     lines = [
         f"# name: {profile.name}",
         f"# kind: {profile.kind}",
@@ -538,9 +539,7 @@ def write_profile_csv(path, profile: Profile) -> Path:
         "y_mm,z_mm",
     ]
     lines += [f"{y * 1000.0:.10f},{z * 1000.0:.10f}" for y, z in zip(profile.y_m, profile.z_m, strict=True)]
-    tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    tmp.replace(p)
-    return p
+    return write_text(p, "\n".join(lines) + "\n")
 
 
 def builtin_profiles() -> dict[str, str]:

@@ -36,27 +36,48 @@ import numpy as np
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
+from rigid_dynamics.contact.options import Option, declare, validate_options
+from rigid_dynamics.contact.options import defaults as option_defaults
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
-DEFAULT_OPTIONS: dict = {
-    "nx": 40,
-    "ny": 40,
-    "margin": 1.15,
-    "tolerance": 1e-6,
-    "max_iterations": 500,
-    "difference_parameter": 0.0,
-    "element_size_m": None,
-    "max_elements": 250_000,
-}
-"""Options of :class:`BemModel` and their defaults: grid (nx, ny elements), margin m of the potential
-area, tolerance, iteration limit (NORM CG iterations and TANG Newton steps each), Kalker's K.
+OPTIONS = declare(
+    Option("nx", int, 40, "elements along x (rolling direction)", minimum=1, maximum=4096),
+    Option("ny", int, 40, "elements along y (lateral)", minimum=1, maximum=4096),
+    Option("margin", float, 1.15, "potential contact area in Hertz semi-axes", minimum=1.0),
+    Option("tolerance", float, 1e-6, "relative tolerance of NORM and TANG", minimum=0.0, exclusive_minimum=True),
+    Option("max_iterations", int, 500, "NORM CG iterations and TANG Newton steps, each", minimum=1),
+    Option(
+        "difference_parameter",
+        float,
+        0.0,
+        "Kalker's K (dissimilar materials)",
+        minimum=-0.5,
+        maximum=0.5,
+        exclusive_minimum=True,
+        exclusive_maximum=True,
+    ),
+    Option(
+        "element_size_m",
+        float,
+        None,
+        "element size (CONTACT's DX = DS), m; replaces nx, ny: centres at multiples of it from the reference point",
+        minimum=0.0,
+        maximum=0.1,
+        exclusive_minimum=True,
+        allow_none=True,
+    ),
+    Option("max_elements", int, 250_000, "element_size_m: sizes doubled above this many elements", minimum=16),
+)
+"""Options of :class:`BemModel` (name, type, range, default; :mod:`rigid_dynamics.contact.options`): grid
+(nx, ny elements), margin m of the potential area, tolerance, iteration limit (NORM CG iterations and TANG
+Newton steps each), Kalker's K (|K| < 0.5).
 
-``element_size_m`` (a number, or a pair (dx, dy)) replaces the element counts by a size, as CONTACT's DX and DS:
-element centres then lie at integer multiples of the size from the origin of the contact plane (the patch's
-reference point), the grid covers the potential area, and nx, ny follow from it. When nx ny would exceed
-``max_elements`` the sizes are doubled (in the direction with more than 10 elements), as CONTACT does, and the
-result's ``extra`` says so."""
+``element_size_m`` replaces the element counts by a size, as CONTACT's DX and DS: element centres then lie at
+integer multiples of the size from the origin of the contact plane (the patch's reference point), the grid covers
+the potential area, and nx, ny follow from it. When nx ny would exceed ``max_elements`` the sizes are doubled (in
+the direction with more than 10 elements), as CONTACT does, and the result's ``extra`` says so."""
+DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
 
 
 def hertz_ellipse(
@@ -117,39 +138,9 @@ def hertz_ellipse(
 
 
 def _options(options: Mapping | None) -> dict:
-    opts = dict(DEFAULT_OPTIONS)
-    if options is None:
-        return opts
-    unknown = sorted(set(options) - set(DEFAULT_OPTIONS))
-    if unknown:
-        raise ValueError(f"unknown bem option(s) {', '.join(unknown)}: expected any of {', '.join(DEFAULT_OPTIONS)}")
-    opts.update(options)
-    for name in ("nx", "ny", "max_iterations"):
-        value = opts[name]
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise ValueError(f"option {name} = {value!r}: expected an integer >= 1")
-    value = opts["tolerance"]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"option tolerance = {value!r}: expected a finite number > 0")
-    value = opts["margin"]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 1:
-        raise ValueError(f"option margin = {value!r}: expected a finite number >= 1")
-    size = opts["element_size_m"]
-    if size is not None:
-        sizes = size if isinstance(size, (tuple, list)) else (size, size)
-        if len(sizes) != 2 or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and 0 < v < 0.1 for v in sizes
-        ):
-            raise ValueError(
-                f"option element_size_m = {size!r}: expected None, a size in m or a pair (dx, dy) in (0, 0.1)"
-            )
-        opts["element_size_m"] = (float(sizes[0]), float(sizes[1]))
-    value = opts["max_elements"]
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 16:
-        raise ValueError(f"option max_elements = {value!r}: expected an integer >= 16")
-    k = opts["difference_parameter"]
-    if not isinstance(k, (int, float)) or not math.isfinite(k) or abs(k) >= 0.5:
-        raise ValueError(f"option difference_parameter = {k!r}: expected a number with |K| < 0.5")
+    opts = validate_options(OPTIONS, options, "bem")
+    if opts["element_size_m"] is not None:
+        opts["element_size_m"] = (float(opts["element_size_m"]), float(opts["element_size_m"]))
     return opts
 
 
@@ -158,6 +149,7 @@ class BemModel:
 
     name = "bem"
     description = "boundary elements: CONTACT-style NORM + TANG"
+    OPTIONS = OPTIONS
 
     def solve(
         self,
