@@ -102,7 +102,11 @@ def run_fea_report(
         wheel_load_N=wheel_load_N,
     )
     started = time.perf_counter()
-    case_sol = solve_wheelset_case(case, material, "hertz", options={"search": {"field": True}})
+    # the search's patch (plane at the deepest point, midpoint of the two surfaces): the frame the FE sections of the
+    # real profiles are cut in
+    case_sol = solve_wheelset_case(
+        case, material, "hertz", options={"patches": "search", "search": {"field": True}, "spin_rate": "nominal"}
+    )
     summary = {
         "case": {
             "wheel_profile": wheel_profile,

@@ -52,20 +52,22 @@ def _load(value, kind: str, mirror_y: bool, mirror_z: bool):
 
 def _check_flange_outside(curve, name) -> None:
     """A flanged wheel's flange (inner side of the tape circle, y_p < 0) must rise beyond the tape circle (z_p down,
-    away from the axle); a flange that dips towards the axle means the file's z points up.
-    """
+    away from the axle). A deep dip towards the axle on the inner side only (the outer side not dipping alike, as a
+    crowned or circular profile does on both sides) means the file's z points up."""
     import numpy as np
 
-    lo = max(curve.y_min_m, -0.08)
+    lo, hi = max(curve.y_min_m, -0.08), min(curve.y_max_m, 0.08)
     if lo >= -0.005:
         return
-    y = np.linspace(lo, -0.005, 601)
-    dz = curve.z(y) - float(curve.z(0.0))
-    rise, dip = float(np.nanmax(dz)), float(-np.nanmin(dz))
-    if dip > 0.005 and dip > 2.0 * rise:
+    z0 = float(curve.z(0.0))
+    inner = curve.z(np.linspace(lo, -0.005, 601)) - z0
+    outer = curve.z(np.linspace(0.005, hi, 601)) - z0 if hi > 0.005 else np.zeros(1)
+    dip_inner, rise_inner = float(-np.nanmin(inner)), float(np.nanmax(inner))
+    dip_outer = max(float(-np.nanmin(outer)), 0.0)
+    if dip_inner > 0.005 and dip_inner > 2.0 * rise_inner and dip_inner > 2.0 * dip_outer:
         raise ValueError(
-            f"wheel profile {name!r}: its flange dips {1e3 * dip:.1f} mm towards the axle from the tape circle: the "
-            "file's z axis points up; expected z down (away from the axle), or set wheel_profile_mirror_z = true"
+            f"wheel profile {name!r}: its flange dips {1e3 * dip_inner:.1f} mm towards the axle from the tape circle: "
+            "the file's z axis points up; expected z down (away from the axle), or set wheel_profile_mirror_z = true"
         )
 
 
