@@ -51,7 +51,7 @@ def test_bad_solver_option_of_a_quadric_case(capsys, tmp_path, method, solver, f
         ("bem", "[solver.model]\nnx = 3.5", ["'solver.model.nx' = 3.5", "'bem'"]),
         ("fastsim", "[solver.search]\nbogus = 1", ["unknown key 'solver.search.bogus' = 1", "alpha_points"]),
         ("fastsim", "[solver.search]\nalpha_points = 'a'", ["'solver.search.alpha_points' = 'a'", "an integer"]),
-        ("fastsim", "[solver]\nload_sharing = 'x'", ["'solver.load_sharing' = 'x'", "'hertz', 'model'"]),
+        ("fastsim", "[solver]\nspin_rate = 'x'", ["'solver.spin_rate' = 'x'", "'zero-axle-moment', 'nominal'"]),
         ("fea", "[solver.model]\nformulation = 'profiles'", ["[solver.model]", "wheel_profile and rail_profile"]),
     ],
 )

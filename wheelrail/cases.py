@@ -23,6 +23,7 @@ or a rolling speed of 1e6 m/s is bad input, not a case.
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -46,6 +47,14 @@ WHEELSET_GEOMETRY_KEYS = {
     "flange_back_distance_m",
     "nominal_radius_m",
     "rail_inclination_rad",
+    "wheel_profile_left",
+    "rail_profile_left",
+    "rail_profile_cant_rad",
+    "profile_smoothing_m",
+    "wheel_profile_mirror_y",
+    "wheel_profile_mirror_z",
+    "rail_profile_mirror_y",
+    "rail_profile_mirror_z",
 }
 QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
 
@@ -139,7 +148,7 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
         return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
     if kind == "wheelset":
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
-        check_keys(kinematics, {"rolling_speed_m_per_s"}, "kinematics")
+        check_keys(kinematics, {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"}, "kinematics")
         force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
         wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics)
         return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
@@ -156,9 +165,13 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
         table["wheel_load_N"] = wheel_load_N
     if approach_m is not None:
         table["approach_m"] = approach_m
-    if "rolling_speed_m_per_s" in kinematics:
-        table["rolling_speed_m_per_s"] = kinematics["rolling_speed_m_per_s"]
-    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail")):
+    for key in ("rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"):
+        if key in kinematics:
+            table[key] = kinematics[key]
+    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail"), ("wheel_profile_left", "wheel"),
+                      ("rail_profile_left", "rail")):  # fmt: skip
+        if key not in table and key.endswith("_left"):
+            continue
         if key not in table:
             raise ConfigError(f"missing key 'geometry.{key}': expected a built-in profile name or a file path")
         value = table[key]
@@ -184,45 +197,65 @@ def load_case(path: str | Path, method: str | None = None) -> ContactCase:
     return case
 
 
+def _defaults_declaration(defaults: dict, what: str, details: dict | None = None) -> dict:
+    """A declaration for an options mapping known only by its defaults: each option's type from its default (a
+    table where ``details`` gives a ``check``), ranges and choices from ``details`` where given; so an option added
+    to the defaults is accepted, and type-checked.
+    """
+    from rigid_dynamics.contact.options import Option, declare
+
+    options = []
+    for name, default in defaults.items():
+        extra = dict((details or {}).get(name, {}))
+        allow_none = default is None or extra.pop("allow_none", False)
+        kind = dict if "check" in extra else _python_type(default)
+        options.append(Option(name, kind, default, what, allow_none=allow_none, **extra))
+    return declare(*options)
+
+
 def _wheelset_case_options(method: str) -> dict:
-    """Declaration of a wheelset case's ``[solver]`` options (defaults: DEFAULT_CASE_OPTIONS)."""
-    from rigid_dynamics.contact.options import Option, declare, validate_options
+    """Declaration of a wheelset case's ``[solver]`` options, from ``DEFAULT_CASE_OPTIONS`` (wheelset_case.py, which
+    declares no types or ranges of its own): types from the defaults, the known ranges and choices here, the model's
+    options (``[solver.model]``) by the model's own declaration.
+    """
+    from rigid_dynamics.contact import wheelset_case
+    from rigid_dynamics.contact.options import validate_options
     from rigid_dynamics.contact.registry import model_options
     from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
-    from rigid_dynamics.contact.wheelset_case import DEFAULT_CASE_OPTIONS as D
-    from rigid_dynamics.contact.wheelset_case import LOAD_SHARING
 
     def check_model(value, key):
         validate_options(model_options(method), value, method, prefix=f"{key}.")
         _check_joint_rules(method, value, f"solver.{key}")
 
     def check_search(value, key):
-        declared = declare(
-            *(
-                Option(k, _python_type(v), v, "contact search option", allow_none=v is None)
-                for k, v in SEARCH_OPTIONS.items()
-            )
-        )
-        validate_options(declared, value, "contact search", prefix=f"{key}.")
+        validate_options(_defaults_declaration(SEARCH_OPTIONS, "contact search option"), value, "contact search",
+                         prefix=f"{key}.")  # fmt: skip
 
-    return declare(
-        Option("max_iterations", int, D["max_iterations"], "equilibrium iterations", minimum=1),
-        Option(
-            "force_tolerance",
-            float,
-            D["force_tolerance"],
-            "relative, on each wheel's load",
-            minimum=0,
-            exclusive_minimum=True,
-        ),
-        Option("approach_tolerance_m", float, D["approach_tolerance_m"], "m", minimum=0, exclusive_minimum=True),
-        Option("spin_rate", str, D["spin_rate"], "spin rate", choices=("nominal", "mean-rolling-radius")),
-        Option("search", dict, D["search"], "contact search options", allow_none=True, check=check_search),
-        Option(
-            "model", dict, D["model"], f"options of the contact model {method!r}", allow_none=True, check=check_model
-        ),
-        Option("load_sharing", str, D["load_sharing"], "load sharing", choices=LOAD_SHARING, allow_none=True),
-        Option("model_max_iterations", int, D["model_max_iterations"], "load-sharing iterations", minimum=1),
+    def check_patch(value, key):
+        patch_defaults = getattr(importlib.import_module("rigid_dynamics.contact.wheelset_patches"),
+                                 "DEFAULT_PATCH_OPTIONS", None)  # fmt: skip
+        if patch_defaults is not None:
+            validate_options(_defaults_declaration(patch_defaults, "patch option"), value, "patch options",
+                             prefix=f"{key}.")  # fmt: skip
+
+    positive = {"minimum": 0, "exclusive_minimum": True}
+    details = {
+        "max_iterations": {"minimum": 1},
+        "force_tolerance": positive,
+        "approach_tolerance_m": positive,
+        "axle_moment_tolerance": positive,
+        "model_max_iterations": {"minimum": 1},
+        "spin_rate": {"choices": getattr(wheelset_case, "SPIN_RATES", None)},
+        "patches": {"choices": getattr(wheelset_case, "PATCH_MODES", None)},
+        "rolling_speed": {"choices": ("mean", "centre")},
+        "load_sharing": {"choices": getattr(wheelset_case, "LOAD_SHARING", None), "allow_none": True},
+        "model": {"check": check_model},
+        "search": {"check": check_search},
+        "patch": {"check": check_patch},
+    }
+    defaults = wheelset_case.DEFAULT_CASE_OPTIONS
+    return _defaults_declaration(
+        defaults, "wheelset case option", {k: v for k, v in details.items() if k in defaults and v.get("choices", 1)}
     )
 
 

@@ -320,9 +320,20 @@ def cmd_manchester(args) -> int:
     if args.method not in MODELS:
         raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
     with output_folder(args.out, "manchester-a22") as out_dir:
-        run_manchester_a22(out_dir, method=args.method)
-    _print(f"Manchester A-2.2: output written to {out_dir}")
-    return EXIT_OK
+        summary = run_manchester_a22(out_dir, method=args.method, kinematics=args.kinematics)
+    comparison = summary["contact_comparison"]
+    for key, item in comparison["largest_difference"].items():
+        unit = " mm" if key == "contact_y_rail" else " %"
+        scale = 1e3 if key == "contact_y_rail" else 100.0
+        _print(f"  largest difference to CONTACT, {key}: {scale * item['value']:.3g}{unit} (step {item['step']})")
+    if comparison["patch_count_mismatch_steps"]:
+        _print(f"  patch count differs from CONTACT at steps {comparison['patch_count_mismatch_steps']}")
+    verdict = "within" if comparison["within_tolerance"] else "NOT within"
+    _print(
+        f"Manchester A-2.2 ({args.method}, {args.kinematics}): {verdict} the tolerances against CONTACT; "
+        f"output written to {out_dir}"
+    )
+    return EXIT_OK if summary["all_converged"] else EXIT_FAILED
 
 
 # --- shared helpers for subcommands -------------------------------------------------------
@@ -419,7 +430,13 @@ def _add_conicity(sub) -> None:
 def _add_manchester(sub) -> None:
     manchester = sub.add_parser("manchester", help="Manchester Contact Benchmark case A-2.2 sweep")
     manchester.add_argument("--out", type=out_path)
-    manchester.add_argument("--method", default="fastsim")
+    manchester.add_argument("--method", default="bem", help="contact model (default bem, on CONTACT's 0.2 mm grid)")
+    manchester.add_argument(
+        "--kinematics",
+        choices=("deck", "equilibrium"),
+        default="deck",
+        help="deck: CONTACT's roll and pitch rate per step (default); equilibrium: roll and pitch rate solved",
+    )
     manchester.set_defaults(func=cmd_manchester)
 
 

@@ -57,6 +57,7 @@ Detection and normalisation (all formats), recorded in ``Profile.source``:
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -100,6 +101,11 @@ _BUILTIN_FILES = {
     "circ_r300": ("circ_r300.prr", "circular rail head, radius 300 mm (SIMPACK)"),
     "circ_r100": ("circ_r100.prw", "circular wheel profile, radius 100 mm (SIMPACK)"),
 }
+
+BUILTIN_CANT_RAD = {"MBench_UIC60_v3": math.atan(1.0 / 40.0), "MBench_UIC60_v3_ban": math.atan(1.0 / 40.0)}
+"""Cant of the rail already contained in a built-in profile's points, rad (as each file's header states; the
+profile's ``cant_rad``). A profile read from a path has cant 0 unless its user states it (the case key
+``rail_profile_cant_rad``): the cant of a file is data about that file, never inferred from its name."""
 
 _EXT_KIND = {".prw": "wheel", ".prr": "rail", ".whl": "wheel", ".ban": "rail"}
 _NUMBER_SPLIT = re.compile(r"[,;\s]+")
@@ -562,7 +568,10 @@ def load_profile(name_or_path, kind: str | None = None) -> Profile:
         name = lookup[key.lower()]
         if name in _BUILTIN_FILES:
             prof = read_profile(BUILTIN_PROFILE_DIR / _BUILTIN_FILES[name][0])
-            prof = Profile(prof.y_m, prof.z_m, prof.kind, name, prof.source, prof.outline_y_m, prof.outline_z_m)
+            prof = Profile(
+                prof.y_m, prof.z_m, prof.kind, name, prof.source, prof.outline_y_m, prof.outline_z_m,
+                cant_rad=BUILTIN_CANT_RAD.get(name, 0.0),
+            )  # fmt: skip
         else:
             from .standard_profiles import ANALYTIC_PROFILES
 
