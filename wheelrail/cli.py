@@ -330,7 +330,7 @@ def cmd_manchester(args) -> int:
 
     if args.method not in MODELS:
         raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
-    with output_folder(args.out, "manchester-a22") as out_dir:
+    with output_folder(args.out, "manchester-a22", summaries=("manchester_a22_summary.json",)) as out_dir:
         summary = run_manchester_a22(out_dir, method=args.method, kinematics=args.kinematics)
     comparison = summary["contact_comparison"]
     for key, item in comparison["largest_difference"].items():
