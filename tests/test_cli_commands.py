@@ -74,8 +74,14 @@ def test_contact_json_contract_wheelset(capsys, method):
         assert PATCH_KEYS <= set(patch)
         y, z = patch["contact_point_rail_m"]
         assert math.isfinite(y) and math.isfinite(z)
-    vertical = sum(p["normal_force_N"] * math.cos(p["contact_angle_rad"]) for p in record["patches"])
-    assert vertical == pytest.approx(2 * 10e3, rel=0.02)
+    # the total vertical force on the wheels, creep forces included (contact frame: e_y = n x e_x tilts with
+    # the contact angle; its upward part is -sin(delta) on the right wheel, +sin(delta) on the left)
+    vertical = sum(
+        p["normal_force_N"] * math.cos(p["contact_angle_rad"])
+        - (1 if p["side"] == "right" else -1) * p["creep_force_lat_N"] * math.sin(p["contact_angle_rad"])
+        for p in record["patches"]
+    )
+    assert vertical == pytest.approx(2 * 10e3, rel=1e-4)
 
 
 def test_contact_writes_output_folder(tmp_path, capsys):

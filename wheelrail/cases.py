@@ -23,7 +23,6 @@ or a rolling speed of 1e6 m/s is bad input, not a case.
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -197,83 +196,17 @@ def load_case(path: str | Path, method: str | None = None) -> ContactCase:
     return case
 
 
-def _defaults_declaration(defaults: dict, what: str, details: dict | None = None) -> dict:
-    """A declaration for an options mapping known only by its defaults: each option's type from its default (a
-    table where ``details`` gives a ``check``), ranges and choices from ``details`` where given; so an option added
-    to the defaults is accepted, and type-checked.
-    """
-    from rigid_dynamics.contact.options import Option, declare
-
-    options = []
-    for name, default in defaults.items():
-        extra = dict((details or {}).get(name, {}))
-        allow_none = default is None or extra.pop("allow_none", False)
-        kind = dict if "check" in extra else _python_type(default)
-        options.append(Option(name, kind, default, what, allow_none=allow_none, **extra))
-    return declare(*options)
-
-
 def _wheelset_case_options(method: str) -> dict:
-    """Declaration of a wheelset case's ``[solver]`` options, from ``DEFAULT_CASE_OPTIONS`` (wheelset_case.py, which
-    declares no types or ranges of its own): types from the defaults, the known ranges and choices here, the model's
-    options (``[solver.model]``) by the model's own declaration.
-    """
-    from rigid_dynamics.contact import wheelset_case
+    """Declaration of a wheelset case's ``[solver]`` options (rigid_dynamics.contact.wheelset_case.case_options)."""
     from rigid_dynamics.contact.options import validate_options
     from rigid_dynamics.contact.registry import model_options
-    from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
+    from rigid_dynamics.contact.wheelset_case import case_options
 
     def check_model(value, key):
         validate_options(model_options(method), value, method, prefix=f"{key}.")
         _check_joint_rules(method, value, f"solver.{key}")
 
-    def check_search(value, key):
-        validate_options(_defaults_declaration(SEARCH_OPTIONS, "contact search option"), value, "contact search",
-                         prefix=f"{key}.")  # fmt: skip
-
-    def check_patch(value, key):
-        patch_defaults = getattr(importlib.import_module("rigid_dynamics.contact.wheelset_patches"),
-                                 "DEFAULT_PATCH_OPTIONS", None)  # fmt: skip
-        if patch_defaults is not None:
-            validate_options(_defaults_declaration(patch_defaults, "patch option"), value, "patch options",
-                             prefix=f"{key}.")  # fmt: skip
-
-    positive = {"minimum": 0, "exclusive_minimum": True}
-    details = {
-        "max_iterations": {"minimum": 1},
-        "force_tolerance": positive,
-        "approach_tolerance_m": positive,
-        "axle_moment_tolerance": positive,
-        "model_max_iterations": {"minimum": 1},
-        "spin_rate": {"choices": getattr(wheelset_case, "SPIN_RATES", None)},
-        "patches": {"choices": getattr(wheelset_case, "PATCH_MODES", None)},
-        "rolling_speed": {"choices": ("mean", "centre")},
-        "load_sharing": {"choices": getattr(wheelset_case, "LOAD_SHARING", None), "allow_none": True},
-        "model": {"check": check_model},
-        "search": {"check": check_search},
-        "patch": {"check": check_patch},
-    }
-    defaults = wheelset_case.DEFAULT_CASE_OPTIONS
-    return _defaults_declaration(
-        defaults, "wheelset case option", {k: v for k, v in details.items() if k in defaults and v.get("choices", 1)}
-    )
-
-
-def _python_type(value) -> type:
-    """The option type of a default value (None: a number, as the search's ``field_scale``)."""
-    if value is None:
-        return float
-    if isinstance(value, (tuple, list)):
-        return tuple
-    if isinstance(value, bool):
-        return bool
-    if isinstance(value, int):
-        return int
-    if isinstance(value, float):
-        return float
-    if isinstance(value, str):
-        return str
-    return dict
+    return case_options(method, check_model)
 
 
 def _check_joint_rules(method: str, options: dict, key: str) -> None:

@@ -71,9 +71,6 @@ class Option:
         choices: the allowed values of a string option.
         allow_none: ``None`` is a value (the default "not set"; a TOML file cannot give it: omit the key).
         check: for a ``dict`` option, a function ``(value, key) -> None`` raising OptionError.
-        parse: for a value of several forms (a number or a pair), a function ``value -> converted value`` raising
-            ValueError or TypeError; it replaces the type and range checks (``type`` then only names the kind).
-        expected_text: what a valid value is, in words, when ``parse`` is given.
     """
 
     name: str
@@ -87,13 +84,9 @@ class Option:
     choices: tuple | None = None
     allow_none: bool = False
     check: Callable[[Mapping, str], None] | None = None
-    parse: Callable[[Any], Any] | None = None
-    expected_text: str | None = None
 
     def expected(self) -> str:
         """What a valid value is, in words (used in messages and listings)."""
-        if self.expected_text is not None:
-            return self.expected_text
         if self.choices is not None:
             text = "one of " + ", ".join(repr(c) for c in self.choices)
         else:
@@ -123,11 +116,6 @@ class Option:
             if self.allow_none:
                 return None
             raise bad()
-        if self.parse is not None:
-            try:
-                return self.parse(value)
-            except (ValueError, TypeError):
-                raise bad() from None
         if self.type is bool:
             if not isinstance(value, bool):
                 raise bad()

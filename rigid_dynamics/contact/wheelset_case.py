@@ -75,6 +75,57 @@ SPIN_RATES = ("zero-axle-moment", "nominal", "mean-rolling-radius")
 PATCH_MODES = ("contact", "search")
 
 
+def case_options(method: str, check_model=None) -> dict:
+    """Declaration (rigid_dynamics.contact.options) of :func:`solve_wheelset_case`'s options for the model
+    ``method``: the case's own, the search's and the patches' nested, and the model's under ``model`` (checked by
+    ``check_model(value, key)`` when given, else against the model's declaration).
+    """
+    from rigid_dynamics.contact.options import Option, declare, validate_options
+    from rigid_dynamics.contact.registry import model_options
+    from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
+    from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS
+
+    def nested(defaults, what):
+        def kind(v):
+            if v is None or isinstance(v, float):
+                return float
+            return tuple if isinstance(v, (tuple, list)) else type(v)
+
+        declared = declare(
+            *(Option(k, kind(v), v, f"{what} option", allow_none=v is None) for k, v in defaults.items())
+        )
+
+        def check(value, key):
+            validate_options(declared, value, what, prefix=f"{key}.")
+
+        return check
+
+    if check_model is None:
+
+        def check_model(value, key):
+            validate_options(model_options(method), value, method, prefix=f"{key}.")
+
+    d = DEFAULT_CASE_OPTIONS
+    return declare(
+        Option("max_iterations", int, d["max_iterations"], "equilibrium iterations", minimum=1),
+        Option("force_tolerance", float, d["force_tolerance"], "relative, on each wheel's vertical load", minimum=0,
+               exclusive_minimum=True),
+        Option("approach_tolerance_m", float, d["approach_tolerance_m"], "m", minimum=0, exclusive_minimum=True),
+        Option("spin_rate", str, d["spin_rate"], "pitch rate without a prescribed one", choices=SPIN_RATES),
+        Option("axle_moment_tolerance", float, d["axle_moment_tolerance"], "|M| / (W r0)", minimum=0,
+               exclusive_minimum=True),
+        Option("patches", str, d["patches"], "how patches are formed", choices=PATCH_MODES),
+        Option("patch", dict, d["patch"], "options of the CONTACT-style patches (A_SEP, D_SEP, D_COMB, ...)",
+               allow_none=True, check=nested(DEFAULT_PATCH_OPTIONS, "patch")),
+        Option("search", dict, d["search"], "contact search options", allow_none=True,
+               check=nested(SEARCH_OPTIONS, "contact search")),
+        Option("model", dict, d["model"], f"options of the contact model {method!r}", allow_none=True,
+               check=check_model),
+        Option("rolling_speed", str, d["rolling_speed"], "creepages relative to", choices=("mean", "centre")),
+        Option("sides", tuple, d["sides"], "per-wheel kinematics: the wheels solved"),
+    )  # fmt: skip
+
+
 @dataclass(frozen=True)
 class WheelsetCase:
     """A wheelset contact case (the ``[geometry] kind = "wheelset"`` contract of the contact-case files).
@@ -381,6 +432,20 @@ class _Evaluator:
         min_gap = float(finite.min()) if finite.size else math.inf
         return [(p.geometry, p.combination, p.deepest_point_rail_m, p.wheel_point_m) for p in patches], min_gap
 
+    def min_gap(self, pose: WheelsetPose, side: str) -> float:
+        """Smallest gap of one wheel (vertical, from the contact locus; the search's normal gap for "search")."""
+        if self.opts["patches"] == "search":
+            return self.geometry(pose, side)[1]
+        from rigid_dynamics.contact.search import _SideGeometry
+        from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS, contact_locus
+
+        wheel, rail = self.track.fast[side]
+        geo = _SideGeometry(wheel, rail, pose, side, wheel.y_range_m, rail.y_range_m)
+        step = (self.opts["patch"] or {}).get("locus_step_m", DEFAULT_PATCH_OPTIONS["locus_step_m"])
+        gap = contact_locus(geo, step).gap_m
+        finite = gap[np.isfinite(gap)]
+        return float(finite.min()) if finite.size else math.inf
+
     def wheel(self, pose: WheelsetPose, side: str, omega: float) -> _WheelState:
         self.count += 1
         geometries, min_gap = self.geometry(pose, side)
@@ -419,7 +484,7 @@ def _solve_one_wheel(evaluator: _Evaluator, pose_of, side: str, omega: float, q_
     if start is None:
         s = 0.0
         for _ in range(6):
-            _, gap = evaluator.geometry(pose_of(s), side)
+            gap = evaluator.min_gap(pose_of(s), side)
             if not math.isfinite(gap):
                 return None, 0, "search-failed"
             s += gap
@@ -657,7 +722,7 @@ def _solve_whole(evaluator, track, case, omega, q_ref, warm, opts):
         # rigid touch of both wheels (smallest gap 0 per side): Newton with a finite-difference Jacobian
 
         def gaps(sinks):
-            return np.array([evaluator.geometry(pose_of(sinks), side)[1] for side in SIDES])
+            return np.array([evaluator.min_gap(pose_of(sinks), side) for side in SIDES])
 
         sinks = np.zeros(2)
         for _ in range(opts["max_iterations"]):

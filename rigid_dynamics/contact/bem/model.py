@@ -41,17 +41,6 @@ from rigid_dynamics.contact.options import defaults as option_defaults
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
-
-def _element_size(value) -> tuple[float, float]:
-    """``element_size_m`` as a pair (dx, dy) in m: a number or a pair, each in (0, 0.1) (ValueError otherwise)."""
-    sizes = value if isinstance(value, (tuple, list)) else (value, value)
-    if len(sizes) != 2 or not all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and 0 < v < 0.1 for v in sizes
-    ):
-        raise ValueError(value)
-    return float(sizes[0]), float(sizes[1])
-
-
 OPTIONS = declare(
     Option("nx", int, 40, "elements along x (rolling direction)", minimum=1, maximum=4096),
     Option("ny", int, 40, "elements along y (lateral)", minimum=1, maximum=4096),
@@ -72,22 +61,22 @@ OPTIONS = declare(
         "element_size_m",
         float,
         None,
-        "element size in m (or a pair [dx, dy]) replacing nx, ny, as CONTACT's DX, DS",
+        "element size (CONTACT's DX = DS), m; replaces nx, ny: centres at multiples of it from the reference point",
+        minimum=0.0,
+        maximum=0.1,
+        exclusive_minimum=True,
         allow_none=True,
-        parse=_element_size,
-        expected_text="a size in m or a pair [dx, dy], each in (0, 0.1)",
     ),
-    Option("max_elements", int, 250_000, "largest nx ny; beyond it the sizes are doubled (CONTACT's rule)", minimum=16),
+    Option("max_elements", int, 250_000, "element_size_m: sizes doubled above this many elements", minimum=16),
 )
 """Options of :class:`BemModel` (name, type, range, default; :mod:`rigid_dynamics.contact.options`): grid
 (nx, ny elements), margin m of the potential area, tolerance, iteration limit (NORM CG iterations and TANG
 Newton steps each), Kalker's K (|K| < 0.5).
 
-``element_size_m`` (a number, or a pair (dx, dy)) replaces the element counts by a size, as CONTACT's DX and DS:
-element centres then lie at integer multiples of the size from the origin of the contact plane (the patch's
-reference point), the grid covers the potential area, and nx, ny follow from it. When nx ny would exceed
-``max_elements`` the sizes are doubled (in the direction with more than 10 elements), as CONTACT does, and the
-result's ``extra`` says so."""
+``element_size_m`` replaces the element counts by a size, as CONTACT's DX and DS: element centres then lie at
+integer multiples of the size from the origin of the contact plane (the patch's reference point), the grid covers
+the potential area, and nx, ny follow from it. When nx ny would exceed ``max_elements`` the sizes are doubled (in
+the direction with more than 10 elements), as CONTACT does, and the result's ``extra`` says so."""
 DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
 
 
@@ -149,7 +138,10 @@ def hertz_ellipse(
 
 
 def _options(options: Mapping | None) -> dict:
-    return validate_options(OPTIONS, options, "bem")
+    opts = validate_options(OPTIONS, options, "bem")
+    if opts["element_size_m"] is not None:
+        opts["element_size_m"] = (float(opts["element_size_m"]), float(opts["element_size_m"]))
+    return opts
 
 
 class BemModel:
