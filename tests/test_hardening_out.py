@@ -99,3 +99,18 @@ def test_failed_plot_leaves_no_summary(capsys, tmp_path, monkeypatch):
     assert_error(code, err, "cannot write", "fields-single-0.png", "No space left on device", status=3)
     assert sorted(p.name for p in out.iterdir()) == ["case.toml"]  # no summary, no temporary, no lock
     assert_whole_files(out)
+
+
+def test_atomic_write_follows_the_umask(tmp_path):
+    """Every writer of the project (data, plots, the library's save_timeseries) gets 0666 minus the umask."""
+    from rigid_dynamics.files import atomic_write, write_text
+
+    for mask, mode in ((0o022, 0o644), (0o002, 0o664), (0o077, 0o600)):
+        old = os.umask(mask)
+        try:
+            path = write_text(tmp_path / f"t-{mask:o}.txt", "x")
+            blob = atomic_write(tmp_path / f"b-{mask:o}.npz", lambda tmp: tmp.write_bytes(b"PK"))
+        finally:
+            os.umask(old)
+        assert stat.S_IMODE(path.stat().st_mode) == mode and stat.S_IMODE(blob.stat().st_mode) == mode
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []

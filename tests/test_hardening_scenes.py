@@ -47,6 +47,11 @@ def scene_text(name: str, *replacements: tuple[str, str]) -> str:
         ),
         ("hunting-conical", [("speed_m_per_s = 20.0", "speed_m_per_s = 1e6")], ["'speed_m_per_s' = 1000000.0", "200"]),
         ("hunting-conical", [("duration_s = 3.0", "duration_s = -1.0")], ["duration_s", "-1.0"]),
+        (
+            "hunting-conical",
+            [('contact_provider = "conical"', 'contact_provider = "search"')],
+            ["'contact_provider' = 'search'", "analytic conical wheel"],
+        ),
         ("wheel-flat", [("gauge_m = 1.435", "gauge_m = 1e30")], ["'track.gauge_m' = 1e+30", "0.1 to 3"]),
         ("hunting-conical", [("output_step_s = 0.002", "output_step_s = 1e-30")], ["'integrator.output_step_s'"]),
         (

@@ -101,6 +101,8 @@ def cmd_cases(args) -> int:
 
 
 def cmd_contact(args) -> int:
+    from contextlib import ExitStack
+
     from wheelrail.cases import load_case, resolve_case_path, solution_record, solve_case
     from wheelrail.output import copy_input, output_folder, to_json, write_json
 
@@ -108,11 +110,19 @@ def cmd_contact(args) -> int:
     wants_output = args.out is not None or args.plot
     if wants_output and args.out is None and _under_mpi():
         raise ConfigError("--plot under mpiexec: give --out DIR so every rank writes to one folder")
-    if not wants_output or _mpi_rank() != 0:
-        folder = _no_folder(args.out)
-    else:
-        folder = output_folder(args.out, f"contact-{case.name or 'case'}")
-    with folder as out_dir:
+    with ExitStack() as stack:
+        out_dir, refused = None, None
+        if wants_output and _mpi_rank() == 0:
+            try:
+                out_dir = stack.enter_context(output_folder(args.out, f"contact-{case.name or 'case'}"))
+            except ConfigError as exc:
+                refused = exc
+        elif wants_output:
+            out_dir = Path(args.out)  # rank > 0: rank 0 checked and holds the folder
+        if wants_output and _under_mpi() and _mpi_broadcast(refused is not None) and refused is None:
+            return EXIT_BAD_INPUT  # rank > 0 of a refused folder: rank 0 prints the one line
+        if refused is not None:
+            raise refused
         if args.method == "fea" and out_dir is not None:
             case = _with_fea_output(case, out_dir)
         solution = solve_case(case, args.method)
@@ -133,11 +143,12 @@ def cmd_contact(args) -> int:
     return EXIT_OK if ok else EXIT_FAILED
 
 
-def _no_folder(out):
-    """A stand-in for output_folder when this process writes nothing (no --out, or an MPI rank > 0)."""
-    from contextlib import nullcontext
+def _mpi_broadcast(value):
+    """Rank 0's ``value`` on every rank (so that a folder refused on rank 0 stops every rank, none waits forever)."""
+    import dolfinx_solver  # noqa: F401  (must precede mpi4py)
+    from mpi4py import MPI
 
-    return nullcontext(None if out is None or _mpi_rank() == 0 else Path(out))
+    return MPI.COMM_WORLD.bcast(value, root=0)
 
 
 def _with_fea_output(case, out_dir: Path):
@@ -319,7 +330,7 @@ def cmd_manchester(args) -> int:
 
     if args.method not in MODELS:
         raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
-    with output_folder(args.out, "manchester-a22") as out_dir:
+    with output_folder(args.out, "manchester-a22", summaries=("manchester_a22_summary.json",)) as out_dir:
         summary = run_manchester_a22(out_dir, method=args.method, kinematics=args.kinematics)
     comparison = summary["contact_comparison"]
     for key, item in comparison["largest_difference"].items():

@@ -192,8 +192,13 @@ def _lock(out: Path, option: str, text: str) -> Path:
 
 
 @contextmanager
-def output_folder(base: str | Path | None, name: str, *, option: str = "--out") -> Iterator[Path]:
+def output_folder(
+    base: str | Path | None, name: str, *, option: str = "--out", summaries: tuple[str, ...] = ("summary.json",)
+) -> Iterator[Path]:
     """The output folder of one run, checked, locked and cleaned up (module docstring). Use it before the work.
+
+    ``summaries`` are the names of the run's summary files: one left by an earlier run is removed first, so that
+    a summary in the folder always belongs to the files beside it (write it last).
 
     Raises:
         ConfigError: the folder is not usable (empty path, a file, under a file, cannot be created or written,
@@ -208,13 +213,14 @@ def output_folder(base: str | Path | None, name: str, *, option: str = "--out") 
         if not existed:
             _remove_if_empty(out)
         raise
-    try:
-        (out / "summary.json").unlink(missing_ok=True)
-    except OSError as exc:
-        lock.unlink(missing_ok=True)
-        raise ConfigError(
-            f"{option} {text!r}: the old summary.json cannot be removed ({exc.strerror or exc})"
-        ) from None
+    for summary in summaries:
+        try:
+            (out / summary).unlink(missing_ok=True)
+        except OSError as exc:
+            lock.unlink(missing_ok=True)
+            raise ConfigError(
+                f"{option} {text!r}: the old {summary} cannot be removed ({exc.strerror or exc})"
+            ) from None
     try:
         yield out
     finally:

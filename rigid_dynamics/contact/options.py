@@ -152,7 +152,13 @@ class Option:
 
     def describe(self) -> str:
         """One line for listings: ``name  type/range, default  help``."""
-        return f"{self.name} ({self.expected()}; default {self.default!r}): {self.help}"
+        if self.default is None:
+            default = "not set"
+        elif isinstance(self.default, bool):
+            default = "true" if self.default else "false"  # as in TOML
+        else:
+            default = repr(self.default)
+        return f"{self.name} ({self.expected()}; default {default}): {self.help}"
 
 
 def declare(*options: Option) -> dict[str, Option]:

@@ -29,8 +29,6 @@ are detected on the output samples, so their times are known to one output step.
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -888,7 +886,7 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
 
 
 def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
-    """Write the time series of a result to an NPZ file, atomically (temporary name, then os.replace).
+    """Write the time series of a result to an NPZ file atomically (:func:`rigid_dynamics.files.atomic_write`).
 
     The arrays are those of :func:`timeseries_arrays`.
 
@@ -898,15 +896,12 @@ def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_suffix(".npz")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from rigid_dynamics.files import atomic_write
+
     arrays = timeseries_arrays(result)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".npz.tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
+
+    def writer(tmp: Path) -> None:
+        with open(tmp, "wb") as handle:
             np.savez_compressed(handle, **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+
+    return atomic_write(path, writer)  # the one atomic write (usual permissions, no half file on a kill)
