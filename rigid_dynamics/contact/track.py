@@ -53,7 +53,8 @@ def _load(value, kind: str, mirror_y: bool, mirror_z: bool):
 def _check_flange_outside(curve, name) -> None:
     """A flanged wheel's flange (inner side of the tape circle, y_p < 0) must rise beyond the tape circle (z_p down,
     away from the axle). A deep dip towards the axle on the inner side only (the outer side not dipping alike, as a
-    crowned or circular profile does on both sides) means the file's z points up."""
+    crowned or circular profile does on both sides) means the file's z points up.
+    """
     import numpy as np
 
     lo, hi = max(curve.y_min_m, -0.08), min(curve.y_max_m, 0.08)
