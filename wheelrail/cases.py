@@ -9,8 +9,15 @@ A case file has the tables
   ``flange_back_distance_m``, ``nominal_radius_m``, ``rail_inclination_rad``;
 * ``[loading]``: ``normal_force_N`` (quadric) or ``wheel_load_N`` (wheelset), or ``approach_m``;
 * ``[kinematics]``: ``creepage_long``, ``creepage_lat``, ``spin_creepage_1_per_m``,
-  ``rolling_speed_m_per_s`` (quadric); a wheelset case takes only ``rolling_speed_m_per_s`` and
-  derives the creepages from its yaw and geometry;
+  ``rolling_speed_m_per_s`` (quadric); a wheelset case takes ``rolling_speed_m_per_s``, ``roll_rad``,
+  ``pitch_rate_rad_per_s`` and ``wheel_rotation_rad`` (phi, the wheels' rotation angle: an irregularity centred
+  at the wheel angle alpha_0 is at the contact when phi = pi/2 - alpha_0) and derives the creepages from its yaw
+  and geometry;
+* ``[irregularities]`` (wheelset only): wheel out-of-roundness with the dynamics scenes' keys ``polygon_order``,
+  ``polygon_amplitude_m``, ``polygon_phase_rad`` (R_irr = A cos(n alpha + phase)), ``flat_length_m``,
+  ``flat_depth_m`` (0: L^2/(16 r0) for a rounded flat; a new flat has its chord depth), ``flat_angle_rad`` (alpha_0
+  of the flat's centre), ``flat_shape`` ("rounded", default, or "new"; rigid_dynamics.geometry.WheelFlat) and
+  ``side`` ("both", default, "left" or "right");
 * ``[solver]``: for a quadric case the options of the contact model; for a wheelset case the case's options
   (``rigid_dynamics.contact.wheelset_case.DEFAULT_CASE_OPTIONS``) with the model's options in ``[solver.model]``.
   Both are checked against their declarations before any work (:func:`check_solver_options`;
@@ -33,7 +40,7 @@ from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepag
 from rigid_dynamics.materials import Material
 from wheelrail.config import ConfigError, check_keys, get_number, get_table, read_toml, resolve_embedded
 
-TOP_LEVEL_TABLES = {"name", "description", "material", "geometry", "loading", "kinematics", "solver"}
+TOP_LEVEL_TABLES = {"name", "description", "material", "geometry", "loading", "kinematics", "solver", "irregularities"}
 QUADRIC_GEOMETRY_KEYS = {"kind", "radius_long_m", "radius_lat_m"}
 WHEELSET_GEOMETRY_KEYS = {
     "kind",
@@ -56,6 +63,20 @@ WHEELSET_GEOMETRY_KEYS = {
     "rail_profile_mirror_z",
 }
 QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
+WHEELSET_KINEMATICS_KEYS = {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s", "wheel_rotation_rad"}
+WHEEL_IRREGULARITY_KEYS = {
+    "side",
+    "polygon_order",
+    "polygon_amplitude_m",
+    "polygon_phase_rad",
+    "flat_length_m",
+    "flat_depth_m",
+    "flat_angle_rad",
+    "flat_shape",
+}
+"""Keys of a wheelset case's ``[irregularities]``: the dynamics scenes' wheel keys (rigid_dynamics.wheelset.parameters
+.Irregularities: same names, same meaning, same checks) and ``flat_shape`` ("rounded" as the scenes, or "new")."""
+FLAT_SHAPES = ("rounded", "new")
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,18 +164,82 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
             get_number(kinematics, "spin_creepage_1_per_m", "kinematics", default=0.0),
             get_number(kinematics, "rolling_speed_m_per_s", "kinematics", positive=True, default=1.0),
         )
+        if "irregularities" in doc:
+            raise ConfigError("table [irregularities]: expected only in a wheelset case (geometry.kind = 'wheelset')")
         geometry = ContactGeometry.quadric(radius_long, radius_lat, approach if approach is not None else 0.0)
         return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
     if kind == "wheelset":
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
-        check_keys(kinematics, {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"}, "kinematics")
+        check_keys(kinematics, WHEELSET_KINEMATICS_KEYS, "kinematics")
         force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
-        wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics)
+        irregularities = get_table(doc, "irregularities", required=False)
+        wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics, irregularities)
         return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
     raise ConfigError(f"key 'geometry.kind' = {kind!r}: expected 'quadric' or 'wheelset'")
 
 
-def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: dict):
+def read_wheel_irregularities(table: dict, nominal_radius_m: float) -> dict:
+    """``[irregularities]`` of a wheelset case -> {"wheel_irregularities_right": (...), "..._left": (...)}.
+
+    The checks are the dynamics scenes' (rigid_dynamics.wheelset.checks.check_scene): a flat shorter than the
+    wheel's diameter and shallower than its radius, a polygon with A n^2 < r0 (the wheel stays convex).
+
+    Raises:
+        ConfigError: one line naming the key, its value and what was expected.
+    """
+    from rigid_dynamics.geometry import HarmonicOutOfRoundness, WheelFlat
+
+    check_keys(table, WHEEL_IRREGULARITY_KEYS, "irregularities")
+    r0 = nominal_radius_m
+    side = table.get("side", "both")
+    if side not in ("both", "left", "right"):
+        raise ConfigError(f"key 'irregularities.side' = {side!r}: expected 'both', 'left' or 'right'")
+    shape = table.get("flat_shape", "rounded")
+    if shape not in FLAT_SHAPES:
+        raise ConfigError(f"key 'irregularities.flat_shape' = {shape!r}: expected 'rounded' or 'new'")
+    order = table.get("polygon_order", 0)
+    if isinstance(order, bool) or not isinstance(order, int) or order < 0:
+        raise ConfigError(f"key 'irregularities.polygon_order' = {order!r}: expected an integer >= 0 (0: no polygon)")
+    values = {}
+    for name in ("polygon_amplitude_m", "polygon_phase_rad", "flat_length_m", "flat_depth_m", "flat_angle_rad"):
+        values[name] = get_number(table, name, "irregularities", default=0.0)
+        if name not in ("polygon_phase_rad", "flat_angle_rad") and values[name] < 0:
+            raise ConfigError(f"key 'irregularities.{name}' = {values[name]!r}: expected a number >= 0")
+    amplitude, length, depth = values["polygon_amplitude_m"], values["flat_length_m"], values["flat_depth_m"]
+    if amplitude > 0 and order == 0:
+        raise ConfigError(
+            f"key 'irregularities.polygon_order' = {order!r}: expected an integer >= 1 with polygon_amplitude_m > 0"
+        )
+    if order > 0 and amplitude >= r0 / order**2:
+        raise ConfigError(
+            f"key 'irregularities.polygon_amplitude_m' = {amplitude!r}: expected an amplitude < r0 / n^2 = "
+            f"{r0 / order**2:.4g} m for polygon_order n = {order} and r0 = {r0:g} m (beyond it the wheel is no "
+            "longer convex)"
+        )
+    if length >= 2.0 * r0:
+        raise ConfigError(
+            f"key 'irregularities.flat_length_m' = {length!r}: expected a length < 2 r0 = {2.0 * r0:g} m (a flat is "
+            "a chord of the wheel)"
+        )
+    if depth > 0 and length == 0:
+        raise ConfigError(f"key 'irregularities.flat_length_m' = {length!r}: expected a length > 0 with flat_depth_m")
+    if depth >= r0:
+        raise ConfigError(f"key 'irregularities.flat_depth_m' = {depth!r}: expected a depth < r0 = {r0:g} m")
+    if shape == "new" and depth > 0:
+        raise ConfigError(
+            f"key 'irregularities.flat_depth_m' = {depth!r}: expected 0 with flat_shape 'new' (a new flat's depth is "
+            "the chord depth of its length, r0 - sqrt(r0^2 - L^2/4))"
+        )
+    wheel = []
+    if order > 0 and amplitude > 0:
+        wheel.append(HarmonicOutOfRoundness(order, amplitude, values["polygon_phase_rad"]))
+    if length > 0:
+        wheel.append(WheelFlat(length, r0, depth if depth > 0 else None, values["flat_angle_rad"], shape))
+    sides = ("right", "left") if side == "both" else (side,)
+    return {f"wheel_irregularities_{s}": tuple(wheel) for s in sides}
+
+
+def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: dict, irregularities=None):
     from rigid_dynamics.contact.wheelset_case import WheelsetCase
     from rigid_dynamics.geometry import load_profile
     from wheelrail.config import build_dataclass
@@ -164,9 +249,15 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
         table["wheel_load_N"] = wheel_load_N
     if approach_m is not None:
         table["approach_m"] = approach_m
-    for key in ("rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"):
+    for key in ("rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s", "wheel_rotation_rad"):
         if key in kinematics:
             table[key] = kinematics[key]
+    if irregularities:
+        from rigid_dynamics.contact.wheelset_case import WheelsetCase
+
+        r0 = table.get("nominal_radius_m", WheelsetCase.__dataclass_fields__["nominal_radius_m"].default)
+        r0 = get_number({"nominal_radius_m": r0}, "nominal_radius_m", "geometry", positive=True)
+        built = read_wheel_irregularities(irregularities, r0)
     for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail"), ("wheel_profile_left", "wheel"),
                       ("rail_profile_left", "rail")):  # fmt: skip
         if key not in table and key.endswith("_left"):
@@ -180,7 +271,10 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
             load_profile(value, kind)
         except ValueError as exc:
             raise ConfigError(f"key 'geometry.{key}' = {value!r}: {exc}") from None
-    return build_dataclass(WheelsetCase, table, "geometry")
+    case = build_dataclass(WheelsetCase, table, "geometry")
+    if irregularities:
+        case = dataclasses.replace(case, **built)
+    return case
 
 
 def load_case(path: str | Path, method: str | None = None) -> ContactCase:

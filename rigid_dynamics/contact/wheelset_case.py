@@ -156,6 +156,12 @@ class WheelsetCase:
         wheel_profile_mirror_y, wheel_profile_mirror_z, rail_profile_mirror_y, rail_profile_mirror_z: turn a
             profile file of another orientation into the internal one (y towards the field side, z down), as
             CONTACT's MIRRORY / MIRRORZ.
+        wheel_rotation_rad: phi, the wheels' rotation angle about the axle (eq 1; the pose's ``spin_rad``), rad:
+            the wheel's material angle alpha (eq 7) at its lowest point is pi/2 - phi, so an irregularity centred
+            at alpha_0 is at the contact when phi = pi/2 - alpha_0. Moves nothing on a round wheel.
+        wheel_irregularities_right, wheel_irregularities_left: out-of-roundness of each wheel, a tuple of
+            rigid_dynamics.geometry wheel irregularities (``HarmonicOutOfRoundness``, ``WheelFlat``,
+            ``MeasuredWheelIrregularity``: anything with ``evaluate(angle_rad, y_m)``); () is a round wheel.
     """
 
     wheel_profile: str
@@ -180,6 +186,9 @@ class WheelsetCase:
     wheel_profile_mirror_z: bool = False
     rail_profile_mirror_y: bool = False
     rail_profile_mirror_z: bool = False
+    wheel_rotation_rad: float = 0.0
+    wheel_irregularities_right: tuple = ()
+    wheel_irregularities_left: tuple = ()
 
     def __post_init__(self) -> None:
         for name in ("wheel_profile", "rail_profile"):
@@ -195,6 +204,7 @@ class WheelsetCase:
             "nominal_radius_m",
             "rail_inclination_rad",
             "rolling_speed_m_per_s",
+            "wheel_rotation_rad",
         )
         for name in finite:
             value = getattr(self, name)
@@ -267,6 +277,18 @@ class WheelsetCase:
             value = getattr(self, name)
             if value is not None and (not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0):
                 raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+        for name in ("wheel_irregularities_right", "wheel_irregularities_left"):
+            value = getattr(self, name)
+            if not isinstance(value, tuple) or not all(callable(getattr(v, "evaluate", None)) for v in value):
+                raise ValueError(
+                    f"{name} = {value!r}: expected a tuple of wheel irregularities (rigid_dynamics.geometry)"
+                )
+
+    @property
+    def wheel_irregularities(self) -> dict:
+        """Side -> the wheel's irregularities (only the sides that have some), as build_track takes them."""
+        sides = {"right": self.wheel_irregularities_right, "left": self.wheel_irregularities_left}
+        return {side: value for side, value in sides.items() if value}
 
 
 @dataclass(frozen=True, eq=False)
@@ -379,6 +401,7 @@ def _creepage(
         normal,
         yaw_rad=case.yaw_rad,
         roll_rad=pose.roll_rad,
+        spin_angle_rad=pose.spin_rad,
         centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
         spin_rate_rad_per_s=omega_spin,
     )
@@ -599,7 +622,7 @@ def solve_wheelset_case(
         raise ValueError(f"sides = {opts['sides']!r}: the whole-wheelset equilibrium (roll_rad None) needs both wheels")
     contact_model = get_model(model)
     if track is None:
-        track = build_track(case)
+        track = build_track(case, wheel_irregularities=case.wheel_irregularities)
     if opts["patches"] == "contact" and opts["patch"]:
         from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS
 
@@ -618,8 +641,9 @@ def solve_wheelset_case(
 
                 def pose_of(s):
                     return WheelsetPose(
-                        y_m=case.lateral_shift_m, z_m=track.rest_z_m + s, yaw_rad=case.yaw_rad, roll_rad=case.roll_rad
-                    )
+                        y_m=case.lateral_shift_m, z_m=track.rest_z_m + s, yaw_rad=case.yaw_rad,
+                        roll_rad=case.roll_rad, spin_rad=case.wheel_rotation_rad,
+                    )  # fmt: skip
 
                 out, its, st = _solve_one_wheel(evaluator, pose_of, side, omega, q_ref, (warm or {}).get(side), opts)
                 total += its
@@ -715,7 +739,7 @@ def _solve_whole(evaluator, track, case, omega, q_ref, warm, opts):
     target = case.wheel_load_N
 
     def pose_of(sinks):
-        return _pose(track, case.lateral_shift_m, case.yaw_rad, sinks)
+        return _pose(track, case.lateral_shift_m, case.yaw_rad, sinks, case.wheel_rotation_rad)
 
     iterations = 0
     if warm is None:
@@ -792,11 +816,11 @@ def _solve_whole(evaluator, track, case, omega, q_ref, warm, opts):
     return states, (touch, sinks, jac), iterations, "not-converged"
 
 
-def _pose(track, lateral_shift_m: float, yaw_rad: float, sinks) -> WheelsetPose:
-    """Pose from the two wheel sinks: z = z_rest + (s_L + s_R)/2, theta = (s_R - s_L)/(2 e_w)."""
+def _pose(track, lateral_shift_m: float, yaw_rad: float, sinks, spin_rad: float = 0.0) -> WheelsetPose:
+    """Pose from the two wheel sinks: z = z_rest + (s_L + s_R)/2, theta = (s_R - s_L)/(2 e_w); phi = spin_rad."""
     z = track.rest_z_m + 0.5 * (sinks[0] + sinks[1])
     roll = (sinks[1] - sinks[0]) / (2.0 * track.half_wheel_distance_m)
-    return WheelsetPose(y_m=lateral_shift_m, z_m=float(z), yaw_rad=yaw_rad, roll_rad=float(roll))
+    return WheelsetPose(y_m=lateral_shift_m, z_m=float(z), yaw_rad=yaw_rad, roll_rad=float(roll), spin_rad=spin_rad)
 
 
 def _search_both(track, lateral_shift_m: float, yaw_rad: float, sinks, search_options):

@@ -68,6 +68,9 @@ class ContactLocus:
         gap_m: vertical gap z_rail - z_wheel at the locus points (negative: interpenetration), m; +inf off the rail.
         rail_z_m: rail surface height N(x, y) below each point, m.
         angle_rad: contact angle of the rail surface there (search.py's convention), rad.
+        weight_line_m3, weighted_x_m, overlap_x_m: out-of-round wheels only (None for a round one, whose weight is
+            the closed form of the module docstring): int c^2 dx along the wheel's surface curve of each y_d (m^3),
+            its x-centroid (m) and the x range where the vertical gap is negative (shape (n, 2), m; nan without).
     """
 
     alpha_rad: np.ndarray
@@ -76,6 +79,9 @@ class ContactLocus:
     gap_m: np.ndarray
     rail_z_m: np.ndarray
     angle_rad: np.ndarray
+    weight_line_m3: np.ndarray | None = None
+    weighted_x_m: np.ndarray | None = None
+    overlap_x_m: np.ndarray | None = None
 
 
 def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 6) -> ContactLocus:
@@ -92,6 +98,8 @@ def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 
     n = max(int(math.ceil((y_hi - y_lo) / step_m)) + 1, 3)
     lat = np.linspace(y_lo, y_hi, n)
     alpha_start = 0.5 * math.pi - geo.pose.spin_rad
+    if _out_of_round(geo):
+        return _out_of_round_locus(geo, lat, alpha_start)
     if _compiled(geo):
         from rigid_dynamics.contact import _patch_kernels as kern
 
@@ -123,6 +131,128 @@ def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 
     tilt = -normal_y if geo.side == "right" else normal_y
     angle = np.arctan2(tilt, -normal_z)
     return ContactLocus(alpha, lat, point, gap, np.where(on_rail, big_n, np.nan), angle)
+
+
+OUT_OF_ROUND_WINDOW_RAD = 0.2
+"""Half width of the wheel-angle window scanned around the lowest point of an out-of-round wheel (as CONTACT's
+compute_oor_whl, which meshes the wheel over -pitch +- 0.2 rad)."""
+OUT_OF_ROUND_SCAN_POINTS = 161  # 2.5e-3 rad apart: 1.15 mm along a 0.46 m wheel
+OUT_OF_ROUND_INTEGRATION_POINTS = 65
+OUT_OF_ROUND_SCREEN_M = 2.0e-4
+"""Only the y_d whose round-wheel gap is below the irregularity's largest radius increase plus this are scanned
+(elsewhere the gap is the round one minus that increase: a lower bound, far from contact)."""
+
+
+def _out_of_round(geo: _SideGeometry) -> bool:
+    """Whether the wheel has irregularities of the rolling angle (its lowest points need the scan)."""
+    rows = getattr(geo.wheel, "irregularity_rows", None)
+    if rows is not None:
+        return rows.shape[0] > 0
+    return bool(getattr(geo.wheel, "irregularities", ()))
+
+
+def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float) -> ContactLocus:
+    """Contact locus of an out-of-round wheel (CONTACT meshes such a wheel in 3-D, compute_oor_whl, instead of
+    assuming a surface of revolution): for each y_d the wheel angle of the smallest vertical gap over a window
+    of the wheel's angle, and the squared interpenetration integrated along x (the weight of the weighted centre,
+    and the overlap's x range that sizes the potential area) -- along a flat the wheel is straight, not a circle
+    of radius r0, and a rounded flat touches at two points along x with a hump between.
+    """
+    n = lat.size
+    half, scan, m = OUT_OF_ROUND_WINDOW_RAD, OUT_OF_ROUND_SCAN_POINTS, OUT_OF_ROUND_INTEGRATION_POINTS
+    if _compiled(geo):
+        from rigid_dynamics.contact import _patch_kernels as kern
+        from rigid_dynamics.contact.search import _irregularity_sum
+
+        # the round wheel's locus screens the y_d that can touch
+        alpha, point = np.empty(n), np.empty((n, 3))
+        gap, rail_z, angle = np.empty(n), np.empty(n), np.empty(n)
+        rail_args = (geo.rail.table_tuple, geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range))
+        kern.contact_locus(
+            lat, alpha_start, geo.rot, geo.centre, geo.wheel.table_tuple, np.zeros((0, 7)), *rail_args,
+            geo.side == "right", 6, alpha, point, gap, rail_z, angle,
+        )  # fmt: skip
+        turns = np.linspace(-math.pi, math.pi, 4097)
+        rise = max(float(_irregularity_sum(geo.wheel.irregularities, turns, np.zeros_like(turns))[0].max()), 0.0)
+        gap = gap - rise
+        near = np.flatnonzero(np.isfinite(gap) & (gap < OUT_OF_ROUND_SCREEN_M))
+        weight, weighted_x = np.zeros(n), np.full(n, np.nan)
+        overlap = np.full((n, 2), np.nan)
+        k = near.size
+        if k:
+            out = [np.empty(k), np.empty((k, 3)), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k),
+                   np.empty((k, 2))]  # fmt: skip
+            kern.out_of_round_locus(
+                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, geo.rot, geo.centre,
+                geo.wheel.table_tuple, geo.wheel.irregularity_rows, *rail_args, geo.side == "right", *out,
+            )  # fmt: skip
+            for target, value in zip((alpha, point, gap, rail_z, angle, weight, weighted_x, overlap), out, strict=True):
+                target[near] = value
+        return ContactLocus(alpha, lat, point, gap, rail_z, angle, weight, weighted_x, overlap)
+    # numpy path (measured irregularity grids): the same scan, refinement and integral, vectorised over y_d
+    r_lo, r_hi = geo.rail_range
+
+    def vertical_gap(a, y):
+        p = geo.wheel_point(a, y)[0]
+        on = (p[..., 1] >= r_lo) & (p[..., 1] <= r_hi) & np.all(np.isfinite(p), axis=-1)
+        big_n = np.asarray(geo.rail.evaluate(p[..., 0], np.clip(p[..., 1], r_lo, r_hi))[0], float)
+        return np.where(on & np.isfinite(big_n), big_n - p[..., 2], np.inf), p
+
+    step = 2.0 * half / (scan - 1)
+    grid = alpha_start - half + step * np.arange(scan)
+    g_scan, _ = vertical_gap(np.broadcast_to(grid, (n, scan)), np.broadcast_to(lat[:, None], (n, scan)))
+    kbest = np.argmin(g_scan, axis=1)
+    lo = alpha_start - half + np.maximum(kbest - 1, 0) * step
+    hi = alpha_start - half + np.minimum(kbest + 1, scan - 1) * step
+    golden = 0.5 * (math.sqrt(5.0) - 1.0)
+    c1, c2 = hi - golden * (hi - lo), lo + golden * (hi - lo)
+    g1, g2 = vertical_gap(c1, lat)[0], vertical_gap(c2, lat)[0]
+    for _ in range(30):
+        left = g1 <= g2
+        hi = np.where(left, c2, hi)
+        lo = np.where(left, lo, c1)
+        new_c1 = np.where(left, hi - golden * (hi - lo), c2)
+        new_c2 = np.where(left, c1, lo + golden * (hi - lo))
+        new_g1 = np.where(left, np.nan, g2)
+        new_g2 = np.where(left, g1, np.nan)
+        fresh = vertical_gap(np.where(left, new_c1, new_c2), lat)[0]
+        g1, g2 = np.where(left, fresh, new_g1), np.where(left, new_g2, fresh)
+        c1, c2 = new_c1, new_c2
+    alpha = 0.5 * (lo + hi)
+    gap, point = vertical_gap(alpha, lat)
+    worse = g_scan[np.arange(n), kbest] < gap
+    alpha = np.where(worse, grid[kbest], alpha)
+    gap, point = vertical_gap(alpha, lat)
+    rail_values = geo.rail.evaluate(point[:, 0], np.clip(point[:, 1], r_lo, r_hi))[:3]
+    big_n, n_x, n_y = (np.asarray(v, float) for v in rail_values)
+    norm = np.sqrt(n_x**2 + n_y**2 + 1.0)
+    tilt = -n_y / norm if geo.side == "right" else n_y / norm
+    finite = np.isfinite(gap)
+    angle = np.where(finite, np.arctan2(tilt, 1.0 / norm), np.nan)
+    rail_z = np.where(finite, big_n, np.nan)
+    inside = g_scan < 0
+    any_in = inside.any(axis=1)
+    first = np.where(any_in, np.argmax(inside, axis=1), kbest)
+    last = np.where(any_in, scan - 1 - np.argmax(inside[:, ::-1], axis=1), kbest)
+    a_lo = np.minimum(alpha - step, alpha_start - half + (first - 1) * step)
+    a_hi = np.maximum(alpha + step, alpha_start - half + (last + 1) * step)
+    a_int = a_lo[:, None] + (a_hi - a_lo)[:, None] * np.linspace(0.0, 1.0, m)
+    g_int, p_int = vertical_gap(a_int, np.broadcast_to(lat[:, None], a_int.shape))
+    c = np.where(g_int < 0, -g_int, 0.0)
+    x = p_int[..., 0]
+    dx = np.abs(np.diff(x, axis=1))
+    weight = np.sum(0.5 * (c[:, 1:] ** 2 + c[:, :-1] ** 2) * dx, axis=1)
+    moment = np.sum(0.5 * (x[:, 1:] * c[:, 1:] ** 2 + x[:, :-1] * c[:, :-1] ** 2) * dx, axis=1)
+    touching = gap < 0
+    weight = np.where(touching, weight, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        weighted_x = np.where(touching & (weight > 0), moment / weight, np.where(touching, point[:, 0], np.nan))
+    over = c > 0
+    x_lo = np.where(over, x, np.inf).min(axis=1)
+    x_hi = np.where(over, x, -np.inf).max(axis=1)
+    x_lo = np.where(touching & (x_lo <= x_hi), x_lo, np.where(touching, point[:, 0], np.nan))
+    x_hi = np.where(touching & np.isfinite(x_lo), np.maximum(x_hi, x_lo), np.nan)
+    return ContactLocus(alpha, lat, point, gap, rail_z, angle, weight, weighted_x, np.stack([x_lo, x_hi], -1))
 
 
 def _compiled(geo: _SideGeometry) -> bool:
@@ -175,7 +305,12 @@ def interpenetration_regions(locus: ContactLocus, nominal_radius_m: float) -> li
     edges = np.diff(np.concatenate([[0], inside.astype(np.int8), [0]]))
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     c = np.where(inside, -locus.gap_m, 0.0)
-    w_line = 16.0 / 15.0 * c**2 * np.sqrt(c / a)
+    if locus.weight_line_m3 is not None:
+        w_line = np.where(inside, locus.weight_line_m3, 0.0)  # out-of-round: integrated along x
+        x_line = np.where(inside, locus.weighted_x_m, 0.0)
+    else:
+        w_line = 16.0 / 15.0 * c**2 * np.sqrt(c / a)
+        x_line = locus.point_m[:, 0]
     y = locus.point_m[:, 1]
     dy = np.abs(np.gradient(y))
     regions = []
@@ -185,7 +320,7 @@ def interpenetration_regions(locus: ContactLocus, nominal_radius_m: float) -> li
         total = float(w.sum())
         if total <= 0:
             continue
-        x_c = float((locus.point_m[sl, 0] * w).sum() / total)
+        x_c = float((x_line[sl] * w).sum() / total)
         y_c = float((y[sl] * w).sum() / total)
         angle = float((locus.angle_rad[sl] * w).sum() / total)
         first = _crossing(locus, start - 1, start) if start > 0 else np.array([y[start], locus.rail_z_m[start]])
@@ -400,7 +535,14 @@ def wheel_patches(
         ends = np.concatenate([r.ends_m for r in group])
         lat = (ends[:, 0] - y_c) * frame[1, 1] + (ends[:, 1] - z_c) * frame[2, 1]
         depth = max(-r.min_gap_m for r in group)
-        half_x = math.sqrt(depth / a_long)
+        if locus.overlap_x_m is not None:
+            # out-of-round: the overlap's own x range (a flat's overlap is longer than the circle's sqrt(depth/a))
+            rows = np.concatenate([locus.overlap_x_m[r.start : r.stop] for r in group])
+            rows = rows[np.all(np.isfinite(rows), axis=1)]
+            x_lo, x_hi = float(rows[:, 0].min()) - x_c, float(rows[:, 1].max()) - x_c
+            half_x = max(-x_lo, x_hi, math.sqrt(depth / a_long) * 0.1)
+        else:
+            half_x = math.sqrt(depth / a_long)
         y_lo, y_hi = float(lat.min()), float(lat.max())
         pad_y = opts["field_margin"] * (y_hi - y_lo) + 2.0e-4
         pad_x = (1.0 + opts["field_margin"]) * half_x + 2.0e-4
