@@ -251,6 +251,8 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
         table["approach_m"] = approach_m
     for key in ("rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s", "wheel_rotation_rad"):
         if key in kinematics:
+            if key == "wheel_rotation_rad":
+                get_number(kinematics, key, "kinematics")  # a number, named under its own table
             table[key] = kinematics[key]
     if irregularities:
         from rigid_dynamics.contact.wheelset_case import WheelsetCase

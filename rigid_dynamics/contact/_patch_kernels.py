@@ -187,7 +187,8 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
         weight[k] = int c^2 dx,  weighted_x[k] = int x c^2 dx / weight[k],  c = max(-g, 0),
 
     by the trapezoidal rule on ``integration_points`` points over the overlap found by the scan (widened by one
-    scan step on each side); overlap_x[k] = the x range where g < 0 (nan, nan without interpenetration).
+    scan step on each side); overlap_x[k] = the x range where g < 0, its ends interpolated linearly between the
+    integration points (nan, nan without interpenetration).
     Fills alpha, point, gap, rail_z, angle like :func:`contact_locus`.
     """
     w = np.empty(18)
@@ -259,7 +260,7 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
             a_hi = max(a_hi, alpha_start - half_window + (last + 1) * step)
         h = (a_hi - a_lo) / (integration_points - 1)
         total, moment = 0.0, 0.0
-        x_prev, c_prev = math.nan, 0.0
+        x_prev, c_prev, g_prev = math.nan, 0.0, math.nan
         x_lo, x_hi = math.inf, -math.inf
         for i in range(integration_points):
             g = _vertical_gap(a_lo + i * h, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
@@ -271,7 +272,10 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
                 dx = abs(x - x_prev)
                 total += 0.5 * (c * c + c_prev * c_prev) * dx
                 moment += 0.5 * (x * c * c + x_prev * c_prev * c_prev) * dx
-            x_prev, c_prev = x, c
+                if math.isfinite(g) and math.isfinite(g_prev) and (g < 0.0) != (g_prev < 0.0):
+                    xc = x_prev + g_prev / (g_prev - g) * (x - x_prev)  # the zero crossing, linearly
+                    x_lo, x_hi = min(x_lo, xc), max(x_hi, xc)
+            x_prev, c_prev, g_prev = x, c, g
         weight[k] = total
         weighted_x[k] = moment / total if total > 0.0 else point[k, 0]
         if x_lo <= x_hi:

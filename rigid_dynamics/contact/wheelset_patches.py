@@ -250,6 +250,12 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
     over = c > 0
     x_lo = np.where(over, x, np.inf).min(axis=1)
     x_hi = np.where(over, x, -np.inf).max(axis=1)
+    g0, g1 = g_int[:, :-1], g_int[:, 1:]
+    flips = np.isfinite(g0) & np.isfinite(g1) & ((g0 < 0) != (g1 < 0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        xc = x[:, :-1] + g0 / (g0 - g1) * (x[:, 1:] - x[:, :-1])  # zero crossings, linearly
+    x_lo = np.minimum(x_lo, np.where(flips, xc, np.inf).min(axis=1))
+    x_hi = np.maximum(x_hi, np.where(flips, xc, -np.inf).max(axis=1))
     x_lo = np.where(touching & (x_lo <= x_hi), x_lo, np.where(touching, point[:, 0], np.nan))
     x_hi = np.where(touching & np.isfinite(x_lo), np.maximum(x_hi, x_lo), np.nan)
     return ContactLocus(alpha, lat, point, gap, rail_z, angle, weight, weighted_x, np.stack([x_lo, x_hi], -1))
