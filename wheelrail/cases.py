@@ -312,6 +312,18 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
         for k, v in ((f.name, getattr(solution, f.name)) for f in dataclasses.fields(solution))
         if isinstance(v, (int, float, str, bool)) and k not in ("success", "message", "status", "wall_time_s")
     }
+    extra["wheel_vertical_load_N"] = {k: float(v) for k, v in solution.wheel_vertical_load_N.items()}
+    # how each patch was formed: CONTACT's weighted reference point (the patch's contact_point_rail_m) and the
+    # deepest point of its interpenetration, both in rail-profile coordinates
+    extra["patch_formation"] = [
+        {
+            "side": p.side,
+            "combination": p.combination,
+            "reference_point_rail_m": [_number(v) for v in p.geometry.contact_point_rail_m],
+            "deepest_point_rail_m": [_number(v) for v in p.deepest_point_rail_m],
+        }
+        for p in solution.patches
+    ]
     return CaseSolution(method, solution.success, solution.message, time.perf_counter() - start, patches, extra)
 
 
