@@ -236,6 +236,32 @@ def test_bad_options():
         model.solve(geometry, Creepage(), STEEL, normal_force_N=-5.0)
     with pytest.raises(ValueError, match="exactly one"):
         hertz_ellipse(1.0, 2.0, E_STAR)
+    with pytest.raises(ValueError, match="element_size_m = -0.001: expected a finite number > 0"):
+        model.solve(geometry, Creepage(), STEEL, options={"element_size_m": -1e-3})
+    with pytest.raises(ValueError, match="element_size_m = 0.0001 together with nx: expected either"):
+        model.solve(geometry, Creepage(), STEEL, options={"element_size_m": 1e-4, "nx": 30})
+    with pytest.raises(ValueError, match=r"element_size_m = 1e-08 gives \d+ x \d+ elements.*at most"):
+        model.solve(geometry, Creepage(), STEEL, options={"element_size_m": 1e-8})
+    with pytest.raises(ValueError, match="norm_method = 'cg': expected one of normcg, polonsky-keer"):
+        model.solve(geometry, Creepage(), STEEL, options={"norm_method": "cg"})
+
+
+def test_grid_by_element_size():
+    """element_size_m (CONTACT's DX = DS): square elements of that size over the potential area widened to whole
+    elements; the Hertz p0 and force within the discretisation error of that element size (Johnson 1985)."""
+    a_c, b_c, p0 = _curvatures(SPIN_A, SPIN_B, SPIN_F)
+    geometry = ContactGeometry(a_c, b_c, 0.0)
+    size = 0.4e-3
+    res = BemModel().solve(geometry, Creepage(), STEEL, normal_force_N=SPIN_F, options={"element_size_m": size})
+    assert res.success
+    ex = res.extra
+    assert ex["dx_m"] == pytest.approx(size, rel=1e-12) and ex["dy_m"] == pytest.approx(size, rel=1e-12)
+    x0, x1, y0, y1 = ex["potential_area_m"]
+    assert ex["nx"] == math.ceil(2 * 1.15 * SPIN_A / size - 1e-9) and ex["ny"] == math.ceil(2 * 1.15 * SPIN_B / size)
+    assert (x0 + x1, y0 + y1) == pytest.approx((0.0, 0.0), abs=1e-15)
+    assert x1 - x0 >= 2 * 1.15 * SPIN_A and x1 - x0 < 2 * 1.15 * SPIN_A + size
+    assert res.normal_force_N == pytest.approx(SPIN_F, rel=1e-9)
+    assert res.max_pressure_Pa == pytest.approx(p0, rel=5e-3)
 
 
 def test_search_field_holds_the_whole_overlap_of_the_long_tread_patch():

@@ -34,6 +34,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.norm import METHODS as NORM_METHODS
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
@@ -42,13 +43,28 @@ from rigid_dynamics.materials import Material
 DEFAULT_OPTIONS: dict = {
     "nx": 40,
     "ny": 40,
+    "element_size_m": None,
     "margin": 1.15,
     "tolerance": 1e-6,
     "max_iterations": 500,
     "difference_parameter": 0.0,
+    "norm_method": "normcg",
 }
-"""Options of :class:`BemModel` and their defaults: grid (nx, ny elements), margin m of the potential
-area, tolerance, iteration limit (NORM CG iterations and TANG Newton steps each), Kalker's K."""
+"""Options of :class:`BemModel` and their defaults:
+
+* ``nx``, ``ny`` (int >= 1): elements along x (rolling) and y (lateral) over the potential contact area;
+* ``element_size_m`` (float > 0 or None): square elements of this side (m; CONTACT's DX = DS) instead of
+  ``nx``, ``ny``: the counts follow from the potential area, which is widened symmetrically to whole elements
+  (not together with ``nx`` or ``ny``; at most ``MAX_ELEMENTS`` elements);
+* ``margin`` (>= 1): margin m of the potential area (module docstring);
+* ``tolerance``, ``max_iterations``: NORM's relative update tolerance and CG limit, TANG's tolerance and Newton
+  limit;
+* ``difference_parameter``: Kalker's K (|K| < 0.5; 0 for quasi-identical bodies);
+* ``norm_method``: ``"normcg"`` (preconditioned) or ``"polonsky-keer"`` (:func:`~.norm.solve_norm`).
+"""
+
+MAX_ELEMENTS = 4_000_000
+"""Largest grid ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
 
 
 def hertz_ellipse(
@@ -116,6 +132,18 @@ def _options(options: Mapping | None) -> dict:
     if unknown:
         raise ValueError(f"unknown bem option(s) {', '.join(unknown)}: expected any of {', '.join(DEFAULT_OPTIONS)}")
     opts.update(options)
+    size = opts["element_size_m"]
+    if size is not None:
+        if isinstance(size, bool) or not isinstance(size, (int, float)) or not math.isfinite(size) or size <= 0:
+            raise ValueError(f"option element_size_m = {size!r}: expected a finite number > 0 (m) or None")
+        both = [k for k in ("nx", "ny") if k in options]
+        if both:
+            raise ValueError(
+                f"option element_size_m = {size!r} together with {' and '.join(both)}: expected either the element "
+                "size or the element counts"
+            )
+    if opts["norm_method"] not in NORM_METHODS:
+        raise ValueError(f"option norm_method = {opts['norm_method']!r}: expected one of {', '.join(NORM_METHODS)}")
     for name in ("nx", "ny", "max_iterations"):
         value = opts[name]
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
@@ -137,6 +165,11 @@ class BemModel:
 
     name = "bem"
     description = "boundary elements: CONTACT-style NORM + TANG"
+
+    @staticmethod
+    def check_options(options: Mapping | None) -> dict:
+        """Validate ``options`` (:data:`DEFAULT_OPTIONS`) without solving; ValueError naming the option and value."""
+        return _options(options)
 
     def solve(
         self,
@@ -221,12 +254,22 @@ class BemModel:
             if x_lim[1] <= x_lim[0] or y_lim[1] <= y_lim[0]:
                 return no_contact("the sampled undeformed distance gives an empty potential contact area")
         k_diff = float(opts["difference_parameter"])
+        norm_method = opts["norm_method"]
         tol, max_it = float(opts["tolerance"]), int(opts["max_iterations"])
         if geometry.undeformed is not None:
             xs, ys = np.asarray(geometry.undeformed.x_m), np.asarray(geometry.undeformed.y_m)
             field_box = (float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
         grown = 0
+        size = opts["element_size_m"]
         while True:
+            if size is not None:
+                x_lim, nx = _whole_elements(x_lim, float(size))
+                y_lim, ny = _whole_elements(y_lim, float(size))
+                if nx * ny > MAX_ELEMENTS:
+                    raise ValueError(
+                        f"option element_size_m = {size!r} gives {nx} x {ny} elements over the potential contact "
+                        f"area: expected at most {MAX_ELEMENTS} (a larger element size)"
+                    )
             dx = (x_lim[1] - x_lim[0]) / nx
             dy = (y_lim[1] - y_lim[0]) / ny
             x = x_lim[0] + dx * (np.arange(nx) + 0.5)
@@ -234,7 +277,9 @@ class BemModel:
             xx, yy = np.meshgrid(x, y)
             h = np.asarray(geometry.gap_m(xx, yy), float)
             influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
-            norm = solve_norm(influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it)
+            norm = solve_norm(
+                influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it, method=norm_method
+            )
             contact = norm.pressure_Pa > 0
             edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
             if not edge or geometry.undeformed is None or grown >= 3:
@@ -264,6 +309,7 @@ class BemModel:
                 max_iterations=max_it,
                 tractions_Pa=(tang.traction_x_Pa, tang.traction_y_Pa),
                 initial_pressure_Pa=norm.pressure_Pa,
+                method=norm_method,
             )
             change = abs(norm.normal_force_N - previous)
             previous = norm.normal_force_N
@@ -341,6 +387,14 @@ class BemModel:
                 "potential_area_enlargements": grown,
             },
         )
+
+
+def _whole_elements(limits: tuple[float, float], size_m: float) -> tuple[tuple[float, float], int]:
+    """Widen ``limits`` (m) symmetrically to a whole number (>= 1) of elements of ``size_m``; (limits, count)."""
+    width = limits[1] - limits[0]
+    count = max(1, math.ceil(width / size_m - 1e-9))
+    centre = 0.5 * (limits[0] + limits[1])
+    return (centre - 0.5 * count * size_m, centre + 0.5 * count * size_m), count
 
 
 def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
