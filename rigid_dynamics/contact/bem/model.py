@@ -49,6 +49,8 @@ DEFAULT_OPTIONS: dict = {
     "max_iterations": 500,
     "difference_parameter": 0.0,
     "norm_method": "normcg",
+    "extrapolate": False,
+    "rolling_slip_point": "centre",
 }
 """Options of :class:`BemModel` and their defaults:
 
@@ -60,8 +62,21 @@ DEFAULT_OPTIONS: dict = {
 * ``tolerance``, ``max_iterations``: NORM's relative update tolerance and CG limit, TANG's tolerance and Newton
   limit;
 * ``difference_parameter``: Kalker's K (|K| < 0.5; 0 for quasi-identical bodies);
-* ``norm_method``: ``"normcg"`` (preconditioned) or ``"polonsky-keer"`` (:func:`~.norm.solve_norm`).
+* ``norm_method``: ``"normcg"`` (preconditioned) or ``"polonsky-keer"`` (:func:`~.norm.solve_norm`);
+* ``extrapolate`` (bool): Richardson extrapolation of the creep forces and spin moment from this grid and the
+  grid of 2 x 2 merged elements over the same potential area, F = 2 F_h - F_2h (the steady-rolling
+  discretisation is first order: the leading edge of each row is quantised to element edges); the result
+  reports both grids' values and the estimated error F_h - F of the fine grid (``extra["richardson"]``).
+  Needs even element counts (``element_size_m`` rounds them up to even). Costs about a third more.
+* ``rolling_slip_point``: where the rigid slip of steady rolling is taken, ``"centre"`` (the element centre x_I,
+  as CONTACT without its empirical spin offset) or ``"midpoint"`` (x_I + dx/2, the point at which the upwind
+  difference (u(x_I) - u(x_I + dx))/dx approximates -du/dx to second order). Both are first order overall and
+  converge to one limit from opposite sides; with ``extrapolate`` the midpoint is the better choice
+  (benchmarks/results/bem_rolling_coarse.md).
 """
+
+ROLLING_SLIP_POINTS = {"centre": 0.0, "midpoint": 0.5}
+"""Offset of the rigid slip from the element centre, in elements along x (option ``rolling_slip_point``)."""
 
 MAX_ELEMENTS = 4_000_000
 """Largest grid ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
@@ -142,6 +157,18 @@ def _options(options: Mapping | None) -> dict:
                 f"option element_size_m = {size!r} together with {' and '.join(both)}: expected either the element "
                 "size or the element counts"
             )
+    if not isinstance(opts["extrapolate"], bool):
+        raise ValueError(f"option extrapolate = {opts['extrapolate']!r}: expected true or false")
+    if opts["extrapolate"] and opts["element_size_m"] is None and (opts["nx"] % 2 or opts["ny"] % 2 or opts["nx"] < 4):
+        raise ValueError(
+            f"option extrapolate = true with nx = {opts['nx']!r}, ny = {opts['ny']!r}: expected even element counts "
+            "(nx >= 4), so that 2 x 2 elements merge into the coarse grid"
+        )
+    if opts["rolling_slip_point"] not in ROLLING_SLIP_POINTS:
+        raise ValueError(
+            f"option rolling_slip_point = {opts['rolling_slip_point']!r}: expected one of "
+            f"{', '.join(ROLLING_SLIP_POINTS)}"
+        )
     if opts["norm_method"] not in NORM_METHODS:
         raise ValueError(f"option norm_method = {opts['norm_method']!r}: expected one of {', '.join(NORM_METHODS)}")
     for name in ("nx", "ny", "max_iterations"):
@@ -196,6 +223,17 @@ class BemModel:
         """
         start = time.perf_counter()
         opts = _options(options)
+        result = self._solve(geometry, creepage, material, normal_force_N, opts, None, start)
+        if not opts["extrapolate"] or result.status == "no-contact":
+            return result
+        ex = result.extra
+        x0, x1, y0, y1 = ex["potential_area_m"]
+        coarse_opts = dict(opts, nx=ex["nx"] // 2, ny=max(ex["ny"] // 2, 1), element_size_m=None, extrapolate=False)
+        coarse = self._solve(geometry, creepage, material, normal_force_N, coarse_opts, ((x0, x1), (y0, y1)), start)
+        return _richardson(result, coarse, time.perf_counter() - start)
+
+    def _solve(self, geometry, creepage, material, normal_force_N, opts, fixed_area, start) -> ContactResult:
+        """:meth:`solve` on one grid; ``fixed_area`` ((x0, x1), (y0, y1)) imposes the potential area (m)."""
         if normal_force_N is not None and (not math.isfinite(normal_force_N) or normal_force_N <= 0):
             raise ValueError(f"normal_force_N = {normal_force_N!r}: expected None or a finite number > 0")
         g_mod, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
@@ -261,10 +299,14 @@ class BemModel:
             field_box = (float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
         grown = 0
         size = opts["element_size_m"]
+        if fixed_area is not None:
+            x_lim, y_lim = fixed_area
+            size = None
+        even = bool(opts["extrapolate"])
         while True:
             if size is not None:
-                x_lim, nx = _whole_elements(x_lim, float(size))
-                y_lim, ny = _whole_elements(y_lim, float(size))
+                x_lim, nx = _whole_elements(x_lim, float(size), even)
+                y_lim, ny = _whole_elements(y_lim, float(size), even)
                 if nx * ny > MAX_ELEMENTS:
                     raise ValueError(
                         f"option element_size_m = {size!r} gives {nx} x {ny} elements over the potential contact "
@@ -282,7 +324,7 @@ class BemModel:
             )
             contact = norm.pressure_Pa > 0
             edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
-            if not edge or geometry.undeformed is None or grown >= 3:
+            if not edge or geometry.undeformed is None or grown >= 3 or fixed_area is not None:
                 break
             # a sampled field's contact reached the potential area's edge: enlarge it (within the field) and redo
             cx, cy = 0.5 * (x_lim[0] + x_lim[1]), 0.5 * (y_lim[0] + y_lim[1])
@@ -295,7 +337,8 @@ class BemModel:
             grown += 1
 
         # 2. TANG (alternated with NORM for K != 0: Panagiotopoulos' process)
-        wx, wy = rigid_slip(x, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
+        offset = ROLLING_SLIP_POINTS[opts["rolling_slip_point"]] * dx
+        wx, wy = rigid_slip(x + offset, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
         previous = norm.normal_force_N
         for _ in range(1 if k_diff == 0.0 else 20):
             tang = solve_tang(influence, norm.pressure_Pa, mu, wx, wy, tolerance=tol, max_iterations=max_it)
@@ -389,12 +432,54 @@ class BemModel:
         )
 
 
-def _whole_elements(limits: tuple[float, float], size_m: float) -> tuple[tuple[float, float], int]:
-    """Widen ``limits`` (m) symmetrically to a whole number (>= 1) of elements of ``size_m``; (limits, count)."""
+def _whole_elements(limits: tuple[float, float], size_m: float, even: bool = False) -> tuple[tuple[float, float], int]:
+    """Widen ``limits`` (m) symmetrically to a whole number of elements of ``size_m``; (limits, count).
+
+    The count is >= 1, or even and >= 4 if ``even``.
+    """
     width = limits[1] - limits[0]
     count = max(1, math.ceil(width / size_m - 1e-9))
+    if even:
+        count = max(4, count + count % 2)
     centre = 0.5 * (limits[0] + limits[1])
     return (centre - 0.5 * count * size_m, centre + 0.5 * count * size_m), count
+
+
+def _richardson(fine: ContactResult, coarse: ContactResult, wall_time_s: float) -> ContactResult:
+    """Richardson extrapolation (order 1) of F_x, F_y, M_z from the fine grid h and the merged grid 2h.
+
+    F = 2 F_h - F_2h; the fine grid's estimated error F_h - F = F_2h - F_h is reported per quantity. The
+    normal solution, the fields and the other outputs are the fine grid's.
+    """
+    import dataclasses
+
+    names = ("creep_force_long_N", "creep_force_lat_N", "spin_moment_Nm")
+    values = {k: 2.0 * getattr(fine, k) - getattr(coarse, k) for k in names}
+    success = bool(fine.success and coarse.success)
+    message = fine.message
+    if not coarse.success:
+        message = f"{fine.message}; coarse grid of the extrapolation: {coarse.message}"
+    message += (
+        f"; F_x, F_y, M_z Richardson-extrapolated (order 1) from {fine.extra['nx']} x {fine.extra['ny']} and "
+        f"{coarse.extra['nx']} x {coarse.extra['ny']} elements"
+    )
+    extra = dict(fine.extra)
+    extra["richardson"] = {
+        "coarse_nx": coarse.extra["nx"],
+        "coarse_ny": coarse.extra["ny"],
+        "fine": {k: getattr(fine, k) for k in names},
+        "coarse": {k: getattr(coarse, k) for k in names},
+        "fine_error_estimate": {k: getattr(fine, k) - values[k] for k in names},
+    }
+    return dataclasses.replace(
+        fine,
+        success=success,
+        status=coarse.status if fine.success and not coarse.success else fine.status,
+        message=message,
+        wall_time_s=wall_time_s,
+        extra=extra,
+        **values,
+    )
 
 
 def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
