@@ -56,3 +56,19 @@ def test_element_size_through_the_cli(tmp_path, capsys):
     assert code == 0, out
     data = json.loads(out)
     assert data["success"], data
+
+
+def test_shift_problem_and_kinetic_friction_through_the_cli(tmp_path, capsys):
+    """A quadric case solved as Cattaneo's shift problem with static and kinetic friction, from the [solver] table."""
+    import json
+
+    path = tmp_path / "case.toml"
+    solver = 'nx = 24\nny = 24\nproblem = "shift"\nshift_long_m = 1e-3\nkinetic_friction_coefficient = 0.25\n'
+    path.write_text(CASE + solver)
+    code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    data = json.loads(out)
+    patch = data["patches"][0]
+    # a shift of 1 mm is far beyond full slip: the force on the wheel is -mu_k F_N
+    assert data["success"] and abs(patch["creep_force_long_N"] / -0.25e5 - 1) < 1e-6, patch

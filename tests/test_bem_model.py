@@ -316,3 +316,61 @@ def test_search_field_holds_the_whole_overlap_of_the_long_tread_patch():
         assert np.nanmin(field.distance_m) == pytest.approx(-patch.geometry.approach_m, rel=0.05)
         assert field.x_m[0] < 0 < field.x_m[-1] and field.y_m[0] < 0 < field.y_m[-1]
     assert any(overlap_edges(p.geometry.undeformed) for p in fixed.patches)
+
+
+def test_shift_problem_through_the_model_is_cattaneo():
+    """Option problem = 'shift' (Cattaneo): circular Hertz contact, nu = 0 (no normal-tangential coupling), rigid
+    shift s_x: F_x/(mu F_N) = -(1 - (c/a)^3) with the adhesion radius c from s_x = mu p0 pi a (1 - (c/a)^2)/(2 G)
+    (Johnson 1985, sec. 7.2, for the displacement difference of the pair; tests/test_bem_tang.py)."""
+    material = Material(80e9, 0.0, 0.3)
+    force = 1e4
+    geometry = ContactGeometry.quadric(0.2, 0.2)
+    e_star = 80e9
+    a, _, p0, *_ = hertz_ellipse(
+        geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m, e_star, normal_force_N=force
+    )
+    shift = 0.3 * p0 * math.pi * a * (1 - 0.6**2) / (2 * 80e9)
+    res = BemModel().solve(
+        geometry,
+        Creepage(),
+        material,
+        normal_force_N=force,
+        options={"nx": 40, "ny": 40, "problem": "shift", "shift_long_m": shift},
+    )
+    assert res.success and res.extra["problem"] == "shift"
+    assert res.creep_force_long_N / (0.3 * force) == pytest.approx(-(1 - 0.6**3), rel=0.015)
+    assert abs(res.creep_force_lat_N) < 1e-9 * force and res.fields.slip_m_per_s is None
+    assert 0 < res.extra["slip_distance_max_m"] < shift
+    rotated = BemModel().solve(
+        geometry,
+        Creepage(),
+        material,
+        normal_force_N=force,
+        options={"nx": 40, "ny": 40, "problem": "shift", "shift_rotation_rad": 1e-3},
+    )
+    assert rotated.success and rotated.spin_moment_Nm < 0 and abs(rotated.creep_force_long_N) < 1e-6 * force
+
+
+def test_static_and_kinetic_friction():
+    """kinetic_friction_coefficient mu_k < mu_s: full slip carries mu_k F_N (rolling and shift); in partial slip
+    the force lies between the mu_k-only and mu_s-only solutions."""
+    geometry = ContactGeometry.quadric(0.46, 0.3)
+    opts = {"nx": 24, "ny": 24, "kinetic_friction_coefficient": 0.2}
+    full = BemModel().solve(geometry, Creepage(0.05, 0.0, 0.0), STEEL, normal_force_N=1e5, options=opts)
+    assert full.success and full.creep_force_long_N == pytest.approx(-0.2 * 1e5, rel=1e-4)
+    creepage = Creepage(1e-3, 0.0, 0.0)
+    both = BemModel().solve(geometry, creepage, STEEL, normal_force_N=1e5, options=opts)
+    static = BemModel().solve(geometry, creepage, STEEL, normal_force_N=1e5, options={"nx": 24, "ny": 24})
+    kinetic = BemModel().solve(
+        geometry, creepage, Material(82e9, 0.28, 0.2), normal_force_N=1e5, options={"nx": 24, "ny": 24}
+    )
+    assert both.success
+    assert kinetic.creep_force_long_N < both.creep_force_long_N < static.creep_force_long_N or (
+        static.creep_force_long_N < both.creep_force_long_N < kinetic.creep_force_long_N
+    )
+    with pytest.raises(ValueError, match="kinetic_friction_coefficient = 0: expected a finite number > 0 or None"):
+        BemModel().solve(geometry, creepage, STEEL, options={"kinetic_friction_coefficient": 0})
+    with pytest.raises(ValueError, match="problem = 'slide': expected one of rolling, shift"):
+        BemModel().solve(geometry, creepage, STEEL, options={"problem": "slide"})
+    with pytest.raises(ValueError, match="options shift_\\*: expected problem = 'shift'"):
+        BemModel().solve(geometry, creepage, STEEL, options={"shift_long_m": 1e-6})

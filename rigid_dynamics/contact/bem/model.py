@@ -51,6 +51,11 @@ DEFAULT_OPTIONS: dict = {
     "norm_method": "normcg",
     "extrapolate": False,
     "rolling_slip_point": "centre",
+    "problem": "rolling",
+    "shift_long_m": 0.0,
+    "shift_lat_m": 0.0,
+    "shift_rotation_rad": 0.0,
+    "kinetic_friction_coefficient": None,
 }
 """Options of :class:`BemModel` and their defaults:
 
@@ -72,8 +77,19 @@ DEFAULT_OPTIONS: dict = {
   as CONTACT without its empirical spin offset) or ``"midpoint"`` (x_I + dx/2, the point at which the upwind
   difference (u(x_I) - u(x_I + dx))/dx approximates -du/dx to second order). Both are first order overall and
   converge to one limit from opposite sides; with ``extrapolate`` the midpoint is the better choice
-  (benchmarks/results/bem_rolling_coarse.md).
+  (benchmarks/results/bem_rolling_coarse.md);
+* ``problem``: ``"rolling"`` (steady rolling with the creepages, default) or ``"shift"`` (Cattaneo's shift
+  problem from the unloaded state: the bodies are pressed together and then shifted rigidly, the creepages are
+  not used): the rigid shift of the wheel over the rail is w = (s_x - theta y, s_y + theta x) with ``shift_long_m``
+  s_x, ``shift_lat_m`` s_y (m) and ``shift_rotation_rad`` theta about the normal (rad); the result's slip field is
+  then None (the slip is a distance) and ``extra["slip_distance_max_m"]`` its largest value;
+* ``kinetic_friction_coefficient`` (float > 0 or None): the friction coefficient in slip (CONTACT's FKIN); the
+  material's ``friction_coefficient`` is then the static one (FSTAT: adhesion holds up to it). None: one
+  coefficient.
 """
+
+PROBLEMS = ("rolling", "shift")
+"""Tangential problems of the option ``problem``."""
 
 ROLLING_SLIP_POINTS = {"centre": 0.0, "midpoint": 0.5}
 """Offset of the rigid slip from the element centre, in elements along x (option ``rolling_slip_point``)."""
@@ -164,6 +180,23 @@ def _options(options: Mapping | None) -> dict:
             f"option extrapolate = true with nx = {opts['nx']!r}, ny = {opts['ny']!r}: expected even element counts "
             "(nx >= 4), so that 2 x 2 elements merge into the coarse grid"
         )
+    if opts["problem"] not in PROBLEMS:
+        raise ValueError(f"option problem = {opts['problem']!r}: expected one of {', '.join(PROBLEMS)}")
+    if opts["problem"] == "shift" and opts["extrapolate"]:
+        raise ValueError("option extrapolate = true with problem = 'shift': expected false (it is for steady rolling)")
+    for name in ("shift_long_m", "shift_lat_m", "shift_rotation_rad"):
+        value = opts[name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"option {name} = {value!r}: expected a finite number")
+    if opts["problem"] == "rolling" and any(
+        opts[k] != 0.0 for k in ("shift_long_m", "shift_lat_m", "shift_rotation_rad")
+    ):
+        raise ValueError("options shift_*: expected problem = 'shift' (a steady-rolling case uses the creepages)")
+    mu_k = opts["kinetic_friction_coefficient"]
+    if mu_k is not None and (
+        isinstance(mu_k, bool) or not isinstance(mu_k, (int, float)) or not math.isfinite(mu_k) or mu_k <= 0
+    ):
+        raise ValueError(f"option kinetic_friction_coefficient = {mu_k!r}: expected a finite number > 0 or None")
     if opts["rolling_slip_point"] not in ROLLING_SLIP_POINTS:
         raise ValueError(
             f"option rolling_slip_point = {opts['rolling_slip_point']!r}: expected one of "
@@ -338,10 +371,25 @@ class BemModel:
 
         # 2. TANG (alternated with NORM for K != 0: Panagiotopoulos' process)
         offset = ROLLING_SLIP_POINTS[opts["rolling_slip_point"]] * dx
-        wx, wy = rigid_slip(x + offset, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
+        problem = opts["problem"]
+        if problem == "shift":
+            # rigid shift (m) of the wheel over the rail: translation and rotation about the normal
+            wx, wy = rigid_slip(x, y, opts["shift_long_m"], opts["shift_lat_m"], opts["shift_rotation_rad"])
+        else:
+            wx, wy = rigid_slip(x + offset, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
         previous = norm.normal_force_N
         for _ in range(1 if k_diff == 0.0 else 20):
-            tang = solve_tang(influence, norm.pressure_Pa, mu, wx, wy, tolerance=tol, max_iterations=max_it)
+            tang = solve_tang(
+                influence,
+                norm.pressure_Pa,
+                mu,
+                wx,
+                wy,
+                problem=problem,
+                tolerance=tol,
+                max_iterations=max_it,
+                kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
+            )
             if k_diff == 0.0:
                 break
             norm = solve_norm(
@@ -367,7 +415,8 @@ class BemModel:
         tx, ty = tang.traction_x_Pa, tang.traction_y_Pa
         fx, fy = float(tx.sum() * area), float(ty.sum() * area)
         mz = float((xx * ty - yy * tx).sum() * area)
-        slip_speed = creepage.rolling_speed_m_per_s * np.hypot(tang.slip_x, tang.slip_y)
+        slip_size = np.hypot(tang.slip_x, tang.slip_y)
+        slip_speed = creepage.rolling_speed_m_per_s * slip_size if problem == "rolling" else None
         fields = ContactFields(
             x_m=x,
             y_m=y,
@@ -428,6 +477,8 @@ class BemModel:
                 "slip_elements": int((tang.in_slip & contact).sum()),
                 "contact_touches_potential_area_edge": edge,
                 "potential_area_enlargements": grown,
+                "problem": problem,
+                "slip_distance_max_m": float(slip_size.max()) if problem == "shift" else None,
             },
         )
 
