@@ -26,13 +26,14 @@ kappa = k/|(k, l)|, lambda = l/|(k, l)|, lambda' = lambda - phi', the adhesion-z
     t_y = mu p0/a [lambda sqrt(a_y^2 - x^2) - lambda' sqrt((a_y - d_y)^2 - (x - d_y)^2)]
 
 (Carter's two-dimensional solution per strip when phi = 0). In the slip zone the traction is mu p (Hertz
-pressure) in the direction of the traction of a FASTSIM pass over the same strip (Kalker's three
-flexibilities L1, L2, L3, :mod:`.fastsim`); here that pass uses the elliptic traction bound mu p, where the
-original uses a parabolic bound with a heuristic normal-force factor. The square roots are integrated in
-closed form over each element of Kalker's strip layout (ny strips at the midpoints y_j, nx elements per strip of
-length 2 a_y/nx), split at the adhesion/slip boundary, so the forces are exact along x (only the strips and the
-slip directions are discretised). Forces on the wheel, contact frame, opposing the creepage (F_x = -G ab C11 xi
-at small creepage).
+pressure) in the direction of the traction of a FASTSIM pass over the same strip (three flexibilities L1, L2, L3
+blended towards one as the creepage grows, as :mod:`.fastsim`'s default: with Kalker's unblended three the
+full-slip traction would not oppose the rigid slip); here that pass uses the elliptic traction bound mu p, where
+the original uses Kalker's flexibilities and a parabolic bound with a heuristic normal-force factor.
+The square roots are integrated in closed form over each element of Kalker's strip layout (ny strips at the
+midpoints y_j, nx elements per strip of length 2 a_y/nx), split at the adhesion/slip boundary, so the forces are
+exact along x (only the strips and the slip directions are discretised). Forces on the wheel, contact frame,
+opposing the creepage (F_x = -G ab C11 xi at small creepage).
 
 Rolling direction: ``rolling_direction_rad`` 0 (leading edge at +x, the module convention) or pi (rolling
 towards -x): the problem is mirrored in x (xi -> -xi, phi -> -phi, F_x -> -F_x, M_z -> -M_z).
@@ -47,7 +48,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.contact.fastsim import kalker_flexibilities
+from rigid_dynamics.contact.fastsim import effective_flexibilities
 from rigid_dynamics.contact.kalker import kalker_coefficients
 
 
@@ -226,7 +227,18 @@ def fastrip(
         friction_coefficient=friction_coefficient,
     )
     coef = kalker_coefficients(a / b, poisson_ratio)
-    l1, l2, l3 = kalker_flexibilities(a, b, shear_modulus_Pa, coef)
+    l1, l2, l3 = effective_flexibilities(
+        a,
+        b,
+        fn,
+        xi,
+        eta,
+        phi,
+        shear_modulus_Pa=shear_modulus_Pa,
+        friction_coefficient=friction_coefficient,
+        coefficients=coef,
+        flexibility="three",
+    )
     px = np.zeros((ny, nx))
     py = np.zeros((ny, nx))
     slip = np.zeros((ny, nx), dtype=np.bool_)

@@ -22,8 +22,9 @@ Given the undeformed distance h0(x, y) >= 0 (0 at the deepest point) on a regula
    Force control: delta is found by the secant method on log F(delta) (F ~ delta^1.5).
 
 Tangential part (model ``kpec``): FASTSIM (Kalker 1982, :mod:`.fastsim`) along every row of the KPEC patch from
-its leading edge (+x) with traction bound mu p and Kalker's flexibilities L1, L2, L3 of the equivalent ellipse
-a, b (C_ij for a/b from Kalker's table).
+its leading edge (+x) with traction bound mu p and the flexibilities L1, L2, L3 of the equivalent ellipse a, b
+(C_ij for a/b from Kalker's table; blended towards one flexibility at large creepage as :mod:`.fastsim`'s
+default "three").
 
 Symbols: h0, delta (m); A, B (1/m); a, b (m); p (Pa); x rolling direction (leading edge at +x), y lateral.
 """
@@ -250,7 +251,7 @@ class KpecModel:
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
-        from rigid_dynamics.contact.fastsim import kalker_flexibilities
+        from rigid_dynamics.contact.fastsim import effective_flexibilities
         from rigid_dynamics.contact.kalker import kalker_coefficients
         from rigid_dynamics.contact.models import _options
         from rigid_dynamics.contact.types import ContactFields, ContactResult
@@ -296,7 +297,18 @@ class KpecModel:
                 sol = solve_at(delta)
         converged = normal_force_N is None or abs(sol.normal_force_N / normal_force_N - 1.0) < 1e-8
         coef = kalker_coefficients(sol.semi_axis_long_m / sol.semi_axis_lat_m, nu)
-        l1, l2, l3 = kalker_flexibilities(sol.semi_axis_long_m, sol.semi_axis_lat_m, g_mod, coef)
+        l1, l2, l3 = effective_flexibilities(
+            sol.semi_axis_long_m,
+            sol.semi_axis_lat_m,
+            sol.normal_force_N,
+            creepage.longitudinal,
+            creepage.lateral,
+            creepage.spin_1_per_m,
+            shear_modulus_Pa=g_mod,
+            friction_coefficient=mu,
+            coefficients=coef,
+            flexibility="three",
+        )
         tx = np.zeros(sol.pressure_Pa.shape)
         ty = np.zeros(sol.pressure_Pa.shape)
         slip = np.zeros(sol.pressure_Pa.shape, dtype=np.bool_)
