@@ -134,6 +134,23 @@ def _kpec_rows(h0, x, threshold, pressure):
     return l_max
 
 
+def _normal_influence_at(x, y, i0, j0, dx, dy, shear_modulus_Pa, poisson_ratio) -> np.ndarray:
+    """Displacement difference at element (j0, i0) per unit uniform pressure on each element, (ny, nx), m/Pa.
+
+    Love's rectangle coefficient (1 - nu)/(pi G) * integral of 1/r over the element, from the primitive
+    X asinh(Y/|X|) + Y asinh(X/|Y|) on the element corners (as :func:`~.bem.influence.rectangle_influence`'s zz,
+    evaluated once per corner).
+    """
+    from rigid_dynamics.contact.bem.influence import _x_asinh_y_over_x
+
+    cx = x[i0] - (x[0] - 0.5 * dx) - dx * np.arange(x.size + 1)  # X at the element edges, decreasing
+    cy = y[j0] - (y[0] - 0.5 * dy) - dy * np.arange(y.size + 1)
+    gx, gy = np.meshgrid(cx, cy)
+    prim = _x_asinh_y_over_x(gx, gy) + _x_asinh_y_over_x(gy, gx)
+    acc = prim[:-1, :-1] - prim[:-1, 1:] - prim[1:, :-1] + prim[1:, 1:]
+    return (1.0 - poisson_ratio) / (math.pi * shear_modulus_Pa) * acc
+
+
 def kpec_pressure(
     undeformed_m: np.ndarray,
     x_m: np.ndarray,
@@ -151,8 +168,6 @@ def kpec_pressure(
         approach_m: delta > 0, m.
         shear_modulus_Pa, poisson_ratio: combined G, nu of the pair.
     """
-    from rigid_dynamics.contact.bem.influence import rectangle_influence
-
     h = np.asarray(undeformed_m, float)
     h0 = h - np.nanmin(h)
     h0 = np.where(np.isfinite(h0), h0, np.inf)
@@ -167,8 +182,7 @@ def kpec_pressure(
     _kpec_rows(h0, x, threshold, pressure)
     dx = x[1] - x[0] if x.size > 1 else 1.0
     dy = y[1] - y[0] if y.size > 1 else 1.0
-    coef = rectangle_influence(x[i0] - x[None, :], y[j0] - y[:, None], dx, dy, shear_modulus_Pa, poisson_ratio)
-    u_mid = float(np.sum(coef["zz"] * pressure))
+    u_mid = float(np.sum(_normal_influence_at(x, y, i0, j0, dx, dy, shear_modulus_Pa, poisson_ratio) * pressure))
     p_max = delta / u_mid if u_mid > 0 else 0.0
     pressure *= p_max
     contact = pressure > 0
