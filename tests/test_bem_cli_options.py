@@ -72,3 +72,17 @@ def test_shift_problem_and_kinetic_friction_through_the_cli(tmp_path, capsys):
     patch = data["patches"][0]
     # a shift of 1 mm is far beyond full slip: the force on the wheel is -mu_k F_N
     assert data["success"] and abs(patch["creep_force_long_N"] / -0.25e5 - 1) < 1e-6, patch
+
+
+def test_transient_problem_through_the_cli(tmp_path, capsys):
+    """problem = 'transient' from the [solver] table runs and reports a rising force (forces on the wheel)."""
+    import json
+
+    path = tmp_path / "case.toml"
+    text = CASE.replace("creepage_long = 0.0", "creepage_long = 1e-3")
+    path.write_text(text + 'nx = 12\nny = 12\nproblem = "transient"\ntransient_steps = 4\n')
+    code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    data = json.loads(out)
+    assert data["success"] and data["patches"][0]["creep_force_long_N"] < 0

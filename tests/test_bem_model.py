@@ -374,3 +374,46 @@ def test_static_and_kinetic_friction():
         BemModel().solve(geometry, creepage, STEEL, options={"problem": "slide"})
     with pytest.raises(ValueError, match="options shift_\\*: expected problem = 'shift'"):
         BemModel().solve(geometry, creepage, STEEL, options={"shift_long_m": 1e-6})
+
+
+def test_transient_rolling_tends_to_steady_rolling():
+    """problem = 'transient' (rolling from zero tangential traction, steps dq = dx): the force rises monotonically
+    and tends to the steady-rolling solution of the same grid, whose upwind discretisation is the recursion's fixed
+    point (regression between two of our paths; steady rolling itself is checked against Carter and Kalker's C_ij
+    in tests/test_bem_tang.py). The first step is the shift problem with the rigid shift dx w."""
+    geometry = ContactGeometry.quadric(0.46, 0.3)
+    creepage = Creepage(1e-3, 5e-4, 0.3)
+    opts = {"nx": 12, "ny": 12, "tolerance": 1e-9}
+    steady = BemModel().solve(geometry, creepage, STEEL, normal_force_N=1e5, options=opts)
+    res = BemModel().solve(
+        geometry, creepage, STEEL, normal_force_N=1e5, options={**opts, "problem": "transient", "transient_steps": 100}
+    )
+    assert res.success and steady.success
+    history = np.array(res.extra["transient_forces_N"])
+    assert history.shape == (100, 3)
+    assert np.all(np.diff(history[:, 0]) < 0)  # |F_x| grows step by step (F_x < 0 for xi > 0)
+    assert res.creep_force_long_N == pytest.approx(steady.creep_force_long_N, rel=1e-5)
+    assert res.creep_force_lat_N == pytest.approx(steady.creep_force_lat_N, rel=1e-5)
+    assert res.spin_moment_Nm == pytest.approx(steady.spin_moment_Nm, rel=1e-4)
+    assert history[-1, 0] == pytest.approx(res.creep_force_long_N, rel=1e-12)
+    dx = res.extra["dx_m"]
+    first = BemModel().solve(
+        geometry,
+        creepage,
+        STEEL,
+        normal_force_N=1e5,
+        options={**opts, "problem": "shift", "shift_long_m": dx * 1e-3, "shift_lat_m": dx * 5e-4},
+    )
+    # the first transient step has the spin part of dx w as well: compare without spin
+    no_spin = BemModel().solve(
+        geometry,
+        Creepage(1e-3, 5e-4, 0.0),
+        STEEL,
+        normal_force_N=1e5,
+        options={**opts, "problem": "transient", "transient_steps": 1},
+    )
+    assert no_spin.creep_force_long_N == pytest.approx(first.creep_force_long_N, rel=1e-9)
+    with pytest.raises(ValueError, match="transient_steps = 0: expected an integer >= 1 or None"):
+        BemModel().solve(geometry, creepage, STEEL, options={"problem": "transient", "transient_steps": 0})
+    with pytest.raises(ValueError, match="extrapolate = true with problem = 'transient'"):
+        BemModel().solve(geometry, creepage, STEEL, options={"problem": "transient", "extrapolate": True})

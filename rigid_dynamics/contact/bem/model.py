@@ -56,6 +56,7 @@ DEFAULT_OPTIONS: dict = {
     "shift_lat_m": 0.0,
     "shift_rotation_rad": 0.0,
     "kinetic_friction_coefficient": None,
+    "transient_steps": None,
 }
 """Options of :class:`BemModel` and their defaults:
 
@@ -83,12 +84,19 @@ DEFAULT_OPTIONS: dict = {
   not used): the rigid shift of the wheel over the rail is w = (s_x - theta y, s_y + theta x) with ``shift_long_m``
   s_x, ``shift_lat_m`` s_y (m) and ``shift_rotation_rad`` theta about the normal (rad); the result's slip field is
   then None (the slip is a distance) and ``extra["slip_distance_max_m"]`` its largest value;
+* ``problem = "transient"``: transient rolling from the state without tangential traction (the bodies pressed
+  together, then rolling starts with the creepages): ``transient_steps`` (int >= 1; None: nx) steps of the
+  rolling distance dq = dx (CONTACT's DQ = DX), each a shift problem whose rigid shift is
+  dq w - u'(x + dq), u' the previous step's displacement difference carried along with the particles (Kalker 1990,
+  sec. 5.2); the result is the last step's, ``extra["transient_forces_N"]`` the (F_x, F_y, M_z) of every step.
+  With dq = dx the steady state of this recursion is exactly the steady-rolling discretisation. Quasi-identical
+  bodies only (K = 0);
 * ``kinetic_friction_coefficient`` (float > 0 or None): the friction coefficient in slip (CONTACT's FKIN); the
   material's ``friction_coefficient`` is then the static one (FSTAT: adhesion holds up to it). None: one
   coefficient.
 """
 
-PROBLEMS = ("rolling", "shift")
+PROBLEMS = ("rolling", "shift", "transient")
 """Tangential problems of the option ``problem``."""
 
 ROLLING_SLIP_POINTS = {"centre": 0.0, "midpoint": 0.5}
@@ -182,8 +190,17 @@ def _options(options: Mapping | None) -> dict:
         )
     if opts["problem"] not in PROBLEMS:
         raise ValueError(f"option problem = {opts['problem']!r}: expected one of {', '.join(PROBLEMS)}")
-    if opts["problem"] == "shift" and opts["extrapolate"]:
-        raise ValueError("option extrapolate = true with problem = 'shift': expected false (it is for steady rolling)")
+    if opts["problem"] != "rolling" and opts["extrapolate"]:
+        raise ValueError(
+            f"option extrapolate = true with problem = {opts['problem']!r}: expected false (it is for steady rolling)"
+        )
+    steps = opts["transient_steps"]
+    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1):
+        raise ValueError(f"option transient_steps = {steps!r}: expected an integer >= 1 or None")
+    if opts["problem"] == "transient" and opts["difference_parameter"] != 0.0:
+        raise ValueError(
+            f"option difference_parameter = {opts['difference_parameter']!r} with problem = 'transient': expected 0"
+        )
     for name in ("shift_long_m", "shift_lat_m", "shift_rotation_rad"):
         value = opts[name]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -378,7 +395,13 @@ class BemModel:
         else:
             wx, wy = rigid_slip(x + offset, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
         previous = norm.normal_force_N
-        for _ in range(1 if k_diff == 0.0 else 20):
+        history = None
+        for _ in range(1 if k_diff == 0.0 or problem == "transient" else 20):
+            if problem == "transient":
+                steps = int(opts["transient_steps"] or nx)
+                fields_in = (norm.pressure_Pa, (wx, wy), (xx, yy))
+                tang, history = _transient(influence, mu, fields_in, steps, tol, max_it, opts)
+                break
             tang = solve_tang(
                 influence,
                 norm.pressure_Pa,
@@ -416,7 +439,11 @@ class BemModel:
         fx, fy = float(tx.sum() * area), float(ty.sum() * area)
         mz = float((xx * ty - yy * tx).sum() * area)
         slip_size = np.hypot(tang.slip_x, tang.slip_y)
-        slip_speed = creepage.rolling_speed_m_per_s * slip_size if problem == "rolling" else None
+        slip_speed = None
+        if problem == "rolling":
+            slip_speed = creepage.rolling_speed_m_per_s * slip_size
+        elif problem == "transient":  # slip distance per rolling step dq = dx
+            slip_speed = creepage.rolling_speed_m_per_s * slip_size / dx
         fields = ContactFields(
             x_m=x,
             y_m=y,
@@ -479,8 +506,45 @@ class BemModel:
                 "potential_area_enlargements": grown,
                 "problem": problem,
                 "slip_distance_max_m": float(slip_size.max()) if problem == "shift" else None,
+                "transient_forces_N": history,
             },
         )
+
+
+def _transient(influence, mu, fields_in, steps, tol, max_it, opts):
+    """Transient rolling from zero tangential traction (option problem = "transient"); (last TangSolution, history).
+
+    Step k: the shift problem with the rigid shift W = dx w - u'(x + dx), where u'(x + dx) = u'(x) - dx L t' is the
+    previous displacement difference one element ahead (L the rolling operator: (u(x) - u(x + dx))/dx), so that
+    the slip distance of the step is S = dx w + u(x) - u'(x + dx). History: [F_x, F_y, M_z] per step (N, N m).
+    """
+    area = influence.dx_m * influence.dy_m
+    pressure, (wx, wy), (xx, yy) = fields_in
+    tx = np.zeros(pressure.shape)
+    ty = np.zeros(pressure.shape)
+    history = []
+    tang = None
+    dx = influence.dx_m
+    for _ in range(steps):
+        ux, uy = influence.tangential(tx, ty, rolling=False)
+        lx, ly = influence.tangential(tx, ty, rolling=True)
+        tang = solve_tang(
+            influence,
+            pressure,
+            mu,
+            dx * wx - (ux - dx * lx),
+            dx * wy - (uy - dx * ly),
+            problem="shift",
+            tolerance=tol,
+            max_iterations=max_it,
+            coarse_start=False,
+            kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
+        )
+        tx, ty = tang.traction_x_Pa, tang.traction_y_Pa
+        history.append([float(tx.sum() * area), float(ty.sum() * area), float((xx * ty - yy * tx).sum() * area)])
+        if not tang.converged:
+            break
+    return tang, history
 
 
 def _whole_elements(limits: tuple[float, float], size_m: float, even: bool = False) -> tuple[tuple[float, float], int]:
