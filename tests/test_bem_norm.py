@@ -118,15 +118,15 @@ def test_bad_inputs():
 PERFC_PROFILE = Path(__file__).resolve().parents[1] / "benchmarks" / "data" / "contact_perfc_norm_profile.csv"
 
 
-def _perfc_problem():
-    """CONTACT's perfc_test/norm_problm_1p deck (benchmarks/data/SOURCE.md): 71 x 81 elements of 0.1 mm,
-    h = p(y) + x^2/(2 RM) - PEN, G = 82 GPa, nu = 0.28."""
+def _perfc_problem(level=1):
+    """CONTACT's perfc_test/norm_problm_{level}p deck (benchmarks/data/SOURCE.md): 71 x 81 elements of 0.1 mm
+    (level 1) or 143 x 163 of 0.05 mm (level 2), h = p(y) + x^2/(2 RM) - PEN, G = 82 GPa, nu = 0.28."""
     profile = np.loadtxt(PERFC_PROFILE, delimiter=",")
-    d = 0.1e-3
-    x = -3.55e-3 + d * (np.arange(71) + 0.5)
-    y = -6.15e-3 + d * (np.arange(81) + 0.5)
+    mx, my, d = {1: (71, 81, 0.1e-3), 2: (143, 163, 0.05e-3)}[level]
+    x = -3.55e-3 + d * (np.arange(mx) + 0.5)
+    y = -6.15e-3 + d * (np.arange(my) + 0.5)
     h = np.interp(y, profile[:, 0] * 1e-3, profile[:, 1] * 1e-3)[:, None] + x[None, :] ** 2 / (2 * 0.483931)
-    return InfluenceGrid(71, 81, d, d, 82e9, 0.28), h - 0.02084e-3
+    return InfluenceGrid(mx, my, d, d, 82e9, 0.28), h - 0.02084e-3
 
 
 @pytest.mark.parametrize("force_control", [False, True])
@@ -148,6 +148,17 @@ def test_normcg_on_contacts_perfc_grid(force_control):
     assert sol.normal_force_N == pytest.approx(ref.normal_force_N, rel=1e-7)
     assert sol.approach_shift_m == pytest.approx(ref.approach_shift_m, rel=1e-6, abs=1e-15)
     assert sol.residual < 1e-6
+
+
+@pytest.mark.parametrize(("force_control", "contact_elements", "iterations"), [(False, 12902, 22), (True, 12912, 18)])
+def test_normcg_on_contacts_finer_perfc_grid(force_control, contact_elements, iterations):
+    """perfc_test/norm_problm_2p / _2f (143 x 163 elements): CONTACT's published contact count and no more than its
+    NormCG iterations (get_times.ref_out)."""
+    grid, h = _perfc_problem(2)
+    force = 1.0e4 if force_control else None
+    sol = solve_norm(grid, h + 0.02084e-3 if force_control else h, normal_force_N=force, tolerance=1e-7)
+    assert sol.converged and int((sol.pressure_Pa > 0).sum()) == contact_elements
+    assert sol.iterations <= iterations, sol.iterations
 
 
 def test_normcg_hertz_pressure_order_two():
