@@ -266,7 +266,7 @@ def _rolling_sign(rolling_direction_rad: float) -> float:
 class FastripModel:
     """Hertz + FaStrip (module docstring): the registered model ``fastrip``.
 
-    Options (:data:`DEFAULTS`): ``nx`` (elements per strip, int >= 1), ``ny`` (strips, int >= 1),
+    Options (``defaults``): ``nx`` (elements per strip, int >= 1), ``ny`` (strips, int >= 1),
     ``rolling_direction_rad`` (0 or pi: the direction of rolling in the contact frame). No surface fields are
     returned (the strip layout has a different x grid per strip); ``extra["slip_fraction"]`` is the slip zones'
     share of the strips' length.
@@ -274,7 +274,7 @@ class FastripModel:
 
     name = "fastrip"
     description = "Hertz + FaStrip (strip theory with spin; Sichani et al. 2016)"
-    DEFAULTS: dict = {"nx": 40, "ny": 40, "rolling_direction_rad": 0.0}
+    defaults: dict = {"nx": 40, "ny": 40, "rolling_direction_rad": 0.0}
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One Hertzian patch; forces on the wheel in the contact frame (:class:`~.types.ContactResult`)."""
@@ -283,7 +283,7 @@ class FastripModel:
         from rigid_dynamics.contact.models import _base_result, _hertz, _options
 
         start = time.perf_counter()
-        opts = _options(options, self.DEFAULTS, self.name)
+        opts = _options(options, self.defaults, self.name)
         _rolling_sign(opts["rolling_direction_rad"])
         hertz, reason = _hertz(geometry, material, normal_force_N)
         if hertz is None:

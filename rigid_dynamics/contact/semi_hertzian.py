@@ -262,6 +262,7 @@ class KpecModel:
 
     name = "kpec"
     description = "KPEC semi-Hertzian normal + FASTSIM (non-elliptic patches)"
+    defaults: dict = DEFAULTS
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
@@ -271,7 +272,7 @@ class KpecModel:
         from rigid_dynamics.contact.types import ContactFields, ContactResult
 
         start = time.perf_counter()
-        opts = _options(options, DEFAULTS, self.name)
+        opts = _options(options, self.defaults, self.name)
         for key in ("nx", "ny"):
             value = opts[key]
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 4:
