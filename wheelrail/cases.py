@@ -293,9 +293,16 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
     start = time.perf_counter()
     if case.kind == "quadric":
         model = get_model(method)
-        result = model.solve(
-            case.geometry, case.creepage, case.material, normal_force_N=case.normal_force_N, options=case.solver_options
-        )
+        try:  # a model raises ValueError only for bad input (STYLE 12), e.g. a [solver] option
+            result = model.solve(
+                case.geometry,
+                case.creepage,
+                case.material,
+                normal_force_N=case.normal_force_N,
+                options=case.solver_options,
+            )
+        except ValueError as exc:
+            raise ConfigError(f"[solver]: {exc}") from None
         return CaseSolution(
             method,
             result.success,
