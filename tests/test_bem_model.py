@@ -236,6 +236,66 @@ def test_bad_options():
         model.solve(geometry, Creepage(), STEEL, normal_force_N=-5.0)
     with pytest.raises(ValueError, match="exactly one"):
         hertz_ellipse(1.0, 2.0, E_STAR)
+    with pytest.raises(ValueError, match="element_size_m' = -0.001: expected a finite number > 0"):
+        model.solve(geometry, Creepage(), STEEL, options={"element_size_m": -1e-3})
+    with pytest.raises(ValueError, match="element_size_m = 0.0001 together with nx: expected either"):
+        model.solve(geometry, Creepage(), STEEL, options={"element_size_m": 1e-4, "nx": 30})
+    with pytest.raises(ValueError, match=r"element_size_m = 1e-08 gives \d+ x \d+ elements.*at most"):
+        model.solve(geometry, Creepage(), STEEL, options={"element_size_m": 1e-8})
+    with pytest.raises(ValueError, match="norm_method' = 'cg': expected one of 'normcg', 'polonsky-keer'"):
+        model.solve(geometry, Creepage(), STEEL, options={"norm_method": "cg"})
+    with pytest.raises(ValueError, match="extrapolate' = 1: expected true or false"):
+        model.solve(geometry, Creepage(), STEEL, options={"extrapolate": 1})
+    with pytest.raises(ValueError, match="extrapolate = true with nx = 41, ny = 40: expected even"):
+        model.solve(geometry, Creepage(), STEEL, options={"extrapolate": True, "nx": 41})
+    with pytest.raises(ValueError, match="rolling_slip_point' = 'front': expected one of 'centre', 'midpoint'"):
+        model.solve(geometry, Creepage(), STEEL, options={"rolling_slip_point": "front"})
+
+
+def test_large_spin_coarse_grid_with_richardson_extrapolation():
+    """Large-spin case at 40 x 40 (default margin 1.15): with the rigid slip at the midpoint of the upwind
+    difference and Richardson extrapolation from the 20 x 20 grid, F_y/(mu F_N) is within 1 % of the converged
+    -0.624 (+-0.001, the grid study above); without extrapolation the 40 x 40 error is -6 % (centre) / +1.7 %
+    (midpoint). The reported estimate of the fine grid's error is the applied correction."""
+    a_c, b_c, _ = _curvatures(SPIN_A, SPIN_B, SPIN_F)
+    geometry = ContactGeometry(a_c, b_c, 0.0)
+    creepage = Creepage(0.0, -6.25e-4, 0.625)
+    opts = {"nx": 40, "ny": 40, "rolling_slip_point": "midpoint"}
+    plain = BemModel().solve(geometry, creepage, STEEL, normal_force_N=SPIN_F, options=opts)
+    res = BemModel().solve(geometry, creepage, STEEL, normal_force_N=SPIN_F, options={**opts, "extrapolate": True})
+    assert res.success and "Richardson" in res.message
+    scale = 0.3 * SPIN_F
+    rich = res.extra["richardson"]
+    assert rich["coarse_nx"] == 20 and rich["fine"]["creep_force_lat_N"] == plain.creep_force_lat_N
+    assert res.creep_force_lat_N == pytest.approx(
+        2 * rich["fine"]["creep_force_lat_N"] - rich["coarse"]["creep_force_lat_N"], rel=1e-12
+    )
+    assert res.creep_force_lat_N / scale == pytest.approx(-0.624, rel=0.01)
+    assert abs(plain.creep_force_lat_N / scale + 0.624) > 0.01 * 0.624
+    estimate = rich["fine_error_estimate"]["creep_force_lat_N"]
+    assert estimate == pytest.approx(plain.creep_force_lat_N - res.creep_force_lat_N, rel=1e-12)
+    assert res.normal_force_N == plain.normal_force_N and res.fields.x_m.size == 40
+
+
+def test_grid_by_element_size():
+    """element_size_m (CONTACT's DX = DS): square elements of that size over the potential area widened to whole
+    elements; the Hertz p0 and force within the discretisation error of that element size (Johnson 1985)."""
+    a_c, b_c, p0 = _curvatures(SPIN_A, SPIN_B, SPIN_F)
+    geometry = ContactGeometry(a_c, b_c, 0.0)
+    size = 0.4e-3
+    res = BemModel().solve(geometry, Creepage(), STEEL, normal_force_N=SPIN_F, options={"element_size_m": size})
+    assert res.success
+    ex = res.extra
+    assert ex["dx_m"] == pytest.approx(size, rel=1e-12) and ex["dy_m"] == pytest.approx(size, rel=1e-12)
+    x0, x1, y0, y1 = ex["potential_area_m"]
+    # whole elements centred at multiples of the size from the origin (CONTACT's grid): one more than the width
+    # needs when the symmetric potential area ends inside an element on both sides
+    for key, semi in (("nx", SPIN_A), ("ny", SPIN_B)):
+        assert math.ceil(2 * 1.15 * semi / size - 1e-9) <= ex[key] <= math.ceil(2 * 1.15 * semi / size) + 1
+    assert (x0 + x1, y0 + y1) == pytest.approx((0.0, 0.0), abs=1e-15)
+    assert x1 - x0 >= 2 * 1.15 * SPIN_A and x1 - x0 < 2 * 1.15 * SPIN_A + 2 * size
+    assert res.normal_force_N == pytest.approx(SPIN_F, rel=1e-9)
+    assert res.max_pressure_Pa == pytest.approx(p0, rel=5e-3)
 
 
 def test_search_field_holds_the_whole_overlap_of_the_long_tread_patch():
@@ -261,3 +321,104 @@ def test_search_field_holds_the_whole_overlap_of_the_long_tread_patch():
         assert np.nanmin(field.distance_m) == pytest.approx(-patch.geometry.approach_m, rel=0.05)
         assert field.x_m[0] < 0 < field.x_m[-1] and field.y_m[0] < 0 < field.y_m[-1]
     assert any(overlap_edges(p.geometry.undeformed) for p in fixed.patches)
+
+
+def test_shift_problem_through_the_model_is_cattaneo():
+    """Option problem = 'shift' (Cattaneo): circular Hertz contact, nu = 0 (no normal-tangential coupling), rigid
+    shift s_x: F_x/(mu F_N) = -(1 - (c/a)^3) with the adhesion radius c from s_x = mu p0 pi a (1 - (c/a)^2)/(2 G)
+    (Johnson 1985, sec. 7.2, for the displacement difference of the pair; tests/test_bem_tang.py)."""
+    material = Material(80e9, 0.0, 0.3)
+    force = 1e4
+    geometry = ContactGeometry.quadric(0.2, 0.2)
+    e_star = 80e9
+    a, _, p0, *_ = hertz_ellipse(
+        geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m, e_star, normal_force_N=force
+    )
+    shift = 0.3 * p0 * math.pi * a * (1 - 0.6**2) / (2 * 80e9)
+    res = BemModel().solve(
+        geometry,
+        Creepage(),
+        material,
+        normal_force_N=force,
+        options={"nx": 40, "ny": 40, "problem": "shift", "shift_long_m": shift},
+    )
+    assert res.success and res.extra["problem"] == "shift"
+    assert res.creep_force_long_N / (0.3 * force) == pytest.approx(-(1 - 0.6**3), rel=0.015)
+    assert abs(res.creep_force_lat_N) < 1e-9 * force and res.fields.slip_m_per_s is None
+    assert 0 < res.extra["slip_distance_max_m"] < shift
+    rotated = BemModel().solve(
+        geometry,
+        Creepage(),
+        material,
+        normal_force_N=force,
+        options={"nx": 40, "ny": 40, "problem": "shift", "shift_rotation_rad": 1e-3},
+    )
+    assert rotated.success and rotated.spin_moment_Nm < 0 and abs(rotated.creep_force_long_N) < 1e-6 * force
+
+
+def test_static_and_kinetic_friction():
+    """kinetic_friction_coefficient mu_k < mu_s: full slip carries mu_k F_N (rolling and shift); in partial slip
+    the force lies between the mu_k-only and mu_s-only solutions."""
+    geometry = ContactGeometry.quadric(0.46, 0.3)
+    opts = {"nx": 24, "ny": 24, "kinetic_friction_coefficient": 0.2}
+    full = BemModel().solve(geometry, Creepage(0.05, 0.0, 0.0), STEEL, normal_force_N=1e5, options=opts)
+    assert full.success and full.creep_force_long_N == pytest.approx(-0.2 * 1e5, rel=1e-4)
+    creepage = Creepage(1e-3, 0.0, 0.0)
+    both = BemModel().solve(geometry, creepage, STEEL, normal_force_N=1e5, options=opts)
+    static = BemModel().solve(geometry, creepage, STEEL, normal_force_N=1e5, options={"nx": 24, "ny": 24})
+    kinetic = BemModel().solve(
+        geometry, creepage, Material(82e9, 0.28, 0.2), normal_force_N=1e5, options={"nx": 24, "ny": 24}
+    )
+    assert both.success
+    assert kinetic.creep_force_long_N < both.creep_force_long_N < static.creep_force_long_N or (
+        static.creep_force_long_N < both.creep_force_long_N < kinetic.creep_force_long_N
+    )
+    with pytest.raises(ValueError, match="kinetic_friction_coefficient' = 0.0: expected a finite number > 0"):
+        BemModel().solve(geometry, creepage, STEEL, options={"kinetic_friction_coefficient": 0})
+    with pytest.raises(ValueError, match="problem' = 'slide': expected one of 'rolling', 'shift'"):
+        BemModel().solve(geometry, creepage, STEEL, options={"problem": "slide"})
+    with pytest.raises(ValueError, match="options shift_\\*: expected problem = 'shift'"):
+        BemModel().solve(geometry, creepage, STEEL, options={"shift_long_m": 1e-6})
+
+
+def test_transient_rolling_tends_to_steady_rolling():
+    """problem = 'transient' (rolling from zero tangential traction, steps dq = dx): the force rises monotonically
+    and tends to the steady-rolling solution of the same grid, whose upwind discretisation is the recursion's fixed
+    point (regression between two of our paths; steady rolling itself is checked against Carter and Kalker's C_ij
+    in tests/test_bem_tang.py). The first step is the shift problem with the rigid shift dx w."""
+    geometry = ContactGeometry.quadric(0.46, 0.3)
+    creepage = Creepage(1e-3, 5e-4, 0.3)
+    opts = {"nx": 12, "ny": 12, "tolerance": 1e-9}
+    steady = BemModel().solve(geometry, creepage, STEEL, normal_force_N=1e5, options=opts)
+    res = BemModel().solve(
+        geometry, creepage, STEEL, normal_force_N=1e5, options={**opts, "problem": "transient", "transient_steps": 100}
+    )
+    assert res.success and steady.success
+    history = np.array(res.extra["transient_forces_N"])
+    assert history.shape == (100, 3)
+    assert np.all(np.diff(history[:, 0]) < 0)  # |F_x| grows step by step (F_x < 0 for xi > 0)
+    assert res.creep_force_long_N == pytest.approx(steady.creep_force_long_N, rel=1e-5)
+    assert res.creep_force_lat_N == pytest.approx(steady.creep_force_lat_N, rel=1e-5)
+    assert res.spin_moment_Nm == pytest.approx(steady.spin_moment_Nm, rel=1e-4)
+    assert history[-1, 0] == pytest.approx(res.creep_force_long_N, rel=1e-12)
+    dx = res.extra["dx_m"]
+    first = BemModel().solve(
+        geometry,
+        creepage,
+        STEEL,
+        normal_force_N=1e5,
+        options={**opts, "problem": "shift", "shift_long_m": dx * 1e-3, "shift_lat_m": dx * 5e-4},
+    )
+    # the first transient step has the spin part of dx w as well: compare without spin
+    no_spin = BemModel().solve(
+        geometry,
+        Creepage(1e-3, 5e-4, 0.0),
+        STEEL,
+        normal_force_N=1e5,
+        options={**opts, "problem": "transient", "transient_steps": 1},
+    )
+    assert no_spin.creep_force_long_N == pytest.approx(first.creep_force_long_N, rel=1e-9)
+    with pytest.raises(ValueError, match="transient_steps' = 0: expected an integer >= 1"):
+        BemModel().solve(geometry, creepage, STEEL, options={"problem": "transient", "transient_steps": 0})
+    with pytest.raises(ValueError, match="extrapolate = true with problem = 'transient'"):
+        BemModel().solve(geometry, creepage, STEEL, options={"problem": "transient", "extrapolate": True})

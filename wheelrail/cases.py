@@ -389,9 +389,16 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
     start = time.perf_counter()
     if case.kind == "quadric":
         model = get_model(method)
-        result = model.solve(
-            case.geometry, case.creepage, case.material, normal_force_N=case.normal_force_N, options=case.solver_options
-        )
+        try:  # a model raises ValueError only for bad input (STYLE 12), e.g. a [solver] option
+            result = model.solve(
+                case.geometry,
+                case.creepage,
+                case.material,
+                normal_force_N=case.normal_force_N,
+                options=case.solver_options,
+            )
+        except ValueError as exc:
+            raise ConfigError(f"[solver]: {exc}") from None
         return CaseSolution(
             method,
             result.success,
@@ -408,6 +415,18 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
         for k, v in ((f.name, getattr(solution, f.name)) for f in dataclasses.fields(solution))
         if isinstance(v, (int, float, str, bool)) and k not in ("success", "message", "status", "wall_time_s")
     }
+    extra["wheel_vertical_load_N"] = {k: float(v) for k, v in solution.wheel_vertical_load_N.items()}
+    # how each patch was formed: CONTACT's weighted reference point (the patch's contact_point_rail_m) and the
+    # deepest point of its interpenetration, both in rail-profile coordinates
+    extra["patch_formation"] = [
+        {
+            "side": p.side,
+            "combination": p.combination,
+            "reference_point_rail_m": [_number(v) for v in p.geometry.contact_point_rail_m],
+            "deepest_point_rail_m": [_number(v) for v in p.deepest_point_rail_m],
+        }
+        for p in solution.patches
+    ]
     return CaseSolution(method, solution.success, solution.message, time.perf_counter() - start, patches, extra)
 
 

@@ -183,14 +183,21 @@ def _lattice_rectangle_influence(
     shear_modulus_Pa: float,
     poisson_ratio: float,
     difference_parameter: float,
+    only_normal: bool = False,
 ) -> dict[str, np.ndarray]:
     """:func:`rectangle_influence` on the regular offsets (dj[:, None] dy, di[None, :] dx), consecutive integers.
 
     The four corner terms of neighbouring offsets share corners, so the primitives are evaluated once on
     the corner lattice ((di - 1/2) dx, (dj - 1/2) dy) and differenced (a quarter of the evaluations).
+    ``only_normal``: only the kernel zz (returned alone), from the 1/r primitive.
     """
     cx = (np.arange(di[0], di[-1] + 2) - 0.5) * dx_m
     cy = (np.arange(dj[0], dj[-1] + 2) - 0.5) * dy_m
+    if only_normal:
+        xg, yg = np.meshgrid(cx, cy)
+        v = _x_asinh_y_over_x(xg, yg) + _x_asinh_y_over_x(yg, xg)
+        acc = v[1:, 1:] - v[1:, :-1] - v[:-1, 1:] + v[:-1, :-1]
+        return {"zz": (1.0 - poisson_ratio) / (math.pi * shear_modulus_Pa) * acc}
     prim = _primitives(*np.meshgrid(cx, cy))
     acc = {k: v[1:, 1:] - v[1:, :-1] - v[:-1, 1:] + v[:-1, :-1] for k, v in prim.items()}
     return _kernels_from_primitives(acc, shear_modulus_Pa, poisson_ratio, difference_parameter)
@@ -277,33 +284,50 @@ class InfluenceGrid:
             raise ValueError(f"ny = {self.ny!r}: the 2-D (plane) mode expects ny = 1")
         if self.plane and self.difference_parameter != 0.0:
             raise ValueError(f"difference_parameter = {self.difference_parameter!r}: expected 0 in the 2-D mode")
+        shape = (
+            scipy.fft.next_fast_len(2 * int(self.ny) - 1, real=True) if self.ny > 1 else 1,
+            scipy.fft.next_fast_len(2 * int(self.nx) - 1, real=True),
+        )
+        self._cache["shape"] = shape
+        self._cache["static"] = {}
+        self._cache["rolling"] = {}
+        self._cache["fft"] = {}
+
+    def _compute_kernels(self, names: tuple[str, ...]) -> None:
+        """Fill the static and rolling coefficient caches for ``names`` (lazily: NORM needs only zz)."""
         nx, ny = int(self.nx), int(self.ny)
         di = np.arange(-(nx - 1), nx + 1)  # one extra offset for the rolling difference
-        dj = np.arange(-(ny - 1), ny)
-        xx, yy = np.meshgrid(di * self.dx_m, dj * self.dy_m)
+        # one extra row (offset ny) too: with it the offsets span a whole 2 ny x 2 nx period (preconditioner)
+        dj = np.arange(-(ny - 1), ny + (0 if self.plane else 1))
         if self.plane:
+            xx, _ = np.meshgrid(di * self.dx_m, dj * self.dy_m)
             ext = strip_influence(xx, self.dx_m, self.shear_modulus_Pa, self.poisson_ratio)
         else:
             ext = _lattice_rectangle_influence(
-                di, dj, self.dx_m, self.dy_m, self.shear_modulus_Pa, self.poisson_ratio, self.difference_parameter
+                di,
+                dj,
+                self.dx_m,
+                self.dy_m,
+                self.shear_modulus_Pa,
+                self.poisson_ratio,
+                self.difference_parameter,
+                only_normal=names == ("zz",),
             )
-        static = {k: v[:, : 2 * nx - 1] for k, v in ext.items()}
-        rolling = {k: (v[:, : 2 * nx - 1] - v[:, 1:]) / self.dx_m for k, v in ext.items()}
-        shape = (
-            scipy.fft.next_fast_len(2 * ny - 1, real=True) if ny > 1 else 1,
-            scipy.fft.next_fast_len(2 * nx - 1, real=True),
-        )
-        self._cache["shape"] = shape
-        self._cache["static"] = static
-        self._cache["rolling"] = rolling
-        self._cache["fft"] = {}
+        self._cache["zz_period"] = ext["zz"]
+        for k, v in ext.items():
+            v = v[: 2 * ny - 1]
+            self._cache["static"][k] = v[:, : 2 * nx - 1]
+            self._cache["rolling"][k] = (v[:, : 2 * nx - 1] - v[:, 1:]) / self.dx_m
 
     # --- kernels -----------------------------------------------------------------------------------
     def kernel(self, name: str, rolling: bool = False) -> np.ndarray:
         """Coefficients on offsets, shape (2 ny - 1, 2 nx - 1), entry [dj + ny - 1, di + nx - 1], m/Pa or 1/Pa."""
         if name not in KERNELS:
             raise ValueError(f"kernel = {name!r}: expected one of {', '.join(KERNELS)}")
-        return self._cache["rolling" if rolling else "static"][name]
+        cache = self._cache["rolling" if rolling else "static"]
+        if name not in cache:
+            self._compute_kernels(("zz",) if name == "zz" else KERNELS)
+        return cache[name]
 
     def self_coefficient(self, name: str, rolling: bool = False) -> float:
         """Coefficient of an element on itself (offset 0)."""
@@ -324,10 +348,23 @@ class InfluenceGrid:
 
     # --- operators ---------------------------------------------------------------------------------
     def _forward(self, field_values: np.ndarray) -> np.ndarray:
-        return scipy.fft.rfft2(np.asarray(field_values, float), s=self._cache["shape"])
+        """rfft2 of (..., ny, nx) fields zero-padded to the period (ly, lx), shape (..., ly, lx/2 + 1).
+
+        Done as two 1-D passes so that the padding rows are not transformed along x (about 30 % less work
+        than ``rfft2`` of the padded array; same result to rounding).
+        """
+        ly, lx = self._cache["shape"]
+        spec = scipy.fft.rfft(np.asarray(field_values, float), n=lx, axis=-1)
+        if ly == 1:
+            return spec
+        return scipy.fft.fft(spec, n=ly, axis=-2, overwrite_x=True)
 
     def _backward(self, spectrum: np.ndarray) -> np.ndarray:
-        return scipy.fft.irfft2(spectrum, s=self._cache["shape"])[: self.ny, : self.nx]
+        """Inverse of :meth:`_forward`, cropped to (..., ny, nx); only the ny kept rows are transformed along x."""
+        ly, lx = self._cache["shape"]
+        if ly > 1:
+            spectrum = scipy.fft.ifft(spectrum, axis=-2)[..., : self.ny, :]
+        return scipy.fft.irfft(spectrum, n=lx, axis=-1)[..., : self.nx]
 
     def apply(self, name: str, field_values: np.ndarray, rolling: bool = False) -> np.ndarray:
         """Convolution ``sum_K C_name(I - K) t[K]`` of one kernel with a (ny, nx) field."""
@@ -343,18 +380,39 @@ class InfluenceGrid:
                 spec = spec + self._kernel_fft("zy", False) * self._forward(traction_y_Pa)
         return self._backward(spec)
 
+    def normal_preconditioner(self, residual_m: np.ndarray) -> np.ndarray:
+        """Approximate inverse of the normal operator A_zz: pressure (Pa) for a displacement field (m).
+
+        The inverse of the circulant on the period (ny, nx) of the grid itself (no padding: a quarter of the
+        convolution's FFT size) whose coefficients are A_zz folded onto that period; its symbol is the
+        2 ny x 2 nx circulant's (Vollebregt's FFT preconditioner, J. Comput. Phys. 257 (2014)) at every other
+        frequency. Symbols below 1e-6 of the largest (the 2-D log kernel's) are raised to that floor.
+        A preconditioner for :func:`~.norm.solve_norm`, not an exact inverse on the bounded grid.
+        """
+        if "prec" not in self._cache:
+            ny, nx = int(self.ny), int(self.nx)
+            self.kernel("zz")
+            k = self._cache["zz_period"]  # offsets -(ny - 1)..ny (0 in 2-D) x -(nx - 1)..nx: one 2 ny x 2 nx period
+            # index by offset modulo the period, then add the two halves along each axis
+            folded = np.roll(k, (-(ny - 1) if k.shape[0] > 1 else 0, -(nx - 1)), axis=(0, 1))
+            if folded.shape[0] > 1:
+                folded = folded[:ny] + folded[ny:]
+            folded = folded[:, :nx] + folded[:, nx:]
+            symbol = scipy.fft.rfft2(folded).real
+            floor = 1e-6 * float(np.abs(symbol).max())
+            self._cache["prec"] = 1.0 / np.maximum(symbol, floor)
+        spec = scipy.fft.rfft2(residual_m)
+        spec *= self._cache["prec"]
+        return scipy.fft.irfft2(spec, s=(self.ny, self.nx))
+
     def _forward_pair(self, first: np.ndarray, second: np.ndarray) -> np.ndarray:
         """Spectra of two (ny, nx) fields in one batched FFT call, shape (2, ly, lx/2 + 1)."""
-        ly, lx = self._cache["shape"]
-        buf = np.zeros((2, ly, lx))
-        buf[0, : self.ny, : self.nx] = first
-        buf[1, : self.ny, : self.nx] = second
-        return scipy.fft.rfft2(buf)
+        return self._forward(np.stack((first, second)))
 
     def _backward_pair(self, first: np.ndarray, second: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Inverse of two spectra in one batched FFT call, each cropped to (ny, nx)."""
-        out = scipy.fft.irfft2(np.stack((first, second)), s=self._cache["shape"])
-        return out[0, : self.ny, : self.nx], out[1, : self.ny, : self.nx]
+        out = self._backward(np.stack((first, second)))
+        return out[0], out[1]
 
     def tangential(
         self, traction_x_Pa: np.ndarray, traction_y_Pa: np.ndarray, rolling: bool = False, pressure_Pa=None

@@ -34,6 +34,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.norm import METHODS as NORM_METHODS
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
 from rigid_dynamics.contact.options import Option, declare, validate_options
@@ -44,40 +45,75 @@ from rigid_dynamics.materials import Material
 OPTIONS = declare(
     Option("nx", int, 40, "elements along x (rolling direction)", minimum=1, maximum=4096),
     Option("ny", int, 40, "elements along y (lateral)", minimum=1, maximum=4096),
+    Option("element_size_m", float, None, "square elements of this side instead of nx, ny (CONTACT's DX = DS), m",
+           minimum=0.0, maximum=0.1, exclusive_minimum=True, allow_none=True),
     Option("margin", float, 1.15, "potential contact area in Hertz semi-axes", minimum=1.0),
     Option("tolerance", float, 1e-6, "relative tolerance of NORM and TANG", minimum=0.0, exclusive_minimum=True),
     Option("max_iterations", int, 500, "NORM CG iterations and TANG Newton steps, each", minimum=1),
-    Option(
-        "difference_parameter",
-        float,
-        0.0,
-        "Kalker's K (dissimilar materials)",
-        minimum=-0.5,
-        maximum=0.5,
-        exclusive_minimum=True,
-        exclusive_maximum=True,
-    ),
-    Option(
-        "element_size_m",
-        float,
-        None,
-        "element size (CONTACT's DX = DS), m; replaces nx, ny: centres at multiples of it from the reference point",
-        minimum=0.0,
-        maximum=0.1,
-        exclusive_minimum=True,
-        allow_none=True,
-    ),
-    Option("max_elements", int, 250_000, "element_size_m: sizes doubled above this many elements", minimum=16),
-)
-"""Options of :class:`BemModel` (name, type, range, default; :mod:`rigid_dynamics.contact.options`): grid
-(nx, ny elements), margin m of the potential area, tolerance, iteration limit (NORM CG iterations and TANG
-Newton steps each), Kalker's K (|K| < 0.5).
-
-``element_size_m`` replaces the element counts by a size, as CONTACT's DX and DS: element centres then lie at
-integer multiples of the size from the origin of the contact plane (the patch's reference point), the grid covers
-the potential area, and nx, ny follow from it. When nx ny would exceed ``max_elements`` the sizes are doubled (in
-the direction with more than 10 elements), as CONTACT does, and the result's ``extra`` says so."""
+    Option("difference_parameter", float, 0.0, "Kalker's K (dissimilar materials)", minimum=-0.5, maximum=0.5,
+           exclusive_minimum=True, exclusive_maximum=True),
+    Option("norm_method", str, "normcg", "NORM solver", choices=tuple(NORM_METHODS)),
+    Option("extrapolate", bool, False, "Richardson extrapolation of the creep forces from a 2 x 2-merged grid"),
+    Option("rolling_slip_point", str, "centre", "where the rolling slip is taken", choices=("centre", "midpoint")),
+    Option("problem", str, "rolling", "tangential problem", choices=("rolling", "shift", "transient")),
+    Option("shift_long_m", float, 0.0, "shift problem: rigid shift along x, m"),
+    Option("shift_lat_m", float, 0.0, "shift problem: rigid shift along y, m"),
+    Option("shift_rotation_rad", float, 0.0, "shift problem: rigid rotation about the normal, rad"),
+    Option("kinetic_friction_coefficient", float, None, "friction coefficient in slip (the material's is static)",
+           minimum=0.0, exclusive_minimum=True, allow_none=True),
+    Option("transient_steps", int, None, "transient problem: rolling steps of dx (None: nx)", minimum=1,
+           allow_none=True),
+)  # fmt: skip
 DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
+"""Options of :class:`BemModel` and their defaults:
+
+* ``nx``, ``ny`` (int >= 1): elements along x (rolling) and y (lateral) over the potential contact area;
+* ``element_size_m`` (float > 0 or None): square elements of this side (m; CONTACT's DX = DS) instead of
+  ``nx``, ``ny``: the counts follow from the potential area, widened to whole elements whose centres lie at
+  integer multiples of the size from the contact plane's origin (the patch's reference point), as CONTACT's grid
+  (not together with ``nx`` or ``ny``; at most ``MAX_ELEMENTS`` elements);
+* a patch whose ``undeformed.potential_area_m`` is given (the wheelset case's CONTACT-style patches: a rectangle
+  holding the whole rigid overlap) is solved on that area, without the margin rule and its enlargements;
+* ``margin`` (>= 1): margin m of the potential area (module docstring);
+* ``tolerance``, ``max_iterations``: NORM's relative update tolerance and CG limit, TANG's tolerance and Newton
+  limit;
+* ``difference_parameter``: Kalker's K (|K| < 0.5; 0 for quasi-identical bodies);
+* ``norm_method``: ``"normcg"`` (preconditioned) or ``"polonsky-keer"`` (:func:`~.norm.solve_norm`);
+* ``extrapolate`` (bool): Richardson extrapolation of the creep forces and spin moment from this grid and the
+  grid of 2 x 2 merged elements over the same potential area, F = 2 F_h - F_2h (the steady-rolling
+  discretisation is first order: the leading edge of each row is quantised to element edges); the result
+  reports both grids' values and the estimated error F_h - F of the fine grid (``extra["richardson"]``).
+  Needs even element counts (``element_size_m`` rounds them up to even). Costs about a third more.
+* ``rolling_slip_point``: where the rigid slip of steady rolling is taken, ``"centre"`` (the element centre x_I,
+  as CONTACT without its empirical spin offset) or ``"midpoint"`` (x_I + dx/2, the point at which the upwind
+  difference (u(x_I) - u(x_I + dx))/dx approximates -du/dx to second order). Both are first order overall and
+  converge to one limit from opposite sides; with ``extrapolate`` the midpoint is the better choice
+  (benchmarks/results/bem_rolling_coarse.md);
+* ``problem``: ``"rolling"`` (steady rolling with the creepages, default) or ``"shift"`` (Cattaneo's shift
+  problem from the unloaded state: the bodies are pressed together and then shifted rigidly, the creepages are
+  not used): the rigid shift of the wheel over the rail is w = (s_x - theta y, s_y + theta x) with ``shift_long_m``
+  s_x, ``shift_lat_m`` s_y (m) and ``shift_rotation_rad`` theta about the normal (rad); the result's slip field is
+  then None (the slip is a distance) and ``extra["slip_distance_max_m"]`` its largest value;
+* ``problem = "transient"``: transient rolling from the state without tangential traction (the bodies pressed
+  together, then rolling starts with the creepages): ``transient_steps`` (int >= 1; None: nx) steps of the
+  rolling distance dq = dx (CONTACT's DQ = DX), each a shift problem whose rigid shift is
+  dq w - u'(x + dq), u' the previous step's displacement difference carried along with the particles (Kalker 1990,
+  sec. 5.2); the result is the last step's, ``extra["transient_forces_N"]`` the (F_x, F_y, M_z) of every step.
+  With dq = dx the steady state of this recursion is exactly the steady-rolling discretisation. Quasi-identical
+  bodies only (K = 0);
+* ``kinetic_friction_coefficient`` (float > 0 or None): the friction coefficient in slip (CONTACT's FKIN); the
+  material's ``friction_coefficient`` is then the static one (FSTAT: adhesion holds up to it). None: one
+  coefficient.
+"""
+
+PROBLEMS = ("rolling", "shift", "transient")
+"""Tangential problems of the option ``problem``."""
+
+ROLLING_SLIP_POINTS = {"centre": 0.0, "midpoint": 0.5}
+"""Offset of the rigid slip from the element centre, in elements along x (option ``rolling_slip_point``)."""
+
+MAX_ELEMENTS = 4_000_000
+"""Largest grid ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
 
 
 def hertz_ellipse(
@@ -139,8 +175,32 @@ def hertz_ellipse(
 
 def _options(options: Mapping | None) -> dict:
     opts = validate_options(OPTIONS, options, "bem")
-    if opts["element_size_m"] is not None:
-        opts["element_size_m"] = (float(opts["element_size_m"]), float(opts["element_size_m"]))
+    options = options or {}
+    size = opts["element_size_m"]
+    if size is not None:
+        both = [k for k in ("nx", "ny") if k in options]
+        if both:
+            raise ValueError(
+                f"option element_size_m = {size!r} together with {' and '.join(both)}: expected either the element "
+                "size or the element counts"
+            )
+    if opts["extrapolate"] and opts["element_size_m"] is None and (opts["nx"] % 2 or opts["ny"] % 2 or opts["nx"] < 4):
+        raise ValueError(
+            f"option extrapolate = true with nx = {opts['nx']!r}, ny = {opts['ny']!r}: expected even element counts "
+            "(nx >= 4), so that 2 x 2 elements merge into the coarse grid"
+        )
+    if opts["problem"] != "rolling" and opts["extrapolate"]:
+        raise ValueError(
+            f"option extrapolate = true with problem = {opts['problem']!r}: expected false (it is for steady rolling)"
+        )
+    if opts["problem"] == "transient" and opts["difference_parameter"] != 0.0:
+        raise ValueError(
+            f"option difference_parameter = {opts['difference_parameter']!r} with problem = 'transient': expected 0"
+        )
+    if opts["problem"] == "rolling" and any(
+        opts[k] != 0.0 for k in ("shift_long_m", "shift_lat_m", "shift_rotation_rad")
+    ):
+        raise ValueError("options shift_*: expected problem = 'shift' (a steady-rolling case uses the creepages)")
     return opts
 
 
@@ -150,6 +210,11 @@ class BemModel:
     name = "bem"
     description = "boundary elements: CONTACT-style NORM + TANG"
     OPTIONS = OPTIONS
+
+    @staticmethod
+    def check_options(options: Mapping | None) -> dict:
+        """Validate ``options`` (:data:`DEFAULT_OPTIONS`) without solving; ValueError naming the option and value."""
+        return _options(options)
 
     def solve(
         self,
@@ -176,6 +241,17 @@ class BemModel:
         """
         start = time.perf_counter()
         opts = _options(options)
+        result = self._solve(geometry, creepage, material, normal_force_N, opts, None, start)
+        if not opts["extrapolate"] or result.status == "no-contact":
+            return result
+        ex = result.extra
+        x0, x1, y0, y1 = ex["potential_area_m"]
+        coarse_opts = dict(opts, nx=ex["nx"] // 2, ny=max(ex["ny"] // 2, 1), element_size_m=None, extrapolate=False)
+        coarse = self._solve(geometry, creepage, material, normal_force_N, coarse_opts, ((x0, x1), (y0, y1)), start)
+        return _richardson(result, coarse, time.perf_counter() - start)
+
+    def _solve(self, geometry, creepage, material, normal_force_N, opts, fixed_area, start) -> ContactResult:
+        """:meth:`solve` on one grid; ``fixed_area`` ((x0, x1), (y0, y1)) imposes the potential area (m)."""
         if normal_force_N is not None and (not math.isfinite(normal_force_N) or normal_force_N <= 0):
             raise ValueError(f"normal_force_N = {normal_force_N!r}: expected None or a finite number > 0")
         g_mod, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
@@ -226,8 +302,8 @@ class BemModel:
                 *_, depth = hertz_ellipse(*curv, e_star, normal_force_N=normal_force_N)
             if und.potential_area_m is not None:  # a rectangle known to hold the whole rigid overlap
                 x_lim, y_lim = tuple(und.potential_area_m[:2]), tuple(und.potential_area_m[2:])
-            region = finite & (d <= d_min + 0.5 * depth * margin**2)
-            if und.potential_area_m is None:
+            else:
+                region = finite & (d <= d_min + 0.5 * depth * margin**2)
                 jj, ii = np.nonzero(region)
                 xs, ys = np.asarray(und.x_m), np.asarray(und.y_m)
                 hx = 0.5 * (np.abs(np.diff(xs)).min() if xs.size > 1 else 0.0)
@@ -237,17 +313,26 @@ class BemModel:
             if x_lim[1] <= x_lim[0] or y_lim[1] <= y_lim[0]:
                 return no_contact("the sampled undeformed distance gives an empty potential contact area")
         k_diff = float(opts["difference_parameter"])
+        norm_method = opts["norm_method"]
         tol, max_it = float(opts["tolerance"]), int(opts["max_iterations"])
         if geometry.undeformed is not None:
             xs, ys = np.asarray(geometry.undeformed.x_m), np.asarray(geometry.undeformed.y_m)
             field_box = (float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
         grown = 0
-        coarsened = 0
+        size = opts["element_size_m"]
+        if fixed_area is not None:
+            x_lim, y_lim = fixed_area
+            size = None
+        even = bool(opts["extrapolate"])
         while True:
-            if opts["element_size_m"] is not None:
-                (x_lim, y_lim, nx, ny), coarsened = _aligned_grid(
-                    x_lim, y_lim, *opts["element_size_m"], opts["max_elements"]
-                )
+            if size is not None:
+                x_lim, nx = _whole_elements(x_lim, float(size), even)
+                y_lim, ny = _whole_elements(y_lim, float(size), even)
+                if nx * ny > MAX_ELEMENTS:
+                    raise ValueError(
+                        f"option element_size_m = {size!r} gives {nx} x {ny} elements over the potential contact "
+                        f"area: expected at most {MAX_ELEMENTS} (a larger element size)"
+                    )
             dx = (x_lim[1] - x_lim[0]) / nx
             dy = (y_lim[1] - y_lim[0]) / ny
             x = x_lim[0] + dx * (np.arange(nx) + 0.5)
@@ -255,15 +340,13 @@ class BemModel:
             xx, yy = np.meshgrid(x, y)
             h = np.asarray(geometry.gap_m(xx, yy), float)
             influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
-            norm = solve_norm(influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it)
+            norm = solve_norm(
+                influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it, method=norm_method
+            )
             contact = norm.pressure_Pa > 0
             edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
-            if (
-                not edge
-                or geometry.undeformed is None
-                or geometry.undeformed.potential_area_m is not None
-                or grown >= 3
-            ):
+            given = geometry.undeformed is not None and geometry.undeformed.potential_area_m is not None
+            if not edge or geometry.undeformed is None or grown >= 3 or fixed_area is not None or given:
                 break
             # a sampled field's contact reached the potential area's edge: enlarge it (within the field) and redo
             cx, cy = 0.5 * (x_lim[0] + x_lim[1]), 0.5 * (y_lim[0] + y_lim[1])
@@ -276,10 +359,32 @@ class BemModel:
             grown += 1
 
         # 2. TANG (alternated with NORM for K != 0: Panagiotopoulos' process)
-        wx, wy = rigid_slip(x, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
+        offset = ROLLING_SLIP_POINTS[opts["rolling_slip_point"]] * dx
+        problem = opts["problem"]
+        if problem == "shift":
+            # rigid shift (m) of the wheel over the rail: translation and rotation about the normal
+            wx, wy = rigid_slip(x, y, opts["shift_long_m"], opts["shift_lat_m"], opts["shift_rotation_rad"])
+        else:
+            wx, wy = rigid_slip(x + offset, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
         previous = norm.normal_force_N
-        for _ in range(1 if k_diff == 0.0 else 20):
-            tang = solve_tang(influence, norm.pressure_Pa, mu, wx, wy, tolerance=tol, max_iterations=max_it)
+        history = None
+        for _ in range(1 if k_diff == 0.0 or problem == "transient" else 20):
+            if problem == "transient":
+                steps = int(opts["transient_steps"] or nx)
+                fields_in = (norm.pressure_Pa, (wx, wy), (xx, yy))
+                tang, history = _transient(influence, mu, fields_in, steps, tol, max_it, opts)
+                break
+            tang = solve_tang(
+                influence,
+                norm.pressure_Pa,
+                mu,
+                wx,
+                wy,
+                problem=problem,
+                tolerance=tol,
+                max_iterations=max_it,
+                kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
+            )
             if k_diff == 0.0:
                 break
             norm = solve_norm(
@@ -290,6 +395,7 @@ class BemModel:
                 max_iterations=max_it,
                 tractions_Pa=(tang.traction_x_Pa, tang.traction_y_Pa),
                 initial_pressure_Pa=norm.pressure_Pa,
+                method=norm_method,
             )
             change = abs(norm.normal_force_N - previous)
             previous = norm.normal_force_N
@@ -304,7 +410,12 @@ class BemModel:
         tx, ty = tang.traction_x_Pa, tang.traction_y_Pa
         fx, fy = float(tx.sum() * area), float(ty.sum() * area)
         mz = float((xx * ty - yy * tx).sum() * area)
-        slip_speed = creepage.rolling_speed_m_per_s * np.hypot(tang.slip_x, tang.slip_y)
+        slip_size = np.hypot(tang.slip_x, tang.slip_y)
+        slip_speed = None
+        if problem == "rolling":
+            slip_speed = creepage.rolling_speed_m_per_s * slip_size
+        elif problem == "transient":  # slip distance per rolling step dq = dx
+            slip_speed = creepage.rolling_speed_m_per_s * slip_size / dx
         fields = ContactFields(
             x_m=x,
             y_m=y,
@@ -365,29 +476,101 @@ class BemModel:
                 "slip_elements": int((tang.in_slip & contact).sum()),
                 "contact_touches_potential_area_edge": edge,
                 "potential_area_enlargements": grown,
-                "element_size_doublings": coarsened,
+                "problem": problem,
+                "slip_distance_max_m": float(slip_size.max()) if problem == "shift" else None,
+                "transient_forces_N": history,
             },
         )
 
 
-def _aligned_grid(x_lim, y_lim, dx: float, dy: float, max_elements: int):
-    """Grid of element size (dx, dy) with element centres at integer multiples of it, covering the limits.
+def _transient(influence, mu, fields_in, steps, tol, max_it, opts):
+    """Transient rolling from zero tangential traction (option problem = "transient"); (last TangSolution, history).
 
-    Returns ((x_lim, y_lim, nx, ny), doublings): the sizes are doubled while nx ny > max_elements (CONTACT's rule).
+    Step k: the shift problem with the rigid shift W = dx w - u'(x + dx), where u'(x + dx) = u'(x) - dx L t' is the
+    previous displacement difference one element ahead (L the rolling operator: (u(x) - u(x + dx))/dx), so that
+    the slip distance of the step is S = dx w + u(x) - u'(x + dx). History: [F_x, F_y, M_z] per step (N, N m).
     """
-    doublings = 0
-    while True:
-        i0, i1 = math.floor(x_lim[0] / dx + 0.5), math.ceil(x_lim[1] / dx - 0.5)
-        j0, j1 = math.floor(y_lim[0] / dy + 0.5), math.ceil(y_lim[1] / dy - 0.5)
-        nx, ny = i1 - i0 + 1, j1 - j0 + 1
-        if nx * ny <= max_elements or (nx <= 10 and ny <= 10):
+    area = influence.dx_m * influence.dy_m
+    pressure, (wx, wy), (xx, yy) = fields_in
+    tx = np.zeros(pressure.shape)
+    ty = np.zeros(pressure.shape)
+    history = []
+    tang = None
+    dx = influence.dx_m
+    for _ in range(steps):
+        ux, uy = influence.tangential(tx, ty, rolling=False)
+        lx, ly = influence.tangential(tx, ty, rolling=True)
+        tang = solve_tang(
+            influence,
+            pressure,
+            mu,
+            dx * wx - (ux - dx * lx),
+            dx * wy - (uy - dx * ly),
+            problem="shift",
+            tolerance=tol,
+            max_iterations=max_it,
+            coarse_start=False,
+            kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
+        )
+        tx, ty = tang.traction_x_Pa, tang.traction_y_Pa
+        history.append([float(tx.sum() * area), float(ty.sum() * area), float((xx * ty - yy * tx).sum() * area)])
+        if not tang.converged:
             break
-        doublings += 1
-        if nx > 10:
-            dx *= 2.0
-        if ny > 10:
-            dy *= 2.0
-    return (((i0 - 0.5) * dx, (i1 + 0.5) * dx), ((j0 - 0.5) * dy, (j1 + 0.5) * dy), nx, ny), doublings
+    return tang, history
+
+
+def _whole_elements(limits: tuple[float, float], size_m: float, even: bool = False) -> tuple[tuple[float, float], int]:
+    """Widen ``limits`` (m) to whole elements of ``size_m`` whose centres lie at integer multiples of the size from
+    the contact plane's origin (the patch's reference point), as CONTACT's grid; (limits, count).
+
+    The count is >= 1, or even and >= 4 if ``even`` (elements added alternately at the upper and lower end).
+    """
+    first = math.floor(limits[0] / size_m + 0.5 + 1e-9)
+    last = max(math.ceil(limits[1] / size_m - 0.5 - 1e-9), first)
+    minimum = 4 if even else 1
+    while last - first + 1 < minimum or (even and (last - first + 1) % 2):
+        if (last - first) % 2:
+            first -= 1
+        else:
+            last += 1
+    return ((first - 0.5) * size_m, (last + 0.5) * size_m), last - first + 1
+
+
+def _richardson(fine: ContactResult, coarse: ContactResult, wall_time_s: float) -> ContactResult:
+    """Richardson extrapolation (order 1) of F_x, F_y, M_z from the fine grid h and the merged grid 2h.
+
+    F = 2 F_h - F_2h; the fine grid's estimated error F_h - F = F_2h - F_h is reported per quantity. The
+    normal solution, the fields and the other outputs are the fine grid's.
+    """
+    import dataclasses
+
+    names = ("creep_force_long_N", "creep_force_lat_N", "spin_moment_Nm")
+    values = {k: 2.0 * getattr(fine, k) - getattr(coarse, k) for k in names}
+    success = bool(fine.success and coarse.success)
+    message = fine.message
+    if not coarse.success:
+        message = f"{fine.message}; coarse grid of the extrapolation: {coarse.message}"
+    message += (
+        f"; F_x, F_y, M_z Richardson-extrapolated (order 1) from {fine.extra['nx']} x {fine.extra['ny']} and "
+        f"{coarse.extra['nx']} x {coarse.extra['ny']} elements"
+    )
+    extra = dict(fine.extra)
+    extra["richardson"] = {
+        "coarse_nx": coarse.extra["nx"],
+        "coarse_ny": coarse.extra["ny"],
+        "fine": {k: getattr(fine, k) for k in names},
+        "coarse": {k: getattr(coarse, k) for k in names},
+        "fine_error_estimate": {k: getattr(fine, k) - values[k] for k in names},
+    }
+    return dataclasses.replace(
+        fine,
+        success=success,
+        status=coarse.status if fine.success and not coarse.success else fine.status,
+        message=message,
+        wall_time_s=wall_time_s,
+        extra=extra,
+        **values,
+    )
 
 
 def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:

@@ -274,6 +274,7 @@ def solve_tang(
     tolerance: float = 1e-8,
     max_iterations: int = 60,
     coarse_start: bool = True,
+    kinetic_friction_coefficient: float | None = None,
 ) -> TangSolution:
     """Solve TANG for steady rolling or the shift problem (module docstring).
 
@@ -285,7 +286,10 @@ def solve_tang(
     Args:
         influence: grid and influence coefficients.
         pressure_Pa: p (ny, nx), Pa (the normal solution).
-        friction_coefficient: mu >= 0 (Coulomb, static = kinetic).
+        friction_coefficient: mu >= 0, the static coefficient (adhesion holds while |t| <= mu p).
+        kinetic_friction_coefficient: mu_k, 0 <= mu_k (<= mu expected), the traction in slip |t| = mu_k p;
+            None: mu_k = mu (Coulomb with one coefficient). With mu_k < mu an element leaves adhesion at mu p and
+            slides at mu_k p (CONTACT's FSTAT, FKIN).
         rigid_slip_x, rigid_slip_y: w (ny, nx); creepage field (rolling, -) or rigid shift (shift, m).
         problem: "rolling" (steady state) or "shift" (Cattaneo: one step from the unloaded state).
         tolerance: relative tolerance on the slip residual (and GMRES).
@@ -304,6 +308,12 @@ def solve_tang(
             raise ValueError(f"{name} has shape {np.shape(arr)}: expected (ny, nx) = {shape}")
     if not math.isfinite(friction_coefficient) or friction_coefficient < 0:
         raise ValueError(f"friction_coefficient = {friction_coefficient!r}: expected a finite number >= 0")
+    mu_k = friction_coefficient if kinetic_friction_coefficient is None else kinetic_friction_coefficient
+    if not math.isfinite(mu_k) or mu_k < 0 or (mu_k == 0 and friction_coefficient > 0):
+        raise ValueError(
+            f"kinetic_friction_coefficient = {kinetic_friction_coefficient!r}: expected a finite number > 0 "
+            "(or None: the static coefficient)"
+        )
     if not tolerance > 0:
         raise ValueError(f"tolerance = {tolerance!r}: expected > 0")
     if int(max_iterations) < 1:
@@ -318,7 +328,8 @@ def solve_tang(
         wx = wx + cx
         wy = wy + cy
     contact = p > 0
-    bound = friction_coefficient * np.where(contact, p, 0.0)
+    bound = mu_k * np.where(contact, p, 0.0)  # traction in slip
+    bound_static = friction_coefficient * np.where(contact, p, 0.0)  # adhesion holds up to this
     zeros = np.zeros(shape)
     if not contact.any() or friction_coefficient == 0.0:
         sx, sy = np.where(contact, wx, 0.0), np.where(contact, wy, 0.0)
@@ -377,6 +388,7 @@ def solve_tang(
             problem=problem,
             tolerance=max(tolerance, 1e-2),  # coarse start only: its discretisation error is larger
             max_iterations=max_iterations,
+            kinetic_friction_coefficient=mu_k,
         )
         tx = np.where(contact, prolong(first.traction_x_Pa), 0.0)
         ty = np.where(contact, prolong(first.traction_y_Pa), 0.0)
@@ -473,7 +485,7 @@ def solve_tang(
         # set changes
         sx, sy = slip_of(tx, ty)
         tmag = np.hypot(tx, ty)
-        to_slip = stick & (tmag > bound)
+        to_slip = stick & (tmag > bound_static)
         wrong = slip & ((np.cos(theta) * sx + np.sin(theta) * sy) > 0)
         if to_slip.any():
             theta = np.where(to_slip, np.arctan2(ty, tx), theta)

@@ -1,0 +1,88 @@
+"""BEM options through the CLI's ``[solver]`` table: bad values end with one ``wheelrail: error:`` line, exit 2."""
+
+import re
+
+import pytest
+
+from wheelrail.cli import main
+
+CASE = """
+[material]
+shear_modulus_Pa = 82e9
+poisson_ratio = 0.28
+friction_coefficient = 0.3
+[geometry]
+kind = "quadric"
+radius_long_m = 0.46
+radius_lat_m = 0.3
+[loading]
+normal_force_N = 1e5
+[kinematics]
+creepage_long = 0.0
+creepage_lat = 0.0
+spin_creepage_1_per_m = 0.0
+rolling_speed_m_per_s = 20.0
+[solver]
+"""
+
+
+@pytest.mark.parametrize(
+    ("solver", "pattern"),
+    [
+        ("element_size_m = -0.001", r"element_size_m' = -0.001: expected a finite number > 0"),
+        ("element_size_m = 1e-9", r"element_size_m = 1e-09 gives \d+ x \d+ elements .*expected at most 4000000"),
+        ("element_size_m = 0.001\nnx = 20", r"element_size_m = 0.001 together with nx: expected either"),
+        ('norm_method = "fast"', r"norm_method' = 'fast': expected one of 'normcg', 'polonsky-keer'"),
+    ],
+)
+def test_bad_bem_solver_options(tmp_path, capsys, solver, pattern):
+    path = tmp_path / "case.toml"
+    path.write_text(CASE + solver + "\n")
+    code = main(["contact", str(path), "--method", "bem", "--json"])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err
+    assert err.startswith("wheelrail: error: ") and err.count("\n") == 1, err
+    assert re.search(pattern, err), err
+
+
+def test_element_size_through_the_cli(tmp_path, capsys):
+    """A case with ``element_size_m`` runs: the grid in the JSON output has that element size."""
+    import json
+
+    path = tmp_path / "case.toml"
+    path.write_text(CASE + "element_size_m = 0.5e-3\n")
+    code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    data = json.loads(out)
+    assert data["success"], data
+
+
+def test_shift_problem_and_kinetic_friction_through_the_cli(tmp_path, capsys):
+    """A quadric case solved as Cattaneo's shift problem with static and kinetic friction, from the [solver] table."""
+    import json
+
+    path = tmp_path / "case.toml"
+    solver = 'nx = 24\nny = 24\nproblem = "shift"\nshift_long_m = 1e-3\nkinetic_friction_coefficient = 0.25\n'
+    path.write_text(CASE + solver)
+    code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    data = json.loads(out)
+    patch = data["patches"][0]
+    # a shift of 1 mm is far beyond full slip: the force on the wheel is -mu_k F_N
+    assert data["success"] and abs(patch["creep_force_long_N"] / -0.25e5 - 1) < 1e-6, patch
+
+
+def test_transient_problem_through_the_cli(tmp_path, capsys):
+    """problem = 'transient' from the [solver] table runs and reports a rising force (forces on the wheel)."""
+    import json
+
+    path = tmp_path / "case.toml"
+    text = CASE.replace("creepage_long = 0.0", "creepage_long = 1e-3")
+    path.write_text(text + 'nx = 12\nny = 12\nproblem = "transient"\ntransient_steps = 4\n')
+    code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    data = json.loads(out)
+    assert data["success"] and data["patches"][0]["creep_force_long_N"] < 0
