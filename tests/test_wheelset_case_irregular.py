@@ -298,3 +298,27 @@ def test_wheelset_case_rejects_non_irregularities():
         dataclasses.replace(CASE, wheel_irregularities_right=(1.0,))
     with pytest.raises(ValueError, match=r"wheel_rotation_rad = nan: expected a finite number"):
         dataclasses.replace(CASE, wheel_rotation_rad=math.nan)
+
+
+def test_out_of_round_locus_numpy_path_equals_the_compiled_one():
+    """Regression (two of our paths): the numpy locus (measured grids take it) on the exact surfaces equals the
+    compiled one on the tabulated surfaces, for the flat at the contact."""
+    track = _track([WheelFlat(0.05, R0)])
+    _, _, pose = _patches(track, 0.34e-3 + 1.0e-4)
+    fast = contact_locus(_geo(track, pose), 2e-4)
+    exact = contact_locus(
+        _SideGeometry(
+            track.wheels["right"],
+            track.rails["right"],
+            pose,
+            "right",
+            track.fast["right"][0].y_range_m,
+            track.fast["right"][1].y_range_m,
+        ),
+        2e-4,
+    )
+    inside = fast.gap_m < 0
+    assert inside.sum() > 20
+    np.testing.assert_allclose(exact.gap_m[inside], fast.gap_m[inside], atol=2e-8)  # Hermite table vs spline
+    np.testing.assert_allclose(exact.weight_line_m3[inside], fast.weight_line_m3[inside], rtol=2e-3)
+    np.testing.assert_allclose(exact.overlap_x_m[inside], fast.overlap_x_m[inside], atol=2e-5)
