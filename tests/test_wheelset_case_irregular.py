@@ -322,3 +322,17 @@ def test_out_of_round_locus_numpy_path_equals_the_compiled_one():
     np.testing.assert_allclose(exact.gap_m[inside], fast.gap_m[inside], atol=2e-8)  # Hermite table vs spline
     np.testing.assert_allclose(exact.weight_line_m3[inside], fast.weight_line_m3[inside], rtol=2e-3)
     np.testing.assert_allclose(exact.overlap_x_m[inside], fast.overlap_x_m[inside], atol=2e-5)
+
+
+def test_wheelset_case_with_a_flat_at_the_contact_carries_the_load_with_bem():
+    """The whole case (per-wheel kinematics, prescribed pitch rate) with the flat at the contact converges with the
+    BEM: the vertical contact force equals the load and the contact is not cut by the potential area."""
+    case = dataclasses.replace(
+        CASE, roll_rad=0.0, pitch_rate_rad_per_s=-1.0 / R0, wheel_irregularities_right=(WheelFlat(0.05, R0),)
+    )
+    sol = solve_wheelset_case(case, STEEL, "bem", options={"sides": ("right",), "model": {"nx": 40, "ny": 30}})
+    assert sol.success, sol.message
+    assert sol.wheel_vertical_load_N["right"] == pytest.approx(80e3, rel=1e-6)
+    (patch,) = sol.patches
+    assert not patch.result.extra.get("contact_touches_potential_area_edge", False)
+    assert patch.result.contact_area_m2 > 3.0e-4  # the round wheel's: 1.7e-4 m^2
