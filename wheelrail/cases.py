@@ -16,8 +16,10 @@ A case file has the tables
 * ``[irregularities]`` (wheelset only): wheel out-of-roundness with the dynamics scenes' keys ``polygon_order``,
   ``polygon_amplitude_m``, ``polygon_phase_rad`` (R_irr = A cos(n alpha + phase)), ``flat_length_m``,
   ``flat_depth_m`` (0: L^2/(16 r0) for a rounded flat; a new flat has its chord depth), ``flat_angle_rad`` (alpha_0
-  of the flat's centre), ``flat_shape`` ("rounded", default, or "new"; rigid_dynamics.geometry.WheelFlat) and
-  ``side`` ("both", default, "left" or "right");
+  of the flat's centre), ``flat_shape`` ("rounded", default, or "new"; rigid_dynamics.geometry.WheelFlat),
+  ``wheel_slices_file`` (a CONTACT wheel slices file, .slcw, relative to the case file: a measured out-of-round
+  wheel relative to its first slice, rigid_dynamics.geometry.slices; the case's wheel_profile should be that
+  slice's file) and ``side`` ("both", default, "left" or "right");
 * ``[solver]``: for a quadric case the options of the contact model; for a wheelset case the case's options
   (``rigid_dynamics.contact.wheelset_case.DEFAULT_CASE_OPTIONS``) with the model's options in ``[solver.model]``.
   Both are checked against their declarations before any work (:func:`check_solver_options`;
@@ -73,6 +75,7 @@ WHEEL_IRREGULARITY_KEYS = {
     "flat_depth_m",
     "flat_angle_rad",
     "flat_shape",
+    "wheel_slices_file",
 }
 """Keys of a wheelset case's ``[irregularities]``: the dynamics scenes' wheel keys (rigid_dynamics.wheelset.parameters
 .Irregularities: same names, same meaning, same checks) and ``flat_shape`` ("rounded" as the scenes, or "new")."""
@@ -140,8 +143,11 @@ def _read_solver(table: dict) -> dict:
     return dict(table)
 
 
-def parse_case(doc: dict, name: str = "") -> ContactCase:
-    """Validate a parsed case document into a ContactCase (ConfigError on any problem)."""
+def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> ContactCase:
+    """Validate a parsed case document into a ContactCase (ConfigError on any problem).
+
+    ``base_dir``: folder that relative file names in the case (``irregularities.wheel_slices_file``) refer to.
+    """
     check_keys(doc, TOP_LEVEL_TABLES, "")
     material = read_material(get_table(doc, "material"))
     geometry_table = get_table(doc, "geometry")
@@ -172,10 +178,21 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
         check_keys(kinematics, WHEELSET_KINEMATICS_KEYS, "kinematics")
         force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
-        irregularities = get_table(doc, "irregularities", required=False)
+        irregularities = dict(get_table(doc, "irregularities", required=False))
+        if "wheel_slices_file" in irregularities:
+            irregularities["wheel_slices_file"] = _slices_path(irregularities["wheel_slices_file"], base_dir)
         wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics, irregularities)
         return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
     raise ConfigError(f"key 'geometry.kind' = {kind!r}: expected 'quadric' or 'wheelset'")
+
+
+def _slices_path(value, base_dir: Path | None) -> str:
+    if not isinstance(value, str) or not value:
+        raise ConfigError(f"key 'irregularities.wheel_slices_file' = {value!r}: expected the path of a .slcw file")
+    path = Path(value).expanduser()
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    return str(path)
 
 
 def read_wheel_irregularities(table: dict, nominal_radius_m: float) -> dict:
@@ -235,6 +252,15 @@ def read_wheel_irregularities(table: dict, nominal_radius_m: float) -> dict:
         wheel.append(HarmonicOutOfRoundness(order, amplitude, values["polygon_phase_rad"]))
     if length > 0:
         wheel.append(WheelFlat(length, r0, depth if depth > 0 else None, values["flat_angle_rad"], shape))
+    if "wheel_slices_file" in table:
+        from rigid_dynamics.geometry.slices import read_wheel_slices
+
+        try:
+            wheel.append(read_wheel_slices(table["wheel_slices_file"]).irregularity)
+        except ValueError as exc:
+            raise ConfigError(
+                f"key 'irregularities.wheel_slices_file' = {table['wheel_slices_file']!r}: {exc}"
+            ) from None
     sides = ("right", "left") if side == "both" else (side,)
     return {f"wheel_irregularities_{s}": tuple(wheel) for s in sides}
 
@@ -286,7 +312,7 @@ def load_case(path: str | Path, method: str | None = None) -> ContactCase:
     declared options too (:func:`check_solver_options`).
     """
     path = resolve_case_path(path)
-    case = parse_case(read_toml(path, "case file"), name=Path(path).stem)
+    case = parse_case(read_toml(path, "case file"), name=Path(path).stem, base_dir=Path(path).parent)
     if method is not None:
         check_solver_options(case, method)
     return case
