@@ -18,8 +18,9 @@ A case file has the tables
   ``flat_depth_m`` (0: L^2/(16 r0) for a rounded flat; a new flat has its chord depth), ``flat_angle_rad`` (alpha_0
   of the flat's centre), ``flat_shape`` ("rounded", default, or "new"; rigid_dynamics.geometry.WheelFlat),
   ``wheel_slices_file`` (a CONTACT wheel slices file, .slcw, relative to the case file: a measured out-of-round
-  wheel relative to its first slice, rigid_dynamics.geometry.slices; the case's wheel_profile should be that
-  slice's file) and ``side`` ("both", default, "left" or "right");
+  wheel relative to its first slice, rigid_dynamics.geometry.slices, smoothed along y with the case's
+  ``profile_smoothing_m``; the case's wheel_profile should be that slice's file) and ``side`` ("both", default,
+  "left" or "right");
 * ``[solver]``: for a quadric case the options of the contact model; for a wheelset case the case's options
   (``rigid_dynamics.contact.wheelset_case.DEFAULT_CASE_OPTIONS``) with the model's options in ``[solver.model]``.
   Both are checked against their declarations before any work (:func:`check_solver_options`;
@@ -195,7 +196,7 @@ def _slices_path(value, base_dir: Path | None) -> str:
     return str(path)
 
 
-def read_wheel_irregularities(table: dict, nominal_radius_m: float) -> dict:
+def read_wheel_irregularities(table: dict, nominal_radius_m: float, smoothing_wavelength_m: float = 0.002) -> dict:
     """``[irregularities]`` of a wheelset case -> {"wheel_irregularities_right": (...), "..._left": (...)}.
 
     The checks are the dynamics scenes' (rigid_dynamics.wheelset.checks.check_scene): a flat shorter than the
@@ -256,7 +257,8 @@ def read_wheel_irregularities(table: dict, nominal_radius_m: float) -> dict:
         from rigid_dynamics.geometry.slices import read_wheel_slices
 
         try:
-            wheel.append(read_wheel_slices(table["wheel_slices_file"]).irregularity)
+            slices = read_wheel_slices(table["wheel_slices_file"], smoothing_wavelength_m=smoothing_wavelength_m)
+            wheel.append(slices.irregularity)
         except ValueError as exc:
             raise ConfigError(
                 f"key 'irregularities.wheel_slices_file' = {table['wheel_slices_file']!r}: {exc}"
@@ -285,7 +287,9 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
 
         r0 = table.get("nominal_radius_m", WheelsetCase.__dataclass_fields__["nominal_radius_m"].default)
         r0 = get_number({"nominal_radius_m": r0}, "nominal_radius_m", "geometry", positive=True)
-        built = read_wheel_irregularities(irregularities, r0)
+        smoothing = table.get("profile_smoothing_m", WheelsetCase.__dataclass_fields__["profile_smoothing_m"].default)
+        smoothing = get_number({"profile_smoothing_m": smoothing}, "profile_smoothing_m", "geometry")
+        built = read_wheel_irregularities(irregularities, r0, max(smoothing, 0.0))
     for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail"), ("wheel_profile_left", "wheel"),
                       ("rail_profile_left", "rail")):  # fmt: skip
         if key not in table and key.endswith("_left"):

@@ -134,12 +134,14 @@ def _transform(base: Profile, y_mm, z_mm):
     return best[1:]
 
 
-def read_wheel_slices(path, lateral_step_m: float = 5.0e-4) -> WheelSlices:
+def read_wheel_slices(path, lateral_step_m: float = 5.0e-4, smoothing_wavelength_m: float = 0.0) -> WheelSlices:
     """Read a CONTACT wheel slices file (module docstring).
 
     Args:
         path: the ``.slcw`` file.
         lateral_step_m: spacing of the common lateral grid on which the slices are resampled, m.
+        smoothing_wavelength_m: L_filt of a smoothing spline applied to each slice's deviation along y (the same
+            filter as the profile splines, rigid_dynamics.geometry.profile; CONTACT's SMOOTH), m; 0: none.
 
     Raises:
         ValueError: unreadable file, bad header, fewer than 4 slices, angles not increasing by >= 0.001 rad or
@@ -191,6 +193,13 @@ def read_wheel_slices(path, lateral_step_m: float = 5.0e-4) -> WheelSlices:
     grid = grid[grid <= hi]
     base_z = np.interp(grid, base.y_m, base.z_m)
     deviation = np.array([np.interp(grid, y, z) - base_z for y, z in profiles])
+    if smoothing_wavelength_m > 0:
+        from scipy.interpolate import make_smoothing_spline
+
+        step_mm = lateral_step_m * 1e3
+        lam = (smoothing_wavelength_m * 1e3 / (2.0 * math.pi)) ** 4 / step_mm
+        y_mm = grid * 1e3
+        deviation = np.array([make_smoothing_spline(y_mm, row, lam=lam)(y_mm) for row in deviation])
     alpha = 0.5 * math.pi - theta  # module docstring
     order = np.argsort(alpha)
     irregularity = MeasuredWheelIrregularity(alpha[order], grid, deviation[order])
