@@ -100,5 +100,5 @@ def test_contact_fea_plot_writes_stress_maps(tmp_path, capsys):
     assert code == 0
     (patch,) = record["patches"]
     assert patch["creep_force_long_N"] is None and patch["normal_force_N"] > 0
-    for name in ("fea_pressure.png", "fea_von_mises_cut.png", "fea_solution.xdmf"):
+    for name in ("fea_pressure.png", "fea_von_mises_cut.png", "fea_solution.vtu"):
         assert (out / "fea" / name).stat().st_size > 0

@@ -119,7 +119,7 @@ def cmd_contact(args) -> int:
 
 
 def _with_fea_output(case, args):
-    """Ask the FEA model to write its XDMF and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
+    """Ask the FEA model to write its VTU grid and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
     import dataclasses
 
     if args.out is None and _under_mpi():
