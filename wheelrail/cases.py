@@ -253,7 +253,39 @@ def patch_record(side: str, geometry: ContactGeometry, creepage: Creepage | None
         "creepage_long": _number(creepage.longitudinal) if creepage else None,
         "creepage_lat": _number(creepage.lateral) if creepage else None,
         "spin_creepage_1_per_m": _number(creepage.spin_1_per_m) if creepage else None,
+        "iterations": int(result.iterations),
+        "wall_time_s": _number(result.wall_time_s),
+        "message": result.message,
+        "diagnostics": _json_safe(result.extra),
     }
+
+
+def _json_safe(value):
+    """``value`` with only JSON-representable parts (numbers, strings, lists, dicts); arrays as lists.
+
+    ``ContactResult.extra`` holds every number a model computed beyond the common fields: ``auto``'s
+    ``selected_model`` and ``selection_reason``, FEA's subsurface maxima with their points and depths
+    (``max_von_mises_Pa``, ``max_von_mises_depth_m``, ...), mesh and solver counters, BEM's grid.
+    """
+    import numpy as np
+
+    if isinstance(value, dict):
+        items = ((str(k), _json_safe(v)) for k, v in value.items())
+        return {k: v for k, v in items if v is not _SKIP}
+    if isinstance(value, (list, tuple)):
+        return [v for v in map(_json_safe, value) if v is not _SKIP]
+    if isinstance(value, np.ndarray):
+        return value.tolist() if value.size <= 1000 else _SKIP
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (bool, int, str)) or value is None:
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    return str(value)
+
+
+_SKIP = object()
 
 
 def solution_record(solution: CaseSolution) -> dict:

@@ -105,6 +105,9 @@ def cmd_contact(args) -> int:
         if _mpi_rank() == 0:
             out_dir = new_output_dir(args.out, f"contact-{case.name or 'case'}")
             copy_input(resolve_case_path(args.case), out_dir, "case.toml")
+            from wheelrail.contact_files import write_solution_files
+
+            record["field_files"] = write_solution_files(solution, out_dir)
             write_json(out_dir / "summary.json", record)
             if args.plot:
                 record["plots"] = _plot_patches(solution, out_dir)
@@ -142,15 +145,13 @@ def new_output_dir_for(case) -> Path:
 
 
 def _plot_patches(solution, out_dir: Path) -> list[str]:
-    from comparisons.contact_plots import plot_contact_fields
+    from wheelrail.contact_files import plot_patch
 
     written = []
     for index, (side, _geometry, _creepage, result) in enumerate(solution.patches):
-        if result.fields is None:
-            continue
-        path = out_dir / f"fields-{side}-{index}.png"
-        plot_contact_fields(result, path)
-        written.append(path.name)
+        path = plot_patch(result, out_dir / f"fields-{side}-{index}.png")
+        if path is not None:
+            written.append(path.name)
     return written
 
 
