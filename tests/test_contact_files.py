@@ -22,7 +22,8 @@ GEOMETRY = ContactGeometry.quadric(0.46, 0.3)
 FORCE_N = 1e4
 
 
-def _solve(method, creepage=Creepage(), options=None):
+def _solve(method, creepage=None, options=None):
+    creepage = Creepage() if creepage is None else creepage
     return get_model(method).solve(GEOMETRY, creepage, STEEL, normal_force_N=FORCE_N, options=options)
 
 
