@@ -123,9 +123,7 @@ def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactR
     out = Path(out_dir)
     arrays = field_arrays(fields)
     curves = outline_curves(fields)
-    outline = (
-        np.concatenate([np.vstack([c, [[np.nan, np.nan]]]) for c in curves])[:-1] if curves else np.zeros((0, 2))
-    )
+    outline = np.concatenate([np.vstack([c, [[np.nan, np.nan]]]) for c in curves])[:-1] if curves else np.zeros((0, 2))
     units = {name: name.rsplit("_", 1)[-1] if name not in MASK_NAMES else "1 (mask)" for name in arrays}
     units.update({"x_m": "m", "y_m": "m", "outline_m": "m", "point_m": "m"})
     point = np.asarray(getattr(geometry, "point_m", np.zeros(3)), float)
