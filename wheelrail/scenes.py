@@ -80,7 +80,11 @@ def load_scene(path: str | Path):
 
 
 def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = True) -> dict:
-    """Write scene.toml, summary.json, timeseries.npz (atomic) and plots; return the summary."""
+    """Write scene.toml, summary.json, timeseries.npz/.csv/.parquet (atomic) and plots; return the summary.
+
+    ``timeseries.csv`` and ``timeseries.parquet`` hold the tidy table of :mod:`rigid_dynamics.wheelset.table`
+    (one row per output time, one column per named quantity, units in the names).
+    """
     from rigid_dynamics.wheelset import timeseries_arrays
     from wheelrail.output import copy_input, write_json, write_npz
 
@@ -89,8 +93,13 @@ def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = Tru
     files = ["scene.toml", "summary.json"]
     arrays = timeseries_arrays(result)
     if arrays:
+        from rigid_dynamics.wheelset.table import write_table
+
         write_npz(out_dir / "timeseries.npz", **arrays)
         files.append("timeseries.npz")
+        for name in ("timeseries.csv", "timeseries.parquet"):
+            write_table(result, out_dir / name)
+            files.append(name)
     if plots and len(result.t) > 1:
         from comparisons.dynamics_plots import plot_simulation
 
