@@ -192,6 +192,28 @@ class CaseSolution:
     patches: list = field(default_factory=list)
     extra: dict = field(default_factory=dict)
 
+    def to_dict(self) -> dict:
+        """The JSON record of ``wheelrail contact --json`` (:func:`solution_record`)."""
+        return solution_record(self)
+
+    def to_dataframe(self):
+        """One row per patch: side, model, forces, pressure, semi-axes, creepages (units in the names)."""
+        import pandas as pd
+
+        rows = [
+            {k: v for k, v in patch.items() if not isinstance(v, (dict, list))} for patch in self.to_dict()["patches"]
+        ]
+        return pd.DataFrame(rows)
+
+    def __repr__(self) -> str:
+        patches = ", ".join(
+            f"{side}: N={result.normal_force_N:.5g} N" for side, _geometry, _creepage, result in self.patches
+        )
+        return (
+            f"CaseSolution(method={self.method!r}, success={self.success}, wall_time_s={self.wall_time_s:.3g}, "
+            f"patches=[{patches}], message={self.message!r})"
+        )
+
 
 def solve_case(case: ContactCase, method: str) -> CaseSolution:
     """Solve a validated case with the contact model ``method``."""
