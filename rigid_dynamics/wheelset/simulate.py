@@ -243,7 +243,7 @@ def build_provider(scene: DynamicsScene):
     choice = scene.contact_provider
     track, irr = scene.track, scene.irregularities
     if choice == "auto":
-        if track.is_conical:
+        if track.is_conical and not irr.needs_search:
             choice = "conical"
         elif irr.any:
             choice = "search"
