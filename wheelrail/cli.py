@@ -9,6 +9,7 @@ Commands:
     wheelrail conicity               equivalent conicity of a wheel/rail pair (EN 15302 method)
     wheelrail manchester             the Manchester Contact Benchmark case A-2.2 sweep
     wheelrail stress                 numerical-stability stress sweep of a scene
+    wheelrail sweep SWEEP.toml       parameter study on dask.distributed (wheelrail.sweep)
 
 Bad input ends with one line ``wheelrail: error: ...`` on stderr naming the key, the value and
 what was expected, and exit status 2; a numerical failure is reported in the results with its
@@ -90,16 +91,19 @@ def cmd_cases(args) -> int:
 
 def cmd_contact(args) -> int:
     from rigid_dynamics.contact.registry import MODELS
-    from wheelrail.cases import load_case, resolve_case_path, solution_record, solve_case
+    from wheelrail.cases import resolve_case_path, solution_record, solve_case
     from wheelrail.output import copy_input, new_output_dir, to_json, write_json
+    from wheelrail.overrides import load_case_with
 
     if args.method not in MODELS:
         raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
-    case = load_case(args.case)
+    case, _, overrides = load_case_with(args.case, args.set)
     if args.method == "fea" and (args.out is not None or args.plot):
         case = _with_fea_output(case, args)
     solution = solve_case(case, args.method)
     record = solution_record(solution)
+    if overrides:
+        record["overrides"] = overrides
     out_dir = None
     if args.out is not None or args.plot:
         if _mpi_rank() == 0:
@@ -182,10 +186,10 @@ def _contact_table(record: dict) -> str:
 
 
 def cmd_run(args) -> int:
-    from wheelrail.scenes import DEFAULT_SCENE, load_scene, resolve_scene_path, write_run_outputs
+    from wheelrail.overrides import load_scene_with
+    from wheelrail.scenes import DEFAULT_SCENE, write_run_outputs
 
-    source = resolve_scene_path(args.scene or DEFAULT_SCENE)
-    scene = load_scene(source)
+    scene, source, overrides = load_scene_with(args.scene or DEFAULT_SCENE, args.set)
     from rigid_dynamics.wheelset import simulate
     from wheelrail.output import new_output_dir
 
@@ -195,7 +199,7 @@ def cmd_run(args) -> int:
         result = simulate(scene, progress=progress)
     finally:
         close()
-    summary = write_run_outputs(result, source, out_dir, plots=not args.no_plots)
+    summary = write_run_outputs(result, source, out_dir, plots=not args.no_plots, extra={"overrides": overrides})
     _print(
         f"{source.stem}: {summary['status']} - {summary['message']}; simulated {summary['simulated_time_s']:.3g} s "
         f"in {summary['wall_time_s']:.3g} s (real-time factor {summary['real_time_factor']:.3g})"
@@ -330,6 +334,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/run-<scene>-<time>)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
+    run.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key (repeatable)")
     run.set_defaults(func=cmd_run)
 
     contact = sub.add_parser("contact", help="solve a contact case")
@@ -337,7 +342,8 @@ def build_parser() -> argparse.ArgumentParser:
     contact.add_argument("--method", default="auto", help="contact model (see `wheelrail models`)")
     contact.add_argument("--json", action="store_true", help="print one JSON object")
     contact.add_argument("--plot", action="store_true", help="write PNG maps of the patch fields")
-    contact.add_argument("--out", type=Path, help="output folder for summary and plots")
+    contact.add_argument("--out", type=Path, help="output folder for summary, field files and plots")
+    contact.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a case key (repeatable)")
     contact.set_defaults(func=cmd_contact)
 
     conicity = sub.add_parser("conicity", help="equivalent conicity (EN 15302 method)")
@@ -368,6 +374,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="1: run serially (default); N >= 2: on a local dask.distributed cluster of N single-threaded processes",
     )
     stress.set_defaults(func=cmd_stress)
+
+    from wheelrail import sweep
+
+    sweep.register(sub)
     return parser
 
 

@@ -114,7 +114,7 @@ def load_scene(path: str | Path):
     return parse_scene(read_toml(path, "scene file"), base_dir=Path(path).parent)
 
 
-def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = True) -> dict:
+def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = True, extra: dict | None = None) -> dict:
     """Write scene.toml, summary.json, timeseries.npz/.csv/.parquet (atomic) and plots; return the summary.
 
     ``timeseries.csv`` and ``timeseries.parquet`` hold the tidy table of :mod:`rigid_dynamics.wheelset.table`
@@ -125,6 +125,7 @@ def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = Tru
 
     copy_input(scene_path, out_dir, "scene.toml")
     summary = dict(result.summary())
+    summary.update({k: v for k, v in (extra or {}).items() if v})  # e.g. the --set overrides of the scene
     files = ["scene.toml", "summary.json"]
     irregularities = getattr(result.scene, "irregularities", None)
     for key in IRREGULARITY_FILE_KEYS:

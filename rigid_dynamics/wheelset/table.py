@@ -89,8 +89,8 @@ def to_dataframe(result):
 def write_table(result, path: str | Path) -> Path:
     """Write the tidy table to ``path`` atomically: CSV for ``.csv``, Parquet (pyarrow) for ``.parquet``.
 
-    The CSV has one header line of column names (units in the names) and full float precision
-    (``repr`` round trip); NaN is written as an empty field, which ``pandas.read_csv`` reads as NaN.
+    The CSV has one header line of column names (units in the names) and floats written by ``repr`` (they read
+    back exactly); NaN is written as an empty field, which ``pandas.read_csv`` reads as NaN.
     """
     import os
     import tempfile
@@ -104,7 +104,7 @@ def write_table(result, path: str | Path) -> Path:
     os.close(fd)
     try:
         if path.suffix == ".csv":
-            frame.to_csv(tmp, index=False, float_format="%.17g")
+            frame.to_csv(tmp, index=False)
         else:
             frame.to_parquet(tmp, index=False, engine="pyarrow")
         os.replace(tmp, path)
