@@ -22,7 +22,7 @@ description = "two speeds, two frictions, one point over its budget, one bad poi
 scene = "hunting-conical"
 metrics = ["max_abs_lateral_displacement_m"]
 [set]
-duration_s = 0.05
+duration_s = 0.02
 [grid]
 speed_m_per_s = [10.0, 30.0]
 "material.friction_coefficient" = [0.2, 0.4]
@@ -34,6 +34,12 @@ speed_m_per_s = -5.0
 """
 
 
+@pytest.fixture(scope="module")
+def client():
+    with local_dask_client(2) as dask_client:
+        yield dask_client
+
+
 @pytest.fixture
 def sweep_file(tmp_path):
     path = tmp_path / "study.toml"
@@ -41,23 +47,22 @@ def sweep_file(tmp_path):
     return path
 
 
-def test_sweep_on_local_cluster_keeps_statuses_survives_a_killed_worker_and_resumes(sweep_file, tmp_path):
+def test_sweep_on_local_cluster_keeps_statuses_survives_a_killed_worker_and_resumes(client, sweep_file, tmp_path):
     spec = load_sweep(sweep_file)
     assert len(spec["points"]) == 6
     out = tmp_path / "out"
     killed = []
-    with local_dask_client(2) as client:
 
-        def kill_a_busy_worker(record, done, total):
-            if killed:
-                return
-            busy = [address for address, keys in client.processing().items() if keys]
-            pids = client.run(os.getpid)
-            if busy:
-                os.kill(pids[busy[0]], signal.SIGKILL)
-                killed.append(busy[0])
+    def kill_a_busy_worker(record, done, total):
+        if killed:
+            return
+        busy = [address for address, keys in client.processing().items() if keys]
+        pids = client.run(os.getpid)
+        if busy:
+            os.kill(pids[busy[0]], signal.SIGKILL)
+            killed.append(busy[0])
 
-        summary = run_sweep(spec, out, client=client, on_record=kill_a_busy_worker)
+    summary = run_sweep(spec, out, client=client, on_record=kill_a_busy_worker)
     assert killed, "no worker was busy after the first point"
     assert summary["points"] == 6 and summary["ran"] == 6
     assert summary["statuses"] == {"ok": 4, "budget-exceeded": 1, "invalid-input": 1}
@@ -83,8 +88,7 @@ def test_sweep_on_local_cluster_keeps_statuses_survives_a_killed_worker_and_resu
     again = run_sweep(spec, out, client=None, workers=1)
     assert again["ran"] == 0 and again["skipped"] == 6
     spec["points"].append({"speed_m_per_s": 15.0})
-    with local_dask_client(1) as client:
-        more = run_sweep(spec, out, client=client)
+    more = run_sweep(spec, out, client=client)
     assert more["ran"] == 1 and more["skipped"] == 6 and more["points"] == 7
     assert json.loads((out / "summary.json").read_text())["points"] == 7
 
@@ -92,11 +96,11 @@ def test_sweep_on_local_cluster_keeps_statuses_survives_a_killed_worker_and_resu
 def test_cli_sweep_with_set_and_bad_input(sweep_file, tmp_path, capsys):
     sweep_file.write_text(SWEEP.split("[[points]]")[0].replace("[10.0, 30.0]", "[10.0]"))
     out = tmp_path / "cli"
-    code = main(["sweep", str(sweep_file), "--out", str(out), "--workers", "1", "--quiet", "--set", "duration_s=0.02"])
+    code = main(["sweep", str(sweep_file), "--out", str(out), "--workers", "1", "--quiet", "--set", "duration_s=0.01"])
     assert code == 0
     assert "2 points (2 ok); ran 2" in capsys.readouterr().out
     table = pd.read_csv(out / "sweep.csv")
-    assert list(table["simulated_time_s"]) == pytest.approx([0.02, 0.02])  # --set wins over [set]
+    assert list(table["simulated_time_s"]) == pytest.approx([0.01, 0.01])  # --set wins over [set]
     assert (out / "sweep.toml").read_text() == sweep_file.read_text()
 
     for argv, pattern in (
@@ -127,11 +131,10 @@ def test_bad_sweep_files(tmp_path, text, pattern):
         load_sweep(path)
 
 
-def test_case_sweep_over_models_serially(tmp_path):
+def test_case_sweep_over_models(client, tmp_path):
     path = tmp_path / "case.toml"
     path.write_text('case = "hertz-quadric"\n[grid]\nmethod = ["hertz", "linear", "fastsim"]\n')
-    with local_dask_client(1) as client:
-        summary = run_sweep(load_sweep(path), tmp_path / "o", client=client)
+    summary = run_sweep(load_sweep(path), tmp_path / "o", client=client)
     assert summary["statuses"] == {"ok": 3}
     table = pd.read_csv(tmp_path / "o" / "sweep.csv")
     assert list(table["method"]) == ["hertz", "linear", "fastsim"]
