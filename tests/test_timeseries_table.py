@@ -24,7 +24,13 @@ def run_dir(tmp_path_factory):
 
 
 def test_csv_and_parquet_load_in_pandas_and_match_the_npz(run_dir):
+    import json
+
     import pandas as pd
+
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert {"timeseries.csv", "timeseries.parquet"} <= set(summary["files"])
+    assert summary["startup_s"] >= 0 and summary["setup_s"] >= 0  # reported apart from the model's wall_time_s
 
     csv = pd.read_csv(run_dir / "timeseries.csv")
     parquet = pd.read_parquet(run_dir / "timeseries.parquet")
