@@ -10,6 +10,7 @@ Commands:
     wheelrail manchester             the Manchester Contact Benchmark case A-2.2 sweep
     wheelrail stress                 numerical-stability stress sweep of a scene
     wheelrail sweep SWEEP.toml       parameter study on dask.distributed (wheelrail.sweep)
+    wheelrail critical-speed SCENE   linear and nonlinear (limit-cycle) critical speed (wheelrail.critical)
 
 Bad input ends with one line ``wheelrail: error: ...`` on stderr naming the key, the value and
 what was expected, and exit status 2; a numerical failure is reported in the results with its
@@ -382,9 +383,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     stress.set_defaults(func=cmd_stress)
 
-    from wheelrail import sweep
+    from wheelrail import critical, sweep
 
     sweep.register(sub)
+    critical.register(sub)
     return parser
 
 
