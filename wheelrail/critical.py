@@ -65,10 +65,12 @@ def cmd_critical_speed(args) -> int:
     from wheelrail.overrides import load_scene_with
 
     scene, source, overrides = load_scene_with(args.scene, args.set)
-    for name in ("high", "low", "duration"):
+    for name in ("high", "low", "duration", "threshold_mm"):
         value = getattr(args, name)
         if value is not None and not (math.isfinite(value) and value > 0):
-            raise ConfigError(f"--{name} {value!r}: expected a finite number > 0")
+            raise ConfigError(f"--{name.replace('_', '-')} {value!r}: expected a finite number > 0")
+    if args.steps < 1:
+        raise ConfigError(f"--steps {args.steps!r}: expected an integer >= 1")
     linear = linear_critical_speed(scene)
     print(f"{source.stem}: linear critical speed {_speed(linear['speed_m_per_s'])} ({linear['model']})")
     high = args.high or (1.2 * linear["speed_m_per_s"] if linear["speed_m_per_s"] else 2.0 * scene.speed_m_per_s)
@@ -76,7 +78,23 @@ def cmd_critical_speed(args) -> int:
     if not low < high:
         raise ConfigError(f"--low {low!r}: expected a speed below --high {high!r}")
     duration = args.duration or 3.0
-    nonlinear = limit_cycle_search(scene, high, low, duration_s=duration, speed_steps=args.steps)
+    from functools import partial
+
+    from rigid_dynamics.wheelset import build_provider, simulate
+
+    try:
+        provider = build_provider(scene)  # the contact geometry does not depend on the speed: build it once
+    except ValueError as exc:
+        raise ConfigError(f"scene {args.scene!r}: {exc}") from None
+    nonlinear = limit_cycle_search(
+        scene,
+        high,
+        low,
+        duration_s=duration,
+        speed_steps=args.steps,
+        threshold_m=1e-3 * args.threshold_mm,
+        simulate=partial(simulate, provider=provider),
+    )
     print(f"{source.stem}: nonlinear critical speed {_speed(nonlinear['speed_m_per_s'])}: {nonlinear['message']}")
     out_dir = new_output_dir(args.out, f"critical-speed-{source.stem}")
     copy_input(source, out_dir, "scene.toml")
@@ -99,6 +117,9 @@ def register(sub) -> None:
     parser.add_argument("--low", type=float, help="lowest speed tried, m/s (default 0.4 x --high)")
     parser.add_argument("--steps", type=int, default=6, help="continuation steps from --high to --low (default 6)")
     parser.add_argument("--duration", type=float, help="simulated time per run, s (default 3)")
+    parser.add_argument(
+        "--threshold-mm", type=float, default=1.0, help="smallest lateral amplitude counted as a cycle, mm (default 1)"
+    )
     parser.add_argument("--out", type=Path, help="output folder")
     parser.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key (repeatable)")
     parser.set_defaults(func=cmd_critical_speed)
