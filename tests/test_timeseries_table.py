@@ -10,17 +10,23 @@ import pytest
 from rigid_dynamics.wheelset.equations import PATCH_FIELDS, STATE_NAMES
 from rigid_dynamics.wheelset.table import result_columns, timeseries_columns, write_table
 from wheelrail.cli import main
-from wheelrail.scenes import embedded_scenes
 
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
-    scene = embedded_scenes()["hunting-conical"].read_text().replace("duration_s = 3.0", "duration_s = 0.2")
-    path = tmp_path_factory.mktemp("scene") / "short.toml"
-    path.write_text(scene)
     out = tmp_path_factory.mktemp("run")
-    assert main(["run", str(path), "--out", str(out), "--quiet", "--no-plots"]) == 0
+    assert main(["run", "hunting-conical", "--set", "duration_s=0.2", "--out", str(out), "--quiet", "--no-plots"]) == 0
     return out
+
+
+def test_set_overrides_the_scene_and_is_recorded(run_dir, tmp_path, capsys):
+    import json
+
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["overrides"] == {"duration_s": 0.2} and summary["simulated_time_s"] == pytest.approx(0.2)
+    assert main(["run", "hunting-conical", "--set", "speed_m_per_s=-1", "--out", str(tmp_path), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wheelrail: error:") and "speed_m_per_s" in err and len(err.strip().splitlines()) == 1
 
 
 def test_csv_and_parquet_load_in_pandas_and_match_the_npz(run_dir):

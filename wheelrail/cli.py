@@ -115,7 +115,7 @@ def cmd_contact(args) -> int:
             record["field_files"] = write_solution_files(solution, out_dir)
             write_json(out_dir / "summary.json", record)
             if args.plot:
-                record["plots"] = _plot_patches(solution, out_dir)
+                record["plots"] = _plot_patches(solution, out_dir) + _fea_views(solution, out_dir)
                 write_json(out_dir / "summary.json", record)
     if args.json:
         _print(to_json(record))
@@ -157,6 +157,24 @@ def _plot_patches(solution, out_dir: Path) -> list[str]:
         path = plot_patch(result, out_dir / f"fields-{side}-{index}.png")
         if path is not None:
             written.append(path.name)
+    return written
+
+
+def _fea_views(solution, out_dir: Path) -> list[str]:
+    """3-D von Mises views (pyvista) of the FEA grids (``fea_von_mises_3d.png`` next to each ``fea_solution.vtu``)."""
+    from comparisons.fea_views import render_stress_view
+
+    written = []
+    for _side, _geometry, _creepage, result in solution.patches:
+        vtu = (result.extra.get("files") or {}).get("vtu")
+        if vtu:
+            png = Path(vtu).with_name("fea_von_mises_3d.png")
+            try:
+                render_stress_view(vtu, png)
+            except Exception as exc:  # a VTK that cannot render off screen: the data files are written all the same
+                print(f"wheelrail: 3-D view not drawn ({type(exc).__name__}: {exc})", file=sys.stderr)
+                continue
+            written.append(str(png.relative_to(out_dir)))
     return written
 
 
