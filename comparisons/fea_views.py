@@ -22,10 +22,9 @@ def render_stress_view(vtu_path: str | Path, png_path: str | Path, field: str = 
     Raises:
         ValueError: the grid has no such field.
     """
-    import os
-    import tempfile
-
     import pyvista as pv
+
+    from rigid_dynamics.files import atomic_write
 
     grid = pv.read(str(vtu_path))
     if field not in grid.point_data:
@@ -50,15 +49,7 @@ def render_stress_view(vtu_path: str | Path, png_path: str | Path, field: str = 
         plotter.add_mesh(region, scalars=field, cmap="inferno", show_edges=False, scalar_bar_args={"title": field})
         plotter.add_mesh(region.outline(), color="black")
         plotter.view_vector((-1.0, -1.0, 0.8), viewup=(0.0, 0.0, 1.0))  # onto the symmetry faces x = y = 0
-        png_path = Path(png_path)
-        fd, tmp = tempfile.mkstemp(prefix=f".{png_path.stem}.", suffix=".png", dir=png_path.parent)
-        os.close(fd)
-        try:
-            plotter.screenshot(tmp)
-            os.replace(tmp, png_path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        png_path = atomic_write(png_path, lambda tmp: plotter.screenshot(str(tmp)))
     finally:
         plotter.close()
     return png_path

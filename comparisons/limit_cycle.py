@@ -201,9 +201,9 @@ def plot_branch(outcome: dict, path, linear_speed_m_per_s: float | None = None):
     ax.set_xlabel("speed [m/s]")
     ax.set_ylabel("lateral amplitude [mm]")
     ax.legend(fontsize=8)
-    from pathlib import Path
+    from rigid_dynamics.files import save_figure
 
-    path = Path(path)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return path
+    try:
+        return save_figure(fig, path, dpi=110, bbox_inches="tight")  # atomic
+    finally:
+        plt.close(fig)

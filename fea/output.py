@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rigid_dynamics.files import atomic_write, save_figure
+
 FIELD_UNITS = {
     "displacement_m": "m",
     "stress_Pa": "Pa",
@@ -143,26 +145,7 @@ def _write_vtu(path: Path, points, cells, point_data, cell_data) -> None:
     def writer(tmp: Path) -> None:
         meshio.write(tmp, mesh, file_format="vtu")
 
-    _atomic_write(path, writer)
-
-
-def _atomic_write(path: Path, writer) -> None:
-    """Call ``writer(tmp)`` on a temporary name in the same folder, then rename it to ``path``."""
-    import os
-    import tempfile
-
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        writer(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _save_png(fig, path: Path) -> None:
-    _atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=120, bbox_inches="tight", format="png"))
+    atomic_write(path, writer)
 
 
 def _draw(out: Path, fields, cut_xyz, cut_vm, spec, symmetry) -> dict:
@@ -185,8 +168,10 @@ def _draw(out: Path, fields, cut_xyz, cut_vm, spec, symmetry) -> dict:
         ax.set_aspect("equal")
         ax.set_title("FEA contact pressure (white: contact outline)")
         path = out / "fea_pressure.png"
-        _save_png(fig, path)
-        plt.close(fig)
+        try:
+            save_figure(fig, path, dpi=120, bbox_inches="tight")  # atomic (rigid_dynamics.files)
+        finally:
+            plt.close(fig)
         files["pressure_png"] = str(path)
 
     x, z, v = cut_xyz[:, 0], -cut_xyz[:, 2], cut_vm
@@ -207,7 +192,9 @@ def _draw(out: Path, fields, cut_xyz, cut_vm, spec, symmetry) -> dict:
         ax.set_aspect("equal")
         ax.set_title("FEA subsurface von Mises stress, cut y = y_c")
         path = out / "fea_von_mises_cut.png"
-        _save_png(fig, path)
-        plt.close(fig)
+        try:
+            save_figure(fig, path, dpi=120, bbox_inches="tight")  # atomic (rigid_dynamics.files)
+        finally:
+            plt.close(fig)
         files["von_mises_cut_png"] = str(path)
     return files

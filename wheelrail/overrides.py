@@ -71,11 +71,17 @@ def load_scene_with(scene: str | Path, sets: list[str] | None):
     return parse_scene(doc, base_dir=path.parent), path, overrides
 
 
-def load_case_with(case: str | Path, sets: list[str] | None):
-    """Read, override and validate a contact case (embedded name or path); returns (ContactCase, path, overrides)."""
-    from wheelrail.cases import parse_case, resolve_case_path
+def load_case_with(case: str | Path, sets: list[str] | None, method: str | None = None):
+    """Read, override and validate a contact case (embedded name or path); returns (ContactCase, path, overrides).
+
+    With ``method`` the ``[solver]`` table is checked against that model's options (as ``load_case``).
+    """
+    from wheelrail.cases import check_solver_options, parse_case, resolve_case_path
 
     path = resolve_case_path(case)
     overrides = parse_sets(sets)
     doc = apply_overrides(read_toml(path, "case file"), overrides)
-    return parse_case(doc, name=path.stem), path, overrides
+    parsed = parse_case(doc, name=path.stem)
+    if method is not None:
+        check_solver_options(parsed, method)
+    return parsed, path, overrides

@@ -92,23 +92,12 @@ def write_table(result, path: str | Path) -> Path:
     The CSV has one header line of column names (units in the names) and floats written by ``repr`` (they read
     back exactly); NaN is written as an empty field, which ``pandas.read_csv`` reads as NaN.
     """
-    import os
-    import tempfile
+    from rigid_dynamics.files import atomic_write
 
     path = Path(path)
     if path.suffix not in (".csv", ".parquet"):
         raise ValueError(f"path = {str(path)!r}: expected a .csv or .parquet file")
     frame = to_dataframe(result)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        if path.suffix == ".csv":
-            frame.to_csv(tmp, index=False)
-        else:
-            frame.to_parquet(tmp, index=False, engine="pyarrow")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    if path.suffix == ".csv":
+        return atomic_write(path, lambda tmp: frame.to_csv(tmp, index=False))
+    return atomic_write(path, lambda tmp: frame.to_parquet(tmp, index=False, engine="pyarrow"))
