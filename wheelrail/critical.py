@@ -61,7 +61,7 @@ def linear_critical_speed(scene) -> dict:
 def cmd_critical_speed(args) -> int:
     """``wheelrail critical-speed``: print and write the linear and nonlinear critical speeds."""
     from comparisons.limit_cycle import limit_cycle_search, plot_branch
-    from wheelrail.output import copy_input, new_output_dir, write_json
+    from wheelrail.output import copy_input, output_folder, write_json
     from wheelrail.overrides import load_scene_with
 
     scene, source, overrides = load_scene_with(args.scene, args.set)
@@ -71,36 +71,39 @@ def cmd_critical_speed(args) -> int:
             raise ConfigError(f"--{name.replace('_', '-')} {value!r}: expected a finite number > 0")
     if args.steps < 1:
         raise ConfigError(f"--steps {args.steps!r}: expected an integer >= 1")
-    linear = linear_critical_speed(scene)
-    print(f"{source.stem}: linear critical speed {_speed(linear['speed_m_per_s'])} ({linear['model']})")
-    high = args.high or (1.2 * linear["speed_m_per_s"] if linear["speed_m_per_s"] else 2.0 * scene.speed_m_per_s)
-    low = args.low or 0.4 * high
-    if not low < high:
-        raise ConfigError(f"--low {low!r}: expected a speed below --high {high!r}")
-    duration = args.duration or 3.0
+    if args.low is not None and args.high is not None and not args.low < args.high:
+        raise ConfigError(f"--low {args.low!r}: expected a speed below --high {args.high!r}")
     from functools import partial
 
     from rigid_dynamics.wheelset import build_provider, simulate
 
-    try:
-        provider = build_provider(scene)  # the contact geometry does not depend on the speed: build it once
-    except ValueError as exc:
-        raise ConfigError(f"scene {args.scene!r}: {exc}") from None
-    nonlinear = limit_cycle_search(
-        scene,
-        high,
-        low,
-        duration_s=duration,
-        speed_steps=args.steps,
-        threshold_m=1e-3 * args.threshold_mm,
-        simulate=partial(simulate, provider=provider),
-    )
-    print(f"{source.stem}: nonlinear critical speed {_speed(nonlinear['speed_m_per_s'])}: {nonlinear['message']}")
-    out_dir = new_output_dir(args.out, f"critical-speed-{source.stem}")
-    copy_input(source, out_dir, "scene.toml")
-    png = plot_branch(nonlinear, out_dir / "critical_speed.png", linear["speed_m_per_s"])
-    summary = {"linear": linear, "nonlinear": nonlinear, "overrides": overrides, "files": [png.name]}
-    write_json(out_dir / "summary.json", summary)
+    with output_folder(args.out, f"critical-speed-{source.stem}") as out_dir:  # checked before the work
+        copy_input(source, out_dir, "scene.toml")
+        linear = linear_critical_speed(scene)
+        print(f"{source.stem}: linear critical speed {_speed(linear['speed_m_per_s'])} ({linear['model']})")
+        v_lin = linear["speed_m_per_s"]
+        high = args.high or (1.2 * v_lin if v_lin else 2.0 * scene.speed_m_per_s)
+        low = args.low or 0.4 * high
+        if not low < high:
+            raise ConfigError(f"--low {low!r}: expected a speed below --high {high!r}")
+        try:
+            provider = build_provider(scene)  # the contact geometry does not depend on the speed: build it once
+        except ValueError as exc:
+            raise ConfigError(f"scene {args.scene!r}: {exc}") from None
+        nonlinear = limit_cycle_search(
+            scene,
+            high,
+            low,
+            duration_s=args.duration or 3.0,
+            speed_steps=args.steps,
+            threshold_m=1e-3 * args.threshold_mm,
+            simulate=partial(simulate, provider=provider),
+        )
+        speed = _speed(nonlinear["speed_m_per_s"])
+        print(f"{source.stem}: nonlinear critical speed {speed}: {nonlinear['message']}")
+        png = plot_branch(nonlinear, out_dir / "critical_speed.png", v_lin)
+        summary = {"linear": linear, "nonlinear": nonlinear, "overrides": overrides, "files": [png.name]}
+        write_json(out_dir / "summary.json", summary)  # last
     print(f"output written to {out_dir}")
     return 0 if nonlinear["success"] and linear["success"] else 1
 

@@ -395,7 +395,7 @@ def cmd_sweep(args) -> int:
     """``wheelrail sweep``: run a sweep file (module docstring)."""
     import importlib.util
 
-    from wheelrail.output import copy_input, new_output_dir
+    from wheelrail.output import copy_input, output_folder
     from wheelrail.overrides import parse_sets
 
     try:
@@ -416,14 +416,14 @@ def cmd_sweep(args) -> int:
 
         spec["base_doc"] = apply_overrides(spec["base_doc"], overrides)
         spec["set"] = {**spec["set"], **overrides}
-    out_dir = new_output_dir(args.out, f"sweep-{path.stem}")
-    copy_input(path, out_dir, "sweep.toml")
 
     def report(record, done, total):
         if not args.quiet:
             print(f"[{done}/{total}] point {record['point']}: {record['status']}", flush=True)
 
-    summary = run_sweep(spec, out_dir, workers=workers, scheduler=args.scheduler, on_record=report)
+    with output_folder(args.out, f"sweep-{path.stem}") as out_dir:  # checked and locked: one sweep per folder
+        copy_input(path, out_dir, "sweep.toml")
+        summary = run_sweep(spec, out_dir, workers=workers, scheduler=args.scheduler, on_record=report)
     counts = ", ".join(f"{n} {status}" for status, n in sorted(summary["statuses"].items()))
     print(
         f"sweep {path.stem}: {summary['points']} points ({counts}); ran {summary['ran']}, "
