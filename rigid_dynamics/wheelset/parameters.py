@@ -176,6 +176,26 @@ class TrackGeometry:
 
 
 @dataclass(frozen=True)
+class Harmonic:
+    """One harmonic of wheel out-of-roundness, R_irr = A cos(n alpha + phase), uniform across the tread.
+
+    Attributes:
+        order: n, waves per revolution, integer >= 1.
+        amplitude_m: A, m (>= 0).
+        phase_rad: phase, rad.
+    """
+
+    order: int
+    amplitude_m: float
+    phase_rad: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_finite(self, nonnegative=["amplitude_m"])
+        if isinstance(self.order, bool) or not isinstance(self.order, int) or self.order < 1:
+            raise ValueError(f"order = {self.order!r}: expected an integer >= 1")
+
+
+@dataclass(frozen=True)
 class Irregularities:
     """Shape irregularities of the wheels (eq 5: R_irr) and rails (eq 6: N_irr). Zero amplitude = none.
 
@@ -191,6 +211,14 @@ class Irregularities:
         corrugation_wavelength_m: wavelength of sinusoidal rail corrugation, m; 0 = none.
         corrugation_amplitude_m: amplitude of N_irr = A cos(2 pi x / wavelength), m (z down).
         side: which wheels/rails carry the irregularities: "both", "left" or "right".
+        harmonics: further out-of-roundness harmonics, added to the polygon (TOML: ``[[irregularities.harmonics]]``
+            tables with ``order``, ``amplitude_m``, ``phase_rad``).
+        wheel_grid_file: measured out-of-roundness R_irr(alpha, y_p): a CSV grid
+            (:func:`rigid_dynamics.geometry.measured.read_wheel_grid_csv`); "" = none.
+        corrugation_file: measured rail irregularity N_irr(x, y_r) (corrugation): a CSV grid
+            (:func:`rigid_dynamics.geometry.measured.read_rail_grid_csv`); "" = none.
+        Harmonics and measured grids are evaluated by the 3-D contact search (``contact_provider`` "search", the
+        choice of "auto" for them); measured grids run on the Python path.
     """
 
     polygon_order: int = 0
@@ -202,6 +230,9 @@ class Irregularities:
     corrugation_wavelength_m: float = 0.0
     corrugation_amplitude_m: float = 0.0
     side: str = "both"
+    harmonics: tuple[Harmonic, ...] = ()
+    wheel_grid_file: str = ""
+    corrugation_file: str = ""
 
     def __post_init__(self) -> None:
         _check_finite(
@@ -231,7 +262,13 @@ class Irregularities:
             (self.polygon_order > 0 and self.polygon_amplitude_m > 0)
             or self.flat_length_m > 0
             or self.corrugation_amplitude_m > 0
+            or self.needs_search
         )
+
+    @property
+    def needs_search(self) -> bool:
+        """True when only the 3-D contact search evaluates them (harmonics, measured grids)."""
+        return any(h.amplitude_m > 0 for h in self.harmonics) or bool(self.wheel_grid_file or self.corrugation_file)
 
 
 @dataclass(frozen=True)
@@ -370,6 +407,11 @@ class DynamicsScene:
         ):
             if not isinstance(getattr(self, name), cls):
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected a {cls.__name__}")
+        if self.contact_provider in ("conical", "tables") and self.irregularities.needs_search:
+            raise ValueError(
+                f"contact_provider = {self.contact_provider!r} with irregularities harmonics / wheel_grid_file / "
+                "corrugation_file: expected contact_provider 'search' or 'auto' (only the 3-D search evaluates them)"
+            )
 
     @property
     def static_wheel_load_N(self) -> float:

@@ -144,6 +144,25 @@ class SimulationResult:
             return energy
         return energy - energy[0] - self.work_contact_J - self.work_exterior_J
 
+    def to_dataframe(self):
+        """The time series as a tidy pandas DataFrame, one column per named quantity (see wheelset.table)."""
+        from rigid_dynamics.wheelset.table import to_dataframe
+
+        return to_dataframe(self)
+
+    def to_dict(self) -> dict:
+        """The summary with the tidy time-series columns under ``"timeseries"`` (name -> (n,) array)."""
+        from rigid_dynamics.wheelset.table import result_columns
+
+        return {**self.summary(), "timeseries": result_columns(self)}
+
+    def __repr__(self) -> str:
+        return (
+            f"SimulationResult(status={self.status!r}, simulated_time_s={self.simulated_time_s:.4g}, "
+            f"samples={len(self.t)}, wall_time_s={self.wall_time_s:.3g}, contact_model={self.contact_model!r}, "
+            f"provider={self.provider!r}, compiled={self.compiled}, message={self.message!r})"
+        )
+
     def summary(self) -> dict:
         """JSON-serialisable summary (NaN -> None); keys listed in the issue and a few diagnostics."""
         forces = self.wheel_normal_force_N
@@ -229,7 +248,7 @@ def build_provider(scene: DynamicsScene):
     choice = scene.contact_provider
     track, irr = scene.track, scene.irregularities
     if choice == "auto":
-        if track.is_conical:
+        if track.is_conical and not irr.needs_search:
             choice = "conical"
         elif irr.any:
             choice = "search"
