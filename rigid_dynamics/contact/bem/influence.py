@@ -313,7 +313,7 @@ class InfluenceGrid:
                 self.difference_parameter,
                 only_normal=names == ("zz",),
             )
-        self._cache["zz_period"] = ext["zz"]
+        self._cache["period"] = dict(ext)  # offsets -(ny - 1)..ny (0 in 2-D) x -(nx - 1)..nx
         for k, v in ext.items():
             v = v[: 2 * ny - 1]
             self._cache["static"][k] = v[:, : 2 * nx - 1]
@@ -390,20 +390,24 @@ class InfluenceGrid:
         A preconditioner for :func:`~.norm.solve_norm`, not an exact inverse on the bounded grid.
         """
         if "prec" not in self._cache:
-            ny, nx = int(self.ny), int(self.nx)
             self.kernel("zz")
-            k = self._cache["zz_period"]  # offsets -(ny - 1)..ny (0 in 2-D) x -(nx - 1)..nx: one 2 ny x 2 nx period
-            # index by offset modulo the period, then add the two halves along each axis
-            folded = np.roll(k, (-(ny - 1) if k.shape[0] > 1 else 0, -(nx - 1)), axis=(0, 1))
-            if folded.shape[0] > 1:
-                folded = folded[:ny] + folded[ny:]
-            folded = folded[:, :nx] + folded[:, nx:]
-            symbol = scipy.fft.rfft2(folded).real
+            symbol = scipy.fft.rfft2(self._folded_period("zz")).real
             floor = 1e-6 * float(np.abs(symbol).max())
             self._cache["prec"] = 1.0 / np.maximum(symbol, floor)
         spec = scipy.fft.rfft2(residual_m)
         spec *= self._cache["prec"]
         return scipy.fft.irfft2(spec, s=(self.ny, self.nx))
+
+    def _folded_period(self, name: str) -> np.ndarray:
+        """Kernel ``name`` (static) folded onto the grid's own period (ny, nx): the coefficients of the 2 ny x 2 nx
+        period (offsets -(ny - 1)..ny x -(nx - 1)..nx) indexed by offset modulo (ny, nx) and summed.
+        """
+        ny, nx = int(self.ny), int(self.nx)
+        k = self._cache["period"][name]
+        folded = np.roll(k, (-(ny - 1) if k.shape[0] > 1 else 0, -(nx - 1)), axis=(0, 1))
+        if folded.shape[0] > 1:
+            folded = folded[:ny] + folded[ny:]
+        return folded[:, :nx] + folded[:, nx:]
 
     def _forward_pair(self, first: np.ndarray, second: np.ndarray) -> np.ndarray:
         """Spectra of two (ny, nx) fields in one batched FFT call, shape (2, ly, lx/2 + 1)."""
@@ -456,6 +460,28 @@ class InfluenceGrid:
                 np.ascontiguousarray(v, dtype=complex) for v in (kyy / det, -kxy / det, kxx / det)
             )
         return self._cache["inv"]
+
+    def inverse_static_period_spectra(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Spectra (ixx, ixy, iyy), shape (ny, nx/2 + 1), of an approximate inverse of the static tangential operator
+        on the grid's own period (no padding: a quarter of the convolution's FFT size).
+
+        As :meth:`normal_preconditioner` for A_zz (Vollebregt's FFT preconditioner, J. Comput. Phys. 257 (2014)):
+        the kernels xx, xy, yy folded onto the (ny, nx) period, the 2 x 2 symbol [[kxx, kxy], [kxy, kyy]] (real
+        parts) inverted per frequency, kxx, kyy and the determinant floored at 1e-6 of the largest kxx (and its
+        square). Apply with rfft2 / irfft2 on (ny, nx) fields; a preconditioner only.
+        """
+        if "inv_period" not in self._cache:
+            self.kernel("xx")
+            kxx, kxy, kyy = (scipy.fft.rfft2(self._folded_period(name)).real for name in ("xx", "xy", "yy"))
+            floor = 1e-6 * float(np.abs(kxx).max())
+            kxx = np.maximum(kxx, floor)
+            kyy = np.maximum(kyy, floor)
+            det = kxx * kyy - kxy * kxy
+            det = np.where(det > floor * floor, det, floor * floor)
+            self._cache["inv_period"] = tuple(
+                np.ascontiguousarray(v, dtype=complex) for v in (kyy / det, -kxy / det, kxx / det)
+            )
+        return self._cache["inv_period"]
 
     def inverse_static(self, ux_m: np.ndarray, uy_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Approximate inverse of the static tangential operator: the padded circulant's inverse, by FFT.

@@ -222,6 +222,8 @@ def _gmres(apply, rhs: np.ndarray, rtol: float, max_iterations: int, restart: in
             g[:k_used],
         )
         x = x + _combine(basis, y)
+        if abs(g[k_used]) <= rtol * b_norm or hn == 0.0 or total >= max_iterations:
+            break  # converged: the estimate |g| is the residual of x (exact arithmetic); no extra product
         r = rhs - apply(x)
     return x, total
 
@@ -275,6 +277,8 @@ def solve_tang(
     max_iterations: int = 60,
     coarse_start: bool = True,
     kinetic_friction_coefficient: float | None = None,
+    initial_traction: tuple[np.ndarray, np.ndarray] | None = None,
+    initial_slip: np.ndarray | None = None,
 ) -> TangSolution:
     """Solve TANG for steady rolling or the shift problem (module docstring).
 
@@ -294,7 +298,14 @@ def solve_tang(
         problem: "rolling" (steady state) or "shift" (Cattaneo: one step from the unloaded state).
         tolerance: relative tolerance on the slip residual (and GMRES).
         max_iterations: Newton iteration limit (non-convergence is reported in the result).
-        coarse_start: use the nested-iteration start described above.
+        coarse_start: use the nested-iteration start described above (not with ``initial_traction``).
+        initial_traction: warm start (t_x, t_y), each (ny, nx), Pa, e.g. the solution of a nearby problem on the
+            same grid (the previous iteration of a load equilibrium). Zeroed outside the contact; the elements of
+            ``initial_slip`` (default: those with |t| >= mu_k p) start in slip with the traction scaled onto the
+            bound in its direction, the other contact elements in adhesion. Only the start changes: the solution
+            is the same to the tolerance.
+        initial_slip: bool (ny, nx), the slip area of the warm start (e.g. ``TangSolution.in_slip``); only with
+            ``initial_traction``.
 
     Returns:
         :class:`TangSolution`.
@@ -318,6 +329,13 @@ def solve_tang(
         raise ValueError(f"tolerance = {tolerance!r}: expected > 0")
     if int(max_iterations) < 1:
         raise ValueError(f"max_iterations = {max_iterations!r}: expected >= 1")
+    if initial_traction is not None:
+        if len(initial_traction) != 2 or any(np.shape(a) != shape for a in initial_traction):
+            raise ValueError(f"initial_traction: expected a pair of (ny, nx) = {shape} arrays")
+        if not all(np.isfinite(a).all() for a in initial_traction):
+            raise ValueError("initial_traction: expected finite values")
+    if initial_slip is not None and (initial_traction is None or np.shape(initial_slip) != shape):
+        raise ValueError(f"initial_slip: expected a (ny, nx) = {shape} bool array, with initial_traction")
     rolling = problem == "rolling"
     wx = np.asarray(rigid_slip_x, float)
     wy = np.asarray(rigid_slip_y, float)
@@ -350,17 +368,29 @@ def solve_tang(
     lin_total = 0
     n = shape[0] * shape[1]
     padded = influence.padded_shape
-    buf = np.zeros((2, *padded))  # zero-padded traction pair; only the (ny, nx) corner is ever written
+    buf = np.zeros((2, *shape))  # traction pair on the grid (zero-padded by the pruned FFT passes)
     mixed = np.empty((2, padded[0], padded[1] // 2 + 1), complex)
+    mixed_p = np.empty((2, shape[0], shape[1] // 2 + 1), complex)
     k_roll = influence.tangential_spectra(rolling)
-    k_inv = influence.inverse_static_spectra()
+    k_inv = influence.inverse_static_period_spectra()
     tx = np.zeros(shape)
     ty = np.zeros(shape)
     stick = contact.copy()
     slip = np.zeros(shape, bool)
     theta = np.zeros(shape)
     nx, ny = influence.nx, influence.ny
-    if coarse_start and nx % 2 == 0 and nx >= 32 and (ny == 1 and influence.plane or (ny % 2 == 0 and ny >= 32)):
+    if initial_traction is not None:
+        tx = np.where(contact, np.asarray(initial_traction[0], float), 0.0)
+        ty = np.where(contact, np.asarray(initial_traction[1], float), 0.0)
+        if initial_slip is None:
+            slip = contact & (np.hypot(tx, ty) >= bound)
+        else:
+            slip = contact & np.asarray(initial_slip, bool)
+        stick = contact & ~slip
+        theta = np.where(slip, np.arctan2(ty, tx), 0.0)
+        tx = np.where(slip, bound * np.cos(theta), tx)
+        ty = np.where(slip, bound * np.sin(theta), ty)
+    elif coarse_start and nx % 2 == 0 and nx >= 32 and (ny == 1 and influence.plane or (ny % 2 == 0 and ny >= 32)):
         fy = 1 if influence.plane else 2
         coarse = InfluenceGrid(
             nx // 2,
@@ -447,18 +477,16 @@ def solve_tang(
 
         def matvec(v, kind=kind, idx=idx, nh=nh, gex=gex, gey=gey, e=(epx_g, epy_g, diag_g), size=size):
             _spread(v, kind, idx, nh, gex, gey, buf)
-            spec = scipy.fft.rfft2(buf)
-            _mix(spec, *k_roll, mixed)
-            u = scipy.fft.irfft2(mixed, s=padded)
+            _mix(influence._forward(buf), *k_roll, mixed)
+            u = influence._backward(mixed)
             out = np.empty(size)
             _gather_residual(u, v, kind, idx, nh, *e, out)
             return out
 
         def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, ahead_g=ahead_g, size=size):
             _spread_adhesion(v, kind, idx, nh, buf)
-            spec = scipy.fft.rfft2(buf)
-            _mix(spec, *k_inv, mixed)
-            u = scipy.fft.irfft2(mixed, s=padded)
+            _mix(scipy.fft.rfft2(buf), *k_inv, mixed_p)
+            u = scipy.fft.irfft2(mixed_p, s=shape)
             out = np.empty(size)
             _precondition_out(u, v, kind, idx, nh, self_g, ahead_g, influence.dx_m, rolling, out)
             return out
