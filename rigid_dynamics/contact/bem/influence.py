@@ -47,6 +47,7 @@ sizes (m). Displacements per unit traction: m/Pa.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -232,6 +233,12 @@ def strip_influence(
     }
 
 
+SHARED_CACHE_GRIDS = 16
+"""Number of grids (by nx, ny, dx, dy and elastic constants) whose coefficients and spectra are kept for reuse."""
+
+_SHARED_CACHES: OrderedDict = OrderedDict()
+
+
 @dataclass(frozen=True, eq=False)
 class InfluenceGrid:
     """Influence coefficients of a regular nx x ny grid of rectangular elements, applied by FFT.
@@ -248,7 +255,9 @@ class InfluenceGrid:
       (Kalker 1990, sec. 5.2: the previous position of a particle is dx ahead).
 
     The convolution is a zero-padded FFT (period >= 2n - 1 along each axis, so no wrap-around),
-    O(N log N) time and O(N) memory; no dense N x N matrix is formed.
+    O(N log N) time and O(N) memory; no dense N x N matrix is formed. Coefficients and spectra are computed
+    lazily and shared by the grids of equal parameters (the last ``SHARED_CACHE_GRIDS`` distinct ones), so that
+    the repeated solves on one patch grid (e.g. a load equilibrium) compute them once.
 
     Attributes:
         nx, ny: number of elements along x and y.
@@ -284,6 +293,22 @@ class InfluenceGrid:
             raise ValueError(f"ny = {self.ny!r}: the 2-D (plane) mode expects ny = 1")
         if self.plane and self.difference_parameter != 0.0:
             raise ValueError(f"difference_parameter = {self.difference_parameter!r}: expected 0 in the 2-D mode")
+        key = (
+            int(self.nx),
+            int(self.ny),
+            float(self.dx_m),
+            float(self.dy_m),
+            float(self.shear_modulus_Pa),
+            float(self.poisson_ratio),
+            float(self.difference_parameter),
+            bool(self.plane),
+        )
+        shared = _SHARED_CACHES.get(key)
+        if shared is not None and not self._cache:
+            # the coefficients are functions of the key alone: share them with the earlier grid of the same key
+            _SHARED_CACHES.move_to_end(key)
+            object.__setattr__(self, "_cache", shared)
+            return
         shape = (
             scipy.fft.next_fast_len(2 * int(self.ny) - 1, real=True) if self.ny > 1 else 1,
             scipy.fft.next_fast_len(2 * int(self.nx) - 1, real=True),
@@ -292,6 +317,9 @@ class InfluenceGrid:
         self._cache["static"] = {}
         self._cache["rolling"] = {}
         self._cache["fft"] = {}
+        _SHARED_CACHES[key] = self._cache
+        while len(_SHARED_CACHES) > SHARED_CACHE_GRIDS:
+            _SHARED_CACHES.popitem(last=False)
 
     def _compute_kernels(self, names: tuple[str, ...]) -> None:
         """Fill the static and rolling coefficient caches for ``names`` (lazily: NORM needs only zz)."""

@@ -428,6 +428,14 @@ def solve_tang(
         tx = np.where(slip, bound * np.cos(theta), tx)
         ty = np.where(slip, bound * np.sin(theta), ty)
         lin_total += first.linear_iterations
+
+    def _sets_hold() -> bool:
+        """The warm start's sets are consistent: adhesion within the bound, slip opposing the traction."""
+        sx, sy = fresh if fresh is not None else slip_of(tx, ty)
+        over = stick & (np.hypot(tx, ty) > bound_static)
+        wrong = slip & ((np.cos(theta) * sx + np.sin(theta) * sy) > 0)
+        return not (over.any() or wrong.any())
+
     converged = False
     residual = math.inf
     it = 0
@@ -435,6 +443,7 @@ def solve_tang(
     fresh = None  # slip of the current tractions, when already known
     for it in range(1, int(max_iterations) + 1):
         sx, sy = slip_of(tx, ty) if fresh is None else fresh
+        fresh = (sx, sy)
         ex, ey = np.cos(theta), np.sin(theta)
         # residual: adhesion s (2 rows), slip e_perp . s (1 row); e_perp = (-ey, ex)
         s_perp = -ey * sx + ex * sy
@@ -442,7 +451,7 @@ def solve_tang(
         res_h = np.hypot(sx, sy)[stick]
         res_s = np.abs(s_perp[slip])
         residual = max(res_h.max() if res_h.size else 0.0, res_s.max() if res_s.size else 0.0) / scale
-        if residual < tolerance and it > 1:
+        if residual < tolerance and (it > 1 or (initial_traction is not None and _sets_hold())):
             converged = True
             break
         # compact unknowns: adhesion (t_x, t_y) increments, then slip angle increments
