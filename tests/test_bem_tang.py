@@ -223,3 +223,26 @@ def test_period_preconditioner_inverts_the_folded_circulant():
     sym = 0.5 * (dense + dense.T) @ t.reshape(-1)
     assert np.abs(sym - u.reshape(-1)).max() < 1e-9 * np.abs(u).max()
     assert np.abs(back - u.reshape(-1)).max() < 0.05 * np.abs(u).max()
+
+
+def test_coarse_start_on_odd_grid_same_solution():
+    """Regression: the nested-iteration start on an odd grid (33 x 35, padded for merging) gives the solution of the
+    plain start to the tolerance."""
+    g_mod, nu, radius, force = 82e9, 0.28, 0.3, 2e4
+    e_star = g_mod / (1 - nu)
+    a = (3 * force * radius / (4 * e_star)) ** (1 / 3)
+    d = 2.2 * a / 34
+    x = -1.1 * a + d * (np.arange(33) + 0.5)
+    y = -1.1 * a + d * (np.arange(35) + 0.5)
+    xx, yy = np.meshgrid(x, y)
+    grid = InfluenceGrid(33, 35, d, d, g_mod, nu)
+    p = solve_norm(grid, (xx**2 + yy**2) / (2 * radius), normal_force_N=force).pressure_Pa
+    w = rigid_slip(x, y, 2e-4, -6e-4, 0.6)
+    plain = solve_tang(grid, p, 0.3, *w, coarse_start=False)
+    nested = solve_tang(grid, p, 0.3, *w)
+    assert plain.converged and nested.converged
+    mu_fn = 0.3 * p.sum()
+    assert abs(nested.traction_x_Pa.sum() - plain.traction_x_Pa.sum()) < 1e-6 * mu_fn
+    assert abs(nested.traction_y_Pa.sum() - plain.traction_y_Pa.sum()) < 1e-6 * mu_fn
+    assert (nested.in_slip == plain.in_slip).all()
+    assert nested.iterations <= plain.iterations

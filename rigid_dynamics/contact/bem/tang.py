@@ -282,10 +282,11 @@ def solve_tang(
 ) -> TangSolution:
     """Solve TANG for steady rolling or the shift problem (module docstring).
 
-    Nested iteration: on grids of at least 32 x 32 elements (even counts), the problem is first solved
-    on the grid of 2 x 2 merged elements (pressure and rigid slip averaged) and its tractions and slip
-    area start the Newton iteration on the fine grid; this keeps the number of Newton steps small. The coarse
-    problem is solved to a relative residual of 1e-2 only (its discretisation error is larger than that).
+    Nested iteration: on grids of at least 32 x 32 elements, the problem is first solved on the grid of
+    2 x 2 merged elements (pressure and rigid slip averaged; odd counts padded with one element of zero
+    pressure) and its tractions and slip area start the Newton iteration on the fine grid; this keeps the
+    number of Newton steps small. The coarse problem is solved to a relative residual of 1e-2 only (its
+    discretisation error is larger than that).
 
     Args:
         influence: grid and influence coefficients.
@@ -390,11 +391,12 @@ def solve_tang(
         theta = np.where(slip, np.arctan2(ty, tx), 0.0)
         tx = np.where(slip, bound * np.cos(theta), tx)
         ty = np.where(slip, bound * np.sin(theta), ty)
-    elif coarse_start and nx % 2 == 0 and nx >= 32 and (ny == 1 and influence.plane or (ny % 2 == 0 and ny >= 32)):
+    elif coarse_start and nx >= 32 and (ny == 1 and influence.plane or ny >= 32):
         fy = 1 if influence.plane else 2
+        px, py = nx % 2, ny % fy  # odd counts: one element of zero pressure appended for the merging
         coarse = InfluenceGrid(
-            nx // 2,
-            ny // fy,
+            (nx + px) // 2,
+            (ny + py) // fy,
             2 * influence.dx_m,
             fy * influence.dy_m,
             influence.shear_modulus_Pa,
@@ -404,10 +406,11 @@ def solve_tang(
         )
 
         def restrict(a: np.ndarray) -> np.ndarray:
-            return a.reshape(ny // fy, fy, nx // 2, 2).mean(axis=(1, 3))
+            a = np.pad(a, ((0, py), (0, px)))
+            return a.reshape((ny + py) // fy, fy, (nx + px) // 2, 2).mean(axis=(1, 3))
 
         def prolong(a: np.ndarray) -> np.ndarray:
-            return np.repeat(np.repeat(a, fy, axis=0), 2, axis=1)
+            return np.repeat(np.repeat(a, fy, axis=0), 2, axis=1)[:ny, :nx]
 
         first = solve_tang(
             coarse,
