@@ -24,12 +24,16 @@ then min(0.1, max(0.1 residual, 0.3 tolerance/residual)))
 whose matrix-vector products are FFT convolutions (O(N log N), no dense matrix). Right preconditioner:
 for rolling the operator factors exactly as L = C o D, D t = (t_I - t_(I+e_x))/dx (the upwind difference
 acting on the traction; both are convolutions), so D^-1 is a cumulative sum from the leading edge;
-C^-1 is approximated by the inverse of the zero-padded circulant (FFT). The slip rows keep their
+C^-1 is approximated by the inverse of the circulant on the grid's own (ny, nx) period with the kernels
+folded onto it (Vollebregt's FFT preconditioner, as NORM's; a quarter of the padded FFT size:
+:meth:`~.influence.InfluenceGrid.inverse_static_period_spectra`). The slip rows keep their
 diagonal and their strong coupling to the slip element ahead (the rolling kernel at offset -e_x is
 about minus the self-coefficient): that bidiagonal part is solved exactly along each row from the
 leading edge (for the shift problem only the diagonal). The scatter/gather and the 2 x 2 spectral
 products of each GMRES step are numba kernels around two batched real FFT pairs (one for the
-operator, one for the preconditioner). Between steps, adhesion elements whose traction exceeds
+operator, zero-padded with the padding rows skipped along x; one for the preconditioner, unpadded).
+A warm start (``initial_traction``, ``initial_slip``: the solution of a nearby problem) replaces the
+nested-iteration start; times: benchmarks/results/bem_tang.md. Between steps, adhesion elements whose traction exceeds
 the bound move to S and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
 Linearisation of the slip-element equation (derivative of e_perp . s with respect to theta)::
 
@@ -302,7 +306,7 @@ def solve_tang(
         coarse_start: use the nested-iteration start described above (not with ``initial_traction``).
         initial_traction: warm start (t_x, t_y), each (ny, nx), Pa, e.g. the solution of a nearby problem on the
             same grid (the previous iteration of a load equilibrium). Zeroed outside the contact; the elements of
-            ``initial_slip`` (default: those with |t| >= mu_k p) start in slip with the traction scaled onto the
+            ``initial_slip`` (default: those with |t| >= 0.99 mu_k p) start in slip with the traction scaled onto the
             bound in its direction, the other contact elements in adhesion. Only the start changes: the solution
             is the same to the tolerance.
         initial_slip: bool (ny, nx), the slip area of the warm start (e.g. ``TangSolution.in_slip``); only with
@@ -384,7 +388,7 @@ def solve_tang(
         tx = np.where(contact, np.asarray(initial_traction[0], float), 0.0)
         ty = np.where(contact, np.asarray(initial_traction[1], float), 0.0)
         if initial_slip is None:
-            slip = contact & (np.hypot(tx, ty) >= bound)
+            slip = contact & (np.hypot(tx, ty) >= 0.99 * bound)
         else:
             slip = contact & np.asarray(initial_slip, bool)
         stick = contact & ~slip
