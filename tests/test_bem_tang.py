@@ -190,6 +190,11 @@ def test_grids_of_equal_parameters_share_coefficients():
     fresh = InfluenceGrid(12, 10, 1e-4, 1e-4, 82e9, 0.3)
     assert fresh.kernel("xx", True) is not c.kernel("xx", True)
     np.testing.assert_array_equal(fresh.kernel("xx", True), c.kernel("xx", True))
+    for n in range(20):  # bounded: at most 16 grids, at most 100 000 elements in all (the newest always kept)
+        InfluenceGrid(4 + n, 4, 1e-4, 1e-4, 82e9, 0.28)
+    assert len(_SHARED_CACHES) == 16
+    InfluenceGrid(320, 320, 1e-4, 1e-4, 82e9, 0.28)
+    assert list(_SHARED_CACHES) == [(320, 320, 1e-4, 1e-4, 82e9, 0.28, 0.0, False)]
 
 
 def test_period_preconditioner_inverts_the_folded_circulant():

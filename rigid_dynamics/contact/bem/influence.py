@@ -235,6 +235,8 @@ def strip_influence(
 
 SHARED_CACHE_GRIDS = 16
 """Number of grids (by nx, ny, dx, dy and elastic constants) whose coefficients and spectra are kept for reuse."""
+SHARED_CACHE_ELEMENTS = 100_000
+"""Bound on the summed elements of the kept grids (about 0.7 kB each for all kernels; the newest grid is kept)."""
 
 _SHARED_CACHES: OrderedDict = OrderedDict()
 
@@ -256,7 +258,8 @@ class InfluenceGrid:
 
     The convolution is a zero-padded FFT (period >= 2n - 1 along each axis, so no wrap-around),
     O(N log N) time and O(N) memory; no dense N x N matrix is formed. Coefficients and spectra are computed
-    lazily and shared by the grids of equal parameters (the last ``SHARED_CACHE_GRIDS`` distinct ones), so that
+    lazily and shared by the grids of equal parameters (the last ``SHARED_CACHE_GRIDS`` distinct ones, within
+    ``SHARED_CACHE_ELEMENTS`` elements in all), so that
     the repeated solves on one patch grid (e.g. a load equilibrium) compute them once.
 
     Attributes:
@@ -318,7 +321,9 @@ class InfluenceGrid:
         self._cache["rolling"] = {}
         self._cache["fft"] = {}
         _SHARED_CACHES[key] = self._cache
-        while len(_SHARED_CACHES) > SHARED_CACHE_GRIDS:
+        while len(_SHARED_CACHES) > SHARED_CACHE_GRIDS or (
+            len(_SHARED_CACHES) > 1 and sum(k[0] * k[1] for k in _SHARED_CACHES) > SHARED_CACHE_ELEMENTS
+        ):
             _SHARED_CACHES.popitem(last=False)
 
     def _compute_kernels(self, names: tuple[str, ...]) -> None:
