@@ -34,6 +34,7 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
+import rigid_dynamics.contact.bem.influence as influence_module  # noqa: E402
 import rigid_dynamics.contact.bem.model as bem_model  # noqa: E402
 from comparisons.manchester import MATERIAL, a22_case, default_model_options  # noqa: E402
 from rigid_dynamics.contact.bem.influence import _SHARED_CACHES, InfluenceGrid  # noqa: E402
@@ -62,12 +63,19 @@ def load_baseline(commit: str):
     return module.solve_tang
 
 
-def record(run) -> list[dict]:
-    """The TANG calls made while ``run()`` executes: grid, inputs and keyword options of each."""
+def record(run, timing: dict | None = None) -> list[dict]:
+    """The TANG calls made while ``run()`` executes: grid, inputs and keyword options of each.
+
+    ``timing``: filled with the CPU time of ``run()`` and of the TANG calls in it (s).
+    """
     calls = []
     original = bem_model.solve_tang
+    spent = [0.0]
 
     def recorder(influence, pressure, mu, wx, wy, **kw):
+        c0 = time.process_time()
+        out = original(influence, pressure, mu, wx, wy, **kw)
+        spent[0] += time.process_time() - c0
         calls.append(
             {
                 "grid": (influence.nx, influence.ny, influence.dx_m, influence.dy_m),
@@ -76,13 +84,16 @@ def record(run) -> list[dict]:
                 "kw": dict(kw),
             }
         )
-        return original(influence, pressure, mu, wx, wy, **kw)
+        return out
 
     bem_model.solve_tang = recorder
+    c0 = time.process_time()
     try:
         run()
     finally:
         bem_model.solve_tang = original
+    if timing is not None:
+        timing.update(case_cpu_s=time.process_time() - c0, tang_cpu_s=spent[0])
     return calls
 
 
@@ -181,6 +192,11 @@ def summarise(group: dict) -> dict:
         out["max_warm_df_over_mu_fn"] = max(r["warm_df_over_mu_fn"] for r in warm_rows)
     out["all_converged"] = all(r["converged"] for r in rows)
     out["coefficients_ms_per_grid"] = 1e3 * group["coefficients_cpu_s_per_grid"]
+    if "case_timing" in group:
+        out["case_cpu_ms"] = 1e3 * group["case_timing"]["case_cpu_s"]
+        out["tang_cpu_ms_in_case"] = 1e3 * group["case_timing"]["tang_cpu_s"]
+        out["baseline_case_cpu_ms"] = 1e3 * group["case_timing"]["baseline_case_cpu_s"]
+        out["baseline_tang_cpu_ms_in_case"] = 1e3 * group["case_timing"]["baseline_tang_cpu_s"]
     return out
 
 
@@ -207,12 +223,27 @@ def main(steps, baseline_commit):
     baseline = load_baseline(baseline_commit)
     groups = []
     for step in steps:
-        calls = record(
-            lambda step=step: solve_wheelset_case(
-                a22_case(step), MATERIAL, "bem", {"model": default_model_options("bem")}
-            )
-        )
+
+        def case(step=step):
+            return solve_wheelset_case(a22_case(step), MATERIAL, "bem", {"model": default_model_options("bem")})
+
+        case()  # warm-up (JIT, caches)
+        _SHARED_CACHES.clear()
+        timing = {}
+        calls = record(case, timing)
         groups.append(solve_group(f"A-2.2 step {step}", calls, baseline))
+        # the same case as before: the baseline's TANG and no coefficients shared between grids
+        before = {}
+        bem_model.solve_tang, keep = baseline, influence_module.SHARED_CACHE_GRIDS
+        influence_module.SHARED_CACHE_GRIDS = 0
+        try:
+            _SHARED_CACHES.clear()
+            record(case, before)
+        finally:
+            bem_model.solve_tang = solve_tang
+            influence_module.SHARED_CACHE_GRIDS = keep
+        timing.update(baseline_case_cpu_s=before["case_cpu_s"], baseline_tang_cpu_s=before["tang_cpu_s"])
+        groups[-1]["case_timing"] = timing
         print(json.dumps(summarise(groups[-1])), flush=True)
     for n in (40, 100):
         groups.append(solve_group(f"large spin {n}x{n}", large_spin_calls(n), baseline))
@@ -272,6 +303,21 @@ def main(steps, baseline_commit):
         cells += [f"{s['max_cold_df_over_mu_fn']:.1e}", *warm, "yes" if s["all_converged"] else "NO"]
         cells.append(f"{s['coefficients_ms_per_grid']:.1f}")
         lines.append("| " + " | ".join(cells) + " |")
+    lines += [
+        "",
+        "Whole wheelset case (after a warm-up run; coefficient caches emptied before each): CPU ms of "
+        "solve_wheelset_case and of its TANG calls, with the current code (cold TANG, as the case calls it today) "
+        "and with the baseline's TANG and no coefficients shared between grids (as before).",
+        "",
+        "| A-2.2 | TANG calls | case ms: baseline -> current | TANG ms in it: baseline -> current |",
+        "|---|---|---|---|",
+    ]
+    for s in summaries:
+        if "case_cpu_ms" in s:
+            lines.append(
+                f"| {s['name']} | {s['calls']} | {s['baseline_case_cpu_ms']:.0f} -> {s['case_cpu_ms']:.0f} | "
+                f"{s['baseline_tang_cpu_ms_in_case']:.0f} -> {s['tang_cpu_ms_in_case']:.0f} |"
+            )
     write_atomic(out / "bem_tang.md", "\n".join(lines) + "\n")
 
 
