@@ -32,9 +32,10 @@ about minus the self-coefficient): that bidiagonal part is solved exactly along 
 leading edge (for the shift problem only the diagonal). The scatter/gather and the 2 x 2 spectral
 products of each GMRES step are numba kernels around two batched real FFT pairs (one for the
 operator, zero-padded with the padding rows skipped along x; one for the preconditioner, unpadded).
-A warm start (``initial_traction``, ``initial_slip``: the solution of a nearby problem) replaces the
-nested-iteration start; times: benchmarks/results/bem_tang.md. Between steps, adhesion elements whose traction exceeds
-the bound move to S and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
+Between steps, adhesion elements whose traction exceeds the bound move to S and slip elements whose
+slip has turned along their traction (e . s > 0) move back to H. A warm start (``initial_traction``,
+``initial_slip``: the solution of a nearby problem) replaces the nested-iteration start; times:
+benchmarks/results/bem_tang.md.
 Linearisation of the slip-element equation (derivative of e_perp . s with respect to theta)::
 
     d(e_perp . s)/d theta = -e . s + e_perp . (L g e_perp)      (-e . s = |s| > 0 at a solution)
