@@ -24,7 +24,11 @@ from wheelrail.scenes import embedded_scenes, load_scene
 def _at_step(name, step_s, duration_s, **changes):
     scene = load_scene(name)
     integ = replace(
-        scene.integrator, fixed_step_s=step_s, output_step_s=max(step_s, scene.integrator.output_step_s), **changes
+        scene.integrator,
+        method="RK4",
+        fixed_step_s=step_s,
+        output_step_s=max(step_s, scene.integrator.output_step_s),
+        **changes,
     )
     return replace(scene, integrator=integ, duration_s=duration_s)
 
@@ -177,3 +181,34 @@ def test_bad_new_keys(tmp_path, capsys, old, new, pattern):
     assert err.startswith("wheelrail: error: ") and "Traceback" not in err and err.count("\n") == 1
     assert re.search(pattern, err), err
     assert not out.exists()
+
+
+def test_python_rk4_estimates_between_output_samples():
+    """Output times that are no step ends (1 ms output, 0.3 ms step): every output sample after the first check
+    still carries the estimate of the steps since the previous sample, so the status is judged on them."""
+    scene = _at_step("hunting-conical", 3e-4, 0.01)
+    scene = replace(scene, integrator=replace(scene.integrator, output_step_s=1e-3), settling_distance_m=0.0)
+    result = simulate(scene)
+    assert not result.compiled and result.status == "ok", result.message
+    estimates = result.force_error_estimate
+    assert np.isnan(estimates[0]) and np.all(np.isfinite(estimates[2:]))
+
+
+def test_stress_summary_counts_and_lists_warnings():
+    from comparisons.stress import summarize
+
+    records = [
+        {"parameter": "fixed_step_s", "value": 5e-4, "status": "ok", "success": True, "message": "reached",
+         "energy_balance_relative": 1e-4, "force_error_estimate": 1e-3},
+        {"parameter": "fixed_step_s", "value": 1e-3, "status": "warning", "success": False,
+         "message": "reached; force error estimate 0.156", "energy_balance_relative": 1e-3,
+         "force_error_estimate": 0.156},
+        {"parameter": "fixed_step_s", "value": 1e-2, "status": "blow-up", "success": False, "message": "boom",
+         "energy_balance_relative": None, "force_error_estimate": None},
+    ]  # fmt: skip
+    report = summarize(records)
+    assert report["finished"] == 2 and report["stopped"] == 1
+    assert report["warnings"] == [
+        {"parameter": "fixed_step_s", "value": 1e-3, "force_error_estimate": 0.156,
+         "message": "reached; force error estimate 0.156"}
+    ]  # fmt: skip

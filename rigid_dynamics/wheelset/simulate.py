@@ -498,10 +498,9 @@ class _Recorder:
         self.limit_y = scene.integrator.max_lateral_displacement_m
         self.flange_angle = scene.track.flange_contact_angle_rad
 
-    def record(self, t: float, full_state: np.ndarray, compare_forces: np.ndarray | None = None) -> None:
-        """Check and store the sample at (t, full_state). ``compare_forces``: per-wheel (normal, longitudinal,
-        lateral creep) forces (2, 3) of the embedded third-order solution at t; the largest difference from this
-        sample's is stored as its force error estimate, N.
+    def record(self, t: float, full_state: np.ndarray, error: float = math.nan) -> None:
+        """Check and store the sample at (t, full_state) with the force error estimate of the steps since the last
+        sample (N; NaN: none).
         """
         state = full_state[:12]
         if not np.all(np.isfinite(full_state)):
@@ -516,9 +515,6 @@ class _Recorder:
                 table[name][side, slot] = contact.values[name][k]
         forces = np.zeros((2, 3))
         np.add.at(forces, contact.side, contact.force_N)
-        error = math.nan
-        if compare_forces is not None:
-            error = float(np.max(np.abs(_side_force_sums(table) - compare_forces)))
         self.append(t, full_state, table, forces, error)
 
     def append(
@@ -1074,50 +1070,57 @@ def _run_compiled(model, packed, y0, duration, settings, recorder, report, start
 
 
 def _run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
-    """Classical RK4 with a fixed step on the Python right-hand side ``fun``. At every output time that a step ends
-    on, the step is also advanced by the embedded third-order formula (y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6), k5 =
-    f(t + h, y4), compiled.rk4_run) and the contact forces at y3 are handed to the recorder, which stores their
-    largest difference from the sample's forces as the force error estimate. Other output times are interpolated
-    (cubic Hermite) and carry no estimate.
+    """Classical RK4 with a fixed step on the Python right-hand side ``fun``, output by cubic Hermite interpolation.
+
+    Force error estimate (as compiled.rk4_run): every ``round(output_step_s / h)`` steps the step is also advanced
+    by the embedded third-order formula, y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) with k5 = f(t + h, y4) (the next
+    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept; each output sample
+    carries the largest estimate of the checks since the previous sample (two extra contact evaluations per check).
     """
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
+    check_every = max(1, int(round(settings.output_step_s / h)))
     y = y0.copy()
     t = 0.0
     next_out = 1
     k1 = None
+    pending = math.nan
     for i in range(n_steps):
         try:
             k1 = fun(t, y) if k1 is None else k1
             k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
             k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
             k4 = fun(t + h, y + h * k3)
+            y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            t_new = (i + 1) * h
+            k_next = None
+            if (i + 1) % check_every == 0:
+                k_next = fun(t_new, y_new)
+                y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
+                try:
+                    error = float(np.max(np.abs(_contact_force_sums(model, y_new) - _contact_force_sums(model, y3))))
+                except ContactFailure:
+                    error = math.inf
+                pending = error if math.isnan(pending) else max(pending, error)
         except _Stop as stop:
             stop.steps = i
             raise
-        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        t_new = (i + 1) * h
-        k_next = None
         while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
             t_out = out_times[next_out]
             # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
             s = (t_out - t) / h
+            if abs(s - 1.0) < 1e-9:
+                y_out = y_new
+            else:
+                h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+                h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+                y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
             try:
-                if abs(s - 1.0) < 1e-9:
-                    k_next = fun(t_new, y_new)
-                    y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
-                    try:
-                        compare = _contact_force_sums(model, y3)
-                    except ContactFailure:
-                        compare = np.full((2, 3), np.inf)
-                    recorder.record(t_out, y_new, compare)
-                else:
-                    h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-                    h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-                    recorder.record(t_out, h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4)
+                recorder.record(t_out, y_out, pending)
             except _Stop as stop:
                 stop.steps = i + 1
                 raise
+            pending = math.nan
             next_out += 1
         y, t, k1 = y_new, t_new, k_next
         report(t)
