@@ -569,6 +569,10 @@ class _Recorder:
             side = SIDES[int(np.argmin(touching))]
             raise _Stop("wheel-lift", f"the {side} wheel lost contact at t = {t:.6g} s", t, state)
 
+    def set_last_error(self, error: float) -> None:
+        """Set the force error estimate of the last sample (N; NaN: none)."""
+        self.errors[-1] = np.array([error], float)
+
     def append_many(self, times, full_states, tables: dict, forces, errors) -> None:
         """Vectorised :meth:`append` for many samples (tables: name -> (n, 2, 2); forces (n, 2, 3); errors (n,))."""
         n = len(times)
@@ -1074,8 +1078,10 @@ def _run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) ->
 
     Force error estimate (as compiled.rk4_run): every ``round(output_step_s / h)`` steps the step is also advanced
     by the embedded third-order formula, y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) with k5 = f(t + h, y4) (the next
-    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept; each output sample
-    carries the largest estimate of the checks since the previous sample (two extra contact evaluations per check).
+    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept (two extra contact
+    evaluations per check). An output sample at the step's end carries the estimate of that step, other samples
+    the largest of the checks since the previous sample. The samples are recorded (and checked for anomalies)
+    before the estimate is evaluated; a third-order state whose contact cannot be evaluated gives an infinite one.
     """
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
@@ -1091,37 +1097,46 @@ def _run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) ->
             k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
             k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
             k4 = fun(t + h, y + h * k3)
-            y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            t_new = (i + 1) * h
-            k_next = None
-            if (i + 1) % check_every == 0:
-                k_next = fun(t_new, y_new)
-                y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
-                try:
-                    error = float(np.max(np.abs(_contact_force_sums(model, y_new) - _contact_force_sums(model, y3))))
-                except ContactFailure:
-                    error = math.inf
-                pending = error if math.isnan(pending) else max(pending, error)
         except _Stop as stop:
             stop.steps = i
             raise
+        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        t_new = (i + 1) * h
+        at_end = False
         while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
             t_out = out_times[next_out]
             # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
             s = (t_out - t) / h
             if abs(s - 1.0) < 1e-9:
-                y_out = y_new
+                y_out, at_end = y_new, True
             else:
                 h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
                 h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
                 y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
             try:
-                recorder.record(t_out, y_out, pending)
+                recorder.record(t_out, y_out, math.nan if at_end else pending)
             except _Stop as stop:
                 stop.steps = i + 1
                 raise
-            pending = math.nan
+            if not at_end:
+                pending = math.nan
             next_out += 1
+        k_next = None
+        if (i + 1) % check_every == 0:
+            try:
+                k_next = fun(t_new, y_new)
+            except _Stop as stop:
+                stop.steps = i + 1
+                raise
+            y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
+            try:
+                error = float(np.max(np.abs(_contact_force_sums(model, y_new) - _contact_force_sums(model, y3))))
+            except (ContactFailure, ValueError, ArithmeticError):
+                error = math.inf
+            pending = error if math.isnan(pending) else max(pending, error)
+        if at_end:
+            recorder.set_last_error(pending)
+            pending = math.nan
         y, t, k1 = y_new, t_new, k_next
         report(t)
     return n_steps
