@@ -23,13 +23,8 @@ from wheelrail.scenes import embedded_scenes, load_scene
 
 def _at_step(name, step_s, duration_s, **changes):
     scene = load_scene(name)
-    integ = replace(
-        scene.integrator,
-        method="RK4",
-        fixed_step_s=step_s,
-        output_step_s=max(step_s, scene.integrator.output_step_s),
-        **changes,
-    )
+    changes.setdefault("output_step_s", max(step_s, scene.integrator.output_step_s))
+    integ = replace(scene.integrator, method="RK4", fixed_step_s=step_s, **changes)
     return replace(scene, integrator=integ, duration_s=duration_s)
 
 
@@ -70,6 +65,18 @@ def test_status_flags_coarse_steps(name, step_s, duration_s, status):
         assert summary["force_error_estimate"] > result.scene.integrator.force_tolerance
     else:
         assert summary["force_error_estimate"] < result.scene.integrator.force_tolerance
+
+
+def test_sparse_output_still_checks_the_impacts():
+    """Output every 10 ms (an impact lasts about 3 ms): the checks run at least every millisecond of simulated time
+    (simulate.FORCE_CHECK_INTERVAL_S), so the coarse 0.5 ms step is still flagged, with an estimate of the size of
+    the one checked at every step."""
+    sparse = simulate(_at_step("wheel-flat", 5e-4, 0.25, output_step_s=1e-2))
+    dense = simulate(_at_step("wheel-flat", 5e-4, 0.25, output_step_s=5e-4))
+    assert len(sparse.t) == 26 and sparse.status == "warning", sparse.message
+    worst_sparse, worst_dense = np.nanmax(sparse.force_error_estimate), np.nanmax(dense.force_error_estimate)
+    print("sparse", worst_sparse, "dense", worst_dense)
+    assert worst_sparse > 0.3 * worst_dense
 
 
 def test_wheel_flat_at_5_ms_is_not_ok():
