@@ -219,3 +219,22 @@ def test_stress_summary_counts_and_lists_warnings():
         {"parameter": "fixed_step_s", "value": 1e-3, "force_error_estimate": 0.156,
          "message": "reached; force error estimate 0.156"}
     ]  # fmt: skip
+
+
+def test_cli_run_reports_the_warning(tmp_path, capsys):
+    """The status reaches the CLI line (exit status 1) and summary.json."""
+    import json
+
+    text = embedded_scenes()["wheel-flat"].read_text()
+    for old, new in (("fixed_step_s = 5.0e-5", "fixed_step_s = 1.0e-3"), ("duration_s = 0.4", "duration_s = 0.25")):
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / "coarse.toml"
+    path.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--quiet", "--no-plots"]) == 1
+    line = capsys.readouterr().out
+    assert "coarse: warning - reached t = 0.25 s; force error estimate" in line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "warning" and summary["force_error_estimate"] > summary["force_tolerance"] == 0.02
+    assert summary["peaks"]["normal_force_N"]["left"]["position_m"] >= summary["settling_distance_m"]
