@@ -558,7 +558,11 @@ def rk4_run(
                 worst = 0.0
                 for sd in range(2):
                     for k in range(3):
-                        worst = max(worst, abs(f4[sd, k] - f3[sd, k]))
+                        d = abs(f4[sd, k] - f3[sd, k])
+                        if d != d:  # NaN: forces not computable at one of the two states
+                            worst = np.inf
+                        elif d > worst:
+                            worst = d
             if not pending >= worst:  # also when pending is NaN
                 pending = worst
             for i in range(nst):

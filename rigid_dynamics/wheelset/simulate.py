@@ -1215,6 +1215,8 @@ def _run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) ->
                 error = float(np.max(np.abs(_contact_force_sums(model, y_new) - _contact_force_sums(model, y3))))
             except (ContactFailure, ValueError, ArithmeticError):
                 error = math.inf
+            if math.isnan(error):  # forces not computable at one of the two states
+                error = math.inf
             pending = error if math.isnan(pending) else max(pending, error)
         if at_end:
             recorder.set_last_error(pending)
