@@ -200,7 +200,8 @@ def main():
         "cpu_count": os.cpu_count(),
         "python": platform.python_version(),
         "numpy": np.__version__,
-        "note": "one process on a 2-core machine shared with other jobs (load average 5-7 during the run: timings scatter and run slow)",
+        "note": "one process on a 2-core machine shared with other jobs "
+        "(load average 5-7 during the run: timings scatter and run slow)",
     }
     write(records, machine)
 
