@@ -302,6 +302,8 @@ def cmd_stress(args) -> int:
         f"stress sweep of {source.stem}: {len(report['runs'])} runs ({report['finished']} finished, "
         f"{report['stopped']} stopped) on {workers} worker{'s' if workers > 1 else ''}"
     )
+    for run in report.get("warnings", []):
+        _print(f"stress sweep of {source.stem}: {run['parameter']} = {run['value']:g}: warning - {run['message']}")
     for run in report.get("energy_suspect", []):
         _print(
             f"stress sweep of {source.stem}: {run['parameter']} = {run['value']:g} finished with an energy balance "

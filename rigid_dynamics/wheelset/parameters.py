@@ -287,6 +287,15 @@ class IntegratorSettings:
             anomaly (status "force-anomaly").
         max_lateral_displacement_m: |y| beyond this ends the run (status "derailed"), m.
         stop_at_wheel_lift: end the run (status "wheel-lift") when a wheel loses contact.
+        force_tolerance: RK4 only: the largest accepted force error estimate of a step (the per-wheel normal,
+            longitudinal and lateral creep force of RK4 against its embedded third-order solution, simulate.py),
+            relative to the static wheel load, over the samples after the scene's settling distance (the start-up
+            before it is reported apart); a run that finishes above it ends with status "warning". The default
+            0.02 passes the embedded scenes at their own steps and flags the coarser steps at which their force
+            results move (benchmarks/results/step_sensitivity.md).
+        lift_half_step_check: RK4 only: when a wheel lifts off after the settling distance, run the scene again at
+            half the step and compare the settled peaks against ``force_tolerance`` (the re-impacts after a lift
+            move with the step while the local estimate stays small; about three times the cost of the run).
     """
 
     method: str = "RK45"
@@ -300,11 +309,14 @@ class IntegratorSettings:
     max_force_factor: float = 50.0
     max_lateral_displacement_m: float = 0.05
     stop_at_wheel_lift: bool = False
+    force_tolerance: float = 0.02
+    lift_half_step_check: bool = True
 
     def __post_init__(self) -> None:
         _check_finite(
             self,
             positive=[
+                "force_tolerance",
                 "relative_tolerance",
                 "absolute_tolerance",
                 "fixed_step_s",
@@ -330,7 +342,13 @@ class InitialConditions:
         lateral_velocity_m_per_s: y'(0), m/s.
         yaw_rate_rad_per_s: psi'(0), rad/s.
         vertical_velocity_m_per_s: z'(0), m/s (z down).
-        longitudinal_creepage: initial slip of the spin, phi'(0) = (1 - xi0) V / r0 (dimensionless).
+        longitudinal_creepage: xi0, initial slip of the spin, phi'(0) = (1 - xi0) V / r_roll (dimensionless), r_roll
+            the mean rolling radius of the two wheels at the initial equilibrium pose (simulate.consistent_start):
+            0 starts rolling without a common longitudinal creepage.
+        free_rolling: start on the free-rolling path: the yaw rate is solved together with the spin rate so that
+            the creep forces exert no yaw and no spin moment at t = 0 (no creep-force spike;
+            simulate.consistent_start); ``yaw_rate_rad_per_s`` is then the starting guess. False keeps the given
+            yaw rate (an offset wheelset then starts with the creepages of its rolling-radius difference).
     """
 
     lateral_displacement_m: float = 0.0
@@ -339,6 +357,7 @@ class InitialConditions:
     yaw_rate_rad_per_s: float = 0.0
     vertical_velocity_m_per_s: float = 0.0
     longitudinal_creepage: float = 0.0
+    free_rolling: bool = True
 
     def __post_init__(self) -> None:
         _check_finite(self)
@@ -360,6 +379,11 @@ class DynamicsScene:
         contact_provider: "auto" (conical analytic for conical wheels, tables for ideal geometry,
             3-D search with irregularities), "conical", "tables" or "search".
         contact_tolerance: relative force tolerance handed to the "auto" contact model.
+        settling_distance_m: distance travelled from the start after which the summary's peaks are taken (the
+            start-up from the initial offset is not a result), m; the full-run peaks are reported beside them.
+            The default 10 m covers the start-up of the embedded polygonal-wheel scene from its 1 mm offset (two-point
+            contact flips move its peaks with the step over the first 10 m, benchmarks/results/step_sensitivity.md);
+            scenes that start centred set less.
         fastsim_elements_per_strip, fastsim_strips: FASTSIM's grid (nx, ny) when the model is "fastsim" or "auto"
             picks it. 20 x 20 keeps the creep forces within ~0.5 % of a 200 x 200 grid, 15 x 10 within 1 %,
             9 x 8 within 2 % (benchmarks/results/fastsim_grid.md) at 1/2, 1/3 and 1/9 of the cost.
@@ -380,11 +404,14 @@ class DynamicsScene:
     contact_tolerance: float = 0.05
     fastsim_elements_per_strip: int = 20
     fastsim_strips: int = 20
+    settling_distance_m: float = 10.0
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
 
     def __post_init__(self) -> None:
-        _check_finite(self, positive=["speed_m_per_s", "duration_s", "contact_tolerance"])
+        _check_finite(
+            self, positive=["speed_m_per_s", "duration_s", "contact_tolerance"], nonnegative=["settling_distance_m"]
+        )
         if self.contact_provider not in CONTACT_PROVIDERS:
             raise ValueError(
                 f"contact_provider = {self.contact_provider!r}: expected one of {', '.join(CONTACT_PROVIDERS)}"
