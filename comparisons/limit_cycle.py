@@ -103,15 +103,20 @@ def limit_cycle_search(
         )
     runs, branch = [], []
 
+    def usable(result) -> bool:
+        # a run ending in "warning" (its force error estimate above the scene's tolerance: peak forces not
+        # converged, e.g. flange impacts) still gives the lateral amplitude the search needs; it is recorded
+        return result.success or result.status == "warning"
+
     def run(base, speed):
         result = simulate(replace(base, speed_m_per_s=float(speed), duration_s=duration_s))
-        amplitude, persistence = cycle_amplitude(result) if result.success else (math.nan, math.nan)
+        amplitude, persistence = cycle_amplitude(result) if usable(result) else (math.nan, math.nan)
         for _ in range(extensions):  # a slow decay of a large oscillation: run on from where it stopped
-            if not (result.success and amplitude > threshold_m and 0.5 <= persistence < persist_ratio):
+            if not (usable(result) and amplitude > threshold_m and 0.5 <= persistence < persist_ratio):
                 break
             result = simulate(replace(_start_from(base, result), speed_m_per_s=float(speed), duration_s=duration_s))
-            amplitude, persistence = cycle_amplitude(result) if result.success else (math.nan, math.nan)
-        cycle = result.success and amplitude > threshold_m and persistence >= persist_ratio
+            amplitude, persistence = cycle_amplitude(result) if usable(result) else (math.nan, math.nan)
+        cycle = usable(result) and amplitude > threshold_m and persistence >= persist_ratio
         runs.append(
             {
                 "speed_m_per_s": float(speed),
@@ -126,7 +131,7 @@ def limit_cycle_search(
 
     first = replace(scene, initial=replace(scene.initial, lateral_displacement_m=disturbance_m))
     result, cycle = run(first, high_speed_m_per_s)
-    if not result.success:
+    if not usable(result):
         return _outcome(False, "run-failed", f"run at {high_speed_m_per_s:.4g} m/s: {result.message}", None, runs)
     if not cycle:
         message = (
@@ -139,7 +144,7 @@ def limit_cycle_search(
     lower = None
     for speed in np.linspace(high_speed_m_per_s, low_speed_m_per_s, speed_steps + 1)[1:]:
         trial, cycle = run(_start_from(scene, on_cycle), speed)
-        if not trial.success and trial.status != "ok":
+        if not usable(trial):
             return _outcome(False, "run-failed", f"run at {speed:.4g} m/s: {trial.message}", None, runs, branch)
         if not cycle:
             lower = float(speed)
@@ -161,6 +166,9 @@ def limit_cycle_search(
         f"limit cycle (amplitude > {threshold_m * 1e3:.3g} mm) down to {upper:.4g} m/s (amplitude "
         f"{branch[-1][1] * 1e3:.3g} mm), none at {lower:.4g} m/s; {len(runs)} runs"
     )
+    warned = sum(r["status"] == "warning" for r in runs)
+    if warned:
+        message += f" ({warned} ended in warning: force error above tolerance, amplitudes used, peaks not converged)"
     return _outcome(True, "ok", message, upper, runs, branch, (lower, upper))
 
 
