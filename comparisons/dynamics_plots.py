@@ -104,11 +104,16 @@ def plot_stress(records: list[dict], path: str | Path | None = None):
         rows = [r for r in records if r["parameter"] == name]
         for i, key in enumerate(("energy_balance_relative", "max_force_ratio")):
             ax = axes[i, j]
-            for ok, marker, color in ((True, "o", "k"), (False, "x", "tab:red")):
-                pts = [(r["value"], r[key]) for r in rows if r["success"] == ok and r[key] is not None]
+            kinds = (("ok", "o", "k"), ("warning", "^", "tab:orange"), ("stopped", "x", "tab:red"))
+            for kind, marker, color in kinds:
+                pts = [
+                    (r["value"], r[key])
+                    for r in rows
+                    if r[key] is not None and (r["status"] if r["status"] in ("ok", "warning") else "stopped") == kind
+                ]
                 if pts:
                     xs, ys = zip(*pts, strict=True)
-                    ax.plot(xs, ys, marker, color=color, label="finished" if ok else "stopped")
+                    ax.plot(xs, ys, marker, color=color, label=kind)
             ax.set_xscale("log" if all((r["value"] or 0) > 0 for r in rows) else "linear")
             if key == "energy_balance_relative":
                 ax.set_yscale("log")

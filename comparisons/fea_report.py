@@ -19,7 +19,7 @@ Metrics on the BEM grid (cells of equal area; the FEA pressure interpolated bili
 * outline mismatch                     D_O = area(C_fea XOR C_bem) / A_bem  on the grid masks
 
 Writes ``fea_report.json``, ``fea_report.md``, ``fea_vs_bem_<side>_<k>.png`` and the FEA's own
-XDMF/PNG files (``fea_<side>_<k>/``) into the output folder. Under ``mpiexec -n N`` the FEA runs in
+VTU/PNG files (``fea_<side>_<k>/``) into the output folder. Under ``mpiexec -n N`` the FEA runs in
 parallel and rank 0 writes the report files.
 """
 

@@ -13,7 +13,10 @@ good sample with status and failure state). Per run the record holds:
 * ``max_force_ratio``: the largest normal force over the static wheel load (the force anomaly measure;
   the run stops as "force-anomaly" above ``IntegratorSettings.max_force_factor``);
 * ``max_approach_m``: the deepest interpenetration (the constraint measure of an elastic contact);
-* ``max_abs_lateral_displacement_m``, ``real_time_factor``, ``rhs_evaluations``, ``wall_time_s``.
+* ``max_abs_lateral_displacement_m``, ``real_time_factor``, ``rhs_evaluations``, ``wall_time_s``;
+* ``force_error_estimate``: RK4 runs: the largest force error estimate after the settling distance, relative to
+  the static wheel load (SimulationResult.summary); above the scene's ``force_tolerance`` the run ends with status
+  ``"warning"``: it finished, but its forces move with the step.
 
 Besides the statuses of ``simulate``, a record can end as ``"error"`` (the run raised; ``message`` holds the
 exception) or, on dask, ``"worker-lost"`` (the worker process running it died): one bad run never stops the sweep.
@@ -72,6 +75,7 @@ RECORD_FIELDS = (
     "max_force_ratio",
     "max_approach_m",
     "max_abs_lateral_displacement_m",
+    "force_error_estimate",
     "method",
     "provider",
     "contact_model",
@@ -157,6 +161,7 @@ def run_record(result: SimulationResult, parameter: str = "", value: float = mat
         "max_force_ratio": num(force_ratio),
         "max_approach_m": num(max_approach),
         "max_abs_lateral_displacement_m": num(lateral),
+        "force_error_estimate": result.summary().get("force_error_estimate"),
         "method": result.method,
         "provider": result.provider,
         "contact_model": result.contact_model,
@@ -366,13 +371,24 @@ def nonlinear_critical_speed(
 
 
 def summarize(records) -> dict:
-    """``runs``, ``finished``, ``stopped``, ``statuses``, ``max_energy_balance_relative`` and ``energy_suspect``
-    of a sweep's records (see :func:`run_stress_sweep`).
+    """``runs``, ``finished``, ``stopped``, ``statuses``, ``max_energy_balance_relative``, ``energy_suspect`` and
+    ``warnings`` of a sweep's records (see :func:`run_stress_sweep`). Runs with status "ok" or "warning" count as
+    finished; the warnings are listed with their messages.
     """
     statuses: dict[str, int] = {}
     for r in records:
         statuses[r["status"]] = statuses.get(r["status"], 0) + 1
-    finished = [r for r in records if r["success"]]
+    finished = [r for r in records if r["status"] in FINISHED_STATUSES]
+    warnings = [
+        {
+            "parameter": r["parameter"],
+            "value": r["value"],
+            "force_error_estimate": r.get("force_error_estimate"),
+            "message": r["message"],
+        }
+        for r in records
+        if r["status"] == "warning"
+    ]
     energies = [r["energy_balance_relative"] for r in finished if r["energy_balance_relative"] is not None]
     suspect = [
         {"parameter": r["parameter"], "value": r["value"], "energy_balance_relative": r["energy_balance_relative"]}
@@ -386,8 +402,12 @@ def summarize(records) -> dict:
         "statuses": statuses,
         "max_energy_balance_relative": max(energies) if energies else None,
         "energy_suspect": suspect,
+        "warnings": warnings,
     }
 
+
+FINISHED_STATUSES = ("ok", "warning")
+"""Statuses of runs that reached their end time ("warning": with a force error estimate above the tolerance)."""
 
 ENERGY_SUSPECT_RELATIVE = 0.01
 """A finished run whose energy balance (module docstring) exceeds this is listed as suspect by run_stress_sweep:

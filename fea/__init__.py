@@ -3,6 +3,6 @@
 * :mod:`fea.model`: :class:`FeaModel`, the registered ``fea`` contact model.
 * :mod:`fea.solver`: elastic block vs rigid indenter (primal-dual active set).
 * :mod:`fea.two_body`: two elastic bodies with node-to-surface pairing.
-* :mod:`fea.postprocess`, :mod:`fea.output`: pressure field, stresses, XDMF and PNG.
+* :mod:`fea.postprocess`, :mod:`fea.output`: pressure field, stresses, VTU grid and PNG.
 * :mod:`fea.hertz_reference`: closed-form Hertz solutions for sizing and verification.
 """

@@ -22,8 +22,8 @@ Frame: contact frame of the patch (x rolling, y lateral, z normal rail -> wheel)
 for the body below the contact plane, the pressure acts on the wheel along +z. Units SI.
 
 Runs unchanged under ``mpiexec -n N``: the mesh is built on rank 0 and partitioned, every rank
-returns the same :class:`ContactResult` (fields gathered); files are written collectively (XDMF)
-or by rank 0 (PNG).
+returns the same :class:`ContactResult` (fields gathered); the VTU grid is gathered to rank 0, which
+writes it and the PNGs.
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ class FeaOptions:
         grid_points: points per side of the regular output grid of the pressure.
         filter_radius_factor: pressure averaging radius in element sizes (see fea.postprocess).
         stresses: compute subsurface stresses.
-        output_dir: folder for XDMF and PNG output, or None.
+        output_dir: folder for the VTU grid and PNG output, or None.
         min_mesh_quality: smallest accepted minSICN. max_elements: largest accepted element count.
     """
 
@@ -142,7 +142,7 @@ OPTIONS = declare_dataclass(
         "grid_points": {"help": "points per side of the output pressure grid", "minimum": 8},
         "filter_radius_factor": {"help": "pressure averaging radius in element sizes", "minimum": 0},
         "stresses": {"help": "compute subsurface stresses"},
-        "output_dir": {"help": "folder for XDMF and PNG output"},
+        "output_dir": {"help": "folder for the VTU grid and PNG output"},
         "min_mesh_quality": {"help": "smallest accepted minSICN", "minimum": 0, "maximum": 1},
         "max_elements": {"help": "largest accepted element count", "minimum": 1},
     },

@@ -1,7 +1,13 @@
-"""Files of an FE contact solution: XDMF (ParaView) and PNG maps.
+"""Files of an FE contact solution: one VTU grid (ParaView, pyvista, meshio) and PNG maps.
 
-* ``fea_solution.xdmf`` (+ .h5): mesh, displacement u (m), recovered stress tensor (Pa), von Mises (Pa);
-  written collectively by all ranks.
+* ``fea_solution.vtu``: one unstructured grid (linear tetrahedra, coordinates in m) with every field at
+  its nodes, units in the names: ``displacement_m`` (3), ``stress_Pa`` (9, row-major sigma_ij of the
+  recovered nodal stress), ``principal_stress_Pa`` (3, s1 >= s2 >= s3), ``von_mises_Pa``,
+  ``max_shear_Pa`` ((s1 - s3)/2) and, where the mesh has body tags, the cell field ``body``.
+  A P2 displacement is interpolated to the vertices. The grid is gathered to rank 0 under MPI and
+  written by meshio atomically (temporary name + rename). One grid per file: ``meshio.read``,
+  ``pyvista.read`` and ParaView open it as it is (an XDMF with one grid per function, as DOLFINx writes
+  it, is not readable by meshio or pyvista).
 * ``fea_pressure.png``: contact pressure on the contact plane (contact frame x, y in mm) with the
   outline of the contact area (p > 0).
 * ``fea_von_mises_cut.png``: von Mises stress in the plane y = y_c through the patch centre
@@ -15,13 +21,23 @@ from pathlib import Path
 
 import numpy as np
 
-from rigid_dynamics.files import save_figure
+from rigid_dynamics.files import atomic_write, save_figure
+
+FIELD_UNITS = {
+    "displacement_m": "m",
+    "stress_Pa": "Pa",
+    "principal_stress_Pa": "Pa",
+    "von_mises_Pa": "Pa",
+    "max_shear_Pa": "Pa",
+    "body": "physical group tag of the cell",
+}
+"""Fields of ``fea_solution.vtu`` and their units (also in the names)."""
 
 
 def write_outputs(output_dir, sol, stress_fn, fields, domain, spec, young_modulus_Pa, poisson_ratio, comm) -> dict:
-    """Write the XDMF file and the PNG maps into ``output_dir``; return {kind: path}."""
+    """Write the VTU grid and the PNG maps into ``output_dir``; return {kind: path} (same on every rank)."""
     import dolfinx_solver  # noqa: F401
-    from dolfinx import fem, io
+    from dolfinx import fem
 
     from fea import postprocess as post
 
@@ -34,29 +50,102 @@ def write_outputs(output_dir, sol, stress_fn, fields, domain, spec, young_modulu
         stress_fn, _, _ = post.recover_nodal_stress(sol.displacement, young_modulus_Pa, poisson_ratio)
     msh = sol.displacement.function_space.mesh
     S = fem.functionspace(msh, ("Lagrange", 1))
-    vm = fem.Function(S, name="von_mises")
+    V1 = fem.functionspace(msh, ("Lagrange", 1, (3,)))
+    u1 = fem.Function(V1)
+    u1.interpolate(sol.displacement)
+    u1.x.scatter_forward()
+    grid = _gather_vertex_grid(msh, comm, S, u1, stress_fn, getattr(domain, "cell_tags", None))
+    vtu = out / "fea_solution.vtu"
+    if comm.rank == 0:
+        _write_vtu(vtu, *grid)
+    files["vtu"] = str(vtu)
+
     n = S.dofmap.index_map.size_local
     tensors = stress_fn.x.array[: n * 9].reshape(-1, 3, 3)
-    vm.x.array[:n] = post.principal_measures(tensors)["von_mises"]
-    vm.x.scatter_forward()
-    xdmf = out / "fea_solution.xdmf"
-    with io.XDMFFile(comm, str(xdmf), "w") as f:
-        f.write_mesh(msh)
-        f.write_function(sol.displacement)
-        f.write_function(stress_fn)
-        f.write_function(vm)
-    files["xdmf"] = str(xdmf)
-
+    von_mises = post.principal_measures(tensors)["von_mises"]
     coords = S.tabulate_dof_coordinates()[:n]
     yc = spec.center_m[1]
     slab = 1e-9 * spec.half_width_m if domain.symmetry == "quarter" else 0.5 * spec.contact_size_m
     sel = np.abs(coords[:, 1] - yc) <= slab
     xyz_parts = comm.gather(coords[sel], root=0)
-    vm_parts = comm.gather(vm.x.array[:n][sel], root=0)
+    vm_parts = comm.gather(von_mises[sel], root=0)
     if comm.rank == 0:
         cut_xyz, cut_vm = np.concatenate(xyz_parts), np.concatenate(vm_parts)
         files.update(_draw(out, fields, cut_xyz, cut_vm, spec, domain.symmetry))
     return comm.bcast(files, root=0)
+
+
+def _gather_vertex_grid(msh, comm, S, u1, stress_fn, cell_tags):
+    """Vertex coordinates, tetrahedra and vertex fields of the whole mesh on rank 0 (None elsewhere).
+
+    P1 dofs and the vertices of a linear geometry are matched cell by cell (same reference ordering);
+    every rank sends its owned vertices with their global geometry indices and its owned cells.
+    """
+    from fea import postprocess as post
+
+    geometry = msh.geometry
+    gmap = geometry.index_map()
+    n_owned = gmap.size_local
+    n_all = n_owned + gmap.num_ghosts
+    tdim = msh.topology.dim
+    n_cells = msh.topology.index_map(tdim).size_local
+    geom_cells = np.asarray(geometry.dofmaps[0])
+    if geom_cells.shape[1] != 4:
+        raise ValueError(f"mesh geometry with {geom_cells.shape[1]} nodes per cell: expected linear tetrahedra")
+    vertex_to_dof = np.empty(n_all, dtype=np.int64)
+    vertex_to_dof[geom_cells.ravel()] = np.asarray(S.dofmap.list).ravel()
+    dofs = vertex_to_dof[:n_owned]
+    bs_u, bs_s = u1.function_space.dofmap.index_map_bs, stress_fn.function_space.dofmap.index_map_bs
+    disp = u1.x.array.reshape(-1, bs_u)[dofs]
+    stress = stress_fn.x.array.reshape(-1, bs_s)[dofs].reshape(-1, 3, 3)
+    measures = post.principal_measures(stress)
+    global_index = gmap.local_to_global(np.arange(n_all, dtype=np.int32))
+    cells = global_index[geom_cells[:n_cells]]
+    body = None
+    if cell_tags is not None:
+        body = np.full(n_cells, -1, dtype=np.int32)
+        keep = cell_tags.indices < n_cells
+        body[cell_tags.indices[keep]] = cell_tags.values[keep]
+    local = (
+        global_index[:n_owned],
+        geometry.x[:n_owned, :3],
+        cells,
+        {
+            "displacement_m": disp,
+            "stress_Pa": stress.reshape(-1, 9),
+            "principal_stress_Pa": measures["principal"],
+            "von_mises_Pa": measures["von_mises"],
+            "max_shear_Pa": measures["max_shear"],
+        },
+        body,
+    )
+    parts = comm.gather(local, root=0)
+    if comm.rank != 0:
+        return None, None, None, None
+    n_global = gmap.size_global
+    points = np.empty((n_global, 3))
+    point_data = {name: np.empty((n_global, *value.shape[1:])) for name, value in parts[0][3].items()}
+    for index, xyz, _, values, _ in parts:
+        points[index] = xyz
+        for name, value in values.items():
+            point_data[name][index] = value
+    cells = np.concatenate([part[2] for part in parts])
+    cell_data = {}
+    if parts[0][4] is not None:
+        cell_data["body"] = [np.concatenate([part[4] for part in parts])]
+    return points, cells, point_data, cell_data
+
+
+def _write_vtu(path: Path, points, cells, point_data, cell_data) -> None:
+    """Write one tetrahedral grid with meshio (binary, zlib), atomically."""
+    import meshio
+
+    mesh = meshio.Mesh(points, [("tetra", cells)], point_data=point_data, cell_data=cell_data)
+
+    def writer(tmp: Path) -> None:
+        meshio.write(tmp, mesh, file_format="vtu")
+
+    atomic_write(path, writer)
 
 
 def _draw(out: Path, fields, cut_xyz, cut_vm, spec, symmetry) -> dict:

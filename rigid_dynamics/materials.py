@@ -62,3 +62,37 @@ class Material:
 
 STEEL = Material()
 """Wheel and rail steel as in the Manchester Contact Benchmark: G = 82 GPa, nu = 0.28, mu = 0.3."""
+
+
+def combined_from_pair(
+    shear_modulus_1_Pa: float,
+    poisson_ratio_1: float,
+    shear_modulus_2_Pa: float,
+    poisson_ratio_2: float,
+    friction_coefficient: float,
+) -> Material:
+    """Combined constants of two different elastic bodies (Kalker 1990, section 1.4).
+
+    1/G = (1/G1 + 1/G2)/2 and nu/G = (nu1/G1 + nu2/G2)/2. With these, G/(1 - nu) equals Hertz's
+    combined modulus E* of the pair, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Johnson 1985, eq 4.22),
+    so :attr:`Material.combined_modulus_Pa` holds for the pair. The difference parameter
+    K = (G/4) ((1 - 2 nu1)/G1 - (1 - 2 nu2)/G2), which couples normal and tangential problems, is
+    neglected by the quasi-identical theories and not represented.
+
+    Args:
+        shear_modulus_1_Pa, poisson_ratio_1: G1 (Pa) and nu1 of the first body (e.g. the wheel).
+        shear_modulus_2_Pa, poisson_ratio_2: G2 (Pa) and nu2 of the second body (e.g. the rail).
+        friction_coefficient: mu of the pair.
+
+    Raises:
+        ValueError: a modulus is not a finite number > 0 or a Poisson ratio is outside (-1, 0.5).
+    """
+    for name, value in (("shear_modulus_1_Pa", shear_modulus_1_Pa), ("shear_modulus_2_Pa", shear_modulus_2_Pa)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+    for name, value in (("poisson_ratio_1", poisson_ratio_1), ("poisson_ratio_2", poisson_ratio_2)):
+        if not (isinstance(value, (int, float)) and -1.0 < value < 0.5):
+            raise ValueError(f"{name} = {value!r}: expected a value in (-1, 0.5)")
+    shear = 2.0 / (1.0 / shear_modulus_1_Pa + 1.0 / shear_modulus_2_Pa)
+    poisson = 0.5 * shear * (poisson_ratio_1 / shear_modulus_1_Pa + poisson_ratio_2 / shear_modulus_2_Pa)
+    return Material(shear, poisson, friction_coefficient)

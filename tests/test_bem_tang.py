@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.influence import _SHARED_CACHES, InfluenceGrid
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
 
@@ -147,3 +147,107 @@ def test_bad_inputs():
         solve_tang(grid, p, 0.3, w, w, tolerance=-1.0)
     with pytest.raises(ValueError, match="max_iterations"):
         solve_tang(grid, p, 0.3, w, w, max_iterations=0)
+    with pytest.raises(ValueError, match="initial_traction"):
+        solve_tang(grid, p, 0.3, w, w, initial_traction=(w[:-1], w[:-1]))
+    with pytest.raises(ValueError, match="initial_slip"):
+        solve_tang(grid, p, 0.3, w, w, initial_slip=p > 0)
+
+
+@pytest.mark.parametrize("with_slip_area", [True, False])
+def test_warm_start_same_solution(with_slip_area):
+    """Regression: a warm start (initial_traction, initial_slip) from a nearby problem's solution gives the cold
+    solution to the tolerance, in fewer Newton steps; started from the solution itself it stops at once."""
+    grid, p, x, a, d = _hertz_grid(40, 1.1, 82e9, 0.28, 0.3, 2e4)
+    w = rigid_slip(x, x, 2e-4, -6e-4, 0.6)
+    cold = solve_tang(grid, p, 0.3, *w)
+    near = solve_tang(grid, 1.02 * p, 0.3, *rigid_slip(x, x, 2.1e-4, -5.8e-4, 0.6))
+    assert cold.converged and near.converged
+    slip = near.in_slip if with_slip_area else None
+    warm = solve_tang(grid, p, 0.3, *w, initial_traction=(near.traction_x_Pa, near.traction_y_Pa), initial_slip=slip)
+    assert warm.converged
+    mu_fn = 0.3 * p.sum()
+    for got, ref in ((warm.traction_x_Pa, cold.traction_x_Pa), (warm.traction_y_Pa, cold.traction_y_Pa)):
+        assert abs(got.sum() - ref.sum()) < 1e-6 * mu_fn
+        assert np.abs(got - ref).max() < 1e-4 * 0.3 * p.max()
+    assert (warm.in_slip == cold.in_slip).all()
+    if with_slip_area:
+        assert warm.iterations < cold.iterations
+    same = solve_tang(
+        grid, p, 0.3, *w, initial_traction=(cold.traction_x_Pa, cold.traction_y_Pa), initial_slip=cold.in_slip
+    )
+    assert same.converged and same.iterations == 1 and same.linear_iterations == 0
+
+
+def test_grids_of_equal_parameters_share_coefficients():
+    """Regression: a new grid of equal parameters reuses the coefficients (same arrays); others do not."""
+    a = InfluenceGrid(12, 10, 1e-4, 1e-4, 82e9, 0.28)
+    kxx = a.kernel("xx", True)
+    b = InfluenceGrid(12, 10, 1e-4, 1e-4, 82e9, 0.28)
+    assert b.kernel("xx", True) is kxx
+    c = InfluenceGrid(12, 10, 1e-4, 1e-4, 82e9, 0.3)
+    assert c.kernel("xx", True) is not kxx
+    _SHARED_CACHES.clear()
+    fresh = InfluenceGrid(12, 10, 1e-4, 1e-4, 82e9, 0.3)
+    assert fresh.kernel("xx", True) is not c.kernel("xx", True)
+    np.testing.assert_array_equal(fresh.kernel("xx", True), c.kernel("xx", True))
+    for n in range(20):  # bounded: at most 16 grids, at most 100 000 elements in all (the newest always kept)
+        InfluenceGrid(4 + n, 4, 1e-4, 1e-4, 82e9, 0.28)
+    assert len(_SHARED_CACHES) == 16
+    InfluenceGrid(320, 320, 1e-4, 1e-4, 82e9, 0.28)
+    assert list(_SHARED_CACHES) == [(320, 320, 1e-4, 1e-4, 82e9, 0.28, 0.0, False)]
+
+
+def test_period_preconditioner_inverts_the_folded_circulant():
+    """The tangential preconditioner's spectra invert the block circulant on the (ny, nx) period whose coefficients
+    are the rectangle influences (Love/Cerruti closed forms, influence.rectangle_influence) summed over the offsets
+    congruent modulo the period: checked against that dense matrix built independently of the FFT."""
+    from rigid_dynamics.contact.bem.influence import rectangle_influence
+
+    nx, ny, dx, dy, g_mod, nu = 6, 5, 1e-3, 0.7e-3, 82e9, 0.28
+    grid = InfluenceGrid(nx, ny, dx, dy, g_mod, nu)
+    ixx, ixy, iyy = grid.inverse_static_period_spectra()
+    di = np.arange(-(nx - 1), nx + 1)
+    dj = np.arange(-(ny - 1), ny + 1)
+    ddi, ddj = np.meshgrid(di, dj)
+    kern = rectangle_influence(ddi * dx, ddj * dy, dx, dy, g_mod, nu)
+    n = nx * ny
+    dense = np.zeros((2 * n, 2 * n))
+    for row in range(n):
+        jr, ir = divmod(row, nx)
+        for col in range(n):
+            jc, ic = divmod(col, nx)
+            sel = ((ddj - (jr - jc)) % ny == 0) & ((ddi - (ir - ic)) % nx == 0)
+            for a, b, name in ((0, 0, "xx"), (0, 1, "xy"), (1, 0, "xy"), (1, 1, "yy")):
+                dense[a * n + row, b * n + col] = kern[name][sel].sum()
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=(2, ny, nx))
+    spec = np.fft.rfft2(u)
+    t = np.fft.irfft2(np.stack((ixx * spec[0] + ixy * spec[1], ixy * spec[0] + iyy * spec[1])), s=(ny, nx))
+    back = dense @ t.reshape(-1)
+    # the symbol's real part is inverted: exact for the symmetric part of the (slightly non-symmetric) folded xy
+    sym = 0.5 * (dense + dense.T) @ t.reshape(-1)
+    assert np.abs(sym - u.reshape(-1)).max() < 1e-9 * np.abs(u).max()
+    assert np.abs(back - u.reshape(-1)).max() < 0.05 * np.abs(u).max()
+
+
+def test_coarse_start_on_odd_grid_same_solution():
+    """Regression: the nested-iteration start on an odd grid (33 x 35, padded for merging) gives the solution of the
+    plain start to the tolerance."""
+    g_mod, nu, radius, force = 82e9, 0.28, 0.3, 2e4
+    e_star = g_mod / (1 - nu)
+    a = (3 * force * radius / (4 * e_star)) ** (1 / 3)
+    d = 2.2 * a / 34
+    x = -1.1 * a + d * (np.arange(33) + 0.5)
+    y = -1.1 * a + d * (np.arange(35) + 0.5)
+    xx, yy = np.meshgrid(x, y)
+    grid = InfluenceGrid(33, 35, d, d, g_mod, nu)
+    p = solve_norm(grid, (xx**2 + yy**2) / (2 * radius), normal_force_N=force).pressure_Pa
+    w = rigid_slip(x, y, 2e-4, -6e-4, 0.6)
+    plain = solve_tang(grid, p, 0.3, *w, coarse_start=False)
+    nested = solve_tang(grid, p, 0.3, *w)
+    assert plain.converged and nested.converged
+    mu_fn = 0.3 * p.sum()
+    assert abs(nested.traction_x_Pa.sum() - plain.traction_x_Pa.sum()) < 1e-6 * mu_fn
+    assert abs(nested.traction_y_Pa.sum() - plain.traction_y_Pa.sum()) < 1e-6 * mu_fn
+    assert (nested.in_slip == plain.in_slip).all()
+    assert nested.iterations <= plain.iterations

@@ -108,5 +108,11 @@ def test_contact_fea_plot_writes_stress_maps(tmp_path, capsys):
     assert code == 0
     (patch,) = record["patches"]
     assert patch["creep_force_long_N"] is None and patch["normal_force_N"] > 0
-    for name in ("fea_pressure.png", "fea_von_mises_cut.png", "fea_solution.xdmf"):
+    for name in ("fea_pressure.png", "fea_von_mises_cut.png", "fea_solution.vtu", "fea_von_mises_3d.png"):
         assert (out / "fea" / name).stat().st_size > 0
+    # the summary carries the subsurface maxima and their depths (below the surface: depth > 0)
+    summary = json.loads((out / "summary.json").read_text())
+    diagnostics = summary["patches"][0]["diagnostics"]
+    assert diagnostics["max_shear_Pa"] > 0 and diagnostics["max_shear_depth_m"] > 0
+    assert diagnostics["axis_max_shear_depth_m"] > 0
+    assert (out / summary["field_files"][0]["vtu"]).stat().st_size > 0

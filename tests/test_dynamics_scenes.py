@@ -49,7 +49,11 @@ def test_scene_runs(name):
     provider = "conical" if scene.track.is_conical else "tables"
     result = simulate(replace(scene, duration_s=0.01, contact_provider=provider))
     assert result.success, result.message
-    peaks = result.summary()["peak_normal_force_N"]
+    # 0.01 s: the settled peaks exist only where the scene's settling distance is that short; full-run peaks always
+    summary = result.summary()
+    if summary["distance_travelled_m"] < scene.settling_distance_m:
+        assert summary["peak_normal_force_N"] == {"left": None, "right": None}
+    peaks = summary["full_run_peak_normal_force_N"]
     assert peaks["left"] > 0.5 * scene.static_wheel_load_N and peaks["right"] > 0.5 * scene.static_wheel_load_N
     assert np.all(np.isfinite(result.states))
 

@@ -206,7 +206,7 @@ def test_outputs_written(tmp_path):
     r = FeaModel().solve(
         ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"quick": True, "output_dir": str(tmp_path)}
     )
-    for key in ("xdmf", "pressure_png", "von_mises_cut_png"):
+    for key in ("vtu", "pressure_png", "von_mises_cut_png"):
         assert Path(r.extra["files"][key]).is_file()
 
 

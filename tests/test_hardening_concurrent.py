@@ -33,7 +33,8 @@ def test_stale_lock_of_a_killed_run_is_taken_over(capsys, tmp_path):
     (out / LOCK_NAME).write_text(f"{dead.pid} {socket.gethostname()} then\n")
     code, _, err = run(capsys, "contact", "hertz-quadric", "--out", out)
     assert code == 0, err
-    assert sorted(assert_whole_files(out)) == ["case.toml", "summary.json"]
+    names = ["case.toml", "fields-single-0.npz", "fields-single-0.vtu", "outline-single-0.vtu", "summary.json"]
+    assert sorted(assert_whole_files(out)) == names
     assert not (out / LOCK_NAME).exists()
 
 

@@ -72,7 +72,14 @@ def test_files_get_the_usual_permissions(capsys, tmp_path):
         os.umask(old)
     assert code == 0
     names = assert_whole_files(tmp_path / "o")
-    assert sorted(names) == ["case.toml", "fields-single-0.png", "summary.json"]
+    assert sorted(names) == [
+        "case.toml",
+        "fields-single-0.npz",
+        "fields-single-0.png",
+        "fields-single-0.vtu",
+        "outline-single-0.vtu",
+        "summary.json",
+    ]
     for name in names:
         assert stat.S_IMODE((tmp_path / "o" / name).stat().st_mode) == 0o644, name
     assert not (tmp_path / "o" / LOCK_NAME).exists()
@@ -97,7 +104,13 @@ def test_failed_plot_leaves_no_summary(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr(plots, "plot_contact_fields", fail)
     code, _, err = run(capsys, "contact", "hertz-quadric", "--method", "fastsim", "--plot", "--out", out)
     assert_error(code, err, "cannot write", "fields-single-0.png", "No space left on device", status=3)
-    assert sorted(p.name for p in out.iterdir()) == ["case.toml"]  # no summary, no temporary, no lock
+    # no summary, no temporary, no lock (the field files written before the plot are whole)
+    assert sorted(p.name for p in out.iterdir()) == [
+        "case.toml",
+        "fields-single-0.npz",
+        "fields-single-0.vtu",
+        "outline-single-0.vtu",
+    ]
     assert_whole_files(out)
 
 

@@ -15,6 +15,9 @@ HEAVY = (
     "meshio",
     "dask",
     "distributed",
+    "pandas",
+    "pyarrow",
+    "contourpy",
 )
 
 CODE = """

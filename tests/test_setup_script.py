@@ -49,3 +49,9 @@ def test_stops_with_a_message_when_none(tmp_path):
 def test_script_is_used_by_setup():
     assert "find_python.sh" in (ROOT / "tools" / "setup_venv.sh").read_text()
     assert os.access(SCRIPT, os.R_OK)
+
+
+def test_setup_compiles_the_numba_kernels_with_progress():
+    text = (ROOT / "tools" / "setup_venv.sh").read_text()
+    assert "-m wheelrail.warmup" in text and "compiling the numba kernels" in text
+    assert text.index("pip install") < text.index("wheelrail.warmup") < text.index(".installed")

@@ -9,6 +9,8 @@ Commands:
     wheelrail conicity               equivalent conicity of a wheel/rail pair (EN 15302 method)
     wheelrail manchester             the Manchester Contact Benchmark case A-2.2 sweep
     wheelrail stress                 numerical-stability stress sweep of a scene
+    wheelrail sweep SWEEP.toml       parameter study on dask.distributed (wheelrail.sweep)
+    wheelrail critical-speed SCENE   linear and nonlinear (limit-cycle) critical speed (wheelrail.critical)
 
 Exit statuses (README, "What a run tells you"): 0 every result ok; 1 the work ran but a result is not ok
 (its status and message say why; the outputs are written); 2 bad input, found before any work: one line
@@ -103,10 +105,12 @@ def cmd_cases(args) -> int:
 def cmd_contact(args) -> int:
     from contextlib import ExitStack
 
-    from wheelrail.cases import load_case, resolve_case_path, solution_record, solve_case
+    from wheelrail.cases import resolve_case_path, solution_record, solve_case
     from wheelrail.output import copy_input, output_folder, to_json, write_json
+    from wheelrail.overrides import load_case_with
 
-    case = load_case(args.case, method=args.method)  # checks --method and [solver] against the model's options
+    # checks --method and [solver] against the model's options; --set overrides before validation
+    case, _, overrides = load_case_with(args.case, args.set, method=args.method)
     wants_output = args.out is not None or args.plot
     if wants_output and args.out is None and _under_mpi():
         raise ConfigError("--plot under mpiexec: give --out DIR so every rank writes to one folder")
@@ -127,10 +131,15 @@ def cmd_contact(args) -> int:
             case = _with_fea_output(case, out_dir)
         solution = solve_case(case, args.method)
         record = solution_record(solution)
+        if overrides:
+            record["overrides"] = overrides
         if out_dir is not None and _mpi_rank() == 0:
+            from wheelrail.contact_files import write_solution_files
+
             copy_input(resolve_case_path(args.case), out_dir, "case.toml")
+            record["field_files"] = write_solution_files(solution, out_dir)  # NPZ + VTU per patch
             if args.plot:
-                record["plots"] = _plot_patches(solution, out_dir)
+                record["plots"] = _plot_patches(solution, out_dir) + _fea_views(solution, out_dir)
             write_json(out_dir / "summary.json", record)  # last: a summary exists only when every output does
     if args.json:
         _print(to_json(record))
@@ -152,7 +161,7 @@ def _mpi_broadcast(value):
 
 
 def _with_fea_output(case, out_dir: Path):
-    """Ask the FEA model to write its XDMF and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
+    """Ask the FEA model to write its VTU grid and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
     import dataclasses
 
     fea_dir = str(Path(out_dir) / "fea")
@@ -165,15 +174,32 @@ def _with_fea_output(case, out_dir: Path):
 
 
 def _plot_patches(solution, out_dir: Path) -> list[str]:
-    from comparisons.contact_plots import plot_contact_fields
+    """PNG per patch: the model's fields, or for an analytic model Hertz's ellipse and pressure."""
+    from wheelrail.contact_files import plot_patch
 
     written = []
     for index, (side, _geometry, _creepage, result) in enumerate(solution.patches):
-        if result.fields is None:
-            continue
-        path = out_dir / f"fields-{side}-{index}.png"
-        plot_contact_fields(result, path)  # saved atomically (rigid_dynamics.files.save_figure)
-        written.append(path.name)
+        path = plot_patch(result, out_dir / f"fields-{side}-{index}.png")
+        if path is not None:
+            written.append(path.name)
+    return written
+
+
+def _fea_views(solution, out_dir: Path) -> list[str]:
+    """3-D von Mises views (pyvista) of the FEA grids (``fea_von_mises_3d.png`` next to each ``fea_solution.vtu``)."""
+    from comparisons.fea_views import render_stress_view
+
+    written = []
+    for _side, _geometry, _creepage, result in solution.patches:
+        vtu = (result.extra.get("files") or {}).get("vtu")
+        if vtu:
+            png = Path(vtu).with_name("fea_von_mises_3d.png")
+            try:
+                render_stress_view(vtu, png)
+            except Exception as exc:  # a VTK that cannot render off screen: the data files are written all the same
+                print(f"wheelrail: 3-D view not drawn ({type(exc).__name__}: {exc})", file=sys.stderr)
+                continue
+            written.append(str(png.relative_to(out_dir)))
     return written
 
 
@@ -196,7 +222,7 @@ def _contact_table(record: dict) -> str:
             value = patch.get(key)
             cells.append(f"{'-':>13}" if value is None else f"{value * scale:13.5g}")
         lines.append(f"{patch['side']:<8}" + "".join(cells))
-    lines.append(f"wall time {record['wall_time_s']:.3g} s")
+    lines.append(f"wall time {record['wall_time_s']:.3g} s (set-up, compiled-code loading {record['setup_s']:.2g} s)")
     return "\n".join(lines)
 
 
@@ -205,22 +231,29 @@ def _contact_table(record: dict) -> str:
 
 def cmd_run(args) -> int:
     from wheelrail.output import output_folder
-    from wheelrail.scenes import DEFAULT_SCENE, load_scene, resolve_scene_path, write_run_outputs
+    from wheelrail.overrides import load_scene_with
+    from wheelrail.scenes import DEFAULT_SCENE, write_run_outputs
 
-    source = resolve_scene_path(args.scene or DEFAULT_SCENE)
-    scene = load_scene(source)
+    scene, source, overrides = load_scene_with(args.scene or DEFAULT_SCENE, args.set)
     from rigid_dynamics.wheelset import simulate
 
     with output_folder(args.out, f"run-{source.stem}") as out_dir:
         progress, close = _progress_bar(args.quiet, f"{source.stem}")
+        before = time.perf_counter()
         try:
             result = simulate(scene, progress=progress)
         finally:
             close()
-        summary = write_run_outputs(result, source, out_dir, plots=not args.no_plots)
+        timing = {  # wall_time_s is the model's own work; what came before it is reported apart
+            "startup_s": before - getattr(args, "started_at", before),
+            "setup_s": time.perf_counter() - before - result.wall_time_s,
+        }
+        extra = {"overrides": overrides, **timing}
+        summary = write_run_outputs(result, source, out_dir, plots=not args.no_plots, extra=extra)
     _print(
         f"{source.stem}: {summary['status']} - {summary['message']}; simulated {summary['simulated_time_s']:.3g} s "
-        f"in {summary['wall_time_s']:.3g} s (real-time factor {summary['real_time_factor']:.3g})"
+        f"in {summary['wall_time_s']:.3g} s (real-time factor {summary['real_time_factor']:.3g}); "
+        f"start-up {timing['startup_s']:.2g} s, set-up and compiled-code loading {timing['setup_s']:.2g} s"
     )
     _print(f"output written to {out_dir}")
     return EXIT_OK if summary.get("success", summary["status"] == "ok") and summary["status"] == "ok" else EXIT_FAILED
@@ -269,6 +302,8 @@ def cmd_stress(args) -> int:
         f"stress sweep of {source.stem}: {len(report['runs'])} runs ({report['finished']} finished, "
         f"{report['stopped']} stopped) on {workers} worker{'s' if workers > 1 else ''}"
     )
+    for run in report.get("warnings", []):
+        _print(f"stress sweep of {source.stem}: {run['parameter']} = {run['value']:g}: warning - {run['message']}")
     for run in report.get("energy_suspect", []):
         _print(
             f"stress sweep of {source.stem}: {run['parameter']} = {run['value']:g} finished with an energy balance "
@@ -403,6 +438,7 @@ def _add_run(sub) -> None:
     run.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/run-<scene>-<time>)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
+    run.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key (repeatable)")
     run.set_defaults(func=cmd_run)
 
 
@@ -412,7 +448,8 @@ def _add_contact(sub) -> None:
     contact.add_argument("--method", default="auto", help="contact model (see `wheelrail models`)")
     contact.add_argument("--json", action="store_true", help="print one JSON object")
     contact.add_argument("--plot", action="store_true", help="write PNG maps of the patch fields")
-    contact.add_argument("--out", type=out_path, help="output folder for summary and plots")
+    contact.add_argument("--out", type=out_path, help="output folder for summary, field files and plots")
+    contact.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a case key (repeatable)")
     contact.set_defaults(func=cmd_contact)
 
 
@@ -471,7 +508,7 @@ COMMANDS: list = [_add_listings, _add_run, _add_contact, _add_conicity, _add_man
 A new subcommand in its own module: write ``cmd_x(args) -> int`` and ``add_x(sub)`` there, and add
 ``"package.module:add_x"`` to :data:`COMMAND_MODULES` (imported only when the parser is built)."""
 
-COMMAND_MODULES: list[str] = []
+COMMAND_MODULES: list[str] = ["wheelrail.sweep:register", "wheelrail.critical:register"]
 """``"module:function"`` strings of subcommands defined in other modules (see :data:`COMMANDS`)."""
 
 
@@ -522,6 +559,7 @@ def main(argv: list[str] | None = None) -> int:
         previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         args = build_parser().parse_args(argv)
+        args.started_at = start
         return args.func(args)
     except ConfigError as exc:
         print(f"wheelrail: error: {exc}", file=sys.stderr)

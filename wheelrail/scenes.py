@@ -55,8 +55,42 @@ def _check_profiles(table: dict, prefix: str = "") -> None:
                 raise ConfigError(f"key {dotted!r} = {value!r}: {exc}") from None
 
 
-def parse_scene(doc: dict):
-    """Validate a parsed scene document into a DynamicsScene (ConfigError on any problem)."""
+IRREGULARITY_FILE_KEYS = {"wheel_grid_file": "wheel", "corrugation_file": "rail"}
+"""Keys of [irregularities] that name measured grids (CSV, rigid_dynamics.geometry.measured)."""
+
+
+def _resolve_irregularity_files(doc: dict, base_dir: Path | None) -> dict:
+    """Make the measured-grid paths of [irregularities] absolute (relative to the scene file) and read them once,
+    so that a bad file fails before any work with the key named.
+    """
+    table = doc.get("irregularities")
+    if not isinstance(table, dict) or not any(key in table for key in IRREGULARITY_FILE_KEYS):
+        return doc
+    from rigid_dynamics.geometry.measured import read_rail_grid_csv, read_wheel_grid_csv
+
+    table = dict(table)
+    for key, kind in IRREGULARITY_FILE_KEYS.items():
+        value = table.get(key)
+        if value is None or value == "":
+            continue
+        if not isinstance(value, str):
+            raise ConfigError(f"key 'irregularities.{key}' = {value!r}: expected the path of a CSV grid file")
+        path = Path(value).expanduser()
+        if not path.is_absolute() and base_dir is not None:
+            path = base_dir / path
+        try:
+            (read_wheel_grid_csv if kind == "wheel" else read_rail_grid_csv)(path)
+        except ValueError as exc:
+            raise ConfigError(f"key 'irregularities.{key}' = {value!r}: {exc}") from None
+        table[key] = str(path.resolve())
+    return {**doc, "irregularities": table}
+
+
+def parse_scene(doc: dict, base_dir: Path | None = None):
+    """Validate a parsed scene document into a DynamicsScene (ConfigError on any problem).
+
+    ``base_dir``: folder that relative file names in the scene (measured irregularity grids) refer to.
+    """
     from rigid_dynamics.wheelset import DynamicsScene
 
     field_names = {f.name for f in dataclasses.fields(DynamicsScene)}
@@ -70,6 +104,7 @@ def parse_scene(doc: dict):
         if key not in doc:
             raise ConfigError(f"missing key {key!r}: expected a finite number (every scene states it)")
     _check_profiles(doc)
+    doc = _resolve_irregularity_files(doc, base_dir)
     scene = build_dataclass(DynamicsScene, doc)
     from rigid_dynamics.wheelset.checks import SceneError, check_scene
 
@@ -83,21 +118,36 @@ def parse_scene(doc: dict):
 def load_scene(path: str | Path):
     """Read and validate a scene file or embedded scene name."""
     path = resolve_scene_path(path)
-    return parse_scene(read_toml(path, "scene file"))
+    return parse_scene(read_toml(path, "scene file"), base_dir=Path(path).parent)
 
 
-def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = True) -> dict:
-    """Write scene.toml, summary.json, timeseries.npz (atomic) and plots; return the summary."""
+def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = True, extra: dict | None = None) -> dict:
+    """Write scene.toml, summary.json, timeseries.npz/.csv/.parquet (atomic) and plots; return the summary.
+
+    ``timeseries.csv`` and ``timeseries.parquet`` hold the tidy table of :mod:`rigid_dynamics.wheelset.table`
+    (one row per output time, one column per named quantity, units in the names).
+    """
     from rigid_dynamics.wheelset import timeseries_arrays
     from wheelrail.output import copy_input, write_json, write_npz
 
     copy_input(scene_path, out_dir, "scene.toml")
     summary = dict(result.summary())
+    summary.update({k: v for k, v in (extra or {}).items() if v})  # e.g. the --set overrides of the scene
     files = ["scene.toml", "summary.json"]
+    irregularities = getattr(result.scene, "irregularities", None)
+    for key in IRREGULARITY_FILE_KEYS:
+        source = getattr(irregularities, key, "")
+        if source:  # the measured grids the scene read, so that the folder reproduces the run
+            files.append(copy_input(source, out_dir, f"{key.removesuffix('_file')}-{Path(source).name}").name)
     arrays = timeseries_arrays(result)
     if arrays:
+        from rigid_dynamics.wheelset.table import write_table
+
         write_npz(out_dir / "timeseries.npz", **arrays)
         files.append("timeseries.npz")
+        for name in ("timeseries.csv", "timeseries.parquet"):
+            write_table(result, out_dir / name)
+            files.append(name)
     if plots and len(result.t) > 1:
         from comparisons.dynamics_plots import plot_simulation
 

@@ -465,6 +465,16 @@ class AnalyticBatch:
     method: np.ndarray
     converged: np.ndarray
 
+    def to_dict(self) -> dict:
+        """The arrays by name."""
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
+
+    def to_dataframe(self):
+        """One row per patch (arrays flattened in C order), pandas DataFrame."""
+        import pandas as pd
+
+        return pd.DataFrame({name: np.ravel(value) for name, value in self.to_dict().items()})
+
 
 BATCH_METHODS = ("hertz", "linear", "vermeulen-johnson", "fastsim", "auto")
 
@@ -485,9 +495,10 @@ def solve_batch(
     """Vectorised entry point for the dynamics: Hertz + the tangential law for many patches.
 
     Same physics as the registry models (module docstring), without per-patch Python objects.
-    Exactly one of ``normal_force_N`` / ``approach_m`` (arrays broadcast with the curvatures and
-    creepages). Options: those of the chosen model (fastsim: nx, ny, traction_bound, flexibility;
-    auto: tolerance and the fastsim options).
+    Exactly one of ``normal_force_N`` / ``approach_m``. Curvatures, creepages and the load are
+    broadcast together (numpy rules; e.g. scalar curvatures with arrays of creepages), and every
+    array of the result has the broadcast shape. Options: those of the chosen model (fastsim: nx, ny,
+    traction_bound, flexibility; auto: tolerance and the fastsim options).
 
     Raises:
         ValueError: unknown method or option, or bad input.
@@ -497,16 +508,33 @@ def solve_batch(
     fastsim_options = {k: v for k, v in FastsimModel.OPTIONS.items() if k != "fields"}
     declared = {"fastsim": fastsim_options, "auto": {"tolerance": AutoModel.OPTIONS["tolerance"], **fastsim_options}}
     opts = _options(options, declared.get(method, {}), method)
+    inputs = {
+        "curvature_long_1_per_m": curvature_long_1_per_m,
+        "curvature_lat_1_per_m": curvature_lat_1_per_m,
+        "longitudinal": longitudinal,
+        "lateral": lateral,
+        "spin_1_per_m": spin_1_per_m,
+        "normal_force_N": normal_force_N,
+        "approach_m": approach_m,
+    }
+    try:
+        shape = np.broadcast_shapes(*(np.shape(v) for v in inputs.values() if v is not None))
+    except ValueError:
+        shapes = ", ".join(f"{k} {np.shape(v)}" for k, v in inputs.items() if v is not None)
+        raise ValueError(f"array shapes {shapes}: expected shapes that broadcast together") from None
+
+    def full(value):
+        return None if value is None else np.array(np.broadcast_to(np.asarray(value, dtype=float), shape))
+
     hz = hertz_solve_batch(
-        curvature_long_1_per_m,
-        curvature_lat_1_per_m,
-        normal_force_N=normal_force_N,
-        approach_m=approach_m,
+        full(curvature_long_1_per_m),
+        full(curvature_lat_1_per_m),
+        normal_force_N=full(normal_force_N),
+        approach_m=full(approach_m),
         shear_modulus_Pa=material.shear_modulus_Pa,
         poisson_ratio=material.poisson_ratio,
     )
-    shape = hz.normal_force_N.shape
-    xi, eta, phi = (np.broadcast_to(np.asarray(v, dtype=float), shape) for v in (longitudinal, lateral, spin_1_per_m))
+    xi, eta, phi = (full(v) for v in (longitudinal, lateral, spin_1_per_m))
     contact = hz.normal_force_N > 0
     a = np.where(contact, hz.semi_axis_long_m, 1.0)
     b = np.where(contact, hz.semi_axis_lat_m, 1.0)

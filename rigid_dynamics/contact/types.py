@@ -220,3 +220,41 @@ class ContactResult:
     residual: float = 0.0
     wall_time_s: float = 0.0
     extra: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """Every number of the result by name (creepages flattened, ``extra`` kept, fields as arrays or None)."""
+        out = {
+            name: getattr(self, name)
+            for name in self.__dataclass_fields__
+            if name not in ("creepage", "fields", "extra")
+        }
+        if self.creepage is not None:
+            out.update(
+                creepage_long=self.creepage.longitudinal,
+                creepage_lat=self.creepage.lateral,
+                spin_creepage_1_per_m=self.creepage.spin_1_per_m,
+                rolling_speed_m_per_s=self.creepage.rolling_speed_m_per_s,
+            )
+        out["extra"] = dict(self.extra)
+        out["fields"] = None if self.fields is None else dict(vars(self.fields))
+        return out
+
+    def to_dataframe(self):
+        """A one-row pandas DataFrame of the scalar numbers (``extra``'s scalars prefixed ``extra.``)."""
+        import pandas as pd
+
+        row = {k: v for k, v in self.to_dict().items() if k not in ("extra", "fields")}
+        row.update({f"extra.{k}": v for k, v in self.extra.items() if isinstance(v, (int, float, str, bool))})
+        return pd.DataFrame([row])
+
+    def __repr__(self) -> str:
+        def num(value, scale=1.0, unit=""):
+            return "None" if value is None else f"{value * scale:.5g}{unit}"
+
+        return (
+            f"ContactResult(method={self.method!r}, status={self.status!r}, "
+            f"normal_force_N={num(self.normal_force_N)}, creep_force_long_N={num(self.creep_force_long_N)}, "
+            f"creep_force_lat_N={num(self.creep_force_lat_N)}, max_pressure_Pa={num(self.max_pressure_Pa)}, "
+            f"semi_axes_m=({num(self.semi_axis_long_m)}, {num(self.semi_axis_lat_m)}), "
+            f"fields={'yes' if self.fields is not None else 'no'}, message={self.message!r})"
+        )

@@ -458,13 +458,37 @@ def rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec):
     return _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
 
 
+@njit(cache=True, _nrt=False)
+def _side_forces(rec, sides, out):
+    """Per side (left, right) the sums of normal force, longitudinal and lateral creep force of the patches in
+    contact (rec columns 0-2, NaN or 0 for candidates out of contact) into out (2, 3), N.
+    """
+    out[:, :] = 0.0
+    for c in range(sides.shape[0]):
+        if rec[c, 0] > 0.0:
+            for k in range(3):
+                out[sides[c], k] += rec[c, k]
+
+
 @njit(cache=True)
-def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs, states, recs, out_start):
+def rk4_run(
+    y, t0, h, n_steps, out_every, check_every, par, hz, kk, sides, mode, targs, sargs, states, recs, errs, out_start
+):
     """Advance ``n_steps`` RK4 steps from (t0, y); record every ``out_every`` steps into states/recs from
     index ``out_start``. mode 0: tables (targs = (table, grid, slots)); mode 1: 3-D search (sargs =
     compiled_search's (sp, tabs, irrs) + workspace, whose memory carries over between calls; the lateral scan
     runs at each step's first stage and at the recorded samples). Returns (status, steps done, next output
     index, t, y, rhs evaluations).
+
+    Error estimate (into errs, N, per recorded sample): at every recorded sample and every ``check_every`` steps
+    the step that ends there is also advanced by the third-order formula embedded in the classical RK4 stages and
+    the derivative at the step's end, k5 = f(t + h, y4) (which is the next step's k1): y3 = y + h (k1/6 + k2/3 +
+    k3/3 + k5/6), so y4 - y3 = h/6 (k4 - k5) (Hairer, Norsett & Wanner, Solving ODEs I, 2nd ed., section II.4,
+    "embedded formulas" of order 4(3)). The estimate is the largest difference of the per-wheel contact forces
+    (normal, longitudinal and lateral creep force) at y4 and y3: the force error of one step of the third-order
+    formula, an upper estimate of RK4's own (one extra right-hand side per check; two between recorded samples).
+    A sample carries the largest estimate of the checks since the previous sample (inf when the third-order
+    state's right-hand side failed).
     """
     ncand = sides.shape[0]
     ws = _workspace(par, targs[0].shape[0], ncand, np.empty((ncand + 2, N_FIELDS)))
@@ -472,7 +496,10 @@ def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs
     nst = y.shape[0]
     y = y.copy()
     k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
+    k5, k6 = np.empty(nst), np.empty(nst)
     ys, y_new = np.empty(nst), np.empty(nst)
+    f4, f3 = np.empty((2, 3)), np.empty((2, 3))
+    pending = np.nan
     t = t0
     k_out = out_start
     evals = 0
@@ -508,26 +535,48 @@ def rk4_run(y, t0, h, n_steps, out_every, par, hz, kk, sides, mode, targs, sargs
                 finite = False
         if not finite:
             return 1, step, k_out, t, y, evals
-        y, y_new = y_new, y
+        y, y_new = y_new, y  # y_new now holds the step's start
         t = t0 + (step + 1) * h
-        if (step + 1) % out_every == 0 and k_out < states.shape[0]:
-            st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, k1)
+        output = (step + 1) % out_every == 0 and k_out < states.shape[0]
+        if output or (step + 1) % check_every == 0:
+            st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, k5)
             evals += 1
             if st != 0:
                 return st, step + 1, k_out, t, y, evals
+            if output:
+                states[k_out, :] = y
+                recs[k_out, :, :] = rec
+            _side_forces(rec, sides, f4)
+            # the embedded third-order solution and its contact forces
+            for i in range(nst):
+                ys[i] = y_new[i] + h * (k1[i] / 6.0 + k2[i] / 3.0 + k3[i] / 3.0 + k5[i] / 6.0)
+            st = _rhs(t, ys, par, hz, kk, sides, mode, targs, sargs, ws, True, False, k6)
+            evals += 1
+            worst = np.inf
+            if st == 0:
+                _side_forces(rec, sides, f3)
+                worst = 0.0
+                for sd in range(2):
+                    for k in range(3):
+                        d = abs(f4[sd, k] - f3[sd, k])
+                        if d != d:  # NaN: forces not computable at one of the two states
+                            worst = np.inf
+                        elif d > worst:
+                            worst = d
+            if not pending >= worst:  # also when pending is NaN
+                pending = worst
+            for i in range(nst):
+                k1[i] = k5[i]
             have_k1 = True
-            states[k_out, :] = y
-            recs[k_out, :, :] = rec
-            k_out += 1
-            for sd in range(2):
-                total = 0.0
-                for c in range(ncand):
-                    if sides[c] == sd and rec[c, 0] > 0:
-                        total += rec[c, 0]
-                if total > fmax:
-                    return 2, step + 1, k_out, t, y, evals
-            if abs(y[1]) > ymax:
-                return 3, step + 1, k_out, t, y, evals
+            if output:
+                errs[k_out] = pending
+                pending = np.nan
+                k_out += 1
+                for sd in range(2):
+                    if f4[sd, 0] > fmax:
+                        return 2, step + 1, k_out, t, y, evals
+                if abs(y[1]) > ymax:
+                    return 3, step + 1, k_out, t, y, evals
     return 0, n_steps, k_out, t, y, evals
 
 
@@ -545,6 +594,7 @@ def load(packed) -> None:
         1e-3,
         0,
         1,
+        1,
         par,
         hz,
         kk,
@@ -554,6 +604,7 @@ def load(packed) -> None:
         sargs,
         np.zeros((0, 14)),
         np.zeros((0, len(sides) + 2, N_FIELDS)),
+        np.zeros(0),
         0,
     )
     rhs_once(0.0, y, par, hz, kk, sides, mode, targs, sargs, np.zeros(14), rec)

@@ -176,6 +176,26 @@ class TrackGeometry:
 
 
 @dataclass(frozen=True)
+class Harmonic:
+    """One harmonic of wheel out-of-roundness, R_irr = A cos(n alpha + phase), uniform across the tread.
+
+    Attributes:
+        order: n, waves per revolution, integer >= 1.
+        amplitude_m: A, m (>= 0).
+        phase_rad: phase, rad.
+    """
+
+    order: int
+    amplitude_m: float
+    phase_rad: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_finite(self, nonnegative=["amplitude_m"])
+        if isinstance(self.order, bool) or not isinstance(self.order, int) or self.order < 1:
+            raise ValueError(f"order = {self.order!r}: expected an integer >= 1")
+
+
+@dataclass(frozen=True)
 class Irregularities:
     """Shape irregularities of the wheels (eq 5: R_irr) and rails (eq 6: N_irr). Zero amplitude = none.
 
@@ -191,6 +211,14 @@ class Irregularities:
         corrugation_wavelength_m: wavelength of sinusoidal rail corrugation, m; 0 = none.
         corrugation_amplitude_m: amplitude of N_irr = A cos(2 pi x / wavelength), m (z down).
         side: which wheels/rails carry the irregularities: "both", "left" or "right".
+        harmonics: further out-of-roundness harmonics, added to the polygon (TOML: ``[[irregularities.harmonics]]``
+            tables with ``order``, ``amplitude_m``, ``phase_rad``).
+        wheel_grid_file: measured out-of-roundness R_irr(alpha, y_p): a CSV grid
+            (:func:`rigid_dynamics.geometry.measured.read_wheel_grid_csv`); "" = none.
+        corrugation_file: measured rail irregularity N_irr(x, y_r) (corrugation): a CSV grid
+            (:func:`rigid_dynamics.geometry.measured.read_rail_grid_csv`); "" = none.
+        Harmonics and measured grids are evaluated by the 3-D contact search (``contact_provider`` "search", the
+        choice of "auto" for them); measured grids run on the Python path.
     """
 
     polygon_order: int = 0
@@ -202,6 +230,9 @@ class Irregularities:
     corrugation_wavelength_m: float = 0.0
     corrugation_amplitude_m: float = 0.0
     side: str = "both"
+    harmonics: tuple[Harmonic, ...] = ()
+    wheel_grid_file: str = ""
+    corrugation_file: str = ""
 
     def __post_init__(self) -> None:
         _check_finite(
@@ -231,7 +262,13 @@ class Irregularities:
             (self.polygon_order > 0 and self.polygon_amplitude_m > 0)
             or self.flat_length_m > 0
             or self.corrugation_amplitude_m > 0
+            or self.needs_search
         )
+
+    @property
+    def needs_search(self) -> bool:
+        """True when only the 3-D contact search evaluates them (harmonics, measured grids)."""
+        return any(h.amplitude_m > 0 for h in self.harmonics) or bool(self.wheel_grid_file or self.corrugation_file)
 
 
 @dataclass(frozen=True)
@@ -250,6 +287,15 @@ class IntegratorSettings:
             anomaly (status "force-anomaly").
         max_lateral_displacement_m: |y| beyond this ends the run (status "derailed"), m.
         stop_at_wheel_lift: end the run (status "wheel-lift") when a wheel loses contact.
+        force_tolerance: RK4 only: the largest accepted force error estimate of a step (the per-wheel normal,
+            longitudinal and lateral creep force of RK4 against its embedded third-order solution, simulate.py),
+            relative to the static wheel load, over the samples after the scene's settling distance (the start-up
+            before it is reported apart); a run that finishes above it ends with status "warning". The default
+            0.02 passes the embedded scenes at their own steps and flags the coarser steps at which their force
+            results move (benchmarks/results/step_sensitivity.md).
+        lift_half_step_check: RK4 only: when a wheel lifts off after the settling distance, run the scene again at
+            half the step and compare the settled peaks against ``force_tolerance`` (the re-impacts after a lift
+            move with the step while the local estimate stays small; about three times the cost of the run).
     """
 
     method: str = "RK45"
@@ -263,11 +309,14 @@ class IntegratorSettings:
     max_force_factor: float = 50.0
     max_lateral_displacement_m: float = 0.05
     stop_at_wheel_lift: bool = False
+    force_tolerance: float = 0.02
+    lift_half_step_check: bool = True
 
     def __post_init__(self) -> None:
         _check_finite(
             self,
             positive=[
+                "force_tolerance",
                 "relative_tolerance",
                 "absolute_tolerance",
                 "fixed_step_s",
@@ -293,7 +342,13 @@ class InitialConditions:
         lateral_velocity_m_per_s: y'(0), m/s.
         yaw_rate_rad_per_s: psi'(0), rad/s.
         vertical_velocity_m_per_s: z'(0), m/s (z down).
-        longitudinal_creepage: initial slip of the spin, phi'(0) = (1 - xi0) V / r0 (dimensionless).
+        longitudinal_creepage: xi0, initial slip of the spin, phi'(0) = (1 - xi0) V / r_roll (dimensionless), r_roll
+            the mean rolling radius of the two wheels at the initial equilibrium pose (simulate.consistent_start):
+            0 starts rolling without a common longitudinal creepage.
+        free_rolling: start on the free-rolling path: the yaw rate is solved together with the spin rate so that
+            the creep forces exert no yaw and no spin moment at t = 0 (no creep-force spike;
+            simulate.consistent_start); ``yaw_rate_rad_per_s`` is then the starting guess. False keeps the given
+            yaw rate (an offset wheelset then starts with the creepages of its rolling-radius difference).
     """
 
     lateral_displacement_m: float = 0.0
@@ -302,6 +357,7 @@ class InitialConditions:
     yaw_rate_rad_per_s: float = 0.0
     vertical_velocity_m_per_s: float = 0.0
     longitudinal_creepage: float = 0.0
+    free_rolling: bool = True
 
     def __post_init__(self) -> None:
         _check_finite(self)
@@ -323,6 +379,11 @@ class DynamicsScene:
         contact_provider: "auto" (conical analytic for conical wheels, tables for ideal geometry,
             3-D search with irregularities), "conical", "tables" or "search".
         contact_tolerance: relative force tolerance handed to the "auto" contact model.
+        settling_distance_m: distance travelled from the start after which the summary's peaks are taken (the
+            start-up from the initial offset is not a result), m; the full-run peaks are reported beside them.
+            The default 10 m covers the start-up of the embedded polygonal-wheel scene from its 1 mm offset (two-point
+            contact flips move its peaks with the step over the first 10 m, benchmarks/results/step_sensitivity.md);
+            scenes that start centred set less.
         fastsim_elements_per_strip, fastsim_strips: FASTSIM's grid (nx, ny) when the model is "fastsim" or "auto"
             picks it. 20 x 20 keeps the creep forces within ~0.5 % of a 200 x 200 grid, 15 x 10 within 1 %,
             9 x 8 within 2 % (benchmarks/results/fastsim_grid.md) at 1/2, 1/3 and 1/9 of the cost.
@@ -343,11 +404,14 @@ class DynamicsScene:
     contact_tolerance: float = 0.05
     fastsim_elements_per_strip: int = 20
     fastsim_strips: int = 20
+    settling_distance_m: float = 10.0
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
 
     def __post_init__(self) -> None:
-        _check_finite(self, positive=["speed_m_per_s", "duration_s", "contact_tolerance"])
+        _check_finite(
+            self, positive=["speed_m_per_s", "duration_s", "contact_tolerance"], nonnegative=["settling_distance_m"]
+        )
         if self.contact_provider not in CONTACT_PROVIDERS:
             raise ValueError(
                 f"contact_provider = {self.contact_provider!r}: expected one of {', '.join(CONTACT_PROVIDERS)}"
@@ -370,6 +434,11 @@ class DynamicsScene:
         ):
             if not isinstance(getattr(self, name), cls):
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected a {cls.__name__}")
+        if self.contact_provider in ("conical", "tables") and self.irregularities.needs_search:
+            raise ValueError(
+                f"contact_provider = {self.contact_provider!r} with irregularities harmonics / wheel_grid_file / "
+                "corrugation_file: expected contact_provider 'search' or 'auto' (only the 3-D search evaluates them)"
+            )
 
     @property
     def static_wheel_load_N(self) -> float:

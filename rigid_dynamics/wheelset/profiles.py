@@ -160,6 +160,8 @@ def geometry_irregularities(irregularities: Irregularities, nominal_radius_m: fl
     The rounded flat, the polygon and the corrugation are the same functions as in
     rigid_dynamics.wheelset.irregular (which the analytic providers use): geometry.WheelFlat "rounded",
     HarmonicOutOfRoundness, RailCorrugation (A cos(2 pi x / wavelength), over the rail head's central band).
+    Further harmonics are more HarmonicOutOfRoundness objects; measured grids are read from their CSV files
+    (rigid_dynamics.geometry.measured).
     """
     from rigid_dynamics import geometry as geo
     from rigid_dynamics.wheelset.irregular import applies_to
@@ -186,6 +188,16 @@ def geometry_irregularities(irregularities: Irregularities, nominal_radius_m: fl
         rail.append(
             geo.RailCorrugation(wavelength_m=irr.corrugation_wavelength_m, amplitude_m=irr.corrugation_amplitude_m)
         )
+    for harmonic in irr.harmonics:
+        if harmonic.amplitude_m > 0:
+            wheel.append(geo.HarmonicOutOfRoundness(harmonic.order, harmonic.amplitude_m, harmonic.phase_rad))
+    if irr.wheel_grid_file or irr.corrugation_file:
+        from rigid_dynamics.geometry.measured import read_rail_grid_csv, read_wheel_grid_csv
+
+        if irr.wheel_grid_file:
+            wheel.append(read_wheel_grid_csv(irr.wheel_grid_file))
+        if irr.corrugation_file:
+            rail.append(read_rail_grid_csv(irr.corrugation_file))
     sides_w = {s: tuple(wheel) for s in SIDES if applies_to(irr, s)}
     sides_r = {s: tuple(rail) for s in SIDES if applies_to(irr, s)}
     return sides_w, sides_r

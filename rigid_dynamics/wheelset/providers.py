@@ -105,6 +105,22 @@ class PatchSet:
         return len(self.side)
 
 
+def _running_direction_only(irregularities: Irregularities | None, provider: str) -> Irregularities | None:
+    """The irregularities an analytic provider evaluates (irregular.py), None if there are none.
+
+    Raises:
+        ValueError: harmonics or measured grids, which only the 3-D search evaluates.
+    """
+    if irregularities is None or not irregularities.any:
+        return None
+    if irregularities.needs_search:
+        raise ValueError(
+            f"contact_provider = {provider!r} with irregularities harmonics / wheel_grid_file / corrugation_file: "
+            "expected contact_provider 'search' or 'auto' (only the 3-D search evaluates them)"
+        )
+    return irregularities
+
+
 @runtime_checkable
 class ContactProvider(Protocol):
     """What the equations of motion need from a contact-geometry source."""
@@ -208,7 +224,7 @@ class ConicalProvider:
         root = math.sqrt(1 + lam * lam)
         self.rail_centre_y = SIDE_SIGNS * (self.e0 + self.rail_radius * lam / root)
         self.rail_centre_z = np.full(2, self.rail_radius / root)
-        self.irregularities = irregularities if irregularities is not None and irregularities.any else None
+        self.irregularities = _running_direction_only(irregularities, self.name)
         if self.irregularities is not None:
             self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
 
@@ -335,7 +351,7 @@ class TableProvider:
                 merge = p.merge_approach_m if p.merge_approach_m is not None else np.full(n, -np.inf)
                 table[11, :, i, j] = np.maximum(merge, -1.0)  # finite, for the interpolation
         self.table = table
-        self.irregularities = irregularities if irregularities is not None and irregularities.any else None
+        self.irregularities = _running_direction_only(irregularities, self.name)
         if self.irregularities is not None:
             self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
 

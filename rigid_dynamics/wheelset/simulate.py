@@ -22,8 +22,10 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
   raised one of :data:`NUMERICAL_ERRORS`, e.g. for a tiny shear modulus);
 
-and ``"ok"`` when it reaches the end. Events (wheel lift, contact restored, flange contact onset)
-are detected on the output samples, so their times are known to one output step.
+``"warning"`` when a fixed-step RK4 run reaches the end but its error estimate of the contact forces
+(:func:`_force_error_check`) exceeds the scene's ``force_tolerance`` (the numbers are there, but the step is too
+coarse to trust them); and ``"ok"`` when it reaches the end without either. Events (wheel lift, contact
+restored, flange contact onset) are detected on the output samples, so their times are known to one output step.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +59,7 @@ STATUSES = (
     "solver-failed",
     "budget-exceeded",
     "invalid-initial-state",
+    "warning",
 )
 
 
@@ -91,6 +94,13 @@ class SimulationResult:
             recording), s; loading the compiled code from numba's cache (once per process, ~0.1 s) is not counted.
         failure_time_s, failure_state: where the run ended abnormally (None when it did not).
         provider, contact_model, method: what was used; compiled: whether the compiled RK4 loop ran it.
+        force_error_estimate: RK4 runs: per output sample, the estimated error of one step in the per-wheel contact
+            forces (normal, longitudinal and lateral creep force) divided by the static wheel load, (n,); NaN where
+            no step ends at the sample (t = 0, interpolated samples); None for the adaptive methods (their
+            error is controlled by their tolerances).
+        half_step_peak_difference: RK4 runs in which a wheel lifted off after the settling distance: the largest
+            difference of the settled peaks from a run at half the step, relative to the static wheel load
+            (:func:`_half_step_check`); None otherwise.
         scene: the scene that ran.
     """
 
@@ -114,6 +124,8 @@ class SimulationResult:
     contact_model: str = ""
     method: str = ""
     compiled: bool = False
+    force_error_estimate: np.ndarray | None = None
+    half_step_peak_difference: float | None = None
     scene: DynamicsScene | None = field(default=None, repr=False)
 
     @property
@@ -144,9 +156,73 @@ class SimulationResult:
             return energy
         return energy - energy[0] - self.work_contact_J - self.work_exterior_J
 
+    def to_dataframe(self):
+        """The time series as a tidy pandas DataFrame, one column per named quantity (see wheelset.table)."""
+        from rigid_dynamics.wheelset.table import to_dataframe
+
+        return to_dataframe(self)
+
+    def to_dict(self) -> dict:
+        """The summary with the tidy time-series columns under ``"timeseries"`` (name -> (n,) array)."""
+        from rigid_dynamics.wheelset.table import result_columns
+
+        return {**self.summary(), "timeseries": result_columns(self)}
+
+    def __repr__(self) -> str:
+        return (
+            f"SimulationResult(status={self.status!r}, simulated_time_s={self.simulated_time_s:.4g}, "
+            f"samples={len(self.t)}, wall_time_s={self.wall_time_s:.3g}, contact_model={self.contact_model!r}, "
+            f"provider={self.provider!r}, compiled={self.compiled}, message={self.message!r})"
+        )
+
+    @property
+    def settling_distance_m(self) -> float:
+        """The scene's settling distance (DynamicsScene.settling_distance_m; 0 without a scene), m."""
+        return self.scene.settling_distance_m if self.scene is not None else 0.0
+
+    @property
+    def settled(self) -> np.ndarray:
+        """Mask of the output samples after the settling distance (travelled distance x(t) - x(0)), (n,)."""
+        if len(self.t) == 0:
+            return np.zeros(0, bool)
+        return self.states[:, 0] - self.states[0, 0] >= self.settling_distance_m
+
+    def peaks(self, settled: bool = True) -> dict:
+        """Peaks of the per-wheel contact forces on the wheel: for ``normal_force_N`` the largest total normal
+        force, for ``creep_force_long_N`` and ``creep_force_lat_N`` the largest magnitude of the summed creep force
+        (with its sign; patch contact frames), each per side as {"value", "time_s", "position_m"} (position: the
+        distance travelled since t = 0, m); values None when there is no sample. ``settled``: only the samples
+        after the settling distance (:attr:`settled`), else the full run.
+        """
+        mask = self.settled if settled else np.ones(len(self.t), bool)
+        distance = self.states[:, 0] - self.states[0, 0] if len(self.t) else np.zeros(0)
+        out = {}
+        for name in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N"):
+            values = self.patches[name]
+            touching = np.nan_to_num(self.patches["normal_force_N"], nan=0.0) > 0
+            wheel = np.where(touching, np.nan_to_num(values, nan=0.0), 0.0).sum(axis=2) if len(self.t) else values
+            out[name] = {}
+            for i, side in enumerate(SIDES):
+                entry = {"value": None, "time_s": None, "position_m": None}
+                if np.any(mask):
+                    series = np.where(mask, wheel[:, i], np.nan)
+                    key = series if name == "normal_force_N" else np.abs(series)
+                    if np.any(np.isfinite(key)):
+                        k = int(np.nanargmax(key))
+                        entry = {
+                            "value": float(series[k]),
+                            "time_s": float(self.t[k]),
+                            "position_m": float(distance[k]),
+                        }
+                out[name][side] = entry
+        return out
+
     def summary(self) -> dict:
-        """JSON-serialisable summary (NaN -> None); keys listed in the issue and a few diagnostics."""
-        forces = self.wheel_normal_force_N
+        """JSON-serialisable summary (NaN -> None); keys listed in the issue and a few diagnostics.
+
+        Peaks (``peaks``, ``peak_normal_force_N``) are taken after the scene's settling distance, with the time and
+        position of each; ``full_run_peaks`` and ``full_run_peak_normal_force_N`` include the start.
+        """
         lateral = self.states[:, 1] if len(self.t) else np.zeros(0)
         wavelength = dominant_wavelength_m(self.states[:, 0], lateral) if len(self.t) > 4 else math.nan
         residual = self.energy_residual_J
@@ -156,6 +232,8 @@ class SimulationResult:
             value = float(value)
             return value if math.isfinite(value) else None
 
+        peaks = self.peaks(settled=True)
+        full = self.peaks(settled=False)
         return {
             "status": self.status,
             "message": self.message,
@@ -163,9 +241,11 @@ class SimulationResult:
             "simulated_time_s": num(self.simulated_time_s),
             "wall_time_s": num(self.wall_time_s),
             "real_time_factor": num(self.real_time_factor),
-            "peak_normal_force_N": {
-                side: num(np.max(forces[:, i])) if len(self.t) else None for i, side in enumerate(SIDES)
-            },
+            "settling_distance_m": num(self.settling_distance_m),
+            "peak_normal_force_N": {side: peaks["normal_force_N"][side]["value"] for side in SIDES},
+            "peaks": peaks,
+            "full_run_peak_normal_force_N": {side: full["normal_force_N"][side]["value"] for side in SIDES},
+            "full_run_peaks": full,
             "max_abs_lateral_displacement_m": num(np.max(np.abs(lateral))) if len(self.t) else None,
             "dominant_lateral_wavelength_m": num(wavelength),
             "distance_travelled_m": num(self.states[-1, 0] - self.states[0, 0]) if len(self.t) else None,
@@ -179,7 +259,27 @@ class SimulationResult:
             "contact_model": self.contact_model,
             "method": self.method,
             "compiled": self.compiled,
+            **self._error_summary(num),
         }
+
+    def _error_summary(self, num) -> dict:
+        """The force error estimate of a fixed-step run in the summary: the largest after the settling distance
+        (what the status judges) and over the full run, each with its time, and the tolerance.
+        """
+        est = self.force_error_estimate
+        if est is None:
+            return {"force_error_estimate": None}
+        out = {"force_tolerance": num(self.scene.integrator.force_tolerance) if self.scene is not None else None}
+        diff = self.half_step_peak_difference
+        out["half_step_peak_difference"] = None if diff is None else num(diff)
+        for key, mask in (("force_error_estimate", self.settled), ("full_run_force_error_estimate", None)):
+            values = est if mask is None else np.where(mask, est, np.nan)
+            if np.all(np.isnan(values)):
+                out[key], out[f"{key}_time_s"] = None, None
+                continue
+            k = int(np.argmax(np.where(np.isnan(values), -np.inf, values)))
+            out[key], out[f"{key}_time_s"] = num(values[k]), num(self.t[k])
+        return out
 
 
 def dominant_wavelength_m(distance_m, lateral_m) -> float:
@@ -229,7 +329,7 @@ def build_provider(scene: DynamicsScene):
     choice = scene.contact_provider
     track, irr = scene.track, scene.irregularities
     if choice == "auto":
-        if track.is_conical:
+        if track.is_conical and not irr.needs_search:
             choice = "conical"
         elif irr.any:
             choice = "search"
@@ -293,6 +393,117 @@ def initial_state(scene: DynamicsScene) -> np.ndarray:
     return state
 
 
+def _side_force_sums(table: dict) -> np.ndarray:
+    """Per wheel (left, right) the normal, longitudinal and lateral creep forces summed over the patches in contact,
+    (2, 3), N, from a patch table (PATCH_FIELDS -> (2, MAX_SLOTS)).
+    """
+    names = ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")
+    touching = np.nan_to_num(table["normal_force_N"], nan=0.0) > 0
+    return np.stack([np.where(touching, np.nan_to_num(table[n], nan=0.0), 0.0).sum(axis=1) for n in names], axis=1)
+
+
+def _contact_force_sums(model: WheelsetModel, state: np.ndarray) -> np.ndarray:
+    """:func:`_side_force_sums` of the contact at a 12-state (the Python path's force error estimate)."""
+    contact = model.contact(state[:12], record=True)
+    table = {
+        name: np.full((2, MAX_SLOTS), np.nan) for name in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")
+    }
+    for k in range(len(contact.side)):
+        side, slot = int(contact.side[k]), int(contact.slot[k])
+        if slot < MAX_SLOTS:
+            for name in table:
+                table[name][side, slot] = contact.values[name][k]
+    return _side_force_sums(table)
+
+
+def _rolling_radii(sides, normal_N, radius_m) -> np.ndarray:
+    """Rolling radius of each wheel (left, right), m: the radii of its patches in contact weighted by their normal
+    forces; NaN for a wheel without contact.
+    """
+    sides = np.asarray(sides)
+    normal = np.nan_to_num(np.asarray(normal_N, float), nan=0.0)
+    radius = np.nan_to_num(np.asarray(radius_m, float), nan=0.0)
+    out = np.full(2, np.nan)
+    for i in (0, 1):
+        w = np.where((sides == i) & (normal > 0), normal, 0.0)
+        if w.sum() > 0:
+            out[i] = float(np.sum(w * radius) / w.sum())
+    return out
+
+
+def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, deepest=None, rolling=None):
+    """A consistent rolling start from the 12-state of :func:`initial_state`: (state, success, message).
+
+    1. Static equilibrium of z and roll at the initial lateral offset and yaw (WheelsetModel.static_state).
+    2. Free rolling: the spin rate phi' (and, with ``initial.free_rolling``, the yaw rate psi') at which the
+       spin and yaw accelerations vanish, by Newton steps from V / r_roll (r_roll the mean of the two wheels'
+       rolling radii, each the normal-force-weighted mean over its patches) and the given yaw rate; phi' is then
+       scaled by (1 - xi0) with xi0 the scene's ``initial.longitudinal_creepage``. With V / r0 (r0 the nominal
+       radius) a profiled wheel off its tape circle starts with a common longitudinal creepage (r_roll - r0)/r0;
+       with psi' = 0 an offset wheelset starts with the creepages +-(r_right - r_left)/(2 r_roll): both a
+       creep-force spike at t = 0. With the solved psi' the wheelset starts on its kinematic (Klingel) path,
+       psi' = -V (r_right - r_left)/(2 e0 r_roll) to first order, at the extreme of the offset.
+    3. The static equilibrium again at that spin rate.
+
+    ``derivative``, ``deepest``, ``rolling``: the compiled right-hand side's versions (_compiled_static_functions);
+    None: the Python path's.
+    """
+    state, ok, why = model.static_state(state, derivative, deepest)
+    if not ok:
+        return state, ok, why
+    if rolling is None:
+        contact = model.contact(state[:12], record=True)
+        radii = _rolling_radii(contact.side, contact.values["normal_force_N"], contact.values["rolling_radius_m"])
+    else:
+        radii = rolling(state)
+    if not np.all(np.isfinite(radii)):
+        return state, False, f"a wheel has no contact at the static equilibrium (rolling radii {radii} m)"
+    derivative = model.derivative if derivative is None else derivative
+    state = state.copy()
+    ic = model.scene.initial
+    solve_yaw = ic.free_rolling
+    rolling_rate = model.scene.speed_m_per_s / float(np.mean(radii))
+
+    def residual(rates):
+        trial = np.concatenate([state, [0.0, 0.0]])
+        trial[11] = rates[0]
+        if solve_yaw:
+            trial[9] = rates[1]
+        try:
+            d = derivative(0.0, trial)
+        except ContactFailure:
+            return np.full(2, np.nan)
+        return np.array([d[11], d[9] if solve_yaw else 0.0])
+
+    # Newton with a forward-difference Jacobian on (spin rate, yaw rate): the creep forces are about linear in them
+    rates = np.array([rolling_rate, state[9]])
+    steps = np.array([1e-6 * rolling_rate, 1e-6 * rolling_rate * model.scene.wheelset.nominal_radius_m])
+    r = residual(rates)
+    for _ in range(8):
+        if not np.all(np.isfinite(r)):
+            break
+        jac = np.eye(2)
+        for k in range(2 if solve_yaw else 1):
+            trial = rates.copy()
+            trial[k] += steps[k]
+            jac[:, k] = (residual(trial) - r) / steps[k]
+        try:
+            delta = np.linalg.solve(jac, -r)
+        except np.linalg.LinAlgError:
+            break
+        if not np.all(np.isfinite(delta)):
+            break
+        rates = rates + delta
+        r = residual(rates)
+        if abs(delta[0]) < 1e-12 * rolling_rate and abs(delta[1]) < 1e-12 * rolling_rate:
+            break
+    if not np.all(np.isfinite(rates)) or abs(rates[0] / rolling_rate - 1.0) > 0.01:
+        rates = np.array([rolling_rate, state[9]])  # no free-rolling solution nearby: the rolling radii alone
+    state[11] = (1.0 - ic.longitudinal_creepage) * rates[0]
+    state[9] = rates[1]
+    return model.static_state(state, derivative, deepest)
+
+
 class _Recorder:
     """Collects output samples and detects events and anomalies on them. Samples are kept as blocks of rows (one
     row from :meth:`append`, many from :meth:`append_many`), joined by :meth:`arrays`.
@@ -309,6 +520,7 @@ class _Recorder:
         self.potential: list[np.ndarray] = []
         self.work_contact: list[np.ndarray] = []
         self.work_exterior: list[np.ndarray] = []
+        self.errors: list[np.ndarray] = []
         self.events: list[tuple] = []
         self.in_contact = None
         self.flange = None
@@ -316,7 +528,10 @@ class _Recorder:
         self.limit_y = scene.integrator.max_lateral_displacement_m
         self.flange_angle = scene.track.flange_contact_angle_rad
 
-    def record(self, t: float, full_state: np.ndarray) -> None:
+    def record(self, t: float, full_state: np.ndarray, error: float = math.nan) -> None:
+        """Check and store the sample at (t, full_state) with the force error estimate of the steps since the last
+        sample (N; NaN: none).
+        """
         state = full_state[:12]
         if not np.all(np.isfinite(full_state)):
             raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, state)
@@ -330,10 +545,14 @@ class _Recorder:
                 table[name][side, slot] = contact.values[name][k]
         forces = np.zeros((2, 3))
         np.add.at(forces, contact.side, contact.force_N)
-        self.append(t, full_state, table, forces)
+        self.append(t, full_state, table, forces, error)
 
-    def append(self, t: float, full_state: np.ndarray, table: dict, forces: np.ndarray) -> None:
-        """Check and store one sample (patch table: PATCH_FIELDS -> (2, 2); forces per side (2, 3))."""
+    def append(
+        self, t: float, full_state: np.ndarray, table: dict, forces: np.ndarray, error: float = math.nan
+    ) -> None:
+        """Check and store one sample (patch table: PATCH_FIELDS -> (2, 2); forces per side (2, 3); the force error
+        estimate of the step ending there, relative to the static wheel load).
+        """
         state = full_state[:12]
         normal = np.nansum(table["normal_force_N"], axis=1)
         if not (np.all(np.isfinite(forces)) and np.all(np.isfinite(normal))):
@@ -375,12 +594,17 @@ class _Recorder:
         self.potential.append(np.array([self.model.potential_energy_J(state)], float))
         self.work_contact.append(np.array([full_state[12]], float))
         self.work_exterior.append(np.array([full_state[13]], float))
+        self.errors.append(np.array([error], float))
         if self.scene.integrator.stop_at_wheel_lift and not np.all(touching):
             side = SIDES[int(np.argmin(touching))]
             raise _Stop("wheel-lift", f"the {side} wheel lost contact at t = {t:.6g} s", t, state)
 
-    def append_many(self, times, full_states, tables: dict, forces) -> None:
-        """Vectorised :meth:`append` for many samples (tables: name -> (n, 2, 2); forces (n, 2, 3))."""
+    def set_last_error(self, error: float) -> None:
+        """Set the force error estimate of the last sample (N; NaN: none)."""
+        self.errors[-1] = np.array([error], float)
+
+    def append_many(self, times, full_states, tables: dict, forces, errors) -> None:
+        """Vectorised :meth:`append` for many samples (tables: name -> (n, 2, 2); forces (n, 2, 3); errors (n,))."""
         n = len(times)
         if n == 0:
             return
@@ -397,9 +621,19 @@ class _Recorder:
             # store the good samples, then let append() raise with the right status on the bad one
             if stop:
                 self.append_many(
-                    times[:stop], full_states[:stop], {k: v[:stop] for k, v in tables.items()}, forces[:stop]
+                    times[:stop],
+                    full_states[:stop],
+                    {k: v[:stop] for k, v in tables.items()},
+                    forces[:stop],
+                    errors[:stop],
                 )
-            self.append(float(times[stop]), full_states[stop], {k: v[stop] for k, v in tables.items()}, forces[stop])
+            self.append(
+                float(times[stop]),
+                full_states[stop],
+                {k: v[stop] for k, v in tables.items()},
+                forces[stop],
+                float(errors[stop]),
+            )
             return
         flange = np.any((tables["contact_angle_rad"] > self.flange_angle) & (tables["normal_force_N"] > 0), axis=2)
         prev_touch = np.vstack([self.in_contact if self.in_contact is not None else touching[:1], touching[:-1]])
@@ -438,6 +672,7 @@ class _Recorder:
         self.potential.append(-self.model.mass * self.model.gravity * states[:, 2])
         self.work_contact.append(full_states[:, 12].copy())
         self.work_exterior.append(full_states[:, 13].copy())
+        self.errors.append(np.asarray(errors, float).copy())
 
     def arrays(self):
         def joined(blocks, empty_shape):
@@ -453,6 +688,7 @@ class _Recorder:
             joined(self.potential, (0,)),
             joined(self.work_contact, (0,)),
             joined(self.work_exterior, (0,)),
+            joined(self.errors, (0,)),
         )
 
 
@@ -504,9 +740,10 @@ def simulate(
 
     try:
         if use_compiled:
-            state0, ok, why = model.static_state(initial_state(scene), *_compiled_static_functions(packed))
+            derivative, deepest, rolling = _compiled_static_functions(packed)
+            state0, ok, why = consistent_start(model, initial_state(scene), derivative, deepest, rolling)
         else:
-            state0, ok, why = model.static_state(initial_state(scene))
+            state0, ok, why = consistent_start(model, initial_state(scene))
     except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
         state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
@@ -564,7 +801,7 @@ def simulate(
         if use_compiled:
             steps = _run_compiled(model, packed, full0, duration, settings, recorder, report, start)
         elif settings.method == "RK4":
-            steps = _run_rk4(fun, full0, duration, settings, out_times, recorder, report)
+            steps = _run_rk4(fun, full0, duration, settings, out_times, recorder, report, model)
         else:
             steps = _run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
         message = f"reached t = {duration:g} s"
@@ -577,8 +814,14 @@ def simulate(
     except NUMERICAL_ERRORS as exc:  # raised below the driver (e.g. the curvature code for a huge stiffness with RK4)
         status, message = "solver-failed", f"numerical failure: {type(exc).__name__}: {exc}"
     wall = time.perf_counter() - start
-    t, states, patches, forces, kin, pot, wc, we = recorder.arrays()
-    return SimulationResult(
+    t, states, patches, forces, kin, pot, wc, we, errors = recorder.arrays()
+    fixed_step = settings.method == "RK4"
+    if fixed_step:
+        errors = errors / scene.static_wheel_load_N
+        if status == "ok":
+            settled = states[:, 0] - states[0, 0] >= scene.settling_distance_m if len(t) else np.zeros(0, bool)
+            status, message = _force_error_check(errors, t, settled, settings, message)
+    result = SimulationResult(
         status=status,
         message=message,
         t=t,
@@ -599,8 +842,108 @@ def simulate(
         contact_model=getattr(model_obj, "name", type(model_obj).__name__),
         method=settings.method,
         compiled=use_compiled,
+        force_error_estimate=errors if fixed_step else None,
         scene=scene,
     )
+    if fixed_step and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
+        result = _half_step_check(result, provider, model_obj, compiled)
+    return result
+
+
+def _lifted_after_settling(result: SimulationResult) -> bool:
+    """Whether a wheel lost contact after the settling distance (a "wheel-lift" event there)."""
+    if len(result.t) == 0:
+        return False
+    settled_from = result.t[np.argmax(result.settled)] if np.any(result.settled) else math.inf
+    return any(kind == "wheel-lift" and time_s >= settled_from for kind, _, time_s in result.events)
+
+
+def _half_step_check(result: SimulationResult, provider, model_obj, compiled) -> SimulationResult:
+    """The global check of a fixed-step run in which a wheel lifted off: the run again at half the step, and the
+    settled peaks compared (normal, longitudinal and lateral creep force per wheel, relative to the static load).
+
+    After a wheel lift the re-impact depends on the flight: the local force error estimate stays small while the
+    later impacts move (wheel-flat on the rigid track at 0.1 ms: estimate 1e-3, re-impact peaks 3.6 % of the static
+    load against a 0.025 ms run; benchmarks/results/step_sensitivity.md). The difference of the two runs is an upper
+    estimate of the half-step run's error and about the error of this run. "warning" when it exceeds
+    ``force_tolerance``; the wall time and RHS evaluations include the second run.
+    """
+    scene = result.scene
+    settings = scene.integrator
+    half = simulate(
+        replace(
+            scene, integrator=replace(settings, fixed_step_s=0.5 * settings.fixed_step_s, lift_half_step_check=False)
+        ),
+        provider=provider,
+        contact_model=model_obj,
+        compiled=compiled,
+    )
+    total = {
+        "wall_time_s": result.wall_time_s + half.wall_time_s,
+        "rhs_evaluations": result.rhs_evaluations + half.rhs_evaluations,
+    }
+    if half.status not in ("ok", "warning"):
+        return replace(
+            result,
+            status="warning",
+            message=f"{result.message}; a wheel lifted off, and the check at half the step ended {half.status}: "
+            f"{half.message}",
+            **total,
+        )
+    load = scene.static_wheel_load_N
+    mine, theirs = result.peaks(settled=True), half.peaks(settled=True)
+    moved = 0.0
+    for name, sides in mine.items():
+        for side, entry in sides.items():
+            a, b = entry["value"], theirs[name][side]["value"]
+            if a is not None and b is not None:
+                moved = max(moved, abs(a - b) / load)
+    message = (
+        f"{result.message}; a wheel lifted off: the settled peaks at half the step differ by {moved:.3g} of the "
+        f"static wheel load"
+    )
+    status = "ok"
+    if moved > settings.force_tolerance:
+        status = "warning"
+        message += (
+            f", above force_tolerance = {settings.force_tolerance:g}: reduce fixed_step_s = {settings.fixed_step_s:g} s"
+        )
+    return replace(result, status=status, message=message, half_step_peak_difference=moved, **total)
+
+
+def _force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, settings, message: str):
+    """(status, message) of a finished fixed-step run from its force error estimates (relative to the static wheel
+    load): "warning" when the largest after the settling distance (``settled``) exceeds ``settings.force_tolerance``
+    (or an estimate failed there), else "ok"; when only the start-up exceeds it, the message says that the
+    full-run peaks are not converged.
+
+    The estimate is the contact-force difference between RK4 and its embedded third-order solution over the step
+    ending at each recorded sample (compiled.rk4_run, :func:`_run_rk4`). On the embedded scenes it separates the
+    steps whose force results move by more than a few per cent of the static load from those that do not, where the
+    contact-passage time against the step misses the creep-force bias of polygonal-wheel at 1 ms and step doubling
+    underestimates it (benchmarks/results/step_sensitivity.md).
+    """
+
+    def worst(mask):
+        values = np.where(mask & ~np.isnan(errors), errors, -np.inf)
+        k = int(np.argmax(values)) if len(values) else 0
+        return (values[k], k) if len(values) else (-np.inf, 0)
+
+    tol = settings.force_tolerance
+    value, k = worst(settled)
+    if value > tol:
+        what = f"{value:.3g}" if np.isfinite(value) else "not computable (the third-order state failed)"
+        return "warning", (
+            f"{message}; force error estimate {what} of the static wheel load at t = {t[k]:.6g} s exceeds "
+            f"force_tolerance = {tol:g}: reduce fixed_step_s = {settings.fixed_step_s:g} s"
+        )
+    value, k = worst(~settled)
+    if value > tol:
+        return "ok", (
+            f"{message}; the start-up before the settling distance has a force error estimate {value:.3g} at "
+            f"t = {t[k]:.6g} s above force_tolerance = {tol:g}: its peaks (full_run_peaks) are not converged"
+        )
+    return "ok", message
 
 
 def _tolerances(settings, scene):
@@ -742,7 +1085,9 @@ _COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact
 
 
 def _compiled_static_functions(packed):
-    """(derivative, deepest approach per wheel) by the compiled right-hand side, for WheelsetModel.static_state."""
+    """(derivative, deepest approach per wheel, rolling radius per wheel) by the compiled right-hand side, for
+    :func:`consistent_start`.
+    """
     from rigid_dynamics.wheelset import compiled
 
     par, hz, kk, sides, _, mode, targs, sargs = packed
@@ -763,7 +1108,11 @@ def _compiled_static_functions(packed):
         approach = np.nan_to_num(rec[:ncand, 7], nan=-np.inf)
         return [float(np.max(approach[sides == i])) if np.any(sides == i) else 0.0 for i in (0, 1)]
 
-    return derivative, deepest
+    def rolling(state):
+        derivative(0.0, np.concatenate([state, [0.0, 0.0]]))
+        return _rolling_radii(sides, rec[:ncand, 0], rec[:ncand, 10])
+
+    return derivative, deepest, rolling
 
 
 def _run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
@@ -774,17 +1123,19 @@ def _run_compiled(model, packed, y0, duration, settings, recorder, report, start
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
     out_every = max(1, int(round(settings.output_step_s / h)))
+    check_every = _check_every(settings, h)
     n_out = n_steps // out_every
     ncand = len(sides)
     states = np.zeros((n_out, 14))
     recs = np.zeros((n_out, ncand + 2, compiled.N_FIELDS))
+    errs = np.full(n_out, np.nan)
     y, t, done, k_out = y0.copy(), 0.0, 0, 0
     chunk = max(out_every, (2000 // out_every) * out_every)
     fields_ = PATCH_FIELDS
     while done < n_steps:
         todo = min(chunk, n_steps - done)
         status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
-            y, t, h, todo, out_every, par, hz, kk, sides, mode, targs, sargs, states, recs, k_out
+            y, t, h, todo, out_every, check_every, par, hz, kk, sides, mode, targs, sargs, states, recs, errs, k_out
         )
         model.rhs_evaluations += int(evals)
         if k_new > k_out:
@@ -795,7 +1146,9 @@ def _run_compiled(model, packed, y0, duration, settings, recorder, report, start
                     for f, name in enumerate(fields_):
                         tables[name][:, sides[c], slots[c]] = block[:, c, f]
             times = (done // out_every + np.arange(1, k_new - k_out + 1)) * out_every * h
-            recorder.append_many(times, states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy())
+            recorder.append_many(
+                times, states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy(), errs[k_out:k_new]
+            )
         k_out = k_new
         if status != 0:
             stop = _Stop(
@@ -820,15 +1173,38 @@ def _run_compiled(model, packed, y0, duration, settings, recorder, report, start
     return n_steps
 
 
-def _run_rk4(fun, y0, duration, settings, out_times, recorder, report) -> int:
+FORCE_CHECK_INTERVAL_S = 1e-3
+"""Largest simulated time between two force error checks of an RK4 run, s: with sparse output (say 10 ms) a
+wheel-flat impact (about 3 ms at 60 km/h) still meets a check."""
+
+
+def _check_every(settings, step_s: float) -> int:
+    """Steps between force error checks: every output step, at most FORCE_CHECK_INTERVAL_S apart."""
+    out_every = max(1, int(round(settings.output_step_s / step_s)))
+    return max(1, min(out_every, int(round(FORCE_CHECK_INTERVAL_S / step_s))))
+
+
+def _run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
+    """Classical RK4 with a fixed step on the Python right-hand side ``fun``, output by cubic Hermite interpolation.
+
+    Force error estimate (as compiled.rk4_run): every :func:`_check_every` steps the step is also advanced
+    by the embedded third-order formula, y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) with k5 = f(t + h, y4) (the next
+    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept (two extra contact
+    evaluations per check). An output sample at the step's end carries the estimate of that step, other samples
+    the largest of the checks since the previous sample. The samples are recorded (and checked for anomalies)
+    before the estimate is evaluated; a third-order state whose contact cannot be evaluated gives an infinite one.
+    """
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
+    check_every = _check_every(settings, h)
     y = y0.copy()
     t = 0.0
     next_out = 1
+    k1 = None
+    pending = math.nan
     for i in range(n_steps):
         try:
-            k1 = fun(t, y)
+            k1 = fun(t, y) if k1 is None else k1
             k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
             k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
             k4 = fun(t + h, y + h * k3)
@@ -837,23 +1213,44 @@ def _run_rk4(fun, y0, duration, settings, out_times, recorder, report) -> int:
             raise
         y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
         t_new = (i + 1) * h
+        at_end = False
         while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
             t_out = out_times[next_out]
             # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
             s = (t_out - t) / h
             if abs(s - 1.0) < 1e-9:
-                y_out = y_new
+                y_out, at_end = y_new, True
             else:
                 h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
                 h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
                 y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
             try:
-                recorder.record(t_out, y_out)
+                recorder.record(t_out, y_out, math.nan if at_end else pending)
             except _Stop as stop:
                 stop.steps = i + 1
                 raise
+            if not at_end:
+                pending = math.nan
             next_out += 1
-        y, t = y_new, t_new
+        k_next = None
+        if (i + 1) % check_every == 0 or at_end:
+            try:
+                k_next = fun(t_new, y_new)
+            except _Stop as stop:
+                stop.steps = i + 1
+                raise
+            y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
+            try:
+                error = float(np.max(np.abs(_contact_force_sums(model, y_new) - _contact_force_sums(model, y3))))
+            except (ContactFailure, ValueError, ArithmeticError):
+                error = math.inf
+            if math.isnan(error):  # forces not computable at one of the two states
+                error = math.inf
+            pending = error if math.isnan(pending) else max(pending, error)
+        if at_end:
+            recorder.set_last_error(pending)
+            pending = math.nan
+        y, t, k1 = y_new, t_new, k_next
         report(t)
     return n_steps
 
@@ -863,6 +1260,7 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
 
     Arrays: ``t`` (n,), ``states`` (n, 12) with ``state_names``, ``patch_<field>`` (n, 2, 2) for every
     PATCH_FIELDS entry (sides left/right, slots tread/flange), ``contact_force_N`` (n, 2, 3),
+    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult),
     ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
     ``status``/``message``/``sides`` as strings. NaN marks candidates without contact, never a failed number:
     a failed run stops at its last good sample and says so in ``status``.
@@ -880,6 +1278,8 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
         "message": np.array(result.message),
         "sides": np.array(SIDES),
     }
+    if result.force_error_estimate is not None:
+        arrays["force_error_estimate"] = result.force_error_estimate
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
     return arrays

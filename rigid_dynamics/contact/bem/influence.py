@@ -47,6 +47,7 @@ sizes (m). Displacements per unit traction: m/Pa.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -232,6 +233,14 @@ def strip_influence(
     }
 
 
+SHARED_CACHE_GRIDS = 16
+"""Number of grids (by nx, ny, dx, dy and elastic constants) whose coefficients and spectra are kept for reuse."""
+SHARED_CACHE_ELEMENTS = 100_000
+"""Bound on the summed elements of the kept grids (about 0.7 kB each for all kernels; the newest grid is kept)."""
+
+_SHARED_CACHES: OrderedDict = OrderedDict()
+
+
 @dataclass(frozen=True, eq=False)
 class InfluenceGrid:
     """Influence coefficients of a regular nx x ny grid of rectangular elements, applied by FFT.
@@ -248,7 +257,10 @@ class InfluenceGrid:
       (Kalker 1990, sec. 5.2: the previous position of a particle is dx ahead).
 
     The convolution is a zero-padded FFT (period >= 2n - 1 along each axis, so no wrap-around),
-    O(N log N) time and O(N) memory; no dense N x N matrix is formed.
+    O(N log N) time and O(N) memory; no dense N x N matrix is formed. Coefficients and spectra are computed
+    lazily and shared by the grids of equal parameters (the last ``SHARED_CACHE_GRIDS`` distinct ones, within
+    ``SHARED_CACHE_ELEMENTS`` elements in all), so that
+    the repeated solves on one patch grid (e.g. a load equilibrium) compute them once.
 
     Attributes:
         nx, ny: number of elements along x and y.
@@ -284,6 +296,22 @@ class InfluenceGrid:
             raise ValueError(f"ny = {self.ny!r}: the 2-D (plane) mode expects ny = 1")
         if self.plane and self.difference_parameter != 0.0:
             raise ValueError(f"difference_parameter = {self.difference_parameter!r}: expected 0 in the 2-D mode")
+        key = (
+            int(self.nx),
+            int(self.ny),
+            float(self.dx_m),
+            float(self.dy_m),
+            float(self.shear_modulus_Pa),
+            float(self.poisson_ratio),
+            float(self.difference_parameter),
+            bool(self.plane),
+        )
+        shared = _SHARED_CACHES.get(key)
+        if shared is not None and not self._cache:
+            # the coefficients are functions of the key alone: share them with the earlier grid of the same key
+            _SHARED_CACHES.move_to_end(key)
+            object.__setattr__(self, "_cache", shared)
+            return
         shape = (
             scipy.fft.next_fast_len(2 * int(self.ny) - 1, real=True) if self.ny > 1 else 1,
             scipy.fft.next_fast_len(2 * int(self.nx) - 1, real=True),
@@ -292,6 +320,11 @@ class InfluenceGrid:
         self._cache["static"] = {}
         self._cache["rolling"] = {}
         self._cache["fft"] = {}
+        _SHARED_CACHES[key] = self._cache
+        while len(_SHARED_CACHES) > SHARED_CACHE_GRIDS or (
+            len(_SHARED_CACHES) > 1 and sum(k[0] * k[1] for k in _SHARED_CACHES) > SHARED_CACHE_ELEMENTS
+        ):
+            _SHARED_CACHES.popitem(last=False)
 
     def _compute_kernels(self, names: tuple[str, ...]) -> None:
         """Fill the static and rolling coefficient caches for ``names`` (lazily: NORM needs only zz)."""
@@ -313,7 +346,7 @@ class InfluenceGrid:
                 self.difference_parameter,
                 only_normal=names == ("zz",),
             )
-        self._cache["zz_period"] = ext["zz"]
+        self._cache["period"] = dict(ext)  # offsets -(ny - 1)..ny (0 in 2-D) x -(nx - 1)..nx
         for k, v in ext.items():
             v = v[: 2 * ny - 1]
             self._cache["static"][k] = v[:, : 2 * nx - 1]
@@ -390,20 +423,24 @@ class InfluenceGrid:
         A preconditioner for :func:`~.norm.solve_norm`, not an exact inverse on the bounded grid.
         """
         if "prec" not in self._cache:
-            ny, nx = int(self.ny), int(self.nx)
             self.kernel("zz")
-            k = self._cache["zz_period"]  # offsets -(ny - 1)..ny (0 in 2-D) x -(nx - 1)..nx: one 2 ny x 2 nx period
-            # index by offset modulo the period, then add the two halves along each axis
-            folded = np.roll(k, (-(ny - 1) if k.shape[0] > 1 else 0, -(nx - 1)), axis=(0, 1))
-            if folded.shape[0] > 1:
-                folded = folded[:ny] + folded[ny:]
-            folded = folded[:, :nx] + folded[:, nx:]
-            symbol = scipy.fft.rfft2(folded).real
+            symbol = scipy.fft.rfft2(self._folded_period("zz")).real
             floor = 1e-6 * float(np.abs(symbol).max())
             self._cache["prec"] = 1.0 / np.maximum(symbol, floor)
         spec = scipy.fft.rfft2(residual_m)
         spec *= self._cache["prec"]
         return scipy.fft.irfft2(spec, s=(self.ny, self.nx))
+
+    def _folded_period(self, name: str) -> np.ndarray:
+        """Kernel ``name`` (static) folded onto the grid's own period (ny, nx): the coefficients of the 2 ny x 2 nx
+        period (offsets -(ny - 1)..ny x -(nx - 1)..nx) indexed by offset modulo (ny, nx) and summed.
+        """
+        ny, nx = int(self.ny), int(self.nx)
+        k = self._cache["period"][name]
+        folded = np.roll(k, (-(ny - 1) if k.shape[0] > 1 else 0, -(nx - 1)), axis=(0, 1))
+        if folded.shape[0] > 1:
+            folded = folded[:ny] + folded[ny:]
+        return folded[:, :nx] + folded[:, nx:]
 
     def _forward_pair(self, first: np.ndarray, second: np.ndarray) -> np.ndarray:
         """Spectra of two (ny, nx) fields in one batched FFT call, shape (2, ly, lx/2 + 1)."""
@@ -456,6 +493,28 @@ class InfluenceGrid:
                 np.ascontiguousarray(v, dtype=complex) for v in (kyy / det, -kxy / det, kxx / det)
             )
         return self._cache["inv"]
+
+    def inverse_static_period_spectra(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Spectra (ixx, ixy, iyy), shape (ny, nx/2 + 1), of an approximate inverse of the static tangential operator
+        on the grid's own period (no padding: a quarter of the convolution's FFT size).
+
+        As :meth:`normal_preconditioner` for A_zz (Vollebregt's FFT preconditioner, J. Comput. Phys. 257 (2014)):
+        the kernels xx, xy, yy folded onto the (ny, nx) period, the 2 x 2 symbol [[kxx, kxy], [kxy, kyy]] (real
+        parts) inverted per frequency, kxx, kyy and the determinant floored at 1e-6 of the largest kxx (and its
+        square). Apply with rfft2 / irfft2 on (ny, nx) fields; a preconditioner only.
+        """
+        if "inv_period" not in self._cache:
+            self.kernel("xx")
+            kxx, kxy, kyy = (scipy.fft.rfft2(self._folded_period(name)).real for name in ("xx", "xy", "yy"))
+            floor = 1e-6 * float(np.abs(kxx).max())
+            kxx = np.maximum(kxx, floor)
+            kyy = np.maximum(kyy, floor)
+            det = kxx * kyy - kxy * kxy
+            det = np.where(det > floor * floor, det, floor * floor)
+            self._cache["inv_period"] = tuple(
+                np.ascontiguousarray(v, dtype=complex) for v in (kyy / det, -kxy / det, kxx / det)
+            )
+        return self._cache["inv_period"]
 
     def inverse_static(self, ux_m: np.ndarray, uy_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Approximate inverse of the static tangential operator: the padded circulant's inverse, by FFT.

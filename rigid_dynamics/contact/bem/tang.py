@@ -24,13 +24,18 @@ then min(0.1, max(0.1 residual, 0.3 tolerance/residual)))
 whose matrix-vector products are FFT convolutions (O(N log N), no dense matrix). Right preconditioner:
 for rolling the operator factors exactly as L = C o D, D t = (t_I - t_(I+e_x))/dx (the upwind difference
 acting on the traction; both are convolutions), so D^-1 is a cumulative sum from the leading edge;
-C^-1 is approximated by the inverse of the zero-padded circulant (FFT). The slip rows keep their
+C^-1 is approximated by the inverse of the circulant on the grid's own (ny, nx) period with the kernels
+folded onto it (Vollebregt's FFT preconditioner, as NORM's; a quarter of the padded FFT size:
+:meth:`~.influence.InfluenceGrid.inverse_static_period_spectra`). The slip rows keep their
 diagonal and their strong coupling to the slip element ahead (the rolling kernel at offset -e_x is
 about minus the self-coefficient): that bidiagonal part is solved exactly along each row from the
 leading edge (for the shift problem only the diagonal). The scatter/gather and the 2 x 2 spectral
 products of each GMRES step are numba kernels around two batched real FFT pairs (one for the
-operator, one for the preconditioner). Between steps, adhesion elements whose traction exceeds
-the bound move to S and slip elements whose slip has turned along their traction (e . s > 0) move back to H.
+operator, zero-padded with the padding rows skipped along x; one for the preconditioner, unpadded).
+Between steps, adhesion elements whose traction exceeds the bound move to S and slip elements whose
+slip has turned along their traction (e . s > 0) move back to H. A warm start (``initial_traction``,
+``initial_slip``: the solution of a nearby problem) replaces the nested-iteration start; times:
+benchmarks/results/bem_tang.md.
 Linearisation of the slip-element equation (derivative of e_perp . s with respect to theta)::
 
     d(e_perp . s)/d theta = -e . s + e_perp . (L g e_perp)      (-e . s = |s| > 0 at a solution)
@@ -222,6 +227,8 @@ def _gmres(apply, rhs: np.ndarray, rtol: float, max_iterations: int, restart: in
             g[:k_used],
         )
         x = x + _combine(basis, y)
+        if abs(g[k_used]) <= rtol * b_norm or hn == 0.0 or total >= max_iterations:
+            break  # converged: the estimate |g| is the residual of x (exact arithmetic); no extra product
         r = rhs - apply(x)
     return x, total
 
@@ -275,13 +282,16 @@ def solve_tang(
     max_iterations: int = 60,
     coarse_start: bool = True,
     kinetic_friction_coefficient: float | None = None,
+    initial_traction: tuple[np.ndarray, np.ndarray] | None = None,
+    initial_slip: np.ndarray | None = None,
 ) -> TangSolution:
     """Solve TANG for steady rolling or the shift problem (module docstring).
 
-    Nested iteration: on grids of at least 32 x 32 elements (even counts), the problem is first solved
-    on the grid of 2 x 2 merged elements (pressure and rigid slip averaged) and its tractions and slip
-    area start the Newton iteration on the fine grid; this keeps the number of Newton steps small. The coarse
-    problem is solved to a relative residual of 1e-2 only (its discretisation error is larger than that).
+    Nested iteration: on grids of at least 32 x 32 elements, the problem is first solved on the grid of
+    2 x 2 merged elements (pressure and rigid slip averaged; odd counts padded with one element of zero
+    pressure) and its tractions and slip area start the Newton iteration on the fine grid; this keeps the
+    number of Newton steps small. The coarse problem is solved to a relative residual of 1e-2 only (its
+    discretisation error is larger than that).
 
     Args:
         influence: grid and influence coefficients.
@@ -294,7 +304,14 @@ def solve_tang(
         problem: "rolling" (steady state) or "shift" (Cattaneo: one step from the unloaded state).
         tolerance: relative tolerance on the slip residual (and GMRES).
         max_iterations: Newton iteration limit (non-convergence is reported in the result).
-        coarse_start: use the nested-iteration start described above.
+        coarse_start: use the nested-iteration start described above (not with ``initial_traction``).
+        initial_traction: warm start (t_x, t_y), each (ny, nx), Pa, e.g. the solution of a nearby problem on the
+            same grid (the previous iteration of a load equilibrium). Zeroed outside the contact; the elements of
+            ``initial_slip`` (default: those with |t| >= 0.99 mu_k p) start in slip with the traction scaled onto the
+            bound in its direction, the other contact elements in adhesion. Only the start changes: the solution
+            is the same to the tolerance.
+        initial_slip: bool (ny, nx), the slip area of the warm start (e.g. ``TangSolution.in_slip``); only with
+            ``initial_traction``.
 
     Returns:
         :class:`TangSolution`.
@@ -318,6 +335,13 @@ def solve_tang(
         raise ValueError(f"tolerance = {tolerance!r}: expected > 0")
     if int(max_iterations) < 1:
         raise ValueError(f"max_iterations = {max_iterations!r}: expected >= 1")
+    if initial_traction is not None:
+        if len(initial_traction) != 2 or any(np.shape(a) != shape for a in initial_traction):
+            raise ValueError(f"initial_traction: expected a pair of (ny, nx) = {shape} arrays")
+        if not all(np.isfinite(a).all() for a in initial_traction):
+            raise ValueError("initial_traction: expected finite values")
+    if initial_slip is not None and (initial_traction is None or np.shape(initial_slip) != shape):
+        raise ValueError(f"initial_slip: expected a (ny, nx) = {shape} bool array, with initial_traction")
     rolling = problem == "rolling"
     wx = np.asarray(rigid_slip_x, float)
     wy = np.asarray(rigid_slip_y, float)
@@ -350,21 +374,34 @@ def solve_tang(
     lin_total = 0
     n = shape[0] * shape[1]
     padded = influence.padded_shape
-    buf = np.zeros((2, *padded))  # zero-padded traction pair; only the (ny, nx) corner is ever written
+    buf = np.zeros((2, *shape))  # traction pair on the grid (zero-padded by the pruned FFT passes)
     mixed = np.empty((2, padded[0], padded[1] // 2 + 1), complex)
+    mixed_p = np.empty((2, shape[0], shape[1] // 2 + 1), complex)
     k_roll = influence.tangential_spectra(rolling)
-    k_inv = influence.inverse_static_spectra()
+    k_inv = influence.inverse_static_period_spectra()
     tx = np.zeros(shape)
     ty = np.zeros(shape)
     stick = contact.copy()
     slip = np.zeros(shape, bool)
     theta = np.zeros(shape)
     nx, ny = influence.nx, influence.ny
-    if coarse_start and nx % 2 == 0 and nx >= 32 and (ny == 1 and influence.plane or (ny % 2 == 0 and ny >= 32)):
+    if initial_traction is not None:
+        tx = np.where(contact, np.asarray(initial_traction[0], float), 0.0)
+        ty = np.where(contact, np.asarray(initial_traction[1], float), 0.0)
+        if initial_slip is None:
+            slip = contact & (np.hypot(tx, ty) >= 0.99 * bound)
+        else:
+            slip = contact & np.asarray(initial_slip, bool)
+        stick = contact & ~slip
+        theta = np.where(slip, np.arctan2(ty, tx), 0.0)
+        tx = np.where(slip, bound * np.cos(theta), tx)
+        ty = np.where(slip, bound * np.sin(theta), ty)
+    elif coarse_start and nx >= 32 and (ny == 1 and influence.plane or ny >= 32):
         fy = 1 if influence.plane else 2
+        px, py = nx % 2, ny % fy  # odd counts: one element of zero pressure appended for the merging
         coarse = InfluenceGrid(
-            nx // 2,
-            ny // fy,
+            (nx + px) // 2,
+            (ny + py) // fy,
             2 * influence.dx_m,
             fy * influence.dy_m,
             influence.shear_modulus_Pa,
@@ -374,10 +411,11 @@ def solve_tang(
         )
 
         def restrict(a: np.ndarray) -> np.ndarray:
-            return a.reshape(ny // fy, fy, nx // 2, 2).mean(axis=(1, 3))
+            a = np.pad(a, ((0, py), (0, px)))
+            return a.reshape((ny + py) // fy, fy, (nx + px) // 2, 2).mean(axis=(1, 3))
 
         def prolong(a: np.ndarray) -> np.ndarray:
-            return np.repeat(np.repeat(a, fy, axis=0), 2, axis=1)
+            return np.repeat(np.repeat(a, fy, axis=0), 2, axis=1)[:ny, :nx]
 
         first = solve_tang(
             coarse,
@@ -398,6 +436,14 @@ def solve_tang(
         tx = np.where(slip, bound * np.cos(theta), tx)
         ty = np.where(slip, bound * np.sin(theta), ty)
         lin_total += first.linear_iterations
+
+    def _sets_hold() -> bool:
+        """The warm start's sets are consistent: adhesion within the bound, slip opposing the traction."""
+        sx, sy = fresh if fresh is not None else slip_of(tx, ty)
+        over = stick & (np.hypot(tx, ty) > bound_static)
+        wrong = slip & ((np.cos(theta) * sx + np.sin(theta) * sy) > 0)
+        return not (over.any() or wrong.any())
+
     converged = False
     residual = math.inf
     it = 0
@@ -405,6 +451,7 @@ def solve_tang(
     fresh = None  # slip of the current tractions, when already known
     for it in range(1, int(max_iterations) + 1):
         sx, sy = slip_of(tx, ty) if fresh is None else fresh
+        fresh = (sx, sy)
         ex, ey = np.cos(theta), np.sin(theta)
         # residual: adhesion s (2 rows), slip e_perp . s (1 row); e_perp = (-ey, ex)
         s_perp = -ey * sx + ex * sy
@@ -412,7 +459,7 @@ def solve_tang(
         res_h = np.hypot(sx, sy)[stick]
         res_s = np.abs(s_perp[slip])
         residual = max(res_h.max() if res_h.size else 0.0, res_s.max() if res_s.size else 0.0) / scale
-        if residual < tolerance and it > 1:
+        if residual < tolerance and (it > 1 or (initial_traction is not None and _sets_hold())):
             converged = True
             break
         # compact unknowns: adhesion (t_x, t_y) increments, then slip angle increments
@@ -447,18 +494,16 @@ def solve_tang(
 
         def matvec(v, kind=kind, idx=idx, nh=nh, gex=gex, gey=gey, e=(epx_g, epy_g, diag_g), size=size):
             _spread(v, kind, idx, nh, gex, gey, buf)
-            spec = scipy.fft.rfft2(buf)
-            _mix(spec, *k_roll, mixed)
-            u = scipy.fft.irfft2(mixed, s=padded)
+            _mix(influence._forward(buf), *k_roll, mixed)
+            u = influence._backward(mixed)
             out = np.empty(size)
             _gather_residual(u, v, kind, idx, nh, *e, out)
             return out
 
         def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, ahead_g=ahead_g, size=size):
             _spread_adhesion(v, kind, idx, nh, buf)
-            spec = scipy.fft.rfft2(buf)
-            _mix(spec, *k_inv, mixed)
-            u = scipy.fft.irfft2(mixed, s=padded)
+            _mix(scipy.fft.rfft2(buf), *k_inv, mixed_p)
+            u = scipy.fft.irfft2(mixed_p, s=shape)
             out = np.empty(size)
             _precondition_out(u, v, kind, idx, nh, self_g, ahead_g, influence.dx_m, rolling, out)
             return out

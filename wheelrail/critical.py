@@ -1,0 +1,128 @@
+"""``wheelrail critical-speed SCENE``: linear (eigenvalue) and nonlinear (limit-cycle) critical speed of a scene.
+
+Linear: the eigenvalues of the linearised wheelset (rigid_dynamics.wheelset.linear) with the creep coefficients of
+the scene's contact model at its static load; the conicity is the scene's (conical track) or, for real profiles,
+the EN 15302 equivalent conicity at 3 mm amplitude (an estimate: the linear model of a profile pair is a cone).
+Nonlinear: the lowest speed at which the hunting limit cycle survives, followed down in speed from
+``--high`` (default 1.2 x the linear speed) by comparisons.limit_cycle.limit_cycle_search.
+Writes ``summary.json`` and ``critical_speed.png`` (cycle amplitude against speed) into the output folder.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+from wheelrail.config import ConfigError
+
+
+def linear_critical_speed(scene) -> dict:
+    """The linear critical speed of a scene: dict with speed, frequency, conicity used and how it was found."""
+    from rigid_dynamics.wheelset import critical_speed, linear_model_for_scene
+    from rigid_dynamics.wheelset.linear import creep_coefficients
+
+    track = scene.track
+    note = "conical track"
+    proxy = scene
+    if not track.is_conical:
+        from rigid_dynamics.contact.conicity import equivalent_conicity_from_names
+        from rigid_dynamics.geometry import load_profile
+
+        conicity = equivalent_conicity_from_names(
+            wheel_profile=load_profile(track.wheel_profile, "wheel"),
+            rail_profile=load_profile(track.rail_profile, "rail"),
+            gauge_m=track.gauge_m,
+            gauge_height_m=track.gauge_height_m,
+            flange_back_distance_m=track.flange_back_distance_m,
+            nominal_radius_m=scene.wheelset.nominal_radius_m,
+            rail_inclination_rad=track.rail_inclination_rad,
+            amplitude_m=0.003,
+        )["equivalent_conicity"]
+        cone = dataclasses.replace(track, wheel_profile="conical", rail_profile="circular", conicity=conicity)
+        proxy = dataclasses.replace(
+            scene, track=cone, contact_provider="conical", irregularities=type(scene.irregularities)()
+        )
+        note = f"cone of the EN 15302 equivalent conicity {conicity:.4f} (3 mm) of the profile pair"
+    f11, f22 = creep_coefficients(proxy)
+    result = critical_speed(linear_model_for_scene(proxy, f11, f22))
+    return {
+        "success": result.success,
+        "status": result.status,
+        "message": result.message,
+        "speed_m_per_s": result.speed_m_per_s if math.isfinite(result.speed_m_per_s) else None,
+        "frequency_Hz": result.frequency_Hz if math.isfinite(result.frequency_Hz) else None,
+        "conicity": proxy.track.conicity,
+        "model": note,
+        "creep_coefficients_N": [f11, f22],
+    }
+
+
+def cmd_critical_speed(args) -> int:
+    """``wheelrail critical-speed``: print and write the linear and nonlinear critical speeds."""
+    from comparisons.limit_cycle import limit_cycle_search, plot_branch
+    from wheelrail.output import copy_input, output_folder, write_json
+    from wheelrail.overrides import load_scene_with
+
+    scene, source, overrides = load_scene_with(args.scene, args.set)
+    for name in ("high", "low", "duration", "threshold_mm"):
+        value = getattr(args, name)
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ConfigError(f"--{name.replace('_', '-')} {value!r}: expected a finite number > 0")
+    if args.steps < 1:
+        raise ConfigError(f"--steps {args.steps!r}: expected an integer >= 1")
+    if args.low is not None and args.high is not None and not args.low < args.high:
+        raise ConfigError(f"--low {args.low!r}: expected a speed below --high {args.high!r}")
+    from functools import partial
+
+    from rigid_dynamics.wheelset import build_provider, simulate
+
+    with output_folder(args.out, f"critical-speed-{source.stem}") as out_dir:  # checked before the work
+        copy_input(source, out_dir, "scene.toml")
+        linear = linear_critical_speed(scene)
+        print(f"{source.stem}: linear critical speed {_speed(linear['speed_m_per_s'])} ({linear['model']})")
+        v_lin = linear["speed_m_per_s"]
+        high = args.high or (1.2 * v_lin if v_lin else 2.0 * scene.speed_m_per_s)
+        low = args.low or 0.4 * high
+        if not low < high:
+            raise ConfigError(f"--low {low!r}: expected a speed below --high {high!r}")
+        try:
+            provider = build_provider(scene)  # the contact geometry does not depend on the speed: build it once
+        except ValueError as exc:
+            raise ConfigError(f"scene {args.scene!r}: {exc}") from None
+        nonlinear = limit_cycle_search(
+            scene,
+            high,
+            low,
+            duration_s=args.duration or 3.0,
+            speed_steps=args.steps,
+            threshold_m=1e-3 * args.threshold_mm,
+            simulate=partial(simulate, provider=provider),
+        )
+        speed = _speed(nonlinear["speed_m_per_s"])
+        print(f"{source.stem}: nonlinear critical speed {speed}: {nonlinear['message']}")
+        png = plot_branch(nonlinear, out_dir / "critical_speed.png", v_lin)
+        summary = {"linear": linear, "nonlinear": nonlinear, "overrides": overrides, "files": [png.name]}
+        write_json(out_dir / "summary.json", summary)  # last
+    print(f"output written to {out_dir}")
+    return 0 if nonlinear["success"] and linear["success"] else 1
+
+
+def _speed(value) -> str:
+    return "not found" if value is None else f"{value:.4g} m/s ({value * 3.6:.4g} km/h)"
+
+
+def register(sub) -> None:
+    """Add the ``critical-speed`` sub-command to the CLI's sub-parsers."""
+    parser = sub.add_parser("critical-speed", help="linear and nonlinear (limit-cycle) critical speed of a scene")
+    parser.add_argument("scene", help="embedded scene name or TOML file")
+    parser.add_argument("--high", type=float, help="start speed of the limit-cycle search, m/s (default 1.2 x linear)")
+    parser.add_argument("--low", type=float, help="lowest speed tried, m/s (default 0.4 x --high)")
+    parser.add_argument("--steps", type=int, default=6, help="continuation steps from --high to --low (default 6)")
+    parser.add_argument("--duration", type=float, help="simulated time per run, s (default 3)")
+    parser.add_argument(
+        "--threshold-mm", type=float, default=1.0, help="smallest lateral amplitude counted as a cycle, mm (default 1)"
+    )
+    parser.add_argument("--out", type=Path, help="output folder")
+    parser.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key (repeatable)")
+    parser.set_defaults(func=cmd_critical_speed)

@@ -1,0 +1,48 @@
+"""Compile the numba kernels once, at setup (``python -m wheelrail.warmup``; tools/setup_venv.sh runs it).
+
+numba compiles a kernel on its first call and stores it in its on-disk cache (``__pycache__`` next to the
+source), so every later process only loads it (about 0.1 s). Without this step the first compiled run on a
+fresh machine spends a minute or more compiling, silently. Here each embedded scene that takes the compiled
+path runs for two steps, and each contact model with numba kernels solves one small patch, with a progress
+line per item on stderr. The runs' numbers are not used.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+import time
+
+
+def warm_up_all(stream=sys.stderr) -> dict[str, float]:
+    """Compile (or load) every numba kernel the embedded scenes and the contact models use; {item: seconds}."""
+    from rigid_dynamics.materials import STEEL
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.cases import WARM_UP_OPTIONS, warm_up
+    from wheelrail.scenes import embedded_scenes, load_scene
+
+    timings = {}
+    start_all = time.perf_counter()
+    for method in WARM_UP_OPTIONS:
+        print(f"setup: compiling the {method} contact kernels ...", file=stream, flush=True)
+        timings[f"contact {method}"] = warm_up(method, STEEL)
+    for name, path in embedded_scenes().items():
+        scene = load_scene(path)
+        if scene.integrator.method != "RK4":
+            continue  # the adaptive methods run the Python path: nothing to compile
+        step = scene.integrator.fixed_step_s
+        short = dataclasses.replace(scene, duration_s=2 * step)
+        print(f"setup: compiling the dynamics kernels of scene {name} (up to a minute) ...", file=stream, flush=True)
+        start = time.perf_counter()
+        try:
+            simulate(short)
+        except Exception as exc:  # never fail the setup: the scene then compiles on its first run
+            print(f"setup: warning: scene {name} not compiled ({type(exc).__name__}: {exc})", file=stream, flush=True)
+        timings[f"scene {name}"] = time.perf_counter() - start
+    total = time.perf_counter() - start_all
+    print(f"setup: numba kernels ready in {total:.0f} s (cached on disk for every later run)", file=stream, flush=True)
+    return timings
+
+
+if __name__ == "__main__":
+    warm_up_all()
