@@ -15,6 +15,7 @@ Each folder holds
   (``x_m``, ``y_m``, ``pressure_Pa``), for the field norm;
 * ``SOURCE.md``: where the numbers come from.
 
+The files are read by :func:`wheelrail.named_cases.load_named_case` (TOML is read only in wheelrail).
 For a wheelset case the compared quantities are those of the wheel's patches together: N, Fx, Fy summed over
 the patches of ``side`` (each in its own contact frame; CONTACT combines close patches into one), the largest
 max pressure and the summed area.
@@ -22,9 +23,6 @@ max pressure and the summed area.
 
 from __future__ import annotations
 
-import csv
-import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -49,6 +47,8 @@ class NamedCase:
         uncertainty: quantity -> relative error estimate of the reference itself (absent: not known).
         note: one line on the case.
         tags: labels used by the research claims ("hertz", "creep", "spin", "flange", "irregular", ...).
+        case: the validated contact case of ``case.toml`` (``wheelrail.cases.ContactCase``; read by
+            ``wheelrail.named_cases``, since TOML is read only in wheelrail).
     """
 
     name: str
@@ -59,16 +59,29 @@ class NamedCase:
     uncertainty: dict = field(default_factory=dict)
     note: str = ""
     tags: tuple = ()
+    case: object = None
 
     @property
     def case_path(self) -> Path:
         return self.folder / "case.toml"
 
-    def load_case(self):
-        """The validated :class:`wheelrail.cases.ContactCase` of ``case.toml``."""
-        from wheelrail.cases import load_case
+    def reference_grid(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Points (x_m, y_m) on which the reference pressure field is compared, or None (no reference field).
 
-        return load_case(self.case_path)
+        Closed-form Hertz cases: 121 x 121 points over 1.15 times the ellipse's bounding box; BEM references: the
+        stored field's grid.
+        """
+        ref = self.reference
+        if self.source == "closed-form" and "semi_axis_long_m" in ref:
+            return (
+                np.linspace(-1.15, 1.15, 121) * ref["semi_axis_long_m"],
+                np.linspace(-1.15, 1.15, 121) * ref["semi_axis_lat_m"],
+            )
+        path = self.folder / "reference_field.npz"
+        if not path.exists():
+            return None
+        with np.load(path) as data:
+            return np.array(data["x_m"]), np.array(data["y_m"])
 
     def reference_pressure(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray | None:
         """Reference pressure at points (x, y) of the contact plane (Pa), or None when there is none.
@@ -83,13 +96,18 @@ class NamedCase:
         path = self.folder / "reference_field.npz"
         if not path.exists():
             return None
-        from scipy.interpolate import RegularGridInterpolator
-
         with np.load(path) as data:
-            x, y, p = data["x_m"], data["y_m"], data["pressure_Pa"]
-        interp = RegularGridInterpolator((y, x), p, bounds_error=False, fill_value=0.0)
-        xx, yy = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
-        return interp(np.stack([yy.ravel(), xx.ravel()], axis=-1)).reshape(xx.shape)
+            x, y, p = data["x_m"], data["y_m"], data["pressure_Pa"].astype(float)
+        return grid_interpolate(x, y, p, x_m, y_m)
+
+
+def grid_interpolate(x: np.ndarray, y: np.ndarray, values: np.ndarray, x_m, y_m) -> np.ndarray:
+    """Bilinear interpolation of ``values[j, i]`` given at (x[i], y[j]) to points (x_m, y_m); 0 outside the grid."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    interp = RegularGridInterpolator((np.asarray(y), np.asarray(x)), values, bounds_error=False, fill_value=0.0)
+    xx, yy = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    return interp(np.stack([yy.ravel(), xx.ravel()], axis=-1)).reshape(xx.shape)
 
 
 def contact_row_reference(row: dict) -> dict:
@@ -107,53 +125,6 @@ def contact_row_reference(row: dict) -> dict:
     }
 
 
-def _contact_reference(folder: Path) -> dict:
-    with open(folder / "contact_reference.csv", newline="") as handle:
-        rows = list(csv.DictReader(line for line in handle if not line.startswith("#")))
-    if not rows:
-        raise ValueError(f"{folder / 'contact_reference.csv'}: no data row")
-    parts = [contact_row_reference(r) for r in rows]
-    out = {k: sum(p[k] for p in parts) for k in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")}
-    out["max_pressure_Pa"] = max(p["max_pressure_Pa"] for p in parts)
-    out["contact_area_m2"] = sum(p["contact_area_m2"] for p in parts)
-    return out
-
-
-def load_named_case(name_or_folder: str | Path) -> NamedCase:
-    """Read a named case (a name under :data:`CASES_ROOT` or a folder path)."""
-    folder = Path(name_or_folder)
-    if not folder.is_dir():
-        folder = CASES_ROOT / str(name_or_folder)
-    if not folder.is_dir():
-        raise ValueError(f"case {str(name_or_folder)!r}: expected one of {', '.join(named_case_names())}")
-    with open(folder / "reference.toml", "rb") as handle:
-        doc = tomllib.load(handle)
-    source = doc.get("source")
-    if source not in SOURCES:
-        raise ValueError(f"{folder / 'reference.toml'}: source = {source!r}: expected one of {SOURCES}")
-    reference = {k: float(v) for k, v in doc.get("reference", {}).items()}
-    if source == "contact-published":
-        reference = {**_contact_reference(folder), **reference}
-    for key, value in reference.items():
-        if not math.isfinite(value):
-            raise ValueError(f"{folder / 'reference.toml'}: reference.{key} = {value!r}: expected a finite number")
-    return NamedCase(
-        name=folder.name,
-        folder=folder,
-        source=source,
-        side=str(doc.get("side", "single")),
-        reference=reference,
-        uncertainty={k: float(v) for k, v in doc.get("uncertainty", {}).items()},
-        note=str(doc.get("note", "")),
-        tags=tuple(doc.get("tags", ())),
-    )
-
-
 def named_case_names() -> list[str]:
     """Names of the named cases (folders with a reference.toml), sorted."""
     return sorted(p.parent.name for p in CASES_ROOT.glob("*/reference.toml"))
-
-
-def named_cases() -> list[NamedCase]:
-    """All named cases."""
-    return [load_named_case(n) for n in named_case_names()]

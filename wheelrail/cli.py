@@ -9,6 +9,8 @@ Commands:
     wheelrail conicity               equivalent conicity of a wheel/rail pair (EN 15302 method)
     wheelrail manchester             the Manchester Contact Benchmark case A-2.2 sweep
     wheelrail stress                 numerical-stability stress sweep of a scene
+    wheelrail bench                  run time against error of every rung on the named cases
+    wheelrail compare CASE           one named case through the rungs side by side (maps, stresses, report)
 
 Bad input ends with one line ``wheelrail: error: ...`` on stderr naming the key, the value and
 what was expected, and exit status 2; a numerical failure is reported in the results with its
@@ -367,6 +369,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="1: run serially (default); N >= 2: on a local dask.distributed cluster of N single-threaded processes",
     )
     stress.set_defaults(func=cmd_stress)
+
+    from wheelrail.comparison_commands import register
+
+    register(sub)  # bench, compare
     return parser
 
 
