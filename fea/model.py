@@ -64,6 +64,10 @@ class FeaOptions:
         stresses: compute subsurface stresses.
         output_dir: folder for XDMF and PNG output, or None.
         min_mesh_quality: smallest accepted minSICN. max_elements: largest accepted element count.
+        stress_points_m: points (x, y, z) of the contact frame (z < 0: in the body below the contact plane) at
+            which the recovered stress tensor is returned in ``extra["stress_points_Pa"]`` (a list of 3 x 3
+            tensors, Pa; None where a point lies outside the mesh), or None. Quarter models mirror the point
+            into x, y >= 0 and flip the shear components that are odd in x or y.
     """
 
     quick: bool = False
@@ -82,6 +86,7 @@ class FeaOptions:
     output_dir: str | None = None
     min_mesh_quality: float = 0.05
     max_elements: int = 2_000_000
+    stress_points_m: tuple | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -102,6 +107,10 @@ class FeaOptions:
             raise ValueError(f"grid_points = {self.grid_points!r}: expected an integer >= 8")
         if not (math.isfinite(self.filter_radius_factor) and self.filter_radius_factor >= 0):
             raise ValueError(f"filter_radius_factor = {self.filter_radius_factor!r}: expected a number >= 0")
+        if self.stress_points_m is not None:
+            pts = np.asarray(self.stress_points_m, dtype=float)
+            if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
+                raise ValueError("stress_points_m: expected a sequence of finite (x, y, z) points")
 
     @classmethod
     def from_mapping(cls, options: Mapping | None) -> FeaOptions:
@@ -359,6 +368,10 @@ class FeaModel:
             stress_fn, coords, stress = post.recover_nodal_stress(sol.displacement, young_body, nu)
             lower = _lower_body_nodes(domain, stress_fn, len(coords), coords, spec)
             extra.update(_stress_maxima(comm, coords[lower], stress[lower], spec, quadric, post))
+            if opts.stress_points_m is not None:
+                extra["stress_points_Pa"] = _stress_at_points(
+                    comm, stress_fn, np.asarray(opts.stress_points_m, float), domain.symmetry == "quarter"
+                )
 
         if opts.output_dir is not None:
             from fea.output import write_outputs
@@ -408,6 +421,39 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra or {},
         )
+
+
+def _stress_at_points(comm, stress_fn, points: np.ndarray, quarter: bool) -> list:
+    """Recovered (P1) stress tensors at ``points`` (contact frame), as nested lists; None outside the mesh."""
+    from dolfinx import geometry
+
+    query = points.copy()
+    if quarter:
+        query[:, :2] = np.abs(query[:, :2])
+    msh = stress_fn.function_space.mesh
+    tree = geometry.bb_tree(msh, msh.topology.dim)
+    candidates = geometry.compute_collisions_points(tree, query)
+    colliding = geometry.compute_colliding_cells(msh, candidates, query)
+    found, cells = [], []
+    for i in range(len(query)):
+        links = colliding.links(i)
+        if len(links):
+            found.append(i)
+            cells.append(links[0])
+    local = np.full((len(query), 9), np.nan)
+    if found:
+        local[found] = stress_fn.eval(query[found], np.asarray(cells, dtype=np.int32))
+    merged = np.full((len(query), 9), np.nan)
+    for part in comm.allgather(local):
+        take = np.isnan(merged[:, 0]) & ~np.isnan(part[:, 0])
+        merged[take] = part[take]
+    tensors = merged.reshape(-1, 3, 3)
+    if quarter:
+        sx, sy = np.where(points[:, 0] < 0, -1.0, 1.0), np.where(points[:, 1] < 0, -1.0, 1.0)
+        for (i, j), sign in (((0, 1), sx * sy), ((0, 2), sx), ((1, 2), sy)):
+            tensors[:, i, j] *= sign
+            tensors[:, j, i] *= sign
+    return [None if np.isnan(t[0, 0]) else t.tolist() for t in tensors]
 
 
 def _lower_body_nodes(domain, stress_fn, n, coords, spec):
