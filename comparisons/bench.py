@@ -447,6 +447,9 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
         name = f"time_vs_error-{named.name}.png"
         if plot_case(runs, named.name, out_dir / name):
             plots[named.name] = name
+    from comparisons.claims import claims_markdown, evaluate_claims
+
+    claims = evaluate_claims(runs)
     table = tolerance_table(runs)
     summary = {
         "quick": quick,
@@ -457,7 +460,10 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
             case: {f"{int(t * 100)}%": _run_brief(r) for t, r in row.items()} for case, row in table.items()
         },
         "plots": plots,
+        "claims": [{k: v for k, v in c.items()} for c in claims],
     }
     write_json_atomic(out_dir / "bench.json", summary)
-    write_text_atomic(out_dir / "bench.md", markdown(runs, cases, quick, wall_s, plots))
+    text = markdown(runs, cases, quick, wall_s, plots)
+    head, sep, rest = text.partition("## Per case")
+    write_text_atomic(out_dir / "bench.md", head + claims_markdown(claims) + "\n" + sep + rest)
     return summary

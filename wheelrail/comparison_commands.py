@@ -9,6 +9,7 @@ CASE / NAME: a named case of ``comparisons/cases/`` (``wheelrail bench --list``)
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from pathlib import Path
@@ -82,6 +83,99 @@ def cmd_compare(args) -> int:
     return 0 if report["success"] else 1
 
 
+def cmd_demo(args) -> int:
+    """The default demo (``make demo``): polygonal-wheel run, compare at the peak normal force, report."""
+    from comparisons.compare import COMPARE_MODELS, _html, run_compare
+    from comparisons.demo import peak_patch_case
+    from comparisons.files import write_text_atomic
+    from comparisons.named_cases import NamedCase
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.output import new_output_dir
+    from wheelrail.scenes import load_scene, resolve_scene_path, write_run_outputs
+
+    source = resolve_scene_path(args.scene)
+    scene = load_scene(source)
+    out_dir = new_output_dir(args.out, f"demo-{source.stem}")
+    start = time.perf_counter()
+    print(f"demo 1/3: {source.stem}, {scene.duration_s:g} s with {scene.contact_model} (3-D contact search)")
+    result = simulate(scene)
+    summary = write_run_outputs(result, source, out_dir / "run")
+    if not result.success:
+        print(f"demo: the run ended with {result.status}: {result.message}")
+        return 1
+    patch = peak_patch_case(result)
+    print(
+        f"demo 2/3: peak normal force {patch.normal_force_N / 1e3:.1f} kN on the {patch.side} wheel at "
+        f"t = {patch.time_s:.3f} s: re-solved by {', '.join(COMPARE_MODELS)}"
+    )
+    note = (
+        f"{source.stem}: the patch of the largest normal force of the run ({patch.side} wheel, slot {patch.slot}, "
+        f"t = {patch.time_s:.3f} s, N = {patch.normal_force_N / 1e3:.2f} kN), re-solved under that force"
+    )
+    named = NamedCase("peak-contact", out_dir, "none (no reference: the BEM is the most exact rung here)", "single",
+                      {}, note=note, case=patch)  # fmt: skip
+    compare = run_compare(named, out_dir / "compare", models=COMPARE_MODELS)
+    print("demo 3/3: report")
+    models = compare["models"]
+
+    def p0(model):
+        value = models.get(model, {}).get("values", {}).get("max_pressure_Pa")
+        return "-" if value is None else f"{value / 1e6:.0f}"
+
+    def creep(model):
+        v = models.get(model, {}).get("values", {})
+        fx, fy = v.get("creep_force_long_N"), v.get("creep_force_lat_N")
+        return "-" if fx is None or fy is None else f"{math.hypot(fx, fy) / 1e3:.2f}"
+
+    stresses = {s["source"]: s for s in compare["subsurface"]}
+    with_t = stresses.get("BEM pressure + tractions, half-space", {})
+    fea = stresses.get("FEA (frictionless)", {})
+    headlines = [
+        f"run: {result.simulated_time_s:g} s of {source.stem} in {summary['wall_time_s']:.1f} s wall "
+        f"(real-time factor {summary['real_time_factor']:.2g}); peak wheel-rail normal force "
+        f"{patch.normal_force_N / 1e3:.1f} kN at t = {patch.time_s:.3f} s ({patch.side} wheel)",
+        f"at the peak, max pressure [MPa] Hertz {p0('hertz')}, FASTSIM {p0('fastsim')}, BEM {p0('bem')}, "
+        f"FEA {p0('fea')}; creep force [kN] FASTSIM {creep('fastsim')}, BEM {creep('bem')}",
+        "subsurface max von Mises: "
+        + (
+            f"BEM + tractions (half-space) {with_t['max_von_mises_Pa'] / 1e6:.0f} MPa at "
+            f"{with_t['max_von_mises_depth_m'] * 1e3:.2f} mm"
+            if with_t.get("max_von_mises_Pa")
+            else "n/a"
+        )
+        + (
+            f", FEA (frictionless) {fea['max_von_mises_Pa'] / 1e6:.0f} MPa at "
+            f"{fea['max_von_mises_depth_m'] * 1e3:.2f} mm"
+            if fea.get("max_von_mises_Pa")
+            else ", FEA n/a"
+        ),
+    ]
+    run_pngs = sorted(p.name for p in (out_dir / "run").glob("*.png"))
+    compare_md = (out_dir / "compare" / "report.md").read_text()
+    compare_md = compare_md.replace("](", "](compare/").replace("# peak-contact", "## Contact at the peak", 1)
+    lines = [
+        f"# wheelrail demo: {source.stem}",
+        "",
+        *[f"- {h}" for h in headlines],
+        "",
+        f"Total wall time {time.perf_counter() - start:.0f} s. Run folder: run/ (scene.toml, summary.json, "
+        "timeseries.npz); comparison folder: compare/.",
+        "",
+        "## Time series",
+        "",
+        *[f"![{name}](run/{name})" for name in run_pngs],
+        "",
+        compare_md,
+    ]
+    text = "\n".join(lines) + "\n"
+    write_text_atomic(out_dir / "report.md", text)
+    write_text_atomic(out_dir / "report.html", _html(text, f"wheelrail demo: {source.stem}"))
+    print(f"report: {out_dir / 'report.md'} (and report.html)")
+    for line in headlines:
+        print(line)
+    return 0 if compare["success"] else 1
+
+
 def register(sub) -> None:
     """Add the ``bench`` and ``compare`` sub-commands to the CLI's subparsers."""
     bench = sub.add_parser("bench", help="run time against error of every rung on the named cases")
@@ -97,3 +191,8 @@ def register(sub) -> None:
     compare.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
     compare.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/compare-<case>-<time>)")
     compare.set_defaults(func=cmd_compare)
+
+    demo = sub.add_parser("demo", help="the default demo: a run, the contact at its peak through every rung, report")
+    demo.add_argument("scene", nargs="?", default="polygonal-wheel", help="scene with the 3-D contact search")
+    demo.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
+    demo.set_defaults(func=cmd_demo)
