@@ -93,6 +93,7 @@ def cmd_demo(args) -> int:
     from wheelrail.output import new_output_dir
     from wheelrail.scenes import load_scene, resolve_scene_path, write_run_outputs
 
+    models = _check_models(args.models, COMPARE_MODELS)
     source = resolve_scene_path(args.scene)
     scene = load_scene(source)
     out_dir = new_output_dir(args.out, f"demo-{source.stem}")
@@ -106,7 +107,7 @@ def cmd_demo(args) -> int:
     patch = peak_patch_case(result)
     print(
         f"demo 2/3: peak normal force {patch.normal_force_N / 1e3:.1f} kN on the {patch.side} wheel at "
-        f"t = {patch.time_s:.3f} s: re-solved by {', '.join(COMPARE_MODELS)}"
+        f"t = {patch.time_s:.3f} s: re-solved by {', '.join(models)}"
     )
     note = (
         f"{source.stem}: the patch of the largest normal force of the run ({patch.side} wheel, slot {patch.slot}, "
@@ -114,7 +115,7 @@ def cmd_demo(args) -> int:
     )
     named = NamedCase("peak-contact", out_dir, "none (no reference: the BEM is the most exact rung here)", "single",
                       {}, note=note, case=patch)  # fmt: skip
-    compare = run_compare(named, out_dir / "compare", models=COMPARE_MODELS)
+    compare = run_compare(named, out_dir / "compare", models=models)
     print("demo 3/3: report")
     models = compare["models"]
 
@@ -195,4 +196,5 @@ def register(sub) -> None:
     demo = sub.add_parser("demo", help="the default demo: a run, the contact at its peak through every rung, report")
     demo.add_argument("scene", nargs="?", default="polygonal-wheel", help="scene with the 3-D contact search")
     demo.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
+    demo.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
     demo.set_defaults(func=cmd_demo)
