@@ -18,7 +18,8 @@ Pictures (PNG, matplotlib; one 3-D view with pyvista, off-screen):
 * ``subsurface.png``: von Mises stress and the orthogonal shear s_xd on the cut y = y_pmax (depth below the
   rail surface) and von Mises on the cut x = x_pmax, one colour scale per quantity, from (a) the half-space
   solution of the BEM pressure alone, (b) the half-space solution of the BEM pressure AND tangential tractions
-  (rigid_dynamics.contact.subsurface: Boussinesq-Cerruti), (c) FEA (frictionless; recovered nodal stresses);
+  (rigid_dynamics.contact.subsurface: Boussinesq-Cerruti), (c) FEA (recovered nodal stresses) with the BEM's
+  tangential tractions applied as a surface load on the rail block (frictionless where the BEM has none);
 * ``subsurface_3d.png``: pyvista view of the von Mises field (b) below the patch.
 
 Stresses are those of the rail (the body below the contact plane); the rail's surface tractions are the
@@ -142,7 +143,7 @@ def subsurface(named, bem_main, fea_options=None, with_fea: bool = True):
     nu = named.case.material.poisson_ratio
     inside = f.pressure_Pa > 0
     extent = min(np.ptp(f.x_m[inside.any(axis=0)]), np.ptp(f.y_m[inside.any(axis=1)])) + float(abs(f.x_m[1] - f.x_m[0]))
-    xz, yz, cuts = _cut_points(f, 1.2 * extent)
+    xz, yz, cuts = _cut_points(f, 0.6 * extent)  # ~1.2 times the smaller semi-axis (max shear at ~0.5-0.8)
     both = np.vstack([xz, yz])
     sources = []
     start = time.perf_counter()
@@ -167,6 +168,16 @@ def subsurface(named, bem_main, fea_options=None, with_fea: bool = True):
         return cuts, sources, None
     fea_pts = both * np.array([1.0, 1.0, -1.0])
     opts = {**(fea_options or {}), "stress_points_m": [tuple(p) for p in fea_pts]}
+    frictional = bool(np.any(f.traction_long_Pa) or np.any(f.traction_lat_Pa))
+    if frictional:
+        opts["surface_traction"] = {
+            "x_m": f.x_m.tolist(),
+            "y_m": f.y_m.tolist(),
+            "traction_long_Pa": f.traction_long_Pa.tolist(),
+            "traction_lat_Pa": f.traction_lat_Pa.tolist(),
+            "source": f"the BEM ({len(f.x_m)}x{len(f.y_m)})",
+        }
+    fea_label = "FEA (BEM tractions applied)" if frictional else "FEA (frictionless)"
     start = time.perf_counter()
     try:
         fea_result = get_model("fea").solve(
@@ -183,7 +194,7 @@ def subsurface(named, bem_main, fea_options=None, with_fea: bool = True):
         s_f[:, 2, 0] *= -1
         s_f[:, 1, 2] *= -1
         s_f[:, 2, 1] *= -1
-        sources.append(_stress_summary("FEA (frictionless)", both, s_f))
+        sources.append(_stress_summary(fea_label, both, s_f))
     elif fea_result is not None:
         cuts["fea_message"] = f"{fea_result.status}: {fea_result.message}"
     return cuts, sources, fea_result
@@ -448,8 +459,10 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
             "",
             "Half-space solution (Boussinesq-Cerruti point forces integrated over the BEM's uniformly loaded "
             "elements by Gauss quadrature; rigid_dynamics/contact/subsurface.py) of the BEM pressure alone and "
-            "with the BEM's tangential tractions; FEA frictionless (no tangential surface load is applied in the "
-            "FE model). Cuts through the point of maximum BEM pressure; one colour scale per quantity.",
+            "with the BEM's tangential tractions; FEA: the frictionless normal contact solved on the same patch "
+            "under the BEM's normal force, with minus the BEM's tangential tractions (on the wheel) applied to the "
+            "rail block's contact face as a surface load where the BEM has tractions (fea option "
+            "surface_traction). Cuts through the point of maximum BEM pressure; one colour scale per quantity.",
             "",
             "| source | max von Mises [MPa] | at depth [mm] | max shear (s1-s3)/2 [MPa] | at depth [mm] |",
             "|---|---|---|---|---|",
@@ -472,9 +485,8 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
         fea = next((s for s in sources if s["source"].startswith("FEA")), None)
         if fea is not None:
             headlines.append(
-                f"{named.name}: FEA max von Mises {fea['max_von_mises_Pa'] / 1e6:.0f} MPa at "
-                f"{fea['max_von_mises_depth_m'] * 1e3:.2f} mm (frictionless; half-space of the BEM pressure: "
-                f"{sources[0]['max_von_mises_Pa'] / 1e6:.0f} MPa)"
+                f"{named.name}: {fea['source']} max von Mises {fea['max_von_mises_Pa'] / 1e6:.0f} MPa at "
+                f"{fea['max_von_mises_depth_m'] * 1e3:.2f} mm"
             )
     ok = [(m, solved[m]) for m in models if m in solved and solved[m].get("error") is not None]
     if ok:

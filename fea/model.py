@@ -64,6 +64,13 @@ class FeaOptions:
         stresses: compute subsurface stresses.
         output_dir: folder for XDMF and PNG output, or None.
         min_mesh_quality: smallest accepted minSICN. max_elements: largest accepted element count.
+        surface_traction: tangential tractions ON THE WHEEL on a grid of the contact plane, as a mapping with
+            ``x_m``, ``y_m`` (grid), ``traction_long_Pa``, ``traction_lat_Pa`` ([j][i] at (x_m[i], y_m[j]); e.g.
+            a BEM or FASTSIM solution's fields) and optionally ``source`` (a label); the block (the rail) is
+            loaded with minus these (bilinear, 0 outside the grid) as a surface load on its contact face, so
+            its subsurface stresses include the friction of that solution. Rigid formulation only; the model
+            becomes a full block (the load breaks the quarter symmetry). The creep forces of the result stay
+            None (prescribed, not solved). None: frictionless.
         stress_points_m: points (x, y, z) of the contact frame (z < 0: in the body below the contact plane) at
             which the recovered stress tensor is returned in ``extra["stress_points_Pa"]`` (a list of 3 x 3
             tensors, Pa; None where a point lies outside the mesh), or None. Quarter models mirror the point
@@ -87,6 +94,7 @@ class FeaOptions:
     min_mesh_quality: float = 0.05
     max_elements: int = 2_000_000
     stress_points_m: tuple | None = None
+    surface_traction: dict | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -107,6 +115,18 @@ class FeaOptions:
             raise ValueError(f"grid_points = {self.grid_points!r}: expected an integer >= 8")
         if not (math.isfinite(self.filter_radius_factor) and self.filter_radius_factor >= 0):
             raise ValueError(f"filter_radius_factor = {self.filter_radius_factor!r}: expected a number >= 0")
+        if self.surface_traction is not None:
+            t = self.surface_traction
+            missing = {"x_m", "y_m", "traction_long_Pa", "traction_lat_Pa"} - set(t)
+            if missing:
+                raise ValueError(f"surface_traction: missing {sorted(missing)}")
+            shape = (len(t["y_m"]), len(t["x_m"]))
+            for key in ("traction_long_Pa", "traction_lat_Pa"):
+                arr = np.asarray(t[key], dtype=float)
+                if arr.shape != shape or not np.all(np.isfinite(arr)):
+                    raise ValueError(f"surface_traction.{key}: expected finite values of shape {shape}")
+            if self.formulation != "rigid":
+                raise ValueError(f"surface_traction with formulation = {self.formulation!r}: expected 'rigid'")
         if self.stress_points_m is not None:
             pts = np.asarray(self.stress_points_m, dtype=float)
             if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
@@ -246,7 +266,7 @@ class FeaModel:
             elements_per_semi_axis=opts.n_per_semi_axis,
             domain_factor=opts.block_factor,
             center_m=center,
-            symmetry="quarter" if quadric and opts.formulation != "profiles" else "full",
+            symmetry="quarter" if quadric and opts.formulation != "profiles" and not opts.surface_traction else "full",
         )
         t_mesh = time.perf_counter()
         limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
@@ -284,6 +304,7 @@ class FeaModel:
                 return ((x - center[0]) / semi[0]) ** 2 + ((y - center[1]) / semi[1]) ** 2 < 1.0
 
             young_body = e_star * (1.0 - nu**2)
+            traction = _traction_function(opts.surface_traction) if opts.surface_traction else None
             sol = solve_rigid_indenter(
                 domain,
                 gap0,
@@ -295,6 +316,7 @@ class FeaModel:
                 initial_active=initial_active if quadric else None,
                 length_scale_m=min(semi),
                 settings=settings,
+                surface_traction=traction,
             )
 
         extra = {
@@ -307,8 +329,13 @@ class FeaModel:
                 else "two elastic quadric bodies (quarter model), node-to-surface penalty"
                 if opts.formulation == "two-body"
                 else "quarter block, rigid quadric indenter"
-                if quadric
-                else "full block, rigid sampled indenter"
+                if spec.symmetry == "quarter"
+                else f"full block, rigid {'quadric' if quadric else 'sampled'} indenter"
+            ),
+            "surface_traction": (
+                f"minus the wheel tractions of {opts.surface_traction.get('source', 'the given fields')}"
+                if opts.surface_traction
+                else "none (frictionless)"
             ),
             "young_modulus_Pa": young_body,
             "element_size_m": spec.contact_size_m,
@@ -324,7 +351,7 @@ class FeaModel:
 
         # Pressure field (full patch).
         xy, force, weight = sol.node_xy_m, sol.node_force_N, sol.node_weight_m2
-        if quadric:
+        if spec.symmetry == "quarter":
             xy, force, weight = post.mirror_quarter(xy, force, weight)
         radius = opts.filter_radius_factor * spec.contact_size_m / opts.degree  # P2: nodes at h/2
         in_contact_nodes = np.tile(sol.active, 4) if len(xy) == 4 * len(sol.active) else sol.active.copy()
@@ -421,6 +448,23 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra or {},
         )
+
+
+def _traction_function(traction: Mapping):
+    """(x, y) -> minus the wheel's tractions (the rail block's surface load), bilinear, 0 outside the grid."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    grid = (np.asarray(traction["y_m"], float), np.asarray(traction["x_m"], float))
+    parts = [
+        RegularGridInterpolator(grid, -np.asarray(traction[k], float), bounds_error=False, fill_value=0.0)
+        for k in ("traction_long_Pa", "traction_lat_Pa")
+    ]
+
+    def evaluate(x, y):
+        pts = np.column_stack([np.asarray(y, float), np.asarray(x, float)])
+        return parts[0](pts), parts[1](pts)
+
+    return evaluate
 
 
 def _stress_at_points(comm, stress_fn, points: np.ndarray, quarter: bool) -> list:

@@ -40,10 +40,46 @@ def test_compare_hertz_circle_report_and_subsurface_check(tmp_path, monkeypatch)
     by_source = {s["source"]: s for s in summary["subsurface"]}
     bem = by_source["BEM pressure, half-space"]
     fea = by_source["FEA (frictionless)"]
-    # cut grid: 25 depths down to ~2.5 a, so the depth is resolved to ~0.1 a
+    # cut grid: 25 depths down to ~1.2 a, so the depth is resolved to ~0.05 a
     assert bem["max_shear_Pa"] / p0 == pytest.approx(target, rel=0.03)
     assert bem["max_shear_depth_m"] / a == pytest.approx(depth, abs=0.1)
     assert fea["max_shear_Pa"] / p0 == pytest.approx(target, rel=0.06)  # FEA default mesh, nodal recovery
     assert fea["max_shear_depth_m"] / a == pytest.approx(depth, abs=0.1)
     html = (out / "report.html").read_text()
     assert "<table>" in html and 'src="subsurface.png"' in html
+
+
+@pytest.mark.fea
+def test_fea_with_bem_tractions_matches_the_half_space_solution(monkeypatch):
+    """Full slip (mu = 0.3): the BEM tractions applied to the FE block raise its von Mises maximum as in the
+    half-space solution of the same tractions (second method), and agree with it. The maximum moves up by
+    ~0.16 mm in the half-space solution, less than the FE element size (a/6 = 0.55 mm): the FE depth is only
+    checked to that size."""
+    monkeypatch.setattr(compare, "CUT_POINTS", (15, 40))
+    named = load_named_case("creep-long-saturated")
+    from comparisons.bench import solve_contact_case
+
+    patches, ok, _ = solve_contact_case(named.case, "bem", {"nx": 40, "ny": 40})
+    assert ok
+    cuts, sources, fea = compare.subsurface(named, patches[0], {})
+    by = {s["source"]: s for s in sources}
+    frictionless, with_t = by["BEM pressure, half-space"], by["BEM pressure + tractions, half-space"]
+    fe = by["FEA (BEM tractions applied)"]
+    assert "minus the wheel tractions of the BEM" in fea.extra["surface_traction"]
+    assert with_t["max_von_mises_depth_m"] < frictionless["max_von_mises_depth_m"]
+    rise = with_t["max_von_mises_Pa"] - frictionless["max_von_mises_Pa"]
+    assert rise > 0.03 * frictionless["max_von_mises_Pa"]
+    assert fe["max_von_mises_Pa"] - frictionless["max_von_mises_Pa"] > 0.5 * rise
+    assert fe["max_von_mises_Pa"] == pytest.approx(with_t["max_von_mises_Pa"], rel=0.03)
+    assert abs(fe["max_von_mises_depth_m"] - with_t["max_von_mises_depth_m"]) < fea.extra["element_size_m"]
+
+
+def test_fea_surface_traction_option_is_validated():
+    from fea.model import FeaOptions
+
+    with pytest.raises(ValueError, match="surface_traction.traction_lat_Pa: expected finite values of shape"):
+        FeaOptions.from_mapping(
+            {"surface_traction": {"x_m": [0, 1], "y_m": [0], "traction_long_Pa": [[0, 0]], "traction_lat_Pa": [[0]]}}
+        )
+    with pytest.raises(ValueError, match="missing"):
+        FeaOptions.from_mapping({"surface_traction": {"x_m": [0.0]}})
