@@ -280,7 +280,7 @@ def _plot_subsurface(cuts, sources, out_dir):
         for ax, (u, v, title, lo, hi, cmap, xlabel) in zip(row, panels, strict=True):
             mesh = ax.pcolormesh(u * 1e3, d_mm, v, vmin=lo, vmax=hi, cmap=cmap, shading="auto")
             ax.invert_yaxis()
-            ax.set_aspect("equal")
+            ax.set_aspect("equal" if np.ptp(u) < 4 * np.ptp(d_mm) * 1e-3 else "auto")  # long flange patches
             ax.set_title(f"{s['source']}\n{title}", fontsize=8)
             ax.set_xlabel(xlabel)
             ax.set_ylabel("depth [mm]")
