@@ -111,7 +111,8 @@ def cmd_demo(args) -> int:
     )
     note = (
         f"{source.stem}: the patch of the largest normal force of the run ({patch.side} wheel, slot {patch.slot}, "
-        f"t = {patch.time_s:.3f} s, N = {patch.normal_force_N / 1e3:.2f} kN), re-solved under that force"
+        f"t = {patch.time_s:.3f} s, N = {patch.normal_force_N / 1e3:.2f} kN; the first quarter of the run, at most "
+        "0.3 s, is left out: the transient from the static equilibrium), re-solved under that force"
     )
     named = NamedCase("peak-contact", out_dir, "none (no reference: the BEM is the most exact rung here)", "single",
                       {}, note=note, case=patch)  # fmt: skip
