@@ -124,6 +124,7 @@ def _stress_summary(name, points, stress):
         "max_von_mises_depth_m": float(points[k, 2]) if k >= 0 else None,
         "max_shear_Pa": float(tau[kt]) if kt >= 0 else None,
         "max_shear_depth_m": float(points[kt, 2]) if kt >= 0 else None,
+        "max_orthogonal_shear_Pa": float(np.nanmax(np.abs(stress[:, 0, 2]))) if np.any(ok) else None,
         "von_mises": vm,
         "orthogonal_shear": stress[:, 0, 2],
     }
@@ -464,13 +465,15 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
             "rail block's contact face as a surface load where the BEM has tractions (fea option "
             "surface_traction). Cuts through the point of maximum BEM pressure; one colour scale per quantity.",
             "",
-            "| source | max von Mises [MPa] | at depth [mm] | max shear (s1-s3)/2 [MPa] | at depth [mm] |",
-            "|---|---|---|---|---|",
+            "| source | max von Mises [MPa] | at depth [mm] | max shear (s1-s3)/2 [MPa] | at depth [mm] "
+            "| max abs orthogonal shear s_xd [MPa] |",
+            "|---|---|---|---|---|---|",
         ]
         for s in sources:
             lines.append(
                 f"| {s['source']} | {_fmt(s['max_von_mises_Pa'], 1e-6)} | {_fmt(s['max_von_mises_depth_m'], 1e3)} | "
-                f"{_fmt(s['max_shear_Pa'], 1e-6)} | {_fmt(s['max_shear_depth_m'], 1e3)} |"
+                f"{_fmt(s['max_shear_Pa'], 1e-6)} | {_fmt(s['max_shear_depth_m'], 1e3)} | "
+                f"{_fmt(s['max_orthogonal_shear_Pa'], 1e-6)} |"
             )
         lines += ["", f"![subsurface]({pictures['subsurface']})", ""]
         if "subsurface_3d" in pictures:

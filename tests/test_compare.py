@@ -45,6 +45,8 @@ def test_compare_hertz_circle_report_and_subsurface_check(tmp_path, monkeypatch)
     assert bem["max_shear_depth_m"] / a == pytest.approx(depth, abs=0.1)
     assert fea["max_shear_Pa"] / p0 == pytest.approx(target, rel=0.06)  # FEA default mesh, nodal recovery
     assert fea["max_shear_depth_m"] / a == pytest.approx(depth, abs=0.1)
+    # orthogonal shear s_xd (odd in x: the quarter model's mirrored points flip its sign): FEA against the half-space
+    assert fea["max_orthogonal_shear_Pa"] == pytest.approx(bem["max_orthogonal_shear_Pa"], rel=0.1)
     html = (out / "report.html").read_text()
     assert "<table>" in html and 'src="subsurface.png"' in html
 
