@@ -18,6 +18,7 @@ Hertzian pressure, and the Hertz ellipse).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -28,8 +29,10 @@ import numpy as np
 
 from comparisons.contact_plots import plot_contact_fields
 from comparisons.manchester import MATERIAL, a22_case
+from rigid_dynamics.contact.registry import get_model
 from rigid_dynamics.contact.track import build_track
 from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+from rigid_dynamics.files import save_figure, write_text
 
 MODELS = ("hertz", "fastsim", "bem")
 DEFAULT_STEPS = (0, 12, 13, 14)
@@ -90,7 +93,7 @@ def _profiles_png(path: Path, bem, fastsim, hertz, title: str) -> None:
         ax.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -118,13 +121,28 @@ def write_bem_report(out_dir: str | Path, steps=DEFAULT_STEPS, bem_options: dict
     for step in steps:
         case = a22_case(step)
         track = build_track(case)
-        solutions = {}
+        # the equilibrium with Hertz on the search's patches (plane at the deepest point); every model then solves
+        # each patch under force control with Hertz's normal force, so the report compares the models at the same
+        # normal force per patch
+        hertz = solve_wheelset_case(
+            case, MATERIAL, model="hertz", options={"patches": "search", "search": SEARCH_OPTIONS}, track=track
+        )
+        solutions = {"hertz": hertz}
         for name in MODELS:
-            # Hertz load sharing for every model: the report compares models at the same normal force per patch
-            options = {"search": SEARCH_OPTIONS, "load_sharing": "hertz"}
-            if name == "bem":
-                options["model"] = bem_options
-            solutions[name] = solve_wheelset_case(case, MATERIAL, model=name, options=options, track=track)
+            if name == "hertz":
+                continue
+            model = get_model(name)
+            opts = bem_options if name == "bem" else None
+            patches = [
+                dataclasses.replace(
+                    p,
+                    result=model.solve(
+                        p.geometry, p.creepage, MATERIAL, normal_force_N=p.result.normal_force_N, options=opts
+                    ),
+                )
+                for p in hertz.patches
+            ]
+            solutions[name] = dataclasses.replace(hertz, patches=patches)
         entry = {
             "step": step,
             "lateral_shift_m": case.lateral_shift_m,
@@ -171,8 +189,8 @@ def write_bem_report(out_dir: str | Path, steps=DEFAULT_STEPS, bem_options: dict
                     row["profiles_png"] = prof.name
             entry["patches"].append(row)
         report["steps"].append(entry)
-    (out / "bem_report.json").write_text(json.dumps(report, indent=2, default=str))
-    (out / "bem_report.md").write_text(_markdown(report))
+    write_text(out / "bem_report.json", json.dumps(report, indent=2, default=str))
+    write_text(out / "bem_report.md", _markdown(report))
     return report
 
 

@@ -116,8 +116,9 @@ def plot_contact_fields(result: ContactResult, path: str | Path, *, title: str |
         title = ", ".join(parts)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    from rigid_dynamics.files import save_figure
+
+    try:
+        return save_figure(fig, path, dpi=110)  # atomic: a killed run leaves no half PNG under the final name
+    finally:
+        plt.close(fig)

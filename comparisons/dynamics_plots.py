@@ -10,8 +10,6 @@ parameter value, failed runs marked).
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -22,16 +20,9 @@ def _save(fig, path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() != ".png":
         path = path.with_suffix(".png")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    from rigid_dynamics.files import save_figure
+
+    return save_figure(fig, path, dpi=120)
 
 
 def plot_dynamics(result, path: str | Path | None = None, *, title: str | None = None):

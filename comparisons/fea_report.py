@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigid_dynamics.files import save_figure, write_text
 from rigid_dynamics.materials import STEEL, Material
 
 DEFAULT_FEA_OPTIONS = {"elements_per_semi_axis": 8}
@@ -101,7 +102,11 @@ def run_fea_report(
         wheel_load_N=wheel_load_N,
     )
     started = time.perf_counter()
-    case_sol = solve_wheelset_case(case, material, "hertz", options={"search": {"field": True}})
+    # the search's patch (plane at the deepest point, midpoint of the two surfaces): the frame the FE sections of the
+    # real profiles are cut in
+    case_sol = solve_wheelset_case(
+        case, material, "hertz", options={"patches": "search", "search": {"field": True}, "spin_rate": "nominal"}
+    )
     summary = {
         "case": {
             "wheel_profile": wheel_profile,
@@ -172,8 +177,8 @@ def run_fea_report(
         summary["patches"].append(entry)
     summary["wall_time_s"] = time.perf_counter() - started
     if comm.rank == 0:
-        (out / "fea_report.json").write_text(json.dumps(summary, indent=2, default=float))
-        (out / "fea_report.md").write_text(_markdown(summary))
+        write_text(out / "fea_report.json", json.dumps(summary, indent=2, default=float))
+        write_text(out / "fea_report.md", _markdown(summary))
     return summary
 
 
@@ -212,7 +217,7 @@ def _plot(path: Path, bem_fields, p_fea) -> str:
         ax.set_xlabel("x (rolling) / mm")
         ax.set_aspect("equal")
     axes[0].set_ylabel("y (lateral) / mm")
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return str(path)
 

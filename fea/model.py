@@ -35,6 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fea.solver import LINEAR_SOLVERS
+from rigid_dynamics.contact.options import declare_dataclass, validate_options
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
@@ -135,12 +137,7 @@ class FeaOptions:
     @classmethod
     def from_mapping(cls, options: Mapping | None) -> FeaOptions:
         """Validate a mapping of options (unknown keys raise ValueError naming them)."""
-        options = dict(options or {})
-        known = set(cls.__dataclass_fields__)
-        unknown = sorted(set(options) - known)
-        if unknown:
-            raise ValueError(f"unknown fea option(s) {unknown}: expected some of {sorted(known)}")
-        return cls(**options)
+        return cls(**validate_options(OPTIONS, options, "fea"))
 
     @property
     def n_per_semi_axis(self) -> float:
@@ -154,11 +151,46 @@ class FeaOptions:
         return self.domain_factor or (12.0 if self.quick else 20.0)
 
 
+OPTIONS = declare_dataclass(
+    FeaOptions,
+    {
+        "quick": {"help": "coarse mesh (4 elements per semi-axis, block of 12 semi-axes)"},
+        "formulation": {"help": "rigid indenter, two elastic quadrics or real profiles", "choices": FORMULATIONS},
+        "wheel_profile": {"help": "wheel profile name or file (formulation 'profiles')"},
+        "rail_profile": {"help": "rail profile name or file (formulation 'profiles')"},
+        "mesh_size_factor": {
+            "help": "element size at the patch / (min(a, b)/6)",
+            "minimum": 0,
+            "exclusive_minimum": True,
+        },
+        "elements_per_semi_axis": {"help": "elements per semi-axis at the patch", "minimum": 1},
+        "domain_factor": {"help": "half-width and depth of the block in semi-axes", "minimum": 4},
+        "degree": {"help": "displacement degree (2: formulation 'rigid' only)", "minimum": 1, "maximum": 2},
+        "linear_solver": {"help": "linear solver", "choices": LINEAR_SOLVERS},
+        "max_iterations": {"help": "active-set iterations", "minimum": 1},
+        "grid_points": {"help": "points per side of the output pressure grid", "minimum": 8},
+        "filter_radius_factor": {"help": "pressure averaging radius in element sizes", "minimum": 0},
+        "stresses": {"help": "compute subsurface stresses"},
+        "output_dir": {"help": "folder for XDMF and PNG output"},
+        "min_mesh_quality": {"help": "smallest accepted minSICN", "minimum": 0, "maximum": 1},
+        "max_elements": {"help": "largest accepted element count", "minimum": 1},
+    },
+)
+"""Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``
+adds the rules that join two options)."""
+
+
 class FeaModel:
     """Finite-element normal contact (elastic block with combined modulus vs rigid indenter)."""
 
     name = "fea"
     description = "finite elements (FEniCSx): normal contact, subsurface stresses"
+    OPTIONS = OPTIONS
+
+    @staticmethod
+    def check_options(options: Mapping | None) -> None:
+        """Check the options with the rules joining two of them (ValueError), without solving."""
+        FeaOptions.from_mapping(options)
 
     def solve(
         self,

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rigid_dynamics.files import save_figure
+
 
 def write_outputs(output_dir, sol, stress_fn, fields, domain, spec, young_modulus_Pa, poisson_ratio, comm) -> dict:
     """Write the XDMF file and the PNG maps into ``output_dir``; return {kind: path}."""
@@ -77,8 +79,10 @@ def _draw(out: Path, fields, cut_xyz, cut_vm, spec, symmetry) -> dict:
         ax.set_aspect("equal")
         ax.set_title("FEA contact pressure (white: contact outline)")
         path = out / "fea_pressure.png"
-        fig.savefig(path, dpi=120, bbox_inches="tight")
-        plt.close(fig)
+        try:
+            save_figure(fig, path, dpi=120, bbox_inches="tight")  # atomic (rigid_dynamics.files)
+        finally:
+            plt.close(fig)
         files["pressure_png"] = str(path)
 
     x, z, v = cut_xyz[:, 0], -cut_xyz[:, 2], cut_vm
@@ -99,7 +103,9 @@ def _draw(out: Path, fields, cut_xyz, cut_vm, spec, symmetry) -> dict:
         ax.set_aspect("equal")
         ax.set_title("FEA subsurface von Mises stress, cut y = y_c")
         path = out / "fea_von_mises_cut.png"
-        fig.savefig(path, dpi=120, bbox_inches="tight")
-        plt.close(fig)
+        try:
+            save_figure(fig, path, dpi=120, bbox_inches="tight")  # atomic (rigid_dynamics.files)
+        finally:
+            plt.close(fig)
         files["von_mises_cut_png"] = str(path)
     return files

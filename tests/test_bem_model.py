@@ -250,8 +250,10 @@ def test_search_field_holds_the_whole_overlap_of_the_long_tread_patch():
         return over[0].any() or over[-1].any() or over[:, 0].any() or over[:, -1].any()
 
     case = a22_case(0)
-    fitted = solve_wheelset_case(case, MATERIAL, model="hertz")
-    fixed = solve_wheelset_case(case, MATERIAL, model="hertz", options={"search": {"field_scale": 1.6}})
+    fitted = solve_wheelset_case(case, MATERIAL, model="hertz", options={"patches": "search"})
+    fixed = solve_wheelset_case(
+        case, MATERIAL, model="hertz", options={"patches": "search", "search": {"field_scale": 1.6}}
+    )
     assert fitted.success and fixed.success
     for patch in fitted.patches:
         field = patch.geometry.undeformed

@@ -58,7 +58,7 @@ def test_no_contact(name):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_unknown_option_raises(name):
-    with pytest.raises(ValueError, match="unknown option.*'bogus'.*allowed"):
+    with pytest.raises(ValueError, match="unknown .*option 'bogus'.*allowed"):
         get_model(name).solve(geometry(), Creepage(), MATERIAL, normal_force_N=1e4, options={"bogus": 1})
 
 
@@ -69,7 +69,7 @@ def test_fastsim_options():
     )
     assert r.fields is not None and r.fields.pressure_Pa.shape == (10, 30)
     assert r.extra["flexibility"] == "three" and 0 < r.extra["slip_fraction"] < 1
-    with pytest.raises(ValueError, match="traction_bound.*allowed: elliptic, parabolic"):
+    with pytest.raises(ValueError, match="traction_bound.*expected one of 'elliptic', 'parabolic'"):
         model.solve(geometry(), Creepage(), MATERIAL, normal_force_N=8e4, options={"traction_bound": "flat"})
     with pytest.raises(ValueError, match="flexibility"):
         model.solve(geometry(), Creepage(), MATERIAL, normal_force_N=8e4, options={"flexibility": "many"})
@@ -133,5 +133,5 @@ def test_solve_batch_agrees_with_the_per_patch_models(method):
     assert batch.method[0] == "none"
     with pytest.raises(ValueError, match="method"):
         solve_batch("bem", A, B, xi, eta, phi, MATERIAL, normal_force_N=force)
-    with pytest.raises(ValueError, match="unknown option"):
+    with pytest.raises(ValueError, match="unknown .*option"):
         solve_batch(method, A, B, xi, eta, phi, MATERIAL, normal_force_N=force, options={"grid": 3})

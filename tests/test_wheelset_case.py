@@ -34,11 +34,15 @@ def a22(shift_mm, **kwargs):
     return WheelsetCase(**args)
 
 
-NO_FIELD = {"search": {"field": False}}
+NO_FIELD = {"spin_rate": "nominal"}  # the fastest kinematics (no axle-moment iteration)
 
 
 def test_centred_wheelset_is_symmetric_and_carries_the_load():
-    sol = solve_wheelset_case(a22(0.0), STEEL, "hertz", NO_FIELD)
+    """Centred, no yaw: both wheels carry 10 kN (creep forces included), the solution is mirror-symmetric, and
+    the freely rolling wheelset (zero net axle moment) has no longitudinal creepage; with phi' = V/r0 instead
+    (hand derivation, test_creepage.py) xi = 1 - R_w/r0 with R_w the wheel's radius at the reference point and
+    the spin -/+ sin(delta)/r0 on the left/right wheel."""
+    sol = solve_wheelset_case(a22(0.0), STEEL, "linear")
     assert sol.success, sol.message
     assert sol.roll_rad == pytest.approx(0.0, abs=1e-12)
     for side in ("left", "right"):
@@ -47,13 +51,20 @@ def test_centred_wheelset_is_symmetric_and_carries_the_load():
     assert left.side == "left" and right.side == "right"
     np.testing.assert_allclose(left.geometry.point_m * [1, -1, 1], right.geometry.point_m, atol=1e-9)
     assert left.geometry.contact_angle_rad == pytest.approx(right.geometry.contact_angle_rad, abs=1e-9)
-    # Free rolling at phi' = V/r0 without yaw (hand derivation, see test_creepage.py): xi = 1 - R_c/r0 with R_c the
-    # lever of the contact point (wheel point + q/2 along n), spin = -/+ sin(gamma)/r0 on the left/right wheel.
-    for patch, sign in ((left, -1), (right, 1)):
+    assert sol.spin_rate_mode == "zero-axle-moment"
+    assert abs(sol.axle_moment_Nm) < 1e-6 * 10e3 * 0.46
+    for patch in (left, right):
+        assert patch.creepage.longitudinal == pytest.approx(0.0, abs=1e-7)
+    nominal = solve_wheelset_case(a22(0.0), STEEL, "hertz", {"spin_rate": "nominal"})
+    assert nominal.spin_rate_rad_per_s == pytest.approx(2.0 / 0.46, rel=1e-12)
+    for patch, sign in ((p, -1 if p.side == "left" else 1) for p in nominal.patches):
         g = patch.geometry
-        lever = g.rolling_radius_m * math.cos(0) - 0.5 * g.approach_m * math.cos(g.contact_angle_rad)
-        assert patch.creepage.longitudinal == pytest.approx(1 - lever / 0.46, abs=1e-7)
-        assert patch.creepage.spin_1_per_m == pytest.approx(sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6)
+        xi = 1 - g.rolling_radius_m / 0.46  # relative to V (eq 41); the case divides by the mean rolling speed:
+        mean = 2.0 / (2.0 - xi)  # V (2 - xi)/2 (Kalker, CONTACT)
+        assert patch.creepage.longitudinal == pytest.approx(xi * mean, abs=1e-9)
+        assert patch.creepage.spin_1_per_m == pytest.approx(
+            mean * sign * math.sin(g.contact_angle_rad) / 0.46, rel=1e-6
+        )
         assert patch.creepage.lateral == pytest.approx(0.0, abs=1e-12)
 
 
@@ -99,8 +110,13 @@ def test_patch_fields_and_rail_coordinates_are_filled():
     sol = solve_wheelset_case(a22(7.0), STEEL, "hertz")
     flange = max((p for p in sol.patches if p.side == "right"), key=lambda p: p.geometry.contact_angle_rad)
     g = flange.geometry
-    assert g.undeformed is not None and g.undeformed.distance_m.shape == (31, 31)
+    assert g.undeformed is not None and g.undeformed.distance_m.shape == (25, 25)
     assert np.nanmin(g.undeformed.distance_m) == pytest.approx(-g.approach_m, rel=0.05)
+    # the gap is evaluated exactly off the sampled grid: at the plane origin it is the rail-to-wheel distance
+    # along the normal, which the wheel point and the reference point (on the rail) give independently
+    assert g.undeformed.exact is not None
+    x0 = np.array([0.0])
+    assert g.undeformed.evaluate(x0, x0)[0] < 0.0
     y_rail, z_rail = g.contact_point_rail_m
     assert -0.045 < y_rail < -0.030 and 0.0 < z_rail < 0.015  # on the gauge face, below the top
     assert g.rolling_radius_m > 0.47  # up the flange
@@ -119,6 +135,47 @@ def test_canted_rail_file_is_not_canted_twice_and_flange_is_outside_r0():
     assert wheel.evaluate(np.pi / 2, 0.75)[0] == pytest.approx(0.46, abs=1e-9)
 
 
+def test_cant_is_data_of_the_profile_not_of_its_name(tmp_path):
+    """A byte-identical copy of the canted Manchester rail under another name: its cant is whatever the case states
+    (default 0, as for any file), never guessed from the name; stated, it places the rail as the built-in one."""
+    from rigid_dynamics.geometry.readers import BUILTIN_PROFILE_DIR
+
+    copy = tmp_path / "my_rail.prr"
+    copy.write_bytes((BUILTIN_PROFILE_DIR / "MBench_UIC60_v3.prr").read_bytes())
+    builtin = build_track(a22(0.0))
+    stated = build_track(a22(0.0, rail_profile=str(copy), rail_profile_cant_rad=CANT))
+    unstated = build_track(a22(0.0, rail_profile=str(copy)))
+    y = np.linspace(0.72, 0.79, 15)
+    np.testing.assert_allclose(stated.rails["right"].evaluate(0.0, y)[0], builtin.rails["right"].evaluate(0.0, y)[0])
+    assert unstated.rails["right"].cant_rad == pytest.approx(CANT)  # canted by the case's 1:40 on top of the file's
+    assert stated.rails["right"].cant_rad == pytest.approx(0.0, abs=1e-15)
+
+
+def test_a_wheel_file_with_z_up_is_an_error_that_names_the_fix():
+    with pytest.raises(ValueError, match="wheel_profile_mirror_z"):
+        build_track(a22(0.0, wheel_profile_mirror_z=True))  # z turned up: the flange points to the axle
+
+
+def test_left_and_right_profiles_may_differ():
+    """A worn left wheel on the new right one: each side gets its own surface; with equal profiles named on both
+    sides the result is the one-profile shorthand's."""
+    both = build_track(a22(0.0, wheel_profile_left="MBench_S1002_v3"))
+    one = build_track(a22(0.0))
+    y = np.linspace(-0.79, -0.70, 12)
+    np.testing.assert_allclose(
+        both.wheels["left"].evaluate(np.pi / 2, y)[0], one.wheels["left"].evaluate(np.pi / 2, y)[0]
+    )
+    worn = build_track(a22(0.0, wheel_profile_left="worn_high_mileage"))
+    y = np.linspace(-0.78, -0.71, 15)
+    r_worn, r_new = (t.wheels["left"].evaluate(np.pi / 2, y)[0] for t in (worn, one))
+    assert np.nanmax(np.abs(r_worn - r_new)) > 1e-4
+    right = (t.wheels["right"].evaluate(np.pi / 2, -y)[0] for t in (worn, one))
+    np.testing.assert_allclose(*right)
+    sol = solve_wheelset_case(a22(0.0, wheel_profile_left="worn_high_mileage"), STEEL, "hertz", NO_FIELD)
+    assert sol.success, sol.message
+    assert sol.roll_rad != pytest.approx(0.0, abs=1e-7)  # no longer symmetric
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
@@ -133,6 +190,10 @@ def test_canted_rail_file_is_not_canted_twice_and_flange_is_outside_r0():
         ({"gauge_height_m": -0.01}, "gauge_height_m = -0.01"),
         ({"rail_inclination_rad": 0.3}, "rail_inclination_rad = 0.3"),
         ({"rolling_speed_m_per_s": 0.0}, "rolling_speed_m_per_s = 0.0"),
+        ({"rail_profile_cant_rad": 0.3}, "rail_profile_cant_rad = 0.3"),
+        ({"profile_smoothing_m": -1e-3}, "profile_smoothing_m = -0.001"),
+        ({"wheel_profile_mirror_z": 1}, "wheel_profile_mirror_z = 1"),
+        ({"wheel_profile_left": ""}, "wheel_profile_left = ''"),
     ],
 )
 def test_bad_case_raises(kwargs, match):

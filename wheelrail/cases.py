@@ -11,7 +11,13 @@ A case file has the tables
 * ``[kinematics]``: ``creepage_long``, ``creepage_lat``, ``spin_creepage_1_per_m``,
   ``rolling_speed_m_per_s`` (quadric); a wheelset case takes only ``rolling_speed_m_per_s`` and
   derives the creepages from its yaw and geometry;
-* ``[solver]``: options of the contact model (passed through; the model rejects unknown ones).
+* ``[solver]``: for a quadric case the options of the contact model; for a wheelset case the case's options
+  (``rigid_dynamics.contact.wheelset_case.DEFAULT_CASE_OPTIONS``) with the model's options in ``[solver.model]``.
+  Both are checked against their declarations before any work (:func:`check_solver_options`;
+  ``wheelrail models`` lists each model's options).
+
+Numbers are checked against physical ranges as well as types (:data:`PHYSICAL_RANGES`): a creepage of 1e9
+or a rolling speed of 1e6 m/s is bad input, not a case.
 """
 
 from __future__ import annotations
@@ -49,6 +55,14 @@ WHEELSET_GEOMETRY_KEYS = {
     "flange_back_distance_m",
     "nominal_radius_m",
     "rail_inclination_rad",
+    "wheel_profile_left",
+    "rail_profile_left",
+    "rail_profile_cant_rad",
+    "profile_smoothing_m",
+    "wheel_profile_mirror_y",
+    "wheel_profile_mirror_z",
+    "rail_profile_mirror_y",
+    "rail_profile_mirror_z",
 }
 QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
 
@@ -121,6 +135,9 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
     geometry_table = get_table(doc, "geometry")
     kinematics = get_table(doc, "kinematics", required=False)
     solver = _read_solver(get_table(doc, "solver", required=False))
+    for key in ("name", "description"):
+        if key in doc and not isinstance(doc[key], str):
+            raise ConfigError(f"key {key!r} = {doc[key]!r}: expected a string")
     name = str(doc.get("name", name))
     kind = geometry_table.get("kind")
     if kind == "quadric":
@@ -147,7 +164,7 @@ def parse_case(doc: dict, name: str = "") -> ContactCase:
         return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
     if kind == "wheelset":
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
-        check_keys(kinematics, {"rolling_speed_m_per_s"}, "kinematics")
+        check_keys(kinematics, {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"}, "kinematics")
         force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
         wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics)
         return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
@@ -200,9 +217,13 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
         table["wheel_load_N"] = wheel_load_N
     if approach_m is not None:
         table["approach_m"] = approach_m
-    if "rolling_speed_m_per_s" in kinematics:
-        table["rolling_speed_m_per_s"] = kinematics["rolling_speed_m_per_s"]
-    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail")):
+    for key in ("rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s"):
+        if key in kinematics:
+            table[key] = kinematics[key]
+    for key, kind in (("wheel_profile", "wheel"), ("rail_profile", "rail"), ("wheel_profile_left", "wheel"),
+                      ("rail_profile_left", "rail")):  # fmt: skip
+        if key not in table and key.endswith("_left"):
+            continue
         if key not in table:
             raise ConfigError(f"missing key 'geometry.{key}': expected a built-in profile name or a file path")
         value = table[key]
@@ -215,10 +236,82 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
     return build_dataclass(WheelsetCase, table, "geometry")
 
 
-def load_case(path: str | Path) -> ContactCase:
-    """Read and validate a case file (an embedded case name is accepted too)."""
+def load_case(path: str | Path, method: str | None = None) -> ContactCase:
+    """Read and validate a case file (an embedded case name is accepted too).
+
+    With ``method`` (a registered model name) the ``[solver]`` table is checked against that model's
+    declared options too (:func:`check_solver_options`).
+    """
     path = resolve_case_path(path)
-    return parse_case(read_toml(path, "case file"), name=Path(path).stem)
+    case = parse_case(read_toml(path, "case file"), name=Path(path).stem)
+    if method is not None:
+        check_solver_options(case, method)
+    return case
+
+
+def _wheelset_case_options(method: str) -> dict:
+    """Declaration of a wheelset case's ``[solver]`` options (rigid_dynamics.contact.wheelset_case.case_options)."""
+    from rigid_dynamics.contact.options import validate_options
+    from rigid_dynamics.contact.registry import model_options
+    from rigid_dynamics.contact.wheelset_case import case_options
+
+    def check_model(value, key):
+        validate_options(model_options(method), value, method, prefix=f"{key}.")
+        _check_joint_rules(method, value, f"solver.{key}")
+
+    return case_options(method, check_model)
+
+
+def _check_joint_rules(method: str, options: dict, key: str) -> None:
+    """Rules joining two options (a model's ``check_options``, e.g. FEA's degree 2 only with 'rigid')."""
+    from rigid_dynamics.contact.options import OptionError
+    from rigid_dynamics.contact.registry import model_class
+
+    check = getattr(model_class(method), "check_options", None)
+    if check is None:
+        return
+    try:
+        check(options)
+    except OptionError:
+        raise
+    except ValueError as exc:
+        raise ConfigError(f"table [{key}]: {exc}") from None
+
+
+def check_solver_options(case: ContactCase, method: str) -> None:
+    """Check a case's ``[solver]`` table against the declared options of the model ``method``.
+
+    Raises:
+        ConfigError: one line naming the key (``solver.nx``), the value and what was expected.
+    """
+    from rigid_dynamics.contact.options import OptionError, validate_options
+    from rigid_dynamics.contact.registry import MODELS, model_options
+
+    if method not in MODELS:
+        raise ConfigError(f"--method {method!r}: expected one of {', '.join(MODELS)}")
+    try:
+        if case.kind == "quadric":
+            validate_options(model_options(method), case.solver_options, method)
+            _check_joint_rules(method, case.solver_options, "solver")
+        else:
+            validate_options(_wheelset_case_options(method), case.solver_options, "wheelset case")
+    except OptionError as exc:
+        raise ConfigError(option_message(exc, "solver", method)) from None
+
+
+def option_message(exc, table: str, method: str) -> str:
+    """The one-line message for an OptionError met in the table ``table`` of a file."""
+    from rigid_dynamics.contact.registry import MODELS
+
+    key = f"{table}.{exc.key}"
+    owner = f"the contact model {exc.model!r}" if exc.model in MODELS else f"the {exc.model}"
+    if exc.model == "wheelset case" and exc.unknown:
+        owner += f" (options of {method!r} go in [{table}.model])"
+    if exc.unknown and exc.expected == "none":
+        return f"unknown key {key!r} = {exc.value!r}: {owner} takes no options"
+    if exc.unknown:
+        return f"unknown key {key!r} = {exc.value!r}: not an option of {owner}; expected one of {exc.expected}"
+    return f"key {key!r} = {exc.value!r}: expected {exc.expected} (option of {owner})"
 
 
 CASES_DIR = Path(__file__).parent / "cases"

@@ -11,10 +11,18 @@ Commands:
     wheelrail stress                 numerical-stability stress sweep of a scene
     wheelrail bench                  run time against error of every rung on the named cases
     wheelrail compare CASE           one named case through the rungs side by side (maps, stresses, report)
+    wheelrail demo                   the default demo (make demo): a run, its peak contact through every rung
 
-Bad input ends with one line ``wheelrail: error: ...`` on stderr naming the key, the value and
-what was expected, and exit status 2; a numerical failure is reported in the results with its
-status (exit status 1).
+Exit statuses (README, "What a run tells you"): 0 every result ok; 1 the work ran but a result is not ok
+(its status and message say why; the outputs are written); 2 bad input, found before any work: one line
+``wheelrail: error: ...`` on stderr naming the key or option, the value and what was expected; 3 an output
+could not be written (one line naming the file; no summary is written); 130 interrupted (Ctrl-C), 143
+terminated (SIGTERM). No traceback for any of these.
+
+A subcommand is a function ``cmd_<name>(args) -> int`` and a function adding its parser, registered in
+:data:`COMMANDS` (or, from another module, with :func:`register`). Shared validation helpers for subcommands:
+:func:`positive_int_option`, ``wheelrail.config`` (ConfigError, physical ranges), ``wheelrail.output``
+(:func:`~wheelrail.output.output_folder`, atomic writes).
 """
 
 from __future__ import annotations
@@ -27,7 +35,10 @@ from pathlib import Path
 
 from wheelrail.config import ConfigError
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_OUTPUT_FAILED = 0, 1, 2, 3
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+OK_PATCH_STATUSES = ("ok", "no-contact")
+"""Patch statuses of a contact run that keep exit status 0."""
 
 
 MPI_RANK_VARIABLES = ("PMI_RANK", "OMPI_COMM_WORLD_RANK", "PMIX_RANK")
@@ -58,11 +69,13 @@ def _print(*args, **kwargs) -> None:
 
 
 def cmd_models(args) -> int:
-    from rigid_dynamics.contact.registry import MODELS
+    from rigid_dynamics.contact.registry import MODELS, model_options
 
     width = max(len(n) for n in MODELS)
     for name, (_, description) in MODELS.items():
         _print(f"{name:<{width}}  {description}")
+        for option in model_options(name).values():
+            _print(f"{'':<{width}}    {option.describe()}")
     return EXIT_OK
 
 
@@ -91,56 +104,67 @@ def cmd_cases(args) -> int:
 
 
 def cmd_contact(args) -> int:
-    from rigid_dynamics.contact.registry import MODELS
-    from wheelrail.cases import load_case, resolve_case_path, solution_record, solve_case
-    from wheelrail.output import copy_input, new_output_dir, to_json, write_json
+    from contextlib import ExitStack
 
-    if args.method not in MODELS:
-        raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
-    case = load_case(args.case)
-    if args.method == "fea" and (args.out is not None or args.plot):
-        case = _with_fea_output(case, args)
-    solution = solve_case(case, args.method)
-    record = solution_record(solution)
-    out_dir = None
-    if args.out is not None or args.plot:
-        if _mpi_rank() == 0:
-            out_dir = new_output_dir(args.out, f"contact-{case.name or 'case'}")
+    from wheelrail.cases import load_case, resolve_case_path, solution_record, solve_case
+    from wheelrail.output import copy_input, output_folder, to_json, write_json
+
+    case = load_case(args.case, method=args.method)  # checks --method and [solver] against the model's options
+    wants_output = args.out is not None or args.plot
+    if wants_output and args.out is None and _under_mpi():
+        raise ConfigError("--plot under mpiexec: give --out DIR so every rank writes to one folder")
+    with ExitStack() as stack:
+        out_dir, refused = None, None
+        if wants_output and _mpi_rank() == 0:
+            try:
+                out_dir = stack.enter_context(output_folder(args.out, f"contact-{case.name or 'case'}"))
+            except ConfigError as exc:
+                refused = exc
+        elif wants_output:
+            out_dir = Path(args.out)  # rank > 0: rank 0 checked and holds the folder
+        if wants_output and _under_mpi() and _mpi_broadcast(refused is not None) and refused is None:
+            return EXIT_BAD_INPUT  # rank > 0 of a refused folder: rank 0 prints the one line
+        if refused is not None:
+            raise refused
+        if args.method == "fea" and out_dir is not None:
+            case = _with_fea_output(case, out_dir)
+        solution = solve_case(case, args.method)
+        record = solution_record(solution)
+        if out_dir is not None and _mpi_rank() == 0:
             copy_input(resolve_case_path(args.case), out_dir, "case.toml")
-            write_json(out_dir / "summary.json", record)
             if args.plot:
                 record["plots"] = _plot_patches(solution, out_dir)
-                write_json(out_dir / "summary.json", record)
+            write_json(out_dir / "summary.json", record)  # last: a summary exists only when every output does
     if args.json:
         _print(to_json(record))
     else:
         _print(_contact_table(record))
         if out_dir is not None:
             _print(f"output written to {out_dir}")
-    return EXIT_OK if solution.success else EXIT_FAILED
+    statuses = [p["status"] for p in record["patches"]]
+    ok = solution.success and all(status in OK_PATCH_STATUSES for status in statuses)
+    return EXIT_OK if ok else EXIT_FAILED
 
 
-def _with_fea_output(case, args):
+def _mpi_broadcast(value):
+    """Rank 0's ``value`` on every rank (so that a folder refused on rank 0 stops every rank, none waits forever)."""
+    import dolfinx_solver  # noqa: F401  (must precede mpi4py)
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD.bcast(value, root=0)
+
+
+def _with_fea_output(case, out_dir: Path):
     """Ask the FEA model to write its XDMF and stress maps into ``<out>/fea`` (one sub-folder per patch)."""
     import dataclasses
 
-    if args.out is None and _under_mpi():
-        raise ConfigError("--method fea with --plot under mpiexec: give --out DIR so every rank writes to one folder")
-    if args.out is None:
-        args.out = new_output_dir_for(case)
-    fea_dir = str(Path(args.out) / "fea")
+    fea_dir = str(Path(out_dir) / "fea")
     options = dict(case.solver_options)
     if case.kind == "quadric":
         options["output_dir"] = fea_dir
     else:
         options["model"] = dict(options.get("model") or {}, output_dir=fea_dir)
     return dataclasses.replace(case, solver_options=options)
-
-
-def new_output_dir_for(case) -> Path:
-    from wheelrail.output import new_output_dir
-
-    return new_output_dir(None, f"contact-{case.name or 'case'}")
 
 
 def _plot_patches(solution, out_dir: Path) -> list[str]:
@@ -151,7 +175,7 @@ def _plot_patches(solution, out_dir: Path) -> list[str]:
         if result.fields is None:
             continue
         path = out_dir / f"fields-{side}-{index}.png"
-        plot_contact_fields(result, path)
+        plot_contact_fields(result, path)  # saved atomically (rigid_dynamics.files.save_figure)
         written.append(path.name)
     return written
 
@@ -183,26 +207,26 @@ def _contact_table(record: dict) -> str:
 
 
 def cmd_run(args) -> int:
+    from wheelrail.output import output_folder
     from wheelrail.scenes import DEFAULT_SCENE, load_scene, resolve_scene_path, write_run_outputs
 
     source = resolve_scene_path(args.scene or DEFAULT_SCENE)
     scene = load_scene(source)
     from rigid_dynamics.wheelset import simulate
-    from wheelrail.output import new_output_dir
 
-    out_dir = new_output_dir(args.out, f"run-{source.stem}")
-    progress, close = _progress_bar(args.quiet, f"{source.stem}")
-    try:
-        result = simulate(scene, progress=progress)
-    finally:
-        close()
-    summary = write_run_outputs(result, source, out_dir, plots=not args.no_plots)
+    with output_folder(args.out, f"run-{source.stem}") as out_dir:
+        progress, close = _progress_bar(args.quiet, f"{source.stem}")
+        try:
+            result = simulate(scene, progress=progress)
+        finally:
+            close()
+        summary = write_run_outputs(result, source, out_dir, plots=not args.no_plots)
     _print(
         f"{source.stem}: {summary['status']} - {summary['message']}; simulated {summary['simulated_time_s']:.3g} s "
         f"in {summary['wall_time_s']:.3g} s (real-time factor {summary['real_time_factor']:.3g})"
     )
     _print(f"output written to {out_dir}")
-    return EXIT_OK if summary.get("success", summary["status"] == "ok") else EXIT_FAILED
+    return EXIT_OK if summary.get("success", summary["status"] == "ok") and summary["status"] == "ok" else EXIT_FAILED
 
 
 def _progress_bar(quiet: bool, label: str):
@@ -226,29 +250,24 @@ def _progress_bar(quiet: bool, label: str):
 def cmd_stress(args) -> int:
     import importlib.util
 
-    from wheelrail.output import copy_input, new_output_dir, write_json
+    from wheelrail.output import copy_input, output_folder, write_json
     from wheelrail.scenes import DEFAULT_STRESS_SCENE, load_scene, resolve_scene_path
 
-    try:
-        workers = int(args.workers)
-    except ValueError:
-        workers = 0
-    if workers < 1:
-        raise ConfigError(f"--workers {args.workers!r}: expected an integer >= 1")
+    workers = positive_int_option("--workers", args.workers)
     if workers > 1 and importlib.util.find_spec("distributed") is None:
         raise ConfigError(f"--workers {args.workers!r}: needs dask.distributed (pip install 'dask[distributed]')")
     source = resolve_scene_path(args.scene or DEFAULT_STRESS_SCENE)
     scene = load_scene(source)
     from comparisons.stress import ENERGY_SUSPECT_RELATIVE, run_stress_sweep
 
-    out_dir = new_output_dir(args.out, f"stress-{source.stem}")
-    copy_input(source, out_dir, "scene.toml")
-    update, close = _progress_bar(False, f"stress {source.stem}")
-    try:
-        report = run_stress_sweep(scene, out_dir=out_dir, quick=args.quick, workers=workers, progress=update)
-    finally:
-        close()
-    write_json(out_dir / "summary.json", report if isinstance(report, dict) else {"runs": report})
+    with output_folder(args.out, f"stress-{source.stem}") as out_dir:
+        copy_input(source, out_dir, "scene.toml")
+        update, close = _progress_bar(False, f"stress {source.stem}")
+        try:
+            report = run_stress_sweep(scene, out_dir=out_dir, quick=args.quick, workers=workers, progress=update)
+        finally:
+            close()
+        write_json(out_dir / "summary.json", report if isinstance(report, dict) else {"runs": report})
     _print(
         f"stress sweep of {source.stem}: {len(report['runs'])} runs ({report['finished']} finished, "
         f"{report['stopped']} stopped) on {workers} worker{'s' if workers > 1 else ''}"
@@ -275,10 +294,16 @@ def cmd_conicity(args) -> int:
             profiles[kind] = load_profile(value, kind)
         except ValueError as exc:
             raise ConfigError(f"{option} {value!r}: {exc}") from None
+    from wheelrail.config import check_physical_range
+
     for option in ("gauge_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
         value = getattr(args, option)
         if not (value > 0 and value < float("inf")):
             raise ConfigError(f"--{option.replace('_', '-')} {value!r}: expected a finite number > 0")
+    for option in ("gauge_m", "gauge_height_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
+        check_physical_range(f"--{option.replace('_', '-')}", getattr(args, option), option)
+    if args.rail_inclination_rad is not None:
+        check_physical_range("--rail-inclination-rad", args.rail_inclination_rad, "rail_inclination_rad")
     result = equivalent_conicity_from_names(
         wheel_profile=profiles["wheel"],
         rail_profile=profiles["rail"],
@@ -303,64 +328,136 @@ def cmd_conicity(args) -> int:
 
 def cmd_manchester(args) -> int:
     from comparisons.manchester import run_manchester_a22
-    from wheelrail.output import new_output_dir
+    from rigid_dynamics.contact.registry import MODELS
+    from wheelrail.output import output_folder
 
-    out_dir = new_output_dir(args.out, "manchester-a22")
-    run_manchester_a22(out_dir, method=args.method)
-    _print(f"Manchester A-2.2: output written to {out_dir}")
-    return EXIT_OK
+    if args.method not in MODELS:
+        raise ConfigError(f"--method {args.method!r}: expected one of {', '.join(MODELS)}")
+    with output_folder(args.out, "manchester-a22", summaries=("manchester_a22_summary.json",)) as out_dir:
+        summary = run_manchester_a22(out_dir, method=args.method, kinematics=args.kinematics)
+    comparison = summary["contact_comparison"]
+    for key, item in comparison["largest_difference"].items():
+        unit = " mm" if key == "contact_y_rail" else " %"
+        scale = 1e3 if key == "contact_y_rail" else 100.0
+        _print(f"  largest difference to CONTACT, {key}: {scale * item['value']:.3g}{unit} (step {item['step']})")
+    if comparison["patch_count_mismatch_steps"]:
+        _print(f"  patch count differs from CONTACT at steps {comparison['patch_count_mismatch_steps']}")
+    verdict = "within" if comparison["within_tolerance"] else "NOT within"
+    _print(
+        f"Manchester A-2.2 ({args.method}, {args.kinematics}): {verdict} the tolerances against CONTACT; "
+        f"output written to {out_dir}"
+    )
+    return EXIT_OK if summary["all_converged"] else EXIT_FAILED
+
+
+# --- shared helpers for subcommands -------------------------------------------------------
+
+
+def positive_int_option(option: str, value) -> int:
+    """An integer >= 1 given on the command line (ConfigError naming the option and the value otherwise)."""
+    try:
+        number = int(str(value))
+    except ValueError:
+        number = 0
+    if number < 1:
+        raise ConfigError(f"{option} {value!r}: expected an integer >= 1")
+    return number
+
+
+def out_path(text: str) -> Path:
+    """The argparse ``type`` of every ``--out``: a non-empty path (``--out ""`` would mean the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected a folder path (an empty path would mean the current folder)"
+        )
+    return Path(text)
+
+
+def finite_float(option: str):
+    """An argparse ``type`` for a finite number; the error names the option and the value (exit status 2)."""
+
+    def parse(text: str) -> float:
+        import math
+
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected a finite number")
+        return value
+
+    parse.__name__ = option
+    return parse
 
 
 # --- parser -------------------------------------------------------------------------------
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from wheelrail import __version__
-
-    parser = argparse.ArgumentParser(prog="wheelrail", description=__doc__.splitlines()[0])
-    parser.add_argument("--version", action="version", version=f"wheelrail {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    sub.required = True
-
+def _add_listings(sub) -> None:
     sub.add_parser("scenes", help="list the embedded dynamics scenes").set_defaults(func=cmd_scenes)
     sub.add_parser("cases", help="list the embedded contact cases").set_defaults(func=cmd_cases)
-    sub.add_parser("models", help="list the contact models").set_defaults(func=cmd_models)
+    sub.add_parser("models", help="list the contact models and their options").set_defaults(func=cmd_models)
 
+
+def _add_run(sub) -> None:
     run = sub.add_parser("run", help="run a dynamics scene")
     run.add_argument("scene", nargs="?", help="embedded scene name or TOML file (default: the default scene)")
-    run.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/run-<scene>-<time>)")
+    run.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/run-<scene>-<time>)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     run.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
     run.set_defaults(func=cmd_run)
 
+
+def _add_contact(sub) -> None:
     contact = sub.add_parser("contact", help="solve a contact case")
     contact.add_argument("case", help="embedded case name or TOML file")
     contact.add_argument("--method", default="auto", help="contact model (see `wheelrail models`)")
     contact.add_argument("--json", action="store_true", help="print one JSON object")
     contact.add_argument("--plot", action="store_true", help="write PNG maps of the patch fields")
-    contact.add_argument("--out", type=Path, help="output folder for summary and plots")
+    contact.add_argument("--out", type=out_path, help="output folder for summary and plots")
     contact.set_defaults(func=cmd_contact)
 
+
+def _add_conicity(sub) -> None:
     conicity = sub.add_parser("conicity", help="equivalent conicity (EN 15302 method)")
     conicity.add_argument("--wheel", default="MBench_S1002_v3", help="wheel profile: built-in name or file")
     conicity.add_argument("--rail", default="MBench_UIC60_v3", help="rail profile: built-in name or file")
-    conicity.add_argument("--gauge-m", type=float, default=1.435)
-    conicity.add_argument("--gauge-height-m", type=float, default=0.014)
-    conicity.add_argument("--flange-back-distance-m", type=float, default=1.360)
-    conicity.add_argument("--nominal-radius-m", type=float, default=0.46)
-    conicity.add_argument("--rail-inclination-rad", type=float, default=None, help="cant of the rail (default: 1:40)")
-    conicity.add_argument("--amplitude-m", type=float, default=0.003, help="wheelset amplitude (EN 15302: 3 mm)")
+    number = finite_float
+    conicity.add_argument("--gauge-m", type=number("--gauge-m"), default=1.435)
+    conicity.add_argument("--gauge-height-m", type=number("--gauge-height-m"), default=0.014)
+    conicity.add_argument("--flange-back-distance-m", type=number("--flange-back-distance-m"), default=1.360)
+    conicity.add_argument("--nominal-radius-m", type=number("--nominal-radius-m"), default=0.46)
+    conicity.add_argument(
+        "--rail-inclination-rad",
+        type=number("--rail-inclination-rad"),
+        default=None,
+        help="cant of the rail (default: 1:40)",
+    )
+    conicity.add_argument(
+        "--amplitude-m", type=number("--amplitude-m"), default=0.003, help="wheelset amplitude (EN 15302: 3 mm)"
+    )
     conicity.add_argument("--json", action="store_true")
     conicity.set_defaults(func=cmd_conicity)
 
+
+def _add_manchester(sub) -> None:
     manchester = sub.add_parser("manchester", help="Manchester Contact Benchmark case A-2.2 sweep")
-    manchester.add_argument("--out", type=Path)
-    manchester.add_argument("--method", default="fastsim")
+    manchester.add_argument("--out", type=out_path)
+    manchester.add_argument("--method", default="bem", help="contact model (default bem, on CONTACT's 0.2 mm grid)")
+    manchester.add_argument(
+        "--kinematics",
+        choices=("deck", "equilibrium"),
+        default="deck",
+        help="deck: CONTACT's roll and pitch rate per step (default); equilibrium: roll and pitch rate solved",
+    )
     manchester.set_defaults(func=cmd_manchester)
 
+
+def _add_stress(sub) -> None:
     stress = sub.add_parser("stress", help="numerical-stability stress sweep")
     stress.add_argument("scene", nargs="?", help="embedded scene name or TOML file (default: hunting-conical)")
-    stress.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/stress-<scene>-<time>)")
+    stress.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/stress-<scene>-<time>)")
     stress.add_argument("--quick", action="store_true", help="a small sweep")
     stress.add_argument(
         "--workers",
@@ -370,25 +467,91 @@ def build_parser() -> argparse.ArgumentParser:
     )
     stress.set_defaults(func=cmd_stress)
 
-    from wheelrail.comparison_commands import register
 
-    register(sub)  # bench, compare
+COMMANDS: list = [_add_listings, _add_run, _add_contact, _add_conicity, _add_manchester, _add_stress]
+"""Functions ``add(subparsers)`` that add one or more subcommands (each sets ``func`` to its ``cmd_*``).
+
+A new subcommand in its own module: write ``cmd_x(args) -> int`` and ``add_x(sub)`` there, and add
+``"package.module:add_x"`` to :data:`COMMAND_MODULES` (imported only when the parser is built)."""
+
+COMMAND_MODULES: list[str] = ["wheelrail.comparison_commands:register"]  # bench, compare, demo
+"""``"module:function"`` strings of subcommands defined in other modules (see :data:`COMMANDS`)."""
+
+
+def register(add) -> None:
+    """Register a function ``add(subparsers)`` that adds a subcommand (for modules imported before the parser)."""
+    COMMANDS.append(add)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``wheelrail: error: ...`` and exit status 2 (no usage block)."""
+
+    def error(self, message: str):
+        command = self.prog.removeprefix("wheelrail").strip()
+        raise ConfigError(f"{command}: {message}" if command else message)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    import importlib
+
+    from wheelrail import __version__
+
+    parser = _Parser(prog="wheelrail", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"wheelrail {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for add in COMMANDS:
+        add(sub)
+    for target in COMMAND_MODULES:
+        module_name, function = target.split(":")
+        getattr(importlib.import_module(module_name), function)(sub)
     return parser
 
 
+def _terminate(signum, frame):
+    raise SystemExit(EXIT_TERMINATED)  # unwinds like Ctrl-C: temporary files removed, lock released
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``wheelrail`` console script."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Entry point of the ``wheelrail`` console script; returns the exit status (module docstring)."""
+    import signal
+    import threading
+
+    from rigid_dynamics.files import WriteError
+
     start = time.perf_counter()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
+        args = build_parser().parse_args(argv)
         return args.func(args)
     except ConfigError as exc:
         print(f"wheelrail: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except WriteError as exc:
+        print(
+            f"wheelrail: error: cannot write {exc.filename!r}: {exc.strerror} "
+            "(the run's outputs are incomplete; no summary.json was written)",
+            file=sys.stderr,
+        )
+        return EXIT_OUTPUT_FAILED
+    except BrokenPipeError:  # the reader of stdout went away (| head): nothing left to say
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print(f"wheelrail: interrupted after {time.perf_counter() - start:.1f} s", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except ValueError as exc:
+        # The library raises ValueError for bad input it is given (STYLE 12); one that no check of the front
+        # caught is still bad input, reported in one line. WHEELRAIL_DEBUG=1 shows the traceback.
+        if os.environ.get("WHEELRAIL_DEBUG"):
+            raise
+        print(f"wheelrail: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

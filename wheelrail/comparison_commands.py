@@ -178,23 +178,25 @@ def cmd_demo(args) -> int:
 
 
 def register(sub) -> None:
-    """Add the ``bench`` and ``compare`` sub-commands to the CLI's subparsers."""
+    """Add the ``bench``, ``compare`` and ``demo`` sub-commands to the CLI's subparsers."""
+    from wheelrail.cli import out_path
+
     bench = sub.add_parser("bench", help="run time against error of every rung on the named cases")
     bench.add_argument("--quick", action="store_true", help="fewer resolutions (a few minutes on 2 cores)")
     bench.add_argument("--cases", nargs="+", metavar="NAME", help="named cases (default: all)")
     bench.add_argument("--models", nargs="+", metavar="NAME", help="models (default: all rungs)")
-    bench.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/bench-<time>)")
+    bench.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/bench-<time>)")
     bench.add_argument("--list", action="store_true", help="list the named cases")
     bench.set_defaults(func=cmd_bench)
 
     compare = sub.add_parser("compare", help="one case through Hertz, FASTSIM, BEM and FEA side by side")
     compare.add_argument("case", help="named case (see `wheelrail bench --list`) or case folder")
     compare.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
-    compare.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/compare-<case>-<time>)")
+    compare.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/compare-<case>-<time>)")
     compare.set_defaults(func=cmd_compare)
 
     demo = sub.add_parser("demo", help="the default demo: a run, the contact at its peak through every rung, report")
     demo.add_argument("scene", nargs="?", default="polygonal-wheel", help="scene with the 3-D contact search")
-    demo.add_argument("--out", type=Path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
+    demo.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
     demo.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
     demo.set_defaults(func=cmd_demo)

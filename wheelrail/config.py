@@ -22,6 +22,66 @@ class ConfigError(ValueError):
     """A scene or case file is invalid. The message names the key, the value and what was expected."""
 
 
+PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
+    "creepage_long": (-1.0, 1.0, "a creepage is a slip velocity over the rolling speed"),
+    "creepage_lat": (-1.0, 1.0, "a creepage is a slip velocity over the rolling speed"),
+    "spin_creepage_1_per_m": (-20.0, 20.0, "1/m: sin(contact angle) / rolling radius"),
+    "rolling_speed_m_per_s": (0.0, 200.0, "m/s: the rail speed record is 160 m/s"),
+    "speed_m_per_s": (0.0, 200.0, "m/s: the rail speed record is 160 m/s"),
+    "normal_force_N": (0.0, 5.0e6, "N: a wheel load is at most a few hundred kN"),
+    "wheel_load_N": (0.0, 5.0e6, "N: a wheel load is at most a few hundred kN"),
+    "axle_load_N": (0.0, 1.0e7, "N: axle loads are at most a few hundred kN"),
+    "shear_modulus_Pa": (1.0e6, 1.0e12, "Pa: steel 8e10, rubber 1e6"),
+    "young_modulus_Pa": (3.0e6, 3.0e12, "Pa: steel 2.1e11, rubber 3e6"),
+    "friction_coefficient": (0.0, 2.0, "dry steel on steel about 0.3-0.6"),
+    "approach_m": (-1.0, 0.01, "m: Hertz approaches of wheels on rails are below 0.1 mm"),
+    "radius_long_m": (1.0e-4, 1.0e6, "m"),
+    "radius_lat_m": (1.0e-4, 1.0e6, "m"),
+    "mass_kg": (1.0, 1.0e5, "kg: a wheelset is 1-2 t"),
+    "transverse_inertia_kg_m2": (1.0e-3, 1.0e5, "kg m^2"),
+    "axle_inertia_kg_m2": (1.0e-3, 1.0e5, "kg m^2"),
+    "nominal_radius_m": (0.05, 2.0, "m: wheel radii are 0.3-0.63 m (scaled rigs smaller)"),
+    "contact_half_distance_m": (0.05, 2.0, "m: half the distance of the contact points, about half the gauge"),
+    "suspension_half_spacing_m": (0.0, 10.0, "m"),
+    "gauge_m": (0.1, 3.0, "m: track gauges are 0.6-1.7 m"),
+    "gauge_height_m": (0.0, 0.05, "m: gauge is measured 14 mm below the rail top"),
+    "flange_back_distance_m": (0.1, 3.0, "m"),
+    "lateral_shift_m": (-0.1, 0.1, "m: the flangeway clearance is about +-10 mm"),
+    "lateral_displacement_m": (-0.1, 0.1, "m: the flangeway clearance is about +-10 mm"),
+    "longitudinal_stiffness_N_per_m": (0.0, 1.0e12, "N/m"),
+    "lateral_stiffness_N_per_m": (0.0, 1.0e12, "N/m"),
+    "vertical_stiffness_N_per_m": (0.0, 1.0e12, "N/m"),
+    "lateral_damping_N_s_per_m": (0.0, 1.0e10, "N s/m"),
+    "vertical_damping_N_s_per_m": (0.0, 1.0e10, "N s/m"),
+    "duration_s": (0.0, 86400.0, "s: one day of simulated time at most"),
+    "fixed_step_s": (1.0e-8, 1.0, "s"),
+    "max_step_s": (1.0e-8, 10.0, "s"),
+    "output_step_s": (1.0e-7, 100.0, "s: the output holds duration / output_step samples"),
+    "relative_tolerance": (1.0e-14, 1.0, "relative error per step"),
+    "absolute_tolerance": (1.0e-16, 1.0, "absolute error per step"),
+    "contact_tolerance": (0.0, 10.0, "relative creep-force error accepted by auto"),
+    "traction_torque_N_m": (-1.0e6, 1.0e6, "N m: mu N r is about 25 kN m for a 100 kN wheel load"),
+    "rail_head_radius_m": (1.0e-3, 10.0, "m"),
+    "amplitude_m": (1.0e-5, 0.02, "m: EN 15302 uses 3 mm; the flangeway clearance is about 10 mm"),
+    "rail_inclination_rad": (-0.2, 0.2, "rad: 1:40 is 0.025, 1:20 is 0.05"),
+}
+"""Key name -> (lowest, highest, why): numbers outside are bad input however well typed (the range and
+the reason are in the message). Applied to every key of that name in scene and case files."""
+
+
+def check_physical_range(key: str, value: float, name: str | None = None) -> float:
+    """``value`` if it lies in the physical range of ``name`` (default: the last part of the dotted ``key``) or
+    there is none; else ConfigError naming ``key`` (a file's key or a command-line option).
+    """
+    limits = PHYSICAL_RANGES.get(name or key.rsplit(".", 1)[-1])
+    if limits is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
+        low, high, why = limits
+        if not low <= value <= high:
+            what = key if key.startswith("-") else f"key {key!r} ="
+            raise ConfigError(f"{what} {value!r}: expected a number from {low:g} to {high:g} ({why})")
+    return value
+
+
 def read_toml(path: str | Path, what: str = "file") -> dict:
     """Read a TOML file, turning I/O and syntax errors into ConfigError."""
     path = Path(path)
@@ -154,7 +214,7 @@ def build_dataclass(cls: type, table: dict, prefix: str = "") -> Any:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise ConfigError(f"missing key {key!r}: expected {_type_name(hints[name])}")
             continue
-        kwargs[name] = convert_value(table[name], hints[name], key)
+        kwargs[name] = check_physical_range(key, convert_value(table[name], hints[name], key))
     try:
         return cls(**kwargs)
     except ConfigError:
@@ -196,4 +256,4 @@ def get_number(table: dict, name: str, prefix: str, *, positive: bool = False, d
     value = convert_value(table[name], float, key)
     if positive and value <= 0:
         raise ConfigError(f"key {key!r} = {value!r}: expected a number > 0")
-    return value
+    return check_physical_range(key, value)

@@ -1,7 +1,17 @@
 """Output folders and atomic writes.
 
-Every data file is written to a temporary name in the same folder and renamed into place
-(``os.replace`` is atomic on POSIX), so a crash never leaves a half file that looks whole.
+Every file is written through :func:`atomic_write` (from :mod:`rigid_dynamics.files`): a temporary name in
+the same folder, flushed, renamed into place (``os.replace`` is atomic on POSIX), with the permissions of a
+normally created file. A crash, a kill or a full disk never leaves a half file under a final name; a failed
+write raises :class:`~rigid_dynamics.files.WriteError` (an OSError naming the file), which the CLI reports in
+one line (exit status 3).
+
+:func:`output_folder` is where a run gets its folder: it checks before any work that the folder can be
+written (``--out ""``, a path that is a file or lies under a file, a read-only place, a full disk: one
+ConfigError naming ``--out`` and the value), takes a lock file so that two runs never write into the same
+folder, removes a summary left by an earlier run (a folder's ``summary.json`` is always the last run's, and
+is written last), and on leaving releases the lock and removes the folder again if it created it and
+nothing was written.
 """
 
 from __future__ import annotations
@@ -10,28 +20,33 @@ import json
 import math
 import os
 import shutil
-import tempfile
-from collections.abc import Callable
+import socket
+from collections.abc import Iterator
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
+from rigid_dynamics.files import WriteError, atomic_write, save_figure
+from wheelrail.config import ConfigError
 
-def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> Path:
-    """Call ``writer(tmp_path)`` and rename the temporary file to ``path`` only if it succeeds."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        writer(tmp_path)
-        os.replace(tmp_path, path)
-    except BaseException:
-        tmp_path.unlink(missing_ok=True)
-        raise
-    return path
+__all__ = [
+    "LOCK_NAME",
+    "WriteError",
+    "atomic_write",
+    "copy_input",
+    "new_output_dir",
+    "output_folder",
+    "save_figure",
+    "to_json",
+    "write_json",
+    "write_npz",
+    "write_text",
+]
+
+LOCK_NAME = ".wheelrail.lock"
+"""The lock file a run holds in its output folder (pid and host of the run)."""
 
 
 def _json_default(value):
@@ -81,15 +96,145 @@ def write_npz(path: str | Path, **arrays) -> Path:
     return atomic_write(path, writer)
 
 
-def new_output_dir(base: str | Path | None, name: str) -> Path:
-    """The folder a run writes into: ``base`` if given, else ``wheelrail-out/<name>-<UTC time>``."""
-    if base is not None:
-        out = Path(base)
-    else:
-        stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
-        out = Path("wheelrail-out") / f"{name}-{stamp}"
-    out.mkdir(parents=True, exist_ok=True)
+def _check_out(base: str | Path, option: str) -> Path:
+    """The path of ``--out`` if it can be a folder (ConfigError naming the option and the value otherwise)."""
+    text = str(base)
+    if not text.strip():
+        raise ConfigError(
+            f"{option} {text!r}: expected a folder path (an empty path would write into the current folder)"
+        )
+    out = Path(base)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"{option} {text!r}: expected a folder, found a file")
+    for parent in out.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ConfigError(f"{option} {text!r}: expected a folder path, but {str(parent)!r} is a file")
+            break
     return out
+
+
+def _create(out: Path, option: str, text: str, *, exclusive: bool) -> None:
+    try:
+        out.mkdir(parents=True, exist_ok=not exclusive)
+    except FileExistsError:
+        raise
+    except OSError as exc:
+        raise ConfigError(f"{option} {text!r}: the folder cannot be created ({exc.strerror or exc})") from None
+
+
+def new_output_dir(base: str | Path | None, name: str, *, option: str = "--out") -> Path:
+    """The folder a run writes into: ``base`` (checked, created) or a new ``wheelrail-out/<name>-<UTC time>``.
+
+    Prefer :func:`output_folder`, which also locks the folder and checks that it can be written.
+
+    Raises:
+        ConfigError: ``base`` is empty, a file, under a file, or cannot be created.
+    """
+    if base is not None:
+        out = _check_out(base, option)
+        _create(out, option, str(base), exclusive=False)
+        return out
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
+    for attempt in range(1, 1000):
+        out = Path("wheelrail-out") / (f"{name}-{stamp}" if attempt == 1 else f"{name}-{stamp}-{attempt}")
+        _check_out(out, "output folder")
+        try:
+            _create(out, "output folder", str(out), exclusive=True)
+        except FileExistsError:
+            continue  # another run started in the same second: take the next name
+        return out
+    raise ConfigError(f"output folder {str(out)!r}: no free name")  # pragma: no cover
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _lock(out: Path, option: str, text: str) -> Path:
+    """Create the lock file (also the check that the folder can be written); ConfigError if another run holds it."""
+    lock = out / LOCK_NAME
+    content = f"{os.getpid()} {socket.gethostname()} {datetime.now(UTC).isoformat()}\n".encode()
+    for _ in range(2):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666)
+        except FileExistsError:
+            try:
+                pid_text, host = lock.read_text(encoding="utf-8").split()[:2]
+                pid = int(pid_text)
+            except (OSError, ValueError):
+                pid, host = -1, ""
+            if host == socket.gethostname() and not _pid_alive(pid):
+                lock.unlink(missing_ok=True)  # left by a run that was killed
+                continue
+            raise ConfigError(
+                f"{option} {text!r}: another wheelrail run (pid {pid} on {host or 'unknown host'}) is writing into "
+                f"this folder (lock file {LOCK_NAME}); choose another folder or wait for it to finish"
+            ) from None
+        except OSError as exc:
+            raise ConfigError(f"{option} {text!r}: the folder cannot be written ({exc.strerror or exc})") from None
+        try:
+            os.write(fd, content)
+            os.fsync(fd)
+        except OSError as exc:
+            os.close(fd)
+            lock.unlink(missing_ok=True)
+            raise ConfigError(f"{option} {text!r}: the folder cannot be written ({exc.strerror or exc})") from None
+        os.close(fd)
+        return lock
+    raise ConfigError(f"{option} {text!r}: the lock file {LOCK_NAME} cannot be taken")  # pragma: no cover
+
+
+@contextmanager
+def output_folder(
+    base: str | Path | None, name: str, *, option: str = "--out", summaries: tuple[str, ...] = ("summary.json",)
+) -> Iterator[Path]:
+    """The output folder of one run, checked, locked and cleaned up (module docstring). Use it before the work.
+
+    ``summaries`` are the names of the run's summary files: one left by an earlier run is removed first, so that
+    a summary in the folder always belongs to the files beside it (write it last).
+
+    Raises:
+        ConfigError: the folder is not usable (empty path, a file, under a file, cannot be created or written,
+            held by another run).
+    """
+    existed = base is not None and Path(base).is_dir()
+    out = new_output_dir(base, name, option=option)
+    text = str(base) if base is not None else str(out)
+    try:
+        lock = _lock(out, option, text)
+    except ConfigError:
+        if not existed:
+            _remove_if_empty(out)
+        raise
+    for summary in summaries:
+        try:
+            (out / summary).unlink(missing_ok=True)
+        except OSError as exc:
+            lock.unlink(missing_ok=True)
+            raise ConfigError(
+                f"{option} {text!r}: the old {summary} cannot be removed ({exc.strerror or exc})"
+            ) from None
+    try:
+        yield out
+    finally:
+        lock.unlink(missing_ok=True)
+        if not existed:
+            _remove_if_empty(out)
+
+
+def _remove_if_empty(out: Path) -> None:
+    """Remove a folder this run created if nothing was written into it (an unknown model leaves no folder)."""
+    try:
+        out.rmdir()
+    except OSError:
+        pass  # not empty (the run wrote files), or already gone
 
 
 def copy_input(source: str | Path, out_dir: Path, name: str | None = None) -> Path:

@@ -70,7 +70,14 @@ def parse_scene(doc: dict):
         if key not in doc:
             raise ConfigError(f"missing key {key!r}: expected a finite number (every scene states it)")
     _check_profiles(doc)
-    return build_dataclass(DynamicsScene, doc)
+    scene = build_dataclass(DynamicsScene, doc)
+    from rigid_dynamics.wheelset.checks import SceneError, check_scene
+
+    try:
+        check_scene(scene)
+    except SceneError as exc:
+        raise ConfigError(f"key {exc.key!r} = {exc.value!r}: expected {exc.expected}") from None
+    return scene
 
 
 def load_scene(path: str | Path):

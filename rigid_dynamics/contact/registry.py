@@ -5,8 +5,9 @@ Every model solves one patch::
     model.solve(geometry, creepage, material, normal_force_N=None, options=None) -> ContactResult
 
 ``normal_force_N=None`` means approach control (``geometry.approach_m`` is imposed); a number
-means force control. ``options`` is a mapping of model-specific settings (grid size, ...);
-an unknown option raises ``ValueError`` naming it.
+means force control. ``options`` is a mapping of model-specific settings (grid size, ...), declared
+by each model class as ``OPTIONS`` (:mod:`rigid_dynamics.contact.options`; :func:`model_options`); an
+unknown option or a bad value raises ``OptionError`` (a ``ValueError``) naming it.
 
 Models are registered by name as ``"module:Class"`` strings and imported only when asked
 for, so asking for ``hertz`` never imports the BEM, and nothing of FEniCSx is imported unless
@@ -62,6 +63,28 @@ def model_names() -> list[str]:
     return list(MODELS)
 
 
+def model_class(name: str) -> type:
+    """The class registered as ``name`` (imports its module, not its heavy dependencies).
+
+    Raises:
+        ValueError: unknown name (the message lists the choices).
+    """
+    try:
+        target, _ = MODELS[name]
+    except KeyError:
+        raise ValueError(f"contact model = {name!r}: expected one of {', '.join(MODELS)}") from None
+    module_name, class_name = target.split(":")
+    return getattr(importlib.import_module(module_name), class_name)
+
+
+def model_options(name: str) -> dict:
+    """The declared options of the model ``name``: option name -> :class:`~rigid_dynamics.contact.options.Option`.
+
+    Every model class declares them as its ``OPTIONS`` (see :mod:`rigid_dynamics.contact.options`).
+    """
+    return dict(model_class(name).OPTIONS)
+
+
 def get_model(name: str | ContactModel, **kwargs) -> ContactModel:
     """Return an instance of the model registered as ``name`` (or ``name`` itself if it is a model).
 
@@ -73,10 +96,4 @@ def get_model(name: str | ContactModel, **kwargs) -> ContactModel:
         if isinstance(name, ContactModel):
             return name
         raise ValueError(f"contact model = {name!r}: expected a name or a ContactModel")
-    try:
-        target, _ = MODELS[name]
-    except KeyError:
-        raise ValueError(f"contact model = {name!r}: expected one of {', '.join(MODELS)}") from None
-    module_name, class_name = target.split(":")
-    module = importlib.import_module(module_name)
-    return getattr(module, class_name)(**kwargs)
+    return model_class(name)(**kwargs)

@@ -1,76 +1,75 @@
 """Wheel and rail surfaces of both sides for the contact search, built from profiles (rigid_dynamics.geometry).
 
-Rail inclination. ``rail_inclination_rad`` is the inclination of the rail IN THE TRACK. Some profile files
-are already canted (``CANTED_PROFILES``: the Manchester benchmark's MBench_UIC60_v3 rail is canted 1:40,
-its file says so); for those only the difference between the requested inclination and the file's own cant
-is applied, so a 1:40 case with the 1:40 file is not canted twice, and 0 turns it back to vertical.
+Rail inclination. ``rail_inclination_rad`` is the inclination of the rail IN THE TRACK. A profile's points may
+already contain a cant (the Manchester benchmark's MBench_UIC60_v3 rail is canted 1:40, its file says so): that
+cant is data of the profile (``Profile.cant_rad``: the built-in profiles carry theirs, readers.BUILTIN_CANT_RAD;
+for a file the case states it, ``rail_profile_cant_rad``), never inferred from a name. Only the difference between
+the requested inclination and the profile's own cant is applied, so a 1:40 case with the 1:40 file is not canted
+twice, and 0 turns it back to vertical.
+
+Orientation. Profiles are read in the internal convention (readers.py: y towards the field side, z down); a file
+of another orientation is turned by the case's ``*_profile_mirror_y`` / ``*_profile_mirror_z`` (as CONTACT's
+MIRRORY, MIRRORZ). A wheel whose flange comes out inside the tape circle is an error that says so, not something
+mended silently. Left and right profiles may differ (``wheel_profile_left``, ``rail_profile_left``; default the
+right ones, mirrored); ``profile_smoothing_m`` sets the profile splines' smoothing wavelength (default 2 mm).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 from rigid_dynamics.contact.search import SIDES, SideSearch, WheelsetPose, fast_surfaces, search_side
 from rigid_dynamics.materials import Material
 
-CANTED_PROFILES: dict[str, float] = {
-    "MBench_UIC60_v3": math.atan(1.0 / 40.0),
-    "MBench_UIC60_v3_ban": math.atan(1.0 / 40.0),
-}
-"""Profile name (built-in name or file stem) -> cant already contained in its points, rad."""
 
-
-class _RadiusFromProfileDown:
-    """Wheel surface with R = r0 + (z_p - z_p(0)) built from a surface that returned R = r0 - (z_p - z_p(0)).
-
-    With z_p pointing DOWN (profile convention) the flange, at positive z_p, is further from the axle than the
-    tape circle, so R_id = r0 + z_p - z_p(0): the flange tip of an S1002 wheel is 28 mm beyond r0. This adapter
-    mirrors R about r0 (R' = 2 r0 - R, derivatives negated) for a geometry stage that used the opposite sign;
-    :func:`build_track` applies it only when the flange of the placed wheel comes out smaller than r0.
-    """
-
-    def __init__(self, surface):
-        self.surface = surface
-        self.side = surface.side
-        self.nominal_radius_m = surface.nominal_radius_m
-
-    @property
-    def y_range_m(self):
-        return self.surface.y_range_m
-
-    def evaluate(self, angle_rad, y_d_m):
-        r, r_a, r_y, r_aa, r_ay, r_yy = self.surface.evaluate(angle_rad, y_d_m)
-        return (2.0 * self.nominal_radius_m - r, -r_a, -r_y, -r_aa, -r_ay, -r_yy)
-
-    @property
-    def irregularities(self):
-        return self.surface.irregularities
-
-    def ideal_radius(self, y_d_m):
-        r, r_y, r_yy = self.surface.ideal_radius(y_d_m)
-        return 2.0 * self.nominal_radius_m - r, -r_y, -r_yy
-
-    def to_profile_coordinates(self, y_d_m, radius_m):
-        y_p, z_p = self.surface.to_profile_coordinates(y_d_m, radius_m)
-        z_tape = float(self.surface.curve.z(0.0))
-        return y_p, 2.0 * z_tape - z_p
-
-
-def _wheel_with_flange_outside(surface, curve):
-    """The wheel surface, mirrored about r0 if its flange tip (max z_p) has a radius below r0 (see adapter)."""
+def _mirrored(profile, mirror_y: bool, mirror_z: bool):
+    """The profile with y -> -y and/or z -> -z (as CONTACT's MIRRORY / MIRRORZ), for files of other orientations."""
     import numpy as np
 
-    y = np.linspace(curve.y_min_m, curve.y_max_m, 2001)
-    tip = y[int(np.nanargmax(curve.z(y)))]
-    y_d = surface.sign * (tip + surface.tape_circle_offset_m)
-    radius = float(surface.ideal_radius(y_d)[0])
-    return surface if radius >= surface.nominal_radius_m else _RadiusFromProfileDown(surface)
+    from rigid_dynamics.geometry.profile import Profile
+
+    if not (mirror_y or mirror_z):
+        return profile
+    sy, sz = (-1.0 if mirror_y else 1.0), (-1.0 if mirror_z else 1.0)
+    y, z = sy * profile.y_m, sz * profile.z_m
+    oy, oz = sy * profile.outline_y_m, sz * profile.outline_z_m
+    order = np.argsort(y)
+    what = " and ".join(n for n, f in (("y", mirror_y), ("z", mirror_z)) if f)
+    return Profile(
+        y[order], z[order], profile.kind, profile.name, f"{profile.source}; mirrored in {what}", oy, oz,
+        cant_rad=sy * profile.cant_rad,
+    )  # fmt: skip
 
 
-def profile_cant_rad(profile) -> float:
-    """Cant already contained in a rail profile's points (0 unless listed in ``CANTED_PROFILES``), rad."""
-    return CANTED_PROFILES.get(getattr(profile, "name", ""), 0.0)
+def _load(value, kind: str, mirror_y: bool, mirror_z: bool):
+    from rigid_dynamics.geometry import load_profile
+
+    profile = load_profile(value, kind) if isinstance(value, str) else value
+    if hasattr(profile, "y_m"):
+        profile = _mirrored(profile, mirror_y, mirror_z)
+    return profile
+
+
+def _check_flange_outside(curve, name) -> None:
+    """A flanged wheel's flange (inner side of the tape circle, y_p < 0) must rise beyond the tape circle (z_p down,
+    away from the axle). A deep dip towards the axle on the inner side only (the outer side not dipping alike, as a
+    crowned or circular profile does on both sides) means the file's z points up.
+    """
+    import numpy as np
+
+    lo, hi = max(curve.y_min_m, -0.08), min(curve.y_max_m, 0.08)
+    if lo >= -0.005:
+        return
+    z0 = float(curve.z(0.0))
+    inner = curve.z(np.linspace(lo, -0.005, 601)) - z0
+    outer = curve.z(np.linspace(0.005, hi, 601)) - z0 if hi > 0.005 else np.zeros(1)
+    dip_inner, rise_inner = float(-np.nanmin(inner)), float(np.nanmax(inner))
+    dip_outer = max(float(-np.nanmin(outer)), 0.0)
+    if dip_inner > 0.005 and dip_inner > 2.0 * rise_inner and dip_inner > 2.0 * dip_outer:
+        raise ValueError(
+            f"wheel profile {name!r}: its flange dips {1e3 * dip_inner:.1f} mm towards the axle from the tape circle: "
+            "the file's z axis points up; expected z down (away from the axle), or set wheel_profile_mirror_z = true"
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,33 +132,56 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
 
     Args:
         case: provides wheel_profile, rail_profile (names or paths, Profile objects or profile curves), gauge_m,
-            gauge_height_m, flange_back_distance_m, nominal_radius_m, rail_inclination_rad.
+            gauge_height_m, flange_back_distance_m, nominal_radius_m, rail_inclination_rad; optionally (getattr,
+            defaults in brackets) wheel_profile_left, rail_profile_left [the right ones, mirrored],
+            rail_profile_cant_rad [the profile's own ``cant_rad``], profile_smoothing_m [2 mm],
+            wheel_profile_mirror_y/_z, rail_profile_mirror_y/_z [False].
         wheel_irregularities, rail_irregularities: optional side -> tuple of irregularities (geometry module).
 
     Raises:
-        ValueError: unknown profile, bad placement (from rigid_dynamics.geometry).
+        ValueError: unknown profile, bad placement (from rigid_dynamics.geometry), a wheel whose flange comes out
+            inside the tape circle (a file with z up: set wheel_profile_mirror_z).
     """
-    from rigid_dynamics.geometry import TrackGeometry, WheelsetGeometry, load_profile
+    from rigid_dynamics.geometry import TrackGeometry, WheelsetGeometry
+    from rigid_dynamics.geometry.placement import DEFAULT_SMOOTHING_WAVELENGTH_M
 
-    wheel = load_profile(case.wheel_profile, "wheel") if isinstance(case.wheel_profile, str) else case.wheel_profile
-    rail = load_profile(case.rail_profile, "rail") if isinstance(case.rail_profile, str) else case.rail_profile
-    wheelset = WheelsetGeometry(
-        wheel, flange_back_distance_m=case.flange_back_distance_m, nominal_radius_m=case.nominal_radius_m
+    smoothing = getattr(case, "profile_smoothing_m", None)
+    smoothing = DEFAULT_SMOOTHING_WAVELENGTH_M if smoothing is None else smoothing
+    wheel_mirror = (
+        bool(getattr(case, "wheel_profile_mirror_y", False)),
+        bool(getattr(case, "wheel_profile_mirror_z", False)),
     )
-    track = TrackGeometry(
-        rail,
-        gauge_m=case.gauge_m,
-        gauge_height_m=case.gauge_height_m,
-        rail_inclination_rad=case.rail_inclination_rad - profile_cant_rad(rail),
+    rail_mirror = (
+        bool(getattr(case, "rail_profile_mirror_y", False)),
+        bool(getattr(case, "rail_profile_mirror_z", False)),
     )
+    names = {
+        "wheel": {"right": case.wheel_profile, "left": getattr(case, "wheel_profile_left", None) or case.wheel_profile},
+        "rail": {"right": case.rail_profile, "left": getattr(case, "rail_profile_left", None) or case.rail_profile},
+    }
+    stated_cant = getattr(case, "rail_profile_cant_rad", None)
     wheel_irregularities = wheel_irregularities or {}
     rail_irregularities = rail_irregularities or {}
+    wheels, rails, offset = {}, {}, None
+    for side in SIDES:
+        wheel = _load(names["wheel"][side], "wheel", *wheel_mirror)
+        rail = _load(names["rail"][side], "rail", *rail_mirror)
+        wheelset = WheelsetGeometry(
+            wheel, flange_back_distance_m=case.flange_back_distance_m, nominal_radius_m=case.nominal_radius_m,
+            smoothing_wavelength_m=smoothing,
+        )  # fmt: skip
+        cant = stated_cant if stated_cant is not None else float(getattr(rail, "cant_rad", 0.0))
+        track = TrackGeometry(
+            rail, gauge_m=case.gauge_m, gauge_height_m=case.gauge_height_m,
+            rail_inclination_rad=case.rail_inclination_rad - cant, smoothing_wavelength_m=smoothing,
+        )  # fmt: skip
+        wheels[side] = wheelset.wheel_surface(side, wheel_irregularities.get(side, ()))
+        _check_flange_outside(wheelset.curve, getattr(wheel, "name", names["wheel"][side]))
+        rails[side] = track.rail_surface(side, rail_irregularities.get(side, ()))
+        offset = wheelset.tape_circle_offset_m
     return WheelsetTrack(
-        wheels={
-            s: _wheel_with_flange_outside(wheelset.wheel_surface(s, wheel_irregularities.get(s, ())), wheelset.curve)
-            for s in SIDES
-        },
-        rails={s: track.rail_surface(s, rail_irregularities.get(s, ())) for s in SIDES},
+        wheels=wheels,
+        rails=rails,
         nominal_radius_m=case.nominal_radius_m,
-        half_wheel_distance_m=wheelset.tape_circle_offset_m,
+        half_wheel_distance_m=offset,
     )

@@ -16,6 +16,7 @@ Frames and signs (used by every contact model):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,11 +55,21 @@ class UndeformedDistance:
     approach, i.e. ``h(x, y) - approach`` in the notation of the module docstring: negative
     where the undeformed surfaces overlap. x along rolling, y lateral (contact frame), m.
     Points where the local surfaces are not defined (off the profile) hold +inf.
+
+    ``exact``, when given, evaluates the gap at any points of the plane from the surfaces themselves
+    (``exact(x_m, y_m) -> gap``, arrays of one shape); :meth:`evaluate` then uses it instead of interpolating
+    the grid, which only sizes the potential contact area (rigid_dynamics.contact.wheelset_patches).
+    ``potential_area_m`` (x_min, x_max, y_min, y_max), when given, is a rectangle that holds every point with a
+    negative gap (the rigid overlap), hence the whole contact area of quasi-identical elastic bodies (their
+    normal surface displacements under pressure are compressive everywhere): solvers use it as their
+    potential contact area.
     """
 
     x_m: np.ndarray
     y_m: np.ndarray
     distance_m: np.ndarray
+    exact: Callable | None = None
+    potential_area_m: tuple[float, float, float, float] | None = None
 
     def __post_init__(self) -> None:
         nx, ny = len(self.x_m), len(self.y_m)
@@ -68,7 +79,10 @@ class UndeformedDistance:
             )
 
     def evaluate(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-        """Bilinear interpolation of the gap at arbitrary points (+inf outside the grid)."""
+        """The gap at arbitrary points: ``exact`` if given, else bilinear interpolation (+inf outside the grid)."""
+        if self.exact is not None:
+            x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+            return np.asarray(self.exact(x_m, y_m), float).reshape(x_m.shape)
         from scipy.interpolate import RegularGridInterpolator
 
         interp = RegularGridInterpolator((self.y_m, self.x_m), self.distance_m, bounds_error=False, fill_value=np.inf)

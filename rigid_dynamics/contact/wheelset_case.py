@@ -1,48 +1,45 @@
-"""The "wheelset" contact case: a wheelset on two rails at a given lateral shift and yaw, loaded per wheel.
+"""The "wheelset" contact case: one wheelset on two rails at a given lateral shift and yaw (CONTACT's module 1).
 
 This is the set-up of the Manchester Contact Benchmark, case A-2.2 (P. Shackleton, S.D. Iwnicki, Vehicle
-System Dynamics 46 (2008) 129-149): the wheelset is shifted laterally by ``lateral_shift_m`` (towards main +y,
-the right rail) and yawed by ``yaw_rad`` (psi of eq 1: positive turns the wheelset's heading towards +y), and
-its vertical position z and roll angle theta are found so that each wheel carries ``wheel_load_N``:
+System Dynamics 46 (2008) 129-149) and of the wheel-rail module of the CONTACT program (E.A.H. Vollebregt,
+J.J. Kalker; open source): the wheelset is shifted laterally by ``lateral_shift_m`` (towards main +y, the right
+rail) and yawed by ``yaw_rad`` (psi of eq 1), and its vertical position is found so that each wheel carries
+``wheel_load_N``, the **total vertical contact force** on the wheel, creep forces included:
 
-    sum over the wheel's patches of N_k (-n_z,k) = W       (left and right wheel; n_k rail -> wheel, z down)
+    W = - e_z . sum over the wheel's patches of (F_x e_x + F_y e_y + N n)      (main z down, forces on the wheel)
 
-with the patch forces N_k from Hertz's theory (eq 32-38) for the patch's curvatures A, B and approach q
-(contact search, eq 5-33). The two equations are solved by Newton's method in the two wheel sinks
-(s_L, s_R) with z = z_0 + (s_L + s_R)/2 and theta = theta_0 + (s_R - s_L)/(2 b) (b half the distance of the
-wheels), residuals phi_i = (F_i / W)^(2/3) - 1 in contact (nearly linear in the approach, Hertz: F ~ q^1.5)
-and -gap_i / q_W - 1 out of contact (q_W ~ the Hertz approach at load W), with a finite-difference Jacobian.
+Patches (option ``patches``): ``"contact"`` (default) forms them as CONTACT does, from the vertical gap under the
+wheel's contact locus, joining close interpenetration regions into one patch (A_SEP, D_SEP, D_COMB) with the
+contact plane at the weighted centre (rigid_dynamics.contact.wheelset_patches, where the undeformed distance is
+evaluated exactly at any point; regions are joined only for a model that solves the joined gap itself, ``bem``
+and ``fea``, or any model with ``solves_undeformed_distance = True``: the analytic rungs take each region as its
+own patch); ``"search"`` takes the 3-D search's patches (one per local minimum of the
+normal distance, plane at the deepest point; the geometry the dynamics uses). Every patch is solved by the
+requested model under approach control at the wheelset's pose, so all patches of a wheel share its rigid
+displacement and each model carries the load with its own normal forces (Hertz for the analytic rungs).
 
-Load sharing between the patches (option ``load_sharing``):
+Kinematics (``roll_rad`` of the case):
 
-* ``"hertz"``: each patch is solved with the requested contact model (``registry.get_model``) under force
-  control with its Hertz share N_k of the wheel load (so every model carries the same load per patch). Right
-  for the analytic models, whose normal part IS Hertz.
-* ``"model"`` (the way of the CONTACT program's wheel-rail module, E.A.H. Vollebregt, open source: with the
-  total vertical force prescribed it solves the wheel's patches for a wheelset position and iterates that
-  position by Newton/secant steps until the force is met, its m_wr_brentmeth/m_wr_solvecp modules): the patch
-  forces come from the model itself under approach control. At a pose the search gives every patch's
-  rigid approach q_k (and, for ``bem``, its sampled undeformed distance h_k(x, y) - q_k), so all patches of a
-  wheel share the one rigid displacement of the wheelset; the model's normal problem then gives N_k(pose), and
-  the same two equations above are solved with these N_k. Start: the Hertz equilibrium; then Broyden's method
-  (quasi-Newton, "good" rank-one update; Dennis & Schnabel 1983, sec. 8.1) on (s_L, s_R) starting from the Hertz
-  Jacobian (finite differences at the Hertz equilibrium), each step one normal solve per patch (zero
-  creepage: the normal problem does not depend on the tangential one for quasi-identical materials; with
-  Kalker's difference parameter K != 0 in the model options the real creepages are used), until
-  |F_i / W - 1| < ``force_tolerance`` on both wheels (``model_max_iterations``). The tangential
-  problem is solved once at the end under approach control at the converged pose (so the normal forces are
-  those of the equilibrium). Default (None): ``"model"`` when the model is ``bem`` and some patch is not
-  elliptic or a wheel has several patches, else ``"hertz"``. Elastic interaction between patches of one
-  wheel is neglected (each patch is its own half-space problem), as the patches are solved one by one.
+* ``roll_rad`` None — whole-wheelset equilibrium: z and roll theta are solved so that both wheels carry W
+  (two unknowns, the wheel sinks s_L, s_R: z = z_0 + (s_L + s_R)/2, theta = theta_0 + (s_R - s_L)/(2 b)).
+* ``roll_rad`` given — per wheel, as CONTACT's deck: the roll is prescribed and each wheel's vertical position
+  is solved on its own (one unknown per wheel).
 
-Each patch is solved with the creepages of a freely rolling wheelset (eq 39-49, creepage.py): centre velocity
-(V, 0, 0), yaw psi with zero yaw rate, roll theta, spin rate phi' = V / r0 (option
-``spin_rate = "mean-rolling-radius"``: V over the mean rolling radius of the two wheels' main patches, the choice
-of CONTACT's A-2.2 example input, mbench_a22_right.inp, where the longitudinal creepages of the two wheels are
-equal and opposite).
+Residuals phi_i = (F_i / W)^(2/3) - 1 (nearly linear in the sink: F ~ q^1.5); the first step scales the sink by
+(W / F)^(2/3), then secant (per wheel) or Broyden's method (both wheels), until |F_i / W - 1| <
+``force_tolerance``. The tangential problem is part of every evaluation, since its forces carry part of W.
 
-``approach_m`` instead of ``wheel_load_N`` prescribes the deepest approach on each wheel (approach control);
-every patch is then solved under approach control (``load_sharing`` is "approach").
+Pitch rate: the case's ``pitch_rate_rad_per_s`` (the wheelset's angular velocity about its axle, with CONTACT's
+sign: negative for forward rolling; spin rate phi' = -pitch rate), else option ``spin_rate``:
+``"zero-axle-moment"`` (default; a freely rolling wheelset without traction torque settles where the moments of
+all contact forces about the axle cancel: secant iteration on phi', each step a full equilibrium; a model without
+creep forces, ``hertz``, has no moment and keeps V / r0),
+``"nominal"`` (V / r0) or ``"mean-rolling-radius"`` (V over the mean rolling radius of the wheels' main patches).
+Creepages (eq 39-49, creepage.py) of the wheel's material point on the normal through each patch's reference
+point; centre velocity (V, 0, 0), yaw and roll rates 0; relative to the mean rolling speed of the two bodies as
+Kalker and CONTACT define them (option ``rolling_speed``, see ``_creepage``).
+
+``approach_m`` instead of ``wheel_load_N`` prescribes the largest approach on each wheel (approach control).
 """
 
 from __future__ import annotations
@@ -55,21 +52,78 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigid_dynamics.contact.creepage import wheelset_creepage
-from rigid_dynamics.contact.search import SIDES, SideSearch, WheelsetPose
+from rigid_dynamics.contact.search import SIDES, WheelsetPose
 from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
 DEFAULT_CASE_OPTIONS: dict = {
-    "max_iterations": 40,
+    "max_iterations": 40,  # equilibrium iterations (per wheel, or of the whole wheelset)
     "force_tolerance": 1e-6,  # relative, on each wheel's vertical load
     "approach_tolerance_m": 1e-10,
-    "spin_rate": "nominal",  # "nominal": phi' = V/r0; "mean-rolling-radius": V / mean of the wheels' radii
-    "search": None,  # options passed to search.search_side
+    "spin_rate": "zero-axle-moment",  # without a prescribed pitch rate: "zero-axle-moment", "nominal",
+    # "mean-rolling-radius"
+    "axle_moment_tolerance": 1e-6,  # zero-axle-moment: |M| / (W r0) below this
+    "patches": "contact",  # "contact" (CONTACT's module 1) or "search" (the 3-D search's patches)
+    "patch": None,  # options of wheelset_patches.wheel_patches (angle_separation_rad, distance_*_m, ...)
+    "search": None,  # options passed to search.search_side ("search" patches)
     "model": None,  # options passed to the contact model
-    "load_sharing": None,  # "hertz", "model" or None (auto: "model" for bem on non-elliptic/multi-patch wheels)
-    "model_max_iterations": 20,  # iterations of the "model" load-sharing phase (one normal solve per patch each)
+    "rolling_speed": "mean",  # creepages relative to the bodies' mean rolling speed ("mean", Kalker, CONTACT)
+    # or to the wheelset centre's speed ("centre", eq 41); see _creepage
+    "sides": SIDES,  # per-wheel kinematics: the wheels to solve (CONTACT's A-2.2 deck solves the right one)
 }
-LOAD_SHARING = ("hertz", "model")
+SPIN_RATES = ("zero-axle-moment", "nominal", "mean-rolling-radius")
+PATCH_MODES = ("contact", "search")
+
+
+def case_options(method: str, check_model=None) -> dict:
+    """Declaration (rigid_dynamics.contact.options) of :func:`solve_wheelset_case`'s options for the model
+    ``method``: the case's own, the search's and the patches' nested, and the model's under ``model`` (checked by
+    ``check_model(value, key)`` when given, else against the model's declaration).
+    """
+    from rigid_dynamics.contact.options import Option, declare, validate_options
+    from rigid_dynamics.contact.registry import model_options
+    from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
+    from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS
+
+    def nested(defaults, what):
+        def kind(v):
+            if v is None or isinstance(v, float):
+                return float
+            return tuple if isinstance(v, (tuple, list)) else type(v)
+
+        declared = declare(
+            *(Option(k, kind(v), v, f"{what} option", allow_none=v is None) for k, v in defaults.items())
+        )
+
+        def check(value, key):
+            validate_options(declared, value, what, prefix=f"{key}.")
+
+        return check
+
+    if check_model is None:
+
+        def check_model(value, key):
+            validate_options(model_options(method), value, method, prefix=f"{key}.")
+
+    d = DEFAULT_CASE_OPTIONS
+    return declare(
+        Option("max_iterations", int, d["max_iterations"], "equilibrium iterations", minimum=1),
+        Option("force_tolerance", float, d["force_tolerance"], "relative, on each wheel's vertical load", minimum=0,
+               exclusive_minimum=True),
+        Option("approach_tolerance_m", float, d["approach_tolerance_m"], "m", minimum=0, exclusive_minimum=True),
+        Option("spin_rate", str, d["spin_rate"], "pitch rate without a prescribed one", choices=SPIN_RATES),
+        Option("axle_moment_tolerance", float, d["axle_moment_tolerance"], "|M| / (W r0)", minimum=0,
+               exclusive_minimum=True),
+        Option("patches", str, d["patches"], "how patches are formed", choices=PATCH_MODES),
+        Option("patch", dict, d["patch"], "options of the CONTACT-style patches (A_SEP, D_SEP, D_COMB, ...)",
+               allow_none=True, check=nested(DEFAULT_PATCH_OPTIONS, "patch")),
+        Option("search", dict, d["search"], "contact search options", allow_none=True,
+               check=nested(SEARCH_OPTIONS, "contact search")),
+        Option("model", dict, d["model"], f"options of the contact model {method!r}", allow_none=True,
+               check=check_model),
+        Option("rolling_speed", str, d["rolling_speed"], "creepages relative to", choices=("mean", "centre")),
+        Option("sides", tuple, d["sides"], "per-wheel kinematics: the wheels solved"),
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -77,19 +131,31 @@ class WheelsetCase:
     """A wheelset contact case (the ``[geometry] kind = "wheelset"`` contract of the contact-case files).
 
     Attributes:
-        wheel_profile: built-in profile name or file path (both wheels; the left one is mirrored).
-        rail_profile: built-in profile name or file path (both rails; mirrored on the left).
+        wheel_profile: built-in profile name or file path (the right wheel; also the left one, mirrored, unless
+            ``wheel_profile_left`` is given).
+        rail_profile: built-in profile name or file path (the right rail; also the left, mirrored).
         lateral_shift_m: wheelset lateral displacement towards main +y (the right rail), m.
         yaw_rad: psi (eq 1), rad.
         gauge_m: track gauge (distance between the gauge faces at gauge_height_m below the rail tops), m.
         gauge_height_m: depth below the top of the rail where the gauge is measured, m (14 mm in EN 13848-1).
         flange_back_distance_m: distance between the two wheels' inner (back) faces, m.
         nominal_radius_m: r0, wheel radius at the tape circle, m.
-        rail_inclination_rad: cant of the rails towards the track centre, rad (1:40 -> atan(1/40)). Set 0 when
-            the rail profile is already canted (MBench_UIC60_v3.prr): it is applied to the profile as read.
+        rail_inclination_rad: cant of the rails in the track towards the track centre, rad (1:40 -> atan(1/40));
+            only its difference to the profile's own cant (``rail_profile_cant_rad``) is applied to the points.
         wheel_load_N: vertical load per wheel, N (force control), or None.
         approach_m: deepest approach per wheel, m (approach control), or None. Exactly one of the two.
         rolling_speed_m_per_s: V, forward speed of the wheelset, m/s.
+        roll_rad: prescribed roll angle theta (per-wheel kinematics, module docstring), rad; None: solved.
+        pitch_rate_rad_per_s: prescribed angular velocity of the wheelset about its axle, rad/s, with CONTACT's
+            sign (forward rolling is negative; phi' = -pitch rate); None: option ``spin_rate``.
+        wheel_profile_left, rail_profile_left: the left wheel's and rail's profiles when they differ from the
+            right ones (None: the right ones, mirrored).
+        rail_profile_cant_rad: cant already contained in the rail profile's points, rad; None: the profile's own
+            (built-in profiles know theirs, e.g. MBench_UIC60_v3 1:40; a file has 0 unless stated here).
+        profile_smoothing_m: smoothing wavelength L_filt of the profile splines, m (default 2 mm; 0 interpolates).
+        wheel_profile_mirror_y, wheel_profile_mirror_z, rail_profile_mirror_y, rail_profile_mirror_z: turn a
+            profile file of another orientation into the internal one (y towards the field side, z down), as
+            CONTACT's MIRRORY / MIRRORZ.
     """
 
     wheel_profile: str
@@ -104,6 +170,16 @@ class WheelsetCase:
     wheel_load_N: float | None = None
     approach_m: float | None = None
     rolling_speed_m_per_s: float = 1.0
+    roll_rad: float | None = None
+    pitch_rate_rad_per_s: float | None = None
+    wheel_profile_left: str | None = None
+    rail_profile_left: str | None = None
+    rail_profile_cant_rad: float | None = None
+    profile_smoothing_m: float = 0.002
+    wheel_profile_mirror_y: bool = False
+    wheel_profile_mirror_z: bool = False
+    rail_profile_mirror_y: bool = False
+    rail_profile_mirror_z: bool = False
 
     def __post_init__(self) -> None:
         for name in ("wheel_profile", "rail_profile"):
@@ -142,6 +218,51 @@ class WheelsetCase:
             raise ValueError(
                 f"wheel_load_N = {self.wheel_load_N!r}, approach_m = {self.approach_m!r}: expected exactly one of them"
             )
+        for name in ("wheel_profile_left", "rail_profile_left"):
+            value = getattr(self, name)
+            if value is not None and (not isinstance(value, str) or not value):
+                raise ValueError(f"{name} = {value!r}: expected None, a built-in profile name or a file path")
+        for name in (
+            "wheel_profile_mirror_y",
+            "wheel_profile_mirror_z",
+            "rail_profile_mirror_y",
+            "rail_profile_mirror_z",
+        ):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name} = {getattr(self, name)!r}: expected true or false")
+        value = self.rail_profile_cant_rad
+        if value is not None and (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or abs(value) >= 0.2
+        ):
+            raise ValueError(f"rail_profile_cant_rad = {value!r}: expected None or an angle with |angle| < 0.2 rad")
+        value = self.profile_smoothing_m
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or not 0 <= value <= 0.05
+        ):
+            raise ValueError(f"profile_smoothing_m = {value!r}: expected a length in [0, 0.05] m")
+        if self.roll_rad is not None and (
+            isinstance(self.roll_rad, bool)
+            or not isinstance(self.roll_rad, (int, float))
+            or not math.isfinite(self.roll_rad)
+            or abs(self.roll_rad) > 0.1
+        ):
+            raise ValueError(f"roll_rad = {self.roll_rad!r}: expected None or a finite number with |roll| <= 0.1 rad")
+        value = self.pitch_rate_rad_per_s
+        if value is not None:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f"pitch_rate_rad_per_s = {value!r}: expected None or a finite number")
+            free = self.rolling_speed_m_per_s / self.nominal_radius_m
+            if not -2.0 * free < value < -0.5 * free:
+                raise ValueError(
+                    f"pitch_rate_rad_per_s = {value!r}: expected forward rolling, between {-2 * free:.6g} and "
+                    f"{-0.5 * free:.6g} rad/s (-V/r0 = {-free:.6g}; CONTACT's sign: negative forward)"
+                )
         for name in ("wheel_load_N", "approach_m"):
             value = getattr(self, name)
             if value is not None and (not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0):
@@ -150,17 +271,37 @@ class WheelsetCase:
 
 @dataclass(frozen=True, eq=False)
 class PatchSolution:
-    """One solved patch: its side, geometry, creepages and the contact model's result."""
+    """One solved patch: its side, geometry, creepages and the contact model's result.
+
+    Attributes:
+        side: "left" or "right".
+        geometry: the patch geometry (reference point, contact frame, undeformed distance).
+        creepage: creepages at the reference point.
+        result: the model's result (forces on the wheel in the contact frame).
+        combination: "single", "combined" or "blended" (several interpenetration regions in one patch;
+            wheelset_patches), "search" (a search patch).
+        deepest_point_rail_m: (y, z) in rail-profile coordinates of the largest vertical interpenetration, m
+            (the reference point is ``geometry.contact_point_rail_m``).
+    """
 
     side: str
     geometry: ContactGeometry
     creepage: Creepage
     result: ContactResult
+    combination: str = "single"
+    deepest_point_rail_m: tuple[float, float] = (math.nan, math.nan)
+
+    @property
+    def force_main_N(self) -> np.ndarray:
+        """Contact force on the wheel in the main (track) frame, N, shape (3,)."""
+        r = self.result
+        local = np.array([r.creep_force_long_N, r.creep_force_lat_N, r.normal_force_N], float)
+        return self.geometry.frame @ local
 
     @property
     def vertical_force_N(self) -> float:
-        """Upward load carried by this patch, N (normal force times -n_z; main z points down)."""
-        return float(self.result.normal_force_N * -self.geometry.frame[2, 2])
+        """Upward load carried by this patch, creep forces included, N (main z points down)."""
+        return float(-self.force_main_N[2])
 
 
 @dataclass(frozen=True, eq=False)
@@ -171,18 +312,20 @@ class WheelsetCaseSolution:
         success, status, message: status "ok", "not-converged" (equilibrium iteration), "no-contact",
             "search-failed" or "model-failed" (a patch's model did not succeed; see its result).
         wall_time_s: s.
-        vertical_position_m: z of the wheelset centre (main frame, z down), m.
+        vertical_position_m: z of the wheelset centre (main frame, z down), m; per-wheel kinematics: the mean of
+            the two wheels' (see ``wheel_vertical_position_m``).
         roll_rad: theta, rad.
-        patches: all patches, left first, deepest first per side.
-        wheel_vertical_load_N: {"left": ..., "right": ...} vertical load carried at the equilibrium, N: sum of
-            N_k (-n_z,k) with Hertz's N_k ("hertz" sharing) or the model's ("model" sharing, approach control).
-        iterations: equilibrium iterations in all (rigid contact + Hertz + model phase).
-        load_sharing: "hertz", "model" or "approach" (approach-controlled case).
-        model_iterations: iterations of the model phase ("model" sharing; 0 otherwise), each one normal solve
-            per patch.
-        equilibrium_residual: max over the wheels of |vertical load / wheel_load_N - 1| at the final pose (with
-            the forces of the chosen sharing); nan for approach-controlled cases.
-        pose: the final :class:`WheelsetPose`.
+        patches: all patches, left first, along the axle per side.
+        wheel_vertical_load_N: side -> total vertical contact force on the wheel, creep forces included, N.
+        wheel_force_N: side -> total contact force on the wheel in the main frame (x, y, z; z down), N.
+        wheel_vertical_position_m: side -> z of the wheelset centre at which that wheel is in equilibrium, m.
+        iterations: equilibrium iterations in all (model evaluations of the wheels).
+        kinematics: "equilibrium" (z and roll solved) or "per-wheel" (roll prescribed).
+        spin_rate_rad_per_s: phi' used, rad/s. spin_rate_mode: "prescribed" or the ``spin_rate`` option.
+        axle_moment_Nm: moment of all contact forces on the wheelset about its axle (y_d), N m.
+        equilibrium_residual: max over the wheels of |vertical load / wheel_load_N - 1|; nan under approach control.
+        pose: the final :class:`WheelsetPose` (per-wheel kinematics: the last solved wheel's).
+        Per-wheel kinematics with option ``sides`` solves only those wheels: the dicts hold only them.
     """
 
     success: bool
@@ -194,30 +337,459 @@ class WheelsetCaseSolution:
     patches: list[PatchSolution]
     wheel_vertical_load_N: dict
     iterations: int
-    load_sharing: str = "hertz"
-    model_iterations: int = 0
+    kinematics: str = "equilibrium"
+    spin_rate_rad_per_s: float = math.nan
+    spin_rate_mode: str = "prescribed"
+    axle_moment_Nm: float = math.nan
     equilibrium_residual: float = math.nan
+    wheel_force_N: dict = field(default_factory=dict)
+    wheel_vertical_position_m: dict = field(default_factory=dict)
     pose: WheelsetPose | None = None
     extra: dict = field(default_factory=dict)
 
 
-def _hertz_loads(searches: dict[str, SideSearch], material: Material):
-    from rigid_dynamics.contact.hertz import hertz_force_from_approach
+@dataclass(frozen=True, eq=False)
+class _WheelState:
+    """One wheel evaluated at one pose: its solved patches and sums."""
 
-    loads, forces = {}, {}
-    for side, result in searches.items():
-        if not result.patches:
-            loads[side], forces[side] = 0.0, np.zeros(0)
-            continue
-        a = np.array([p.curvature_long_1_per_m for p in result.patches])
-        b = np.array([p.curvature_lat_1_per_m for p in result.patches])
-        q = np.array([p.approach_m for p in result.patches])
-        f = hertz_force_from_approach(
-            a, b, q, shear_modulus_Pa=material.shear_modulus_Pa, poisson_ratio=material.poisson_ratio
-        )
-        up = np.array([-p.frame[2, 2] for p in result.patches])
-        loads[side], forces[side] = float(np.sum(f * up)), f
-    return loads, forces
+    side: str
+    pose: WheelsetPose
+    patches: list[PatchSolution]
+    min_gap_m: float
+    vertical_load_N: float
+    force_N: np.ndarray
+    axle_moment_Nm: float
+    max_approach_m: float
+    failed: list[str]
+
+
+def _creepage(
+    case: WheelsetCase, pose: WheelsetPose, point_m, normal, omega_spin: float, rolling_speed: str = "mean"
+) -> Creepage:
+    """Creepages of the wheel's material point ``point_m`` (main frame) with the patch normal (eq 39-49).
+
+    ``rolling_speed = "centre"``: divided by V = |v_p| of the wheelset centre (eq 41). ``"mean"`` (Kalker's and
+    CONTACT's definition): divided by the mean of the two bodies' rolling speeds through the contact, the rail's V
+    and the wheel's V (1 - xi), i.e. V (2 - xi)/2 with xi the eq-41 creepage; the slip velocities are the same,
+    the creepages differ by the factor 2 / (2 - xi) (1.2 % at a flange contact that rolls 2.4 % faster than r0).
+    """
+    x_d = pose.rotation.T @ (np.asarray(point_m, float) - pose.centre_m)
+    kin = wheelset_creepage(
+        x_d,
+        normal,
+        yaw_rad=case.yaw_rad,
+        roll_rad=pose.roll_rad,
+        centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
+        spin_rate_rad_per_s=omega_spin,
+    )
+    creepage = kin.creepage()
+    if rolling_speed == "centre":
+        return creepage
+    factor = 2.0 / (2.0 - creepage.longitudinal)
+    return Creepage(
+        longitudinal=creepage.longitudinal * factor,
+        lateral=creepage.lateral * factor,
+        spin_1_per_m=creepage.spin_1_per_m * factor,
+        rolling_speed_m_per_s=creepage.rolling_speed_m_per_s / factor,
+    )
+
+
+FIELD_MODELS = ("bem", "fea")
+"""Models that solve the sampled undeformed distance itself (joined patches are theirs; module docstring)."""
+
+
+def _solves_undeformed_distance(model) -> bool:
+    return bool(getattr(model, "solves_undeformed_distance", getattr(model, "name", "") in FIELD_MODELS))
+
+
+class _Evaluator:
+    """Patches, model solutions and sums of one wheel at a pose (counting the evaluations)."""
+
+    def __init__(self, case, material, model, track, opts):
+        self.case, self.material, self.model, self.track, self.opts = case, material, model, track, opts
+        self.count = 0
+
+    def geometry(self, pose: WheelsetPose, side: str):
+        """(list of (geometry, combination, deepest rail point)), smallest gap (vertical or normal), m."""
+        track, opts = self.track, self.opts
+        if opts["patches"] == "search":
+            search_options = dict(opts["search"] or {})
+            result = track.search(pose, side, search_options)
+            return [(g, "search", g.contact_point_rail_m, g.point_m) for g in result.patches], result.min_gap_m
+        from rigid_dynamics.contact.wheelset_patches import wheel_patches
+
+        wheel, rail = track.fast[side]
+        patch_options = dict(opts["patch"] or {})
+        if not _solves_undeformed_distance(self.model):
+            # regions are joined only for a model that solves the joined gap (bem, fea); the analytic rungs take
+            # each interpenetration region as its own patch (a joined patch is no ellipse)
+            patch_options["distance_separation_m"] = 0.0
+        patches, locus = wheel_patches(
+            wheel, rail, pose, side, wheel_lateral_range_m=wheel.y_range_m, rail_lateral_range_m=rail.y_range_m,
+            nominal_radius_m=track.nominal_radius_m, options=patch_options,
+        )  # fmt: skip
+        finite = locus.gap_m[np.isfinite(locus.gap_m)]
+        min_gap = float(finite.min()) if finite.size else math.inf
+        return [(p.geometry, p.combination, p.deepest_point_rail_m, p.wheel_point_m) for p in patches], min_gap
+
+    def min_gap(self, pose: WheelsetPose, side: str) -> float:
+        """Smallest gap of one wheel (vertical, from the contact locus; the search's normal gap for "search")."""
+        if self.opts["patches"] == "search":
+            return self.geometry(pose, side)[1]
+        from rigid_dynamics.contact.search import _SideGeometry
+        from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS, contact_locus
+
+        wheel, rail = self.track.fast[side]
+        geo = _SideGeometry(wheel, rail, pose, side, wheel.y_range_m, rail.y_range_m)
+        step = (self.opts["patch"] or {}).get("locus_step_m", DEFAULT_PATCH_OPTIONS["locus_step_m"])
+        gap = contact_locus(geo, step).gap_m
+        finite = gap[np.isfinite(gap)]
+        return float(finite.min()) if finite.size else math.inf
+
+    def wheel(self, pose: WheelsetPose, side: str, omega: float) -> _WheelState:
+        self.count += 1
+        geometries, min_gap = self.geometry(pose, side)
+        patches, failed = [], []
+        for k, (geometry, how, deepest, material_point) in enumerate(geometries):
+            creepage = _creepage(
+                self.case, pose, material_point, geometry.frame[:, 2], omega, self.opts["rolling_speed"]
+            )
+            result = self.model.solve(
+                geometry, creepage, self.material, normal_force_N=None, options=self.opts["model"]
+            )
+            if not result.success:
+                failed.append(f"{side} patch {k}: {result.message}")
+            patches.append(PatchSolution(side, geometry, creepage, result, how, tuple(deepest)))
+        force = np.zeros(3)
+        moment = 0.0
+        axle = pose.rotation[:, 1]
+        for p in patches:
+            f = p.force_main_N if math.isfinite(p.result.normal_force_N) else np.zeros(3)
+            force += f
+            moment += float(np.cross(p.geometry.point_m - pose.centre_m, f) @ axle)
+        approach = max((p.geometry.approach_m for p in patches), default=-min_gap)
+        return _WheelState(side, pose, patches, min_gap, float(-force[2]), force, moment, approach, failed)
+
+
+def _phi(state: _WheelState, target: float) -> float:
+    return (max(state.vertical_load_N, 0.0) / target) ** (2.0 / 3.0) - 1.0
+
+
+def _solve_one_wheel(evaluator: _Evaluator, pose_of, side: str, omega: float, q_ref: float, start, opts):
+    """Per-wheel kinematics: the sink s of one wheel (pose_of(s)) carrying the load (or the approach)."""
+    case = evaluator.case
+    target = case.wheel_load_N
+    tolerance = opts["force_tolerance"]
+    # rigid touch: the smallest gap moves one-to-one with the vertical position (exact for the vertical gap)
+    if start is None:
+        s = 0.0
+        for _ in range(6):
+            gap = evaluator.min_gap(pose_of(s), side)
+            if not math.isfinite(gap):
+                return None, 0, "search-failed"
+            s += gap
+            if abs(gap) < 1e-12:
+                break
+        s_touch = s
+        s = s_touch + (q_ref if target is not None else case.approach_m)
+    else:
+        s_touch, s = start
+    previous = low = high = None
+    state = None
+    for iteration in range(1, opts["max_iterations"] + 1):
+        state = evaluator.wheel(pose_of(s), side, omega)
+        if state.failed:
+            return (state, (s_touch, s)), iteration, "model-failed"
+        if target is not None:
+            if not state.patches:
+                r = -state.min_gap_m / q_ref - 1.0
+                done = False
+            else:
+                r = _phi(state, target)
+                done = abs(state.vertical_load_N / target - 1.0) < tolerance
+        else:
+            r = state.max_approach_m / case.approach_m - 1.0 if state.patches else -state.min_gap_m / q_ref - 1.0
+            done = state.patches and abs(state.max_approach_m - case.approach_m) < opts["approach_tolerance_m"]
+        if done:
+            return (state, (s_touch, s)), iteration, "ok"
+        # bracket of the root (phi rises with the sink): safeguarded secant (bisection when it leaves the bracket)
+        if r < 0:
+            low = (s, r) if low is None or s > low[0] else low
+        else:
+            high = (s, r) if high is None or s < high[0] else high
+        if previous is None or previous[1] == r:
+            # phi ~ (s - s_touch)/(s* - s_touch) - 1 for a Hertzian wheel: scale the sink below the touch
+            step = -r * max(s - s_touch, 0.2 * q_ref)
+        else:
+            step = -r * (s - previous[0]) / (r - previous[1])
+        previous = (s, r)
+        step = float(np.clip(step, -5.0 * q_ref, 5.0 * q_ref))
+        new = s + step
+        if low is not None and high is not None and not low[0] < new < high[0]:
+            new = 0.5 * (low[0] + high[0])
+        step, s = new - s, new
+        if abs(step) < 1e-15:
+            return (state, (s_touch, s)), iteration, "ok" if target is None else "not-converged"
+    return (state, (s_touch, s)), opts["max_iterations"], "not-converged"
+
+
+def _spin_rate_estimate(case: WheelsetCase, states, mode: str) -> float:
+    if mode != "mean-rolling-radius" or not states:
+        return case.rolling_speed_m_per_s / case.nominal_radius_m
+    radii = []
+    for state in states:
+        if state.patches:
+            main = max(state.patches, key=lambda p: p.result.normal_force_N)
+            radii.append(main.geometry.rolling_radius_m)
+    radius = float(np.mean(radii)) if radii else case.nominal_radius_m
+    return case.rolling_speed_m_per_s / radius
+
+
+def solve_wheelset_case(
+    case: WheelsetCase,
+    material: Material,
+    model="hertz",
+    options: Mapping | None = None,
+    *,
+    track=None,
+) -> WheelsetCaseSolution:
+    """Find the wheelset's vertical position (and roll) carrying the load and solve every patch (module docstring).
+
+    Args:
+        case: the case.
+        material: elastic constants and friction of the pair.
+        model: contact model name (registry) or instance; it gives the forces of the equilibrium too.
+        options: ``DEFAULT_CASE_OPTIONS`` keys.
+        track: optional pre-built :class:`~rigid_dynamics.contact.track.WheelsetTrack` (else built from the case).
+
+    Returns:
+        :class:`WheelsetCaseSolution` (never raises for non-convergence: ``success`` False, status
+        "not-converged", "search-failed" or "model-failed").
+
+    Raises:
+        ValueError: bad case, option or model name; unreadable profile.
+    """
+    from rigid_dynamics.contact.registry import get_model
+    from rigid_dynamics.contact.track import build_track
+
+    started = time.perf_counter()
+    opts = dict(DEFAULT_CASE_OPTIONS)
+    for key, value in (options or {}).items():
+        if key not in DEFAULT_CASE_OPTIONS:
+            raise ValueError(f"wheelset case option {key!r}: expected one of {', '.join(DEFAULT_CASE_OPTIONS)}")
+        opts[key] = value
+    if opts["spin_rate"] not in SPIN_RATES:
+        raise ValueError(f"spin_rate = {opts['spin_rate']!r}: expected one of {', '.join(map(repr, SPIN_RATES))}")
+    if opts["rolling_speed"] not in ("mean", "centre"):
+        raise ValueError(f"rolling_speed = {opts['rolling_speed']!r}: expected 'mean' or 'centre'")
+    if opts["patches"] not in PATCH_MODES:
+        raise ValueError(f"patches = {opts['patches']!r}: expected one of {', '.join(map(repr, PATCH_MODES))}")
+    for name in ("max_iterations",):
+        value = opts[name]
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ValueError(f"{name} = {value!r}: expected an integer >= 1")
+    for name in ("force_tolerance", "approach_tolerance_m", "axle_moment_tolerance"):
+        value = opts[name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+    sides = tuple(opts["sides"]) if isinstance(opts["sides"], (tuple, list)) else (opts["sides"],)
+    if not sides or any(side not in SIDES for side in sides) or len(set(sides)) != len(sides):
+        raise ValueError(f"sides = {opts['sides']!r}: expected a non-empty selection of 'left', 'right'")
+    if case.roll_rad is None and len(sides) != 2:
+        raise ValueError(f"sides = {opts['sides']!r}: the whole-wheelset equilibrium (roll_rad None) needs both wheels")
+    contact_model = get_model(model)
+    if track is None:
+        track = build_track(case)
+    if opts["patches"] == "contact" and opts["patch"]:
+        from rigid_dynamics.contact.wheelset_patches import DEFAULT_PATCH_OPTIONS
+
+        for key in opts["patch"]:
+            if key not in DEFAULT_PATCH_OPTIONS:
+                raise ValueError(f"patch option {key!r}: expected one of {', '.join(DEFAULT_PATCH_OPTIONS)}")
+    evaluator = _Evaluator(case, material, contact_model, track, opts)
+    q_ref = track.reference_approach_m(case, material)
+    per_wheel = case.roll_rad is not None
+
+    def solve_pose(omega, warm):
+        """Equilibrium at spin rate omega: (states per side, warm-start data, iterations, status)."""
+        if per_wheel:
+            states, starts, total, status = {}, {}, 0, "ok"
+            for side in sides:
+
+                def pose_of(s):
+                    return WheelsetPose(
+                        y_m=case.lateral_shift_m, z_m=track.rest_z_m + s, yaw_rad=case.yaw_rad, roll_rad=case.roll_rad
+                    )
+
+                out, its, st = _solve_one_wheel(evaluator, pose_of, side, omega, q_ref, (warm or {}).get(side), opts)
+                total += its
+                if out is None:
+                    return None, None, total, st
+                states[side], starts[side] = out
+                if st != "ok" and status == "ok":
+                    status = st
+            return states, starts, total, status
+        return _solve_whole(evaluator, track, case, omega, q_ref, warm, opts)
+
+    mode = "prescribed" if case.pitch_rate_rad_per_s is not None else opts["spin_rate"]
+    if mode == "prescribed":
+        omega = -float(case.pitch_rate_rad_per_s)
+    else:
+        omega = case.rolling_speed_m_per_s / case.nominal_radius_m
+    states, warm, iterations, status = solve_pose(omega, None)
+    if states is not None and status == "ok" and mode == "mean-rolling-radius":
+        omega = _spin_rate_estimate(case, list(states.values()), mode)
+        states, warm, its, status = solve_pose(omega, warm)
+        iterations += its
+    elif states is not None and status == "ok" and mode == "zero-axle-moment":
+        scale = case.rolling_speed_m_per_s * (case.wheel_load_N or 1.0e4) * case.nominal_radius_m
+        previous = None
+        for _ in range(12):
+            creep = [p.result.creep_force_long_N for st in states.values() for p in st.patches]
+            if not any(c != 0.0 for c in creep):
+                break  # no creep forces (hertz): the pitch rate changes nothing; V / r0 is kept
+            moment = sum(s.axle_moment_Nm for s in states.values())
+            if abs(moment) <= opts["axle_moment_tolerance"] * scale / case.rolling_speed_m_per_s:
+                break
+            if previous is None or previous[1] == moment:
+                new_omega = omega * (1.0 + 1e-4)
+            else:
+                new_omega = omega - moment * (omega - previous[0]) / (moment - previous[1])
+            previous = (omega, moment)
+            omega = float(np.clip(new_omega, 0.9 * omega, 1.1 * omega))
+            states, warm, its, status = solve_pose(omega, warm)
+            iterations += its
+            if states is None or status != "ok":
+                break
+        else:
+            status = "not-converged"
+
+    messages = {
+        "ok": "equilibrium found",
+        "search-failed": "the wheel misses its rail (no finite gap on one side)",
+        "not-converged": "equilibrium iteration did not converge",
+        "model-failed": "a patch's model failed",
+    }
+    if states is None:
+        return WheelsetCaseSolution(
+            False, status, messages.get(status, status), time.perf_counter() - started, math.nan, math.nan, [], {},
+            iterations, "per-wheel" if per_wheel else "equilibrium", omega, mode,
+        )  # fmt: skip
+    patches = [p for side in sides for p in states[side].patches]
+    failed = [f for side in sides for f in states[side].failed]
+    message = messages.get(status, status)
+    if failed:
+        status, message = "model-failed", "; ".join(failed)
+    elif status == "ok" and not patches:
+        status, message = "no-contact", "no patch found"
+    elif status == "ok":
+        message = f"equilibrium found in {iterations} wheel evaluations"
+    target = case.wheel_load_N
+    loads = {side: states[side].vertical_load_N for side in sides}
+    residual = max(abs(loads[side] / target - 1.0) for side in sides) if target is not None else math.nan
+    z = {side: states[side].pose.z_m for side in sides}
+    pose = states[sides[-1]].pose
+    return WheelsetCaseSolution(
+        success=status == "ok",
+        status=status,
+        message=message,
+        wall_time_s=time.perf_counter() - started,
+        vertical_position_m=float(np.mean(list(z.values()))),
+        roll_rad=pose.roll_rad,
+        patches=patches,
+        wheel_vertical_load_N=loads,
+        iterations=iterations,
+        kinematics="per-wheel" if per_wheel else "equilibrium",
+        spin_rate_rad_per_s=float(omega),
+        spin_rate_mode=mode,
+        axle_moment_Nm=float(sum(s.axle_moment_Nm for s in states.values())),
+        equilibrium_residual=float(residual),
+        wheel_force_N={side: states[side].force_N.copy() for side in sides},
+        wheel_vertical_position_m=z,
+        pose=pose,
+    )
+
+
+def _solve_whole(evaluator, track, case, omega, q_ref, warm, opts):
+    """Whole-wheelset equilibrium: sinks (s_L, s_R) so that both wheels carry the load (Broyden's method)."""
+    target = case.wheel_load_N
+
+    def pose_of(sinks):
+        return _pose(track, case.lateral_shift_m, case.yaw_rad, sinks)
+
+    iterations = 0
+    if warm is None:
+        # rigid touch of both wheels (smallest gap 0 per side): Newton with a finite-difference Jacobian
+
+        def gaps(sinks):
+            return np.array([evaluator.min_gap(pose_of(sinks), side) for side in SIDES])
+
+        sinks = np.zeros(2)
+        for _ in range(opts["max_iterations"]):
+            g = gaps(sinks)
+            if not np.all(np.isfinite(g)):
+                return None, None, iterations, "search-failed"
+            if np.all(np.abs(g) < 1e-11):
+                break
+            jac = np.zeros((2, 2))
+            for j in range(2):
+                ds = np.zeros(2)
+                ds[j] = 1e-6
+                jac[:, j] = (gaps(sinks + ds) - g) / 1e-6
+            try:
+                delta = np.linalg.solve(jac, -g)
+            except np.linalg.LinAlgError:
+                return None, None, iterations, "not-converged"
+            sinks = sinks + np.clip(delta, -2e-3, 2e-3)
+        touch = sinks.copy()
+        depth = q_ref if target is not None else case.approach_m
+        sinks = touch + depth
+        jac = np.eye(2) / depth
+    else:
+        touch, sinks, jac = warm
+
+    def residual(states):
+        out = np.zeros(2)
+        for i, side in enumerate(SIDES):
+            st = states[side]
+            if not st.patches:
+                out[i] = -st.min_gap_m / q_ref - 1.0
+            elif target is not None:
+                out[i] = _phi(st, target)
+            else:
+                out[i] = st.max_approach_m / case.approach_m - 1.0
+        return out
+
+    def done(states):
+        if not all(states[side].patches for side in SIDES):
+            return False
+        if target is not None:
+            return all(abs(states[s].vertical_load_N / target - 1.0) < opts["force_tolerance"] for s in SIDES)
+        return all(abs(states[s].max_approach_m - case.approach_m) < opts["approach_tolerance_m"] for s in SIDES)
+
+    previous = None
+    states = None
+    for _ in range(opts["max_iterations"]):
+        pose = pose_of(sinks)
+        states = {side: evaluator.wheel(pose, side, omega) for side in SIDES}
+        iterations += 2
+        if any(states[s].failed for s in SIDES):
+            return states, (touch, sinks, jac), iterations, "model-failed"
+        r = residual(states)
+        if done(states):
+            return states, (touch, sinks, jac), iterations, "ok"
+        if previous is not None:
+            d_s, d_r = sinks - previous[0], r - previous[1]
+            denom = float(d_s @ d_s)
+            if denom > 0:
+                jac = jac + np.outer(d_r - jac @ d_s, d_s) / denom
+        try:
+            delta = np.linalg.solve(jac, -r)
+        except np.linalg.LinAlgError:
+            delta = -r * q_ref
+        previous = (sinks.copy(), r)
+        sinks = sinks + np.clip(np.nan_to_num(delta), -5.0 * q_ref, 5.0 * q_ref)
+    return states, (touch, sinks, jac), iterations, "not-converged"
 
 
 def _pose(track, lateral_shift_m: float, yaw_rad: float, sinks) -> WheelsetPose:
@@ -314,274 +886,3 @@ def rigid_contact(
         x_d = np.array([r * math.cos(alpha), y_d, r * math.sin(alpha)])
         point[side] = pose.rotation @ x_d + pose.centre_m
     return RigidContact(status == "ok", status, pose, gap, radius, point, iterations)
-
-
-def _model_is_bem(contact_model) -> bool:
-    return getattr(contact_model, "name", "") == "bem"
-
-
-def _vertical_loads(searches: dict[str, SideSearch], forces: dict[str, np.ndarray]) -> dict[str, float]:
-    """Per side: sum over its patches of N_k (-n_z,k), N (main z points down, n_k from the rail into the wheel)."""
-    return {
-        side: float(sum(f * -p.frame[2, 2] for f, p in zip(forces[side], searches[side].patches, strict=True)))
-        for side in SIDES
-    }
-
-
-def _spin_rate(case: WheelsetCase, searches: dict[str, SideSearch], forces, spin_rate: str) -> float:
-    """Spin rate phi' (rad/s): V/r0 ("nominal") or V over the mean rolling radius of each wheel's most loaded patch."""
-    if spin_rate == "nominal":
-        return case.rolling_speed_m_per_s / case.nominal_radius_m
-    radii = []
-    for side in SIDES:
-        if searches[side].patches:
-            k = int(np.argmax(forces[side])) if len(forces[side]) else 0
-            radii.append(searches[side].patches[k].rolling_radius_m)
-    mean_radius = float(np.mean(radii)) if radii else case.nominal_radius_m
-    return case.rolling_speed_m_per_s / mean_radius
-
-
-def _creepage(case: WheelsetCase, pose: WheelsetPose, geometry: ContactGeometry, omega_spin: float) -> Creepage:
-    """Creepages of the freely rolling wheelset at the patch (eq 39-49, creepage.py)."""
-    x_d = pose.rotation.T @ (geometry.point_m - pose.centre_m)
-    kin = wheelset_creepage(
-        x_d,
-        geometry.frame[:, 2],
-        yaw_rad=case.yaw_rad,
-        roll_rad=pose.roll_rad,
-        centre_velocity_m_per_s=[case.rolling_speed_m_per_s, 0.0, 0.0],
-        spin_rate_rad_per_s=omega_spin,
-    )
-    return kin.creepage()
-
-
-def _load_residual(searches, loads, target, q_ref) -> np.ndarray:
-    """phi_i = (F_i/W)^(2/3) - 1 on a wheel in contact, -gap_i/q_W - 1 on a wheel without a patch."""
-    out = np.zeros(2)
-    for i, side in enumerate(SIDES):
-        if searches[side].patches:
-            out[i] = (max(loads[side], 0.0) / target) ** (2.0 / 3.0) - 1.0
-        else:
-            out[i] = -searches[side].min_gap_m / q_ref - 1.0
-    return out
-
-
-def solve_wheelset_case(
-    case: WheelsetCase,
-    material: Material,
-    model="hertz",
-    options: Mapping | None = None,
-    *,
-    track=None,
-) -> WheelsetCaseSolution:
-    """Find the wheelset's vertical position and roll carrying the load, then solve every patch.
-
-    Args:
-        case: the case.
-        material: elastic constants and friction of the pair.
-        model: contact model name (registry) or instance, used for the final patch solutions (and for the
-            normal forces of the equilibrium with ``load_sharing = "model"``, module docstring).
-        options: ``DEFAULT_CASE_OPTIONS`` keys; ``load_sharing`` "hertz", "model" or None (automatic).
-        track: optional pre-built :class:`~rigid_dynamics.contact.track.WheelsetTrack` (else built from the case).
-
-    Returns:
-        :class:`WheelsetCaseSolution` (never raises for non-convergence: ``success`` False, status
-        "not-converged", "search-failed" or "model-failed").
-
-    Raises:
-        ValueError: bad case, option or model name; unreadable profile.
-    """
-    from rigid_dynamics.contact.registry import get_model
-    from rigid_dynamics.contact.track import build_track
-
-    started = time.perf_counter()
-    opts = dict(DEFAULT_CASE_OPTIONS)
-    for key, value in (options or {}).items():
-        if key not in DEFAULT_CASE_OPTIONS:
-            raise ValueError(f"wheelset case option {key!r}: expected one of {', '.join(DEFAULT_CASE_OPTIONS)}")
-        opts[key] = value
-    if opts["spin_rate"] not in ("nominal", "mean-rolling-radius"):
-        raise ValueError(f"spin_rate = {opts['spin_rate']!r}: expected 'nominal' or 'mean-rolling-radius'")
-    value = opts["model_max_iterations"]
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise ValueError(f"model_max_iterations = {value!r}: expected an integer >= 1")
-    if opts["load_sharing"] is not None and opts["load_sharing"] not in LOAD_SHARING:
-        raise ValueError(f"load_sharing = {opts['load_sharing']!r}: expected 'hertz', 'model' or None (automatic)")
-    contact_model = get_model(model)
-    if track is None:
-        track = build_track(case)
-    search_options = dict(opts["search"] or {})
-    search_options.setdefault("field", False)
-    field_sampling = bool((opts["search"] or {}).get("field", True))
-
-    def run(sinks, field_sampling=False):
-        so = dict(search_options, field=field_sampling)
-        return _search_both(track, case.lateral_shift_m, case.yaw_rad, sinks, so)
-
-    q_ref = track.reference_approach_m(case, material)
-    target = case.wheel_load_N
-
-    def residual(searches):
-        if target is not None:
-            return _load_residual(searches, _hertz_loads(searches, material)[0], target, q_ref)
-        out = np.zeros(2)
-        for i, side in enumerate(SIDES):
-            result = searches[side]
-            if result.patches:
-                out[i] = max(p.approach_m for p in result.patches) / case.approach_m - 1.0
-            else:
-                out[i] = -result.min_gap_m / q_ref - 1.0
-        return out
-
-    def gaps(searches):
-        return np.array([searches[side].min_gap_m for side in SIDES]) / q_ref
-
-    def newton(func, sinks, tolerance, limit, max_iterations):
-        return _newton_sinks(lambda x: run(x)[1], func, sinks, tolerance, limit, max_iterations)
-
-    # Phase 1: rigid contact, both wheels just touching (smallest gap 0 on each side).
-    sinks, it1, status = newton(gaps, np.zeros(2), 1e-4, 2.0e-3, opts["max_iterations"])
-    # Phase 2: sink into the rails until each wheel carries its load by Hertz (or the prescribed approach).
-    iterations = it1
-    if status == "ok":
-        tolerance = opts["force_tolerance"] if target is not None else opts["approach_tolerance_m"] / case.approach_m
-        sinks, it2, status = newton(residual, sinks, tolerance, 5.0 * q_ref, opts["max_iterations"])
-        iterations += it2
-    messages = {
-        "ok": f"equilibrium found in {iterations} iterations",
-        "search-failed": "the wheel misses its rail (no finite gap on one side)",
-        "not-converged": "equilibrium iteration did not converge",
-    }
-    message = messages[status]
-    pose, searches = run(sinks, field_sampling=field_sampling)
-    loads, forces = _hertz_loads(searches, material)
-
-    # Which load sharing.
-    if target is None:
-        sharing = "approach"
-    elif opts["load_sharing"] is not None:
-        sharing = opts["load_sharing"]
-    else:
-        several = any(len(searches[side].patches) > 1 for side in SIDES)
-        non_elliptic = any(not p.is_elliptic for side in SIDES for p in searches[side].patches)
-        sharing = "model" if _model_is_bem(contact_model) and (several or non_elliptic) else "hertz"
-
-    # Phase 3 ("model" sharing): Broyden iteration with the model's normal forces under approach control.
-    model_iterations = 0
-    normal_results: dict | None = None  # side -> results of the last normal solves (at `searches`)
-    coupled = bool((opts["model"] or {}).get("difference_parameter", 0.0))
-    failed: list[str] = []
-    if sharing == "model" and status == "ok":
-        jac = np.zeros((2, 2))
-        base = residual(searches)
-        step = 2.0e-7
-        for j in range(2):
-            ds = np.zeros(2)
-            ds[j] = step
-            jac[:, j] = (residual(run(sinks + ds)[1]) - base) / step
-        limit = 5.0 * q_ref
-        previous = None
-        status = "not-converged"
-        for model_iterations in range(1, opts["model_max_iterations"] + 1):  # noqa: B007 (reported)
-            if model_iterations > 1:
-                pose, searches = run(sinks, field_sampling=field_sampling)
-            if not all(np.isfinite(s.min_gap_m) for s in searches.values()):
-                status = "search-failed"
-                break
-            if coupled:
-                omega = _spin_rate(case, searches, _hertz_loads(searches, material)[1], opts["spin_rate"])
-            normal_results, forces, failed = {}, {}, []
-            for side in SIDES:
-                normal_results[side] = []
-                for k, geometry in enumerate(searches[side].patches):
-                    if coupled:
-                        creepage = _creepage(case, pose, geometry, omega)
-                    else:
-                        creepage = Creepage(rolling_speed_m_per_s=case.rolling_speed_m_per_s)
-                    result = contact_model.solve(
-                        geometry, creepage, material, normal_force_N=None, options=opts["model"]
-                    )
-                    if not result.success:
-                        failed.append(f"{side} patch {k}: {result.message}")
-                    normal_results[side].append(result)
-                forces[side] = np.array([r.normal_force_N for r in normal_results[side]], float)
-            loads = _vertical_loads(searches, forces)
-            if failed:
-                status = "model-failed"
-                break
-            r = _load_residual(searches, loads, target, q_ref)
-            if not np.all(np.isfinite(r)):
-                break
-            # converged when each wheel's vertical load is within force_tolerance of W (relative)
-            error = [abs(loads[side] / target - 1.0) if searches[side].patches else math.inf for side in SIDES]
-            if max(error) < opts["force_tolerance"]:
-                status = "ok"
-                break
-            if previous is not None:
-                d_s, d_r = sinks - previous[0], r - previous[1]
-                denom = float(d_s @ d_s)
-                if denom > 0:
-                    jac = jac + np.outer(d_r - jac @ d_s, d_s) / denom
-            try:
-                delta = np.linalg.solve(jac, -r)
-            except np.linalg.LinAlgError:
-                delta = -r * limit
-            previous = (sinks.copy(), r)
-            sinks = sinks + np.clip(np.nan_to_num(delta), -limit, limit)
-        iterations += model_iterations
-        model_name = getattr(contact_model, "name", type(contact_model).__name__)
-        if status == "ok":
-            message = (
-                f"equilibrium found in {iterations} iterations ({model_iterations} with the {model_name} "
-                "model's normal forces, load sharing 'model')"
-            )
-        elif status == "model-failed":
-            message = "load sharing 'model': normal solve failed: " + "; ".join(failed)
-        elif status == "search-failed":
-            message = messages["search-failed"] + " (load sharing 'model')"
-        else:
-            message = (
-                f"load sharing 'model': equilibrium with the {model_name} model's normal forces did not "
-                f"converge in {model_iterations} iterations (force tolerance {opts['force_tolerance']:g})"
-            )
-    if target is not None:
-        if sharing == "hertz":
-            loads = _hertz_loads(searches, material)[0]
-        equilibrium_residual = float(max(abs(loads[side] / target - 1.0) for side in SIDES))
-    else:
-        equilibrium_residual = math.nan
-
-    # Final patch solutions (tangential problem at the final pose).
-    patches: list[PatchSolution] = []
-    failed = []
-    omega_spin = _spin_rate(case, searches, forces, opts["spin_rate"])
-    for side in SIDES:
-        for k, geometry in enumerate(searches[side].patches):
-            creepage = _creepage(case, pose, geometry, omega_spin)
-            if sharing == "model" and normal_results is not None and coupled:
-                result = normal_results[side][k]  # solved with the real creepages already
-            else:
-                force = float(forces[side][k]) if sharing == "hertz" else None
-                result = contact_model.solve(geometry, creepage, material, normal_force_N=force, options=opts["model"])
-            if not result.success:
-                failed.append(f"{side} patch {k}: {result.message}")
-            patches.append(PatchSolution(side, geometry, creepage, result))
-    if status == "ok" and failed:
-        status, message = "model-failed", "; ".join(failed)
-    if status == "ok" and not patches:
-        status, message = "no-contact", "no patch found"
-    return WheelsetCaseSolution(
-        success=status == "ok",
-        status=status,
-        message=message,
-        wall_time_s=time.perf_counter() - started,
-        vertical_position_m=pose.z_m,
-        roll_rad=pose.roll_rad,
-        patches=patches,
-        wheel_vertical_load_N=loads,
-        iterations=iterations,
-        load_sharing=sharing,
-        model_iterations=model_iterations,
-        equilibrium_residual=equilibrium_residual,
-        pose=pose,
-    )

@@ -38,6 +38,7 @@ junctions, where it is smeared over about L).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -139,6 +140,9 @@ class Profile:
         outline_y_m, outline_z_m: optional full outline in the same coordinates, including the parts
             trimmed away because they were vertical or overhanging (shape (m,), or empty). Useful for
             meshing and for gauge measurement; must not self-intersect.
+        cant_rad: cant of the rail already contained in the points (rail profiles), rad: the rail is placed
+            in the track with the inclination the case asks for minus this. 0 unless stated (readers.py:
+            built-in profiles carry their own; a file's is its user's to state).
 
     Equality and hashing are by identity (the arrays are read-only).
 
@@ -154,8 +158,11 @@ class Profile:
     source: str = ""
     outline_y_m: np.ndarray = field(default_factory=lambda: np.zeros(0))
     outline_z_m: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    cant_rad: float = 0.0
 
     def __post_init__(self):
+        if not (isinstance(self.cant_rad, (int, float)) and math.isfinite(self.cant_rad) and abs(self.cant_rad) < 0.2):
+            raise ValueError(f"cant_rad = {self.cant_rad!r}: expected a finite angle with |angle| < 0.2 rad")
         if self.kind not in PROFILE_KINDS:
             raise ValueError(f"kind must be one of {PROFILE_KINDS}, got {self.kind!r}")
         y = _as_1d_float(self.y_m, "y_m")

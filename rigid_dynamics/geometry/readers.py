@@ -57,6 +57,7 @@ Detection and normalisation (all formats), recorded in ``Profile.source``:
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -100,6 +101,11 @@ _BUILTIN_FILES = {
     "circ_r300": ("circ_r300.prr", "circular rail head, radius 300 mm (SIMPACK)"),
     "circ_r100": ("circ_r100.prw", "circular wheel profile, radius 100 mm (SIMPACK)"),
 }
+
+BUILTIN_CANT_RAD = {"MBench_UIC60_v3": math.atan(1.0 / 40.0), "MBench_UIC60_v3_ban": math.atan(1.0 / 40.0)}
+"""Cant of the rail already contained in a built-in profile's points, rad (as each file's header states; the
+profile's ``cant_rad``). A profile read from a path has cant 0 unless its user states it (the case key
+``rail_profile_cant_rad``): the cant of a file is data about that file, never inferred from its name."""
 
 _EXT_KIND = {".prw": "wheel", ".prr": "rail", ".whl": "wheel", ".ban": "rail"}
 _NUMBER_SPLIT = re.compile(r"[,;\s]+")
@@ -495,7 +501,7 @@ def read_profile(path, kind: str | None = None) -> Profile:
     if ext not in (".prw", ".prr", ".whl", ".ban", ".csv", ".txt"):
         raise _err(p, f"unknown extension {p.suffix!r}; expected .prw, .prr, .whl, .ban, .csv or .txt")
     try:
-        text = p.read_text(encoding="utf-8", errors="replace")
+        text = p.read_text(encoding="utf-8-sig", errors="replace")  # -sig: a UTF-8 byte-order mark is dropped
     except OSError as exc:
         raise _err(p, f"cannot be read ({exc.strerror or exc})") from None
     if ext in (".prw", ".prr"):
@@ -523,8 +529,9 @@ def write_profile_csv(path, profile: Profile) -> Path:
     """
     if not isinstance(profile, Profile):
         raise ValueError(f"profile must be a Profile, got {type(profile).__name__}")
+    from rigid_dynamics.files import write_text
+
     p = Path(path)
-    tmp = p.with_name(p.name + ".tmp")
     lines = [
         f"# name: {profile.name}",
         f"# kind: {profile.kind}",
@@ -532,9 +539,7 @@ def write_profile_csv(path, profile: Profile) -> Path:
         "y_mm,z_mm",
     ]
     lines += [f"{y * 1000.0:.10f},{z * 1000.0:.10f}" for y, z in zip(profile.y_m, profile.z_m, strict=True)]
-    tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    tmp.replace(p)
-    return p
+    return write_text(p, "\n".join(lines) + "\n")
 
 
 def builtin_profiles() -> dict[str, str]:
@@ -563,7 +568,10 @@ def load_profile(name_or_path, kind: str | None = None) -> Profile:
         name = lookup[key.lower()]
         if name in _BUILTIN_FILES:
             prof = read_profile(BUILTIN_PROFILE_DIR / _BUILTIN_FILES[name][0])
-            prof = Profile(prof.y_m, prof.z_m, prof.kind, name, prof.source, prof.outline_y_m, prof.outline_z_m)
+            prof = Profile(
+                prof.y_m, prof.z_m, prof.kind, name, prof.source, prof.outline_y_m, prof.outline_z_m,
+                cant_rad=BUILTIN_CANT_RAD.get(name, 0.0),
+            )  # fmt: skip
         else:
             from .standard_profiles import ANALYTIC_PROFILES
 

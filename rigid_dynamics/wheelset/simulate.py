@@ -15,10 +15,12 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"force-anomaly"``: a normal force exceeds ``max_force_factor`` times the static wheel load;
 * ``"derailed"``: |y| exceeds ``max_lateral_displacement_m``;
 * ``"contact-failed"``: a contact model failed or the creepages became undefined (rolling speed 0);
-* ``"solver-failed"``: the adaptive solver could not continue (step size too small);
+* ``"solver-failed"``: the adaptive solver could not continue (step size too small), or a numerical exception
+  was raised below the driver (:data:`NUMERICAL_ERRORS`, e.g. the curvature code for a huge stiffness with RK4);
 * ``"budget-exceeded"``: more than ``max_rhs_evaluations`` evaluations or ``max_wall_time_s``;
 * ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
-* ``"invalid-initial-state"``: no static equilibrium was found for the initial state;
+* ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
+  raised one of :data:`NUMERICAL_ERRORS`, e.g. for a tiny shear modulus);
 
 and ``"ok"`` when it reaches the end. Events (wheel lift, contact restored, flange contact onset)
 are detected on the output samples, so their times are known to one output step.
@@ -27,8 +29,6 @@ are detected on the output samples, so their times are known to one output step.
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -58,6 +58,11 @@ STATUSES = (
     "budget-exceeded",
     "invalid-initial-state",
 )
+
+
+NUMERICAL_ERRORS = (ValueError, ArithmeticError, np.linalg.LinAlgError)
+"""Exceptions that the static equilibrium or the integration can raise from below for numerical trouble: turned
+into a status (``invalid-initial-state``, ``solver-failed``) at the driver, never a traceback."""
 
 
 class _Stop(Exception):
@@ -497,10 +502,13 @@ def simulate(
     status, message, fail_t, fail_state = "ok", "", None, None
     steps = 0
 
-    if use_compiled:
-        state0, ok, why = model.static_state(initial_state(scene), *_compiled_static_functions(packed))
-    else:
-        state0, ok, why = model.static_state(initial_state(scene))
+    try:
+        if use_compiled:
+            state0, ok, why = model.static_state(initial_state(scene), *_compiled_static_functions(packed))
+        else:
+            state0, ok, why = model.static_state(initial_state(scene))
+    except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
+        state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
     if packed is not None:
         packed[0][_compiled.P_XF0] = model.frame_x0  # the suspension frame starts where the wheelset does
@@ -566,6 +574,8 @@ def simulate(
         steps = steps or getattr(stop, "steps", 0)
     except ContactFailure as exc:
         status, message = "contact-failed", str(exc)
+    except NUMERICAL_ERRORS as exc:  # raised below the driver (e.g. the curvature code for a huge stiffness with RK4)
+        status, message = "solver-failed", f"numerical failure: {type(exc).__name__}: {exc}"
     wall = time.perf_counter() - start
     t, states, patches, forces, kin, pot, wc, we = recorder.arrays()
     return SimulationResult(
@@ -876,7 +886,7 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
 
 
 def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
-    """Write the time series of a result to an NPZ file, atomically (temporary name, then os.replace).
+    """Write the time series of a result to an NPZ file atomically (:func:`rigid_dynamics.files.atomic_write`).
 
     The arrays are those of :func:`timeseries_arrays`.
 
@@ -886,15 +896,12 @@ def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_suffix(".npz")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from rigid_dynamics.files import atomic_write
+
     arrays = timeseries_arrays(result)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".npz.tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
+
+    def writer(tmp: Path) -> None:
+        with open(tmp, "wb") as handle:
             np.savez_compressed(handle, **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+
+    return atomic_write(path, writer)  # the one atomic write (usual permissions, no half file on a kill)

@@ -36,19 +36,48 @@ import numpy as np
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
+from rigid_dynamics.contact.options import Option, declare, validate_options
+from rigid_dynamics.contact.options import defaults as option_defaults
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 
-DEFAULT_OPTIONS: dict = {
-    "nx": 40,
-    "ny": 40,
-    "margin": 1.15,
-    "tolerance": 1e-6,
-    "max_iterations": 500,
-    "difference_parameter": 0.0,
-}
-"""Options of :class:`BemModel` and their defaults: grid (nx, ny elements), margin m of the potential
-area, tolerance, iteration limit (NORM CG iterations and TANG Newton steps each), Kalker's K."""
+OPTIONS = declare(
+    Option("nx", int, 40, "elements along x (rolling direction)", minimum=1, maximum=4096),
+    Option("ny", int, 40, "elements along y (lateral)", minimum=1, maximum=4096),
+    Option("margin", float, 1.15, "potential contact area in Hertz semi-axes", minimum=1.0),
+    Option("tolerance", float, 1e-6, "relative tolerance of NORM and TANG", minimum=0.0, exclusive_minimum=True),
+    Option("max_iterations", int, 500, "NORM CG iterations and TANG Newton steps, each", minimum=1),
+    Option(
+        "difference_parameter",
+        float,
+        0.0,
+        "Kalker's K (dissimilar materials)",
+        minimum=-0.5,
+        maximum=0.5,
+        exclusive_minimum=True,
+        exclusive_maximum=True,
+    ),
+    Option(
+        "element_size_m",
+        float,
+        None,
+        "element size (CONTACT's DX = DS), m; replaces nx, ny: centres at multiples of it from the reference point",
+        minimum=0.0,
+        maximum=0.1,
+        exclusive_minimum=True,
+        allow_none=True,
+    ),
+    Option("max_elements", int, 250_000, "element_size_m: sizes doubled above this many elements", minimum=16),
+)
+"""Options of :class:`BemModel` (name, type, range, default; :mod:`rigid_dynamics.contact.options`): grid
+(nx, ny elements), margin m of the potential area, tolerance, iteration limit (NORM CG iterations and TANG
+Newton steps each), Kalker's K (|K| < 0.5).
+
+``element_size_m`` replaces the element counts by a size, as CONTACT's DX and DS: element centres then lie at
+integer multiples of the size from the origin of the contact plane (the patch's reference point), the grid covers
+the potential area, and nx, ny follow from it. When nx ny would exceed ``max_elements`` the sizes are doubled (in
+the direction with more than 10 elements), as CONTACT does, and the result's ``extra`` says so."""
+DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
 
 
 def hertz_ellipse(
@@ -109,26 +138,9 @@ def hertz_ellipse(
 
 
 def _options(options: Mapping | None) -> dict:
-    opts = dict(DEFAULT_OPTIONS)
-    if options is None:
-        return opts
-    unknown = sorted(set(options) - set(DEFAULT_OPTIONS))
-    if unknown:
-        raise ValueError(f"unknown bem option(s) {', '.join(unknown)}: expected any of {', '.join(DEFAULT_OPTIONS)}")
-    opts.update(options)
-    for name in ("nx", "ny", "max_iterations"):
-        value = opts[name]
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise ValueError(f"option {name} = {value!r}: expected an integer >= 1")
-    value = opts["tolerance"]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"option tolerance = {value!r}: expected a finite number > 0")
-    value = opts["margin"]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 1:
-        raise ValueError(f"option margin = {value!r}: expected a finite number >= 1")
-    k = opts["difference_parameter"]
-    if not isinstance(k, (int, float)) or not math.isfinite(k) or abs(k) >= 0.5:
-        raise ValueError(f"option difference_parameter = {k!r}: expected a number with |K| < 0.5")
+    opts = validate_options(OPTIONS, options, "bem")
+    if opts["element_size_m"] is not None:
+        opts["element_size_m"] = (float(opts["element_size_m"]), float(opts["element_size_m"]))
     return opts
 
 
@@ -137,6 +149,7 @@ class BemModel:
 
     name = "bem"
     description = "boundary elements: CONTACT-style NORM + TANG"
+    OPTIONS = OPTIONS
 
     def solve(
         self,
@@ -211,13 +224,16 @@ class BemModel:
                 depth = -d_min
             else:
                 *_, depth = hertz_ellipse(*curv, e_star, normal_force_N=normal_force_N)
+            if und.potential_area_m is not None:  # a rectangle known to hold the whole rigid overlap
+                x_lim, y_lim = tuple(und.potential_area_m[:2]), tuple(und.potential_area_m[2:])
             region = finite & (d <= d_min + 0.5 * depth * margin**2)
-            jj, ii = np.nonzero(region)
-            xs, ys = np.asarray(und.x_m), np.asarray(und.y_m)
-            hx = 0.5 * (np.abs(np.diff(xs)).min() if xs.size > 1 else 0.0)
-            hy = 0.5 * (np.abs(np.diff(ys)).min() if ys.size > 1 else 0.0)
-            x_lim = (float(xs[ii].min()) - hx, float(xs[ii].max()) + hx)
-            y_lim = (float(ys[jj].min()) - hy, float(ys[jj].max()) + hy)
+            if und.potential_area_m is None:
+                jj, ii = np.nonzero(region)
+                xs, ys = np.asarray(und.x_m), np.asarray(und.y_m)
+                hx = 0.5 * (np.abs(np.diff(xs)).min() if xs.size > 1 else 0.0)
+                hy = 0.5 * (np.abs(np.diff(ys)).min() if ys.size > 1 else 0.0)
+                x_lim = (float(xs[ii].min()) - hx, float(xs[ii].max()) + hx)
+                y_lim = (float(ys[jj].min()) - hy, float(ys[jj].max()) + hy)
             if x_lim[1] <= x_lim[0] or y_lim[1] <= y_lim[0]:
                 return no_contact("the sampled undeformed distance gives an empty potential contact area")
         k_diff = float(opts["difference_parameter"])
@@ -226,7 +242,12 @@ class BemModel:
             xs, ys = np.asarray(geometry.undeformed.x_m), np.asarray(geometry.undeformed.y_m)
             field_box = (float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
         grown = 0
+        coarsened = 0
         while True:
+            if opts["element_size_m"] is not None:
+                (x_lim, y_lim, nx, ny), coarsened = _aligned_grid(
+                    x_lim, y_lim, *opts["element_size_m"], opts["max_elements"]
+                )
             dx = (x_lim[1] - x_lim[0]) / nx
             dy = (y_lim[1] - y_lim[0]) / ny
             x = x_lim[0] + dx * (np.arange(nx) + 0.5)
@@ -237,7 +258,12 @@ class BemModel:
             norm = solve_norm(influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it)
             contact = norm.pressure_Pa > 0
             edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
-            if not edge or geometry.undeformed is None or grown >= 3:
+            if (
+                not edge
+                or geometry.undeformed is None
+                or geometry.undeformed.potential_area_m is not None
+                or grown >= 3
+            ):
                 break
             # a sampled field's contact reached the potential area's edge: enlarge it (within the field) and redo
             cx, cy = 0.5 * (x_lim[0] + x_lim[1]), 0.5 * (y_lim[0] + y_lim[1])
@@ -339,8 +365,29 @@ class BemModel:
                 "slip_elements": int((tang.in_slip & contact).sum()),
                 "contact_touches_potential_area_edge": edge,
                 "potential_area_enlargements": grown,
+                "element_size_doublings": coarsened,
             },
         )
+
+
+def _aligned_grid(x_lim, y_lim, dx: float, dy: float, max_elements: int):
+    """Grid of element size (dx, dy) with element centres at integer multiples of it, covering the limits.
+
+    Returns ((x_lim, y_lim, nx, ny), doublings): the sizes are doubled while nx ny > max_elements (CONTACT's rule).
+    """
+    doublings = 0
+    while True:
+        i0, i1 = math.floor(x_lim[0] / dx + 0.5), math.ceil(x_lim[1] / dx - 0.5)
+        j0, j1 = math.floor(y_lim[0] / dy + 0.5), math.ceil(y_lim[1] / dy - 0.5)
+        nx, ny = i1 - i0 + 1, j1 - j0 + 1
+        if nx * ny <= max_elements or (nx <= 10 and ny <= 10):
+            break
+        doublings += 1
+        if nx > 10:
+            dx *= 2.0
+        if ny > 10:
+            dy *= 2.0
+    return (((i0 - 0.5) * dx, (i1 + 0.5) * dx), ((j0 - 0.5) * dy, (j1 + 0.5) * dy), nx, ny), doublings
 
 
 def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:

@@ -1,0 +1,474 @@
+"""Contact patches of one wheel on its rail formed as CONTACT's wheel-rail module forms them.
+
+The 3-D search (search.py) gives one patch per local minimum of the normal distance, with the contact plane
+at the deepest point. CONTACT's module 1 (E.A.H. Vollebregt, J.J. Kalker; open source, user guide sec.
+"Identification of contact patches", Vollebregt 2020 "Detailed wheel/rail geometry processing") instead:
+
+1. takes the *vertical* gap g(y) = z_rail(y) - z_wheel(y) between the rail surface and the wheel's contact locus
+   (the line on the wheel where its surface is horizontal along the track, i.e. its lowest points seen along
+   the track; with yaw it leaves the plane x = 0) as a function of the track's lateral coordinate y;
+2. splits {g < 0} into interpenetration regions (intervals of y);
+3. joins regions that lie close: regions whose distance d (between their end points on the rail surface, in the
+   y-z plane) is at most D_COMB and whose contact angles differ by at most A_SEP are solved as one patch, with
+   their elastic interaction (CONTACT blends regions with D_COMB < d <= D_SEP; here they are joined fully and
+   the patch says so in ``combination``), regions further apart are separate patches;
+4. places each patch's *contact reference point* at the interpenetration's weighted centre and its contact plane
+   at the weighted contact angle. With the gap along x approximated as g(x, y) = g(y) + a x^2, a = 1/(2 r0),
+   the weight of a lateral position is (the integral of the squared interpenetration along x)
+
+       w(y) = int (c - a x^2)^2 dx over |x| < t0 = 16/15 c^2 t0,   c = -g(y) > 0,  t0 = sqrt(c / a),
+
+   and y_cp = int y w dy / int w dy (likewise x_cp along the locus, and the angle delta_cp); the reference point
+   is the rail surface point at (x_cp, y_cp);
+5. solves the patch in the plane through the reference point whose normal is the track's vertical rolled by
+   delta_cp (x along the track), on a potential contact area covering the patch's regions.
+
+The undeformed distance on that plane is evaluated *exactly* at any point from the surfaces themselves (no
+interpolation of a sampled grid): from a plane point p, the distance t to the rail along the plane normal n
+(z = N(x, y) by Newton) and s to the wheel (wheel point x_w(alpha, y_d) = p + s n by Newton in (alpha, y_d, s)),
+gap = s - t (:func:`plane_gap`). The BEM rung calls it at its element centres, so its pressure converges with
+the grid. A coarse sample of the same function (``field_points`` per direction) sizes the potential area.
+
+Frames and signs as in search.py: main frame x along the track, y to the right, z down; n from the rail into
+the wheel; contact frame e_x = rolling direction projected on the plane, e_y = n x e_x; the contact angle is
+positive when n tilts towards the track centre (CONTACT prints it with the opposite sign on the right side).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigid_dynamics.contact.curvature import curvature_tensor, principal_relative_curvature, relative_curvature
+from rigid_dynamics.contact.search import WheelsetPose, _SideGeometry, ellipticity_error
+from rigid_dynamics.contact.types import ContactGeometry, UndeformedDistance
+
+DEFAULT_PATCH_OPTIONS: dict = {
+    "angle_separation_rad": 0.5 * math.pi,  # A_SEP of CONTACT (90 degrees)
+    "distance_separation_m": 8.0e-3,  # D_SEP
+    "distance_combination_m": 4.0e-3,  # D_COMB
+    "locus_step_m": 5.0e-5,  # spacing of the contact locus along the axle
+    "field_points": 25,  # coarse sample of the plane gap per direction (sizes the potential area)
+    "field_margin": 0.3,  # margin of the sampled box around the interpenetration, fraction of its extent
+    "ellipticity_tolerance": 0.2,  # single-region patches: is_elliptic when ellipticity_error <= this
+    "rolling_direction": (1.0, 0.0, 0.0),
+}
+"""Options of :func:`wheel_patches` (CONTACT's A_SEP, D_SEP, D_COMB with CONTACT's defaults)."""
+
+
+@dataclass(frozen=True, eq=False)
+class ContactLocus:
+    """The wheel's contact locus on one side and the vertical gap to the rail below it.
+
+    Attributes:
+        alpha_rad, lateral_m: wheel parameters (alpha, y_d) of each locus point, shape (n,).
+        point_m: locus points in the main frame, shape (n, 3).
+        gap_m: vertical gap z_rail - z_wheel at the locus points (negative: interpenetration), m; +inf off the rail.
+        rail_z_m: rail surface height N(x, y) below each point, m.
+        angle_rad: contact angle of the rail surface there (search.py's convention), rad.
+    """
+
+    alpha_rad: np.ndarray
+    lateral_m: np.ndarray
+    point_m: np.ndarray
+    gap_m: np.ndarray
+    rail_z_m: np.ndarray
+    angle_rad: np.ndarray
+
+
+def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 6) -> ContactLocus:
+    """Points of the wheel whose surface is horizontal along the track, and the vertical gap to the rail.
+
+    For each y_d the angle alpha solves f(alpha) = t_a,z t_y,y - t_y,z t_a,y = 0 (z stationary along the
+    surface curve of constant track y; Newton with the analytic second derivatives), starting at the lowest
+    point alpha = pi/2 - phi.
+    """
+    y_lo, y_hi = geo.y_range
+    # only the part of the wheel above its rail: y_d of the rail's ends (the wheelset frame's y at the axle height)
+    ends = (np.array(geo.rail_range)[:, None] - geo.centre[1]) / geo.rot[1, 1]
+    y_lo, y_hi = max(y_lo, float(ends.min()) - 5e-3), min(y_hi, float(ends.max()) + 5e-3)
+    n = max(int(math.ceil((y_hi - y_lo) / step_m)) + 1, 3)
+    lat = np.linspace(y_lo, y_hi, n)
+    alpha_start = 0.5 * math.pi - geo.pose.spin_rad
+    if _compiled(geo):
+        from rigid_dynamics.contact import _patch_kernels as kern
+
+        alpha, point = np.empty(n), np.empty((n, 3))
+        gap, rail_z, angle = np.empty(n), np.empty(n), np.empty(n)
+        kern.contact_locus(
+            lat, alpha_start, geo.rot, geo.centre, geo.wheel.table_tuple, geo.wheel.irregularity_rows,
+            geo.rail.table_tuple, geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range),
+            geo.side == "right", iterations, alpha, point, gap, rail_z, angle,
+        )  # fmt: skip
+        return ContactLocus(alpha, lat, point, gap, rail_z, angle)
+    alpha = np.full(n, alpha_start)
+    for _ in range(iterations):
+        _, _, _, (t_a, t_y, x_aa, x_ay, _), _ = geo.wheel_point(alpha, lat, second=True)
+        f = t_a[:, 2] * t_y[:, 1] - t_y[:, 2] * t_a[:, 1]
+        df = x_aa[:, 2] * t_y[:, 1] + t_a[:, 2] * x_ay[:, 1] - x_ay[:, 2] * t_a[:, 1] - t_y[:, 2] * x_aa[:, 1]
+        step = np.where(np.abs(df) > 1e-12, f / np.where(np.abs(df) > 1e-12, df, 1.0), 0.0)
+        alpha = alpha - np.clip(step, -0.05, 0.05)
+    point = geo.wheel_point(alpha, lat)[0]
+    r_lo, r_hi = geo.rail_range
+    on_rail = (point[:, 1] >= r_lo) & (point[:, 1] <= r_hi) & np.all(np.isfinite(point), axis=1)
+    big_n, n_x, n_y = (
+        np.asarray(v, float) for v in geo.rail.evaluate(point[:, 0], np.clip(point[:, 1], r_lo, r_hi))[:3]
+    )
+    gap = np.where(on_rail & np.isfinite(big_n), big_n - point[:, 2], np.inf)
+    # rail normal (N_x, N_y, -1)/norm points out of the rail (up); contact angle as in search._patch
+    norm = np.sqrt(n_x**2 + n_y**2 + 1.0)
+    normal_y, normal_z = n_y / norm, -1.0 / norm
+    tilt = -normal_y if geo.side == "right" else normal_y
+    angle = np.arctan2(tilt, -normal_z)
+    return ContactLocus(alpha, lat, point, gap, np.where(on_rail, big_n, np.nan), angle)
+
+
+def _compiled(geo: _SideGeometry) -> bool:
+    """Whether both surfaces are search.py's tabulated stand-ins (the compiled kernels apply)."""
+    from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
+
+    return isinstance(geo.wheel, TabulatedWheel) and isinstance(geo.rail, TabulatedRail)
+
+
+@dataclass(frozen=True, eq=False)
+class InterpenetrationRegion:
+    """One interval of the locus with interpenetration, and its weighted centre (module docstring, step 4).
+
+    Attributes:
+        start, stop: index range [start, stop) into the locus.
+        weight: int w dy, m^5.
+        centre_m: weighted (x, y) of the locus points, m. angle_rad: weighted contact angle, rad.
+        ends_m: rail-surface (y, z) of the two zero crossings, shape (2, 2), m.
+        min_gap_m: smallest vertical gap (< 0), m. deepest_index: index of it in the locus.
+    """
+
+    start: int
+    stop: int
+    weight: float
+    centre_m: tuple[float, float]
+    angle_rad: float
+    ends_m: np.ndarray
+    min_gap_m: float
+    deepest_index: int
+
+
+def _crossing(locus: ContactLocus, i: int, j: int) -> np.ndarray:
+    """Rail-surface (y, z) where the gap changes sign between locus points i (g >= 0) and j (g < 0)."""
+    g_i, g_j = locus.gap_m[i], locus.gap_m[j]
+    if not np.isfinite(g_i):
+        t = 1.0
+    else:
+        t = g_i / (g_i - g_j)
+    y = locus.point_m[i, 1] + t * (locus.point_m[j, 1] - locus.point_m[i, 1])
+    z = locus.rail_z_m[i] + t * (locus.rail_z_m[j] - locus.rail_z_m[i]) if np.isfinite(g_i) else locus.rail_z_m[j]
+    return np.array([y, z])
+
+
+def interpenetration_regions(locus: ContactLocus, nominal_radius_m: float) -> list[InterpenetrationRegion]:
+    """The intervals of negative vertical gap, ordered along the axle, with their weighted centres."""
+    a = 0.5 / nominal_radius_m
+    inside = np.isfinite(locus.gap_m) & (locus.gap_m < 0)
+    if not inside.any():
+        return []
+    edges = np.diff(np.concatenate([[0], inside.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    c = np.where(inside, -locus.gap_m, 0.0)
+    w_line = 16.0 / 15.0 * c**2 * np.sqrt(c / a)
+    y = locus.point_m[:, 1]
+    dy = np.abs(np.gradient(y))
+    regions = []
+    for start, stop in zip(starts, stops, strict=True):
+        sl = slice(start, stop)
+        w = w_line[sl] * dy[sl]
+        total = float(w.sum())
+        if total <= 0:
+            continue
+        x_c = float((locus.point_m[sl, 0] * w).sum() / total)
+        y_c = float((y[sl] * w).sum() / total)
+        angle = float((locus.angle_rad[sl] * w).sum() / total)
+        first = _crossing(locus, start - 1, start) if start > 0 else np.array([y[start], locus.rail_z_m[start]])
+        last = _crossing(locus, stop, stop - 1) if stop < len(y) else np.array([y[stop - 1], locus.rail_z_m[stop - 1]])
+        deepest = start + int(np.argmin(locus.gap_m[sl]))
+        regions.append(
+            InterpenetrationRegion(
+                int(start), int(stop), total, (x_c, y_c), angle, np.stack([first, last]),
+                float(locus.gap_m[deepest]), deepest,
+            )
+        )  # fmt: skip
+    return regions
+
+
+def group_regions(regions: list[InterpenetrationRegion], options) -> list[tuple[list[int], str]]:
+    """Indices of the regions forming each patch, and how they were joined ("single", "combined", "blended").
+
+    Neighbouring regions (along the axle) are joined when their contact angles differ by at most A_SEP and the
+    distance between the end of one and the start of the next is at most D_SEP (module docstring, step 3).
+    """
+    groups: list[tuple[list[int], str]] = []
+    for k, region in enumerate(regions):
+        if groups:
+            prev = regions[groups[-1][0][-1]]
+            d = float(np.hypot(*(region.ends_m[0] - prev.ends_m[1])))
+            # the angle of the group so far (weighted) against this region's
+            members = [regions[i] for i in groups[-1][0]]
+            w = sum(m.weight for m in members)
+            angle = sum(m.angle_rad * m.weight for m in members) / w
+            if (
+                abs(region.angle_rad - angle) <= options["angle_separation_rad"]
+                and d <= options["distance_separation_m"]
+            ):
+                how = "combined" if d <= options["distance_combination_m"] else "blended"
+                previous = groups[-1][1]
+                kind = "blended" if "blended" in (how, previous) else how
+                groups[-1] = (groups[-1][0] + [k], kind)
+                continue
+        groups.append(([k], "single"))
+    return groups
+
+
+def plane_gap(geo: _SideGeometry, locus: ContactLocus, origin, frame, x_m, y_m, iterations: int = 10):
+    """Undeformed distance along the plane normal at points (x, y) of the plane (origin, frame), m.
+
+    Returns (gap, alpha, y_d): gap = s - t with the rail at origin + x e_x + y e_y + t n and the wheel at
+    + s n; +inf where either Newton iteration did not converge or the point is off a surface. alpha, y_d are the
+    wheel parameters found (start: the locus point at the same track y).
+    """
+    x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    shape = x_m.shape
+    x, y = np.ascontiguousarray(x_m.ravel()), np.ascontiguousarray(y_m.ravel())
+    if _compiled(geo):
+        from rigid_dynamics.contact import _patch_kernels as kern
+
+        order = np.argsort(locus.point_m[:, 1])
+        gap, alpha, lat = np.empty(x.size), np.empty(x.size), np.empty(x.size)
+        kern.plane_gap(
+            x, y, np.asarray(origin, float), np.ascontiguousarray(frame), np.ascontiguousarray(locus.point_m[order, 1]),
+            locus.lateral_m[order], locus.alpha_rad[order], np.ascontiguousarray(locus.point_m[order, 0]), geo.rot,
+            geo.centre, geo.wheel.table_tuple, geo.wheel.irregularity_rows, geo.rail.table_tuple,
+            geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range), np.array(geo.y_range),
+            iterations, gap, alpha, lat,
+        )  # fmt: skip
+        return gap.reshape(shape), alpha.reshape(shape), lat.reshape(shape)
+    e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
+    base = origin + x[:, None] * e_x + y[:, None] * e_y
+    t_rail = geo._distance_along(base, n, iterations)
+    order = np.argsort(locus.point_m[:, 1])
+    ly = locus.point_m[order, 1]
+    lat = np.interp(base[:, 1], ly, locus.lateral_m[order])
+    alpha = np.interp(base[:, 1], ly, locus.alpha_rad[order])
+    radius = geo.wheel.evaluate(alpha, lat)[0]
+    alpha = alpha + (base[:, 0] - np.interp(base[:, 1], ly, locus.point_m[order, 0])) / radius
+    s = n @ (geo.wheel_point(alpha, lat)[0] - base).T
+    residual = np.full(x.shape, np.inf)
+    for _ in range(iterations):
+        point, _, _, (t_a, t_y, *_), _ = geo.wheel_point(alpha, lat, second=True)
+        res = point - base - s[:, None] * n
+        residual = np.linalg.norm(res, axis=1)
+        if np.all(residual < 1e-12):
+            break
+        jac = np.stack([t_a, t_y, np.broadcast_to(-n, t_a.shape)], -1)
+        delta = np.linalg.solve(jac, -res[..., None])[..., 0]
+        alpha, lat, s = alpha + delta[:, 0], lat + delta[:, 1], s + delta[:, 2]
+    point = geo.wheel_point(alpha, lat)[0]
+    residual = np.linalg.norm(point - base - s[:, None] * n, axis=1)
+    ok = (residual < 1e-10) & (lat >= geo.y_range[0]) & (lat <= geo.y_range[1]) & np.isfinite(t_rail)
+    gap = np.where(ok, s - t_rail, np.inf)
+    return gap.reshape(shape), alpha.reshape(shape), lat.reshape(shape)
+
+
+@dataclass(frozen=True, eq=False)
+class WheelPatch:
+    """A patch of one wheel: the geometry handed to a contact model and how it was formed.
+
+    Attributes:
+        geometry: :class:`ContactGeometry` at the contact reference point (undeformed distance exact).
+        regions: the interpenetration regions joined in it.
+        combination: "single", "combined" (d <= D_COMB) or "blended" (D_COMB < d <= D_SEP, joined fully here).
+        deepest_point_m: main-frame point of the largest vertical interpenetration (on the rail), m.
+        deepest_point_rail_m: (y, z) of it in rail-profile coordinates, m.
+        min_vertical_gap_m: the largest vertical interpenetration (negative), m.
+        wheel_point_m: the wheel's surface point on the normal through the reference point (main frame), m:
+            the material point whose velocity gives the creepages (CONTACT's rolling radius is the wheel's).
+    """
+
+    geometry: ContactGeometry
+    regions: list[InterpenetrationRegion]
+    combination: str
+    deepest_point_m: np.ndarray
+    deepest_point_rail_m: tuple[float, float]
+    min_vertical_gap_m: float
+    wheel_point_m: np.ndarray
+
+
+def _curvatures(geo_exact: _SideGeometry, alpha0: float, y0: float, rail_xy, frame):
+    a_arr, y_arr = np.array([alpha0]), np.array([y0])
+    _, _, _, (t_a, t_y, x_aa, x_ay, x_yy), radius = geo_exact.wheel_point(a_arr, y_arr, second=True)
+    e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
+    k_w = curvature_tensor(t_a[0], t_y[0], x_aa[0], x_ay[0], x_yy[0], n, e_x, e_y)
+    _, n_dx, n_dy, n_xx, n_xy, n_yy = (
+        v[0] for v in geo_exact.rail.evaluate(np.array([rail_xy[0]]), np.array([rail_xy[1]]))
+    )
+    k_r = curvature_tensor(
+        np.array([1.0, 0.0, n_dx]), np.array([0.0, 1.0, n_dy]), np.array([0.0, 0.0, n_xx]),
+        np.array([0.0, 0.0, n_xy]), np.array([0.0, 0.0, n_yy]), n, e_x, e_y,
+    )  # fmt: skip
+    a_rel, b_rel, angle = principal_relative_curvature(relative_curvature(k_w, k_r))
+    return float(a_rel), float(b_rel), float(angle), float(radius[0])
+
+
+def _overlap_ellipse(xs, ys, field, approach: float):
+    """Curvatures (A, B, 0) of the quadric A x^2 + B y^2 - q whose rigid overlap has the sampled overlap's extents
+    (an equivalent ellipse for joined or conformal patches); None when nothing overlaps.
+    """
+    over = np.isfinite(field) & (field < 0)
+    if not over.any() or approach <= 0:
+        return None
+    cols, rows = np.flatnonzero(over.any(axis=0)), np.flatnonzero(over.any(axis=1))
+    hx = 0.5 * (xs[min(cols[-1] + 1, xs.size - 1)] - xs[max(cols[0] - 1, 0)])
+    hy = 0.5 * (ys[min(rows[-1] + 1, ys.size - 1)] - ys[max(rows[0] - 1, 0)])
+    return approach / hx**2, approach / hy**2, 0.0
+
+
+def _box_minimum(gap_of, x0, y0, hx, hy, points: int = 7, passes: int = 3):
+    """Smallest gap near (x0, y0) by successively finer small grids, and where it is."""
+    best = (math.inf, x0, y0)
+    for _ in range(passes):
+        xs = x0 + np.linspace(-hx, hx, points)
+        ys = y0 + np.linspace(-hy, hy, points)
+        gx, gy = np.meshgrid(xs, ys)
+        g = gap_of(gx, gy)
+        k = int(np.argmin(g))
+        if g.flat[k] < best[0]:
+            best = (float(g.flat[k]), float(gx.flat[k]), float(gy.flat[k]))
+        x0, y0 = best[1], best[2]
+        hx, hy = 2.0 * hx / (points - 1), 2.0 * hy / (points - 1)
+    return best
+
+
+def wheel_patches(
+    wheel, rail, pose: WheelsetPose, side: str, *, wheel_lateral_range_m, rail_lateral_range_m,
+    nominal_radius_m: float, options=None,
+) -> tuple[list[WheelPatch], ContactLocus]:  # fmt: skip
+    """Patches of one wheel formed as CONTACT's module 1 forms them (module docstring), and the contact locus.
+
+    Args:
+        wheel, rail: the side's surfaces (search.py's duck type; tabulated stand-ins keep ``.exact``).
+        pose: wheelset pose. side: "left" or "right".
+        wheel_lateral_range_m, rail_lateral_range_m: where the surfaces are defined, m.
+        nominal_radius_m: r0 (the weight's longitudinal curvature a = 1/(2 r0)), m.
+        options: :data:`DEFAULT_PATCH_OPTIONS` keys.
+
+    Returns:
+        (patches ordered along the axle, the locus). No patch when the wheel does not touch its rail.
+
+    Raises:
+        ValueError: unknown option.
+    """
+    opts = dict(DEFAULT_PATCH_OPTIONS)
+    for key, value in (options or {}).items():
+        if key not in DEFAULT_PATCH_OPTIONS:
+            raise ValueError(f"patch option {key!r}: expected one of {', '.join(DEFAULT_PATCH_OPTIONS)}")
+        opts[key] = value
+    geo = _SideGeometry(wheel, rail, pose, side, tuple(wheel_lateral_range_m), tuple(rail_lateral_range_m))
+    exact_wheel, exact_rail = getattr(wheel, "exact", wheel), getattr(rail, "exact", rail)
+    geo_exact = _SideGeometry(exact_wheel, exact_rail, pose, side, geo.y_range, geo.rail_range, geo.rot)
+    locus = contact_locus(geo, opts["locus_step_m"])
+    regions = interpenetration_regions(locus, nominal_radius_m)
+    a_long = 0.5 / nominal_radius_m
+    patches = []
+    for members, how in group_regions(regions, opts):
+        group = [regions[k] for k in members]
+        weight = sum(r.weight for r in group)
+        x_c = sum(r.centre_m[0] * r.weight for r in group) / weight
+        y_c = sum(r.centre_m[1] * r.weight for r in group) / weight
+        delta = sum(r.angle_rad * r.weight for r in group) / weight
+        z_c = float(geo.rail.evaluate(np.array([x_c]), np.array([y_c]))[0][0])
+        origin = np.array([x_c, y_c, z_c])
+        sgn = -1.0 if side == "right" else 1.0
+        n = np.array([0.0, sgn * math.sin(delta), -math.cos(delta)])
+        rolling = np.asarray(opts["rolling_direction"], float)
+        e_x = rolling - np.dot(rolling, n) * n
+        e_x /= np.linalg.norm(e_x)
+        frame = np.stack([e_x, np.cross(n, e_x), n], -1)
+
+        def gap_of(x, y, origin=origin, frame=frame):
+            return plane_gap(geo, locus, origin, frame, x, y)[0]
+
+        # box of the sampled field: the regions' extents projected on e_y, the longest x-extent, a margin
+        ends = np.concatenate([r.ends_m for r in group])
+        lat = (ends[:, 0] - y_c) * frame[1, 1] + (ends[:, 1] - z_c) * frame[2, 1]
+        depth = max(-r.min_gap_m for r in group)
+        half_x = math.sqrt(depth / a_long)
+        y_lo, y_hi = float(lat.min()), float(lat.max())
+        pad_y = opts["field_margin"] * (y_hi - y_lo) + 2.0e-4
+        pad_x = (1.0 + opts["field_margin"]) * half_x + 2.0e-4
+        npts = int(opts["field_points"])
+        xs = x_c - origin[0] + np.linspace(-pad_x, pad_x, npts)
+        ys = np.linspace(y_lo - pad_y, y_hi + pad_y, npts)
+        gx, gy = np.meshgrid(xs, ys)
+        # one call: the sampled field and the plane origin (whose wheel parameters give the curvatures)
+        values, alphas, lats = plane_gap(
+            geo, locus, origin, frame, np.append(gx.ravel(), 0.0), np.append(gy.ravel(), 0.0)
+        )
+        field = values[:-1].reshape(gx.shape)
+        alpha0, lat0 = float(alphas[-1]), float(lats[-1])
+        k = int(np.argmin(field))
+        jj, ii = divmod(k, npts)
+        q_min, _, _ = _box_minimum(gap_of, xs[ii], ys[jj], xs[1] - xs[0], ys[1] - ys[0], passes=2)
+        approach = max(-q_min, 0.0)
+        if not (math.isfinite(alpha0) and math.isfinite(lat0)):
+            alpha0 = float(np.interp(y_c, locus.point_m[:, 1], locus.alpha_rad))
+            lat0 = float(np.interp(y_c, locus.point_m[:, 1], locus.lateral_m))
+        a_rel, b_rel, ell_angle, radius = _curvatures(geo_exact, alpha0, lat0, origin[:2], frame)
+        over = np.isfinite(field) & (field < 0)
+        if over.any():
+            cols, rows = np.flatnonzero(over.any(axis=0)), np.flatnonzero(over.any(axis=1))
+            i0, i1 = max(cols[0] - 1, 0), min(cols[-1] + 1, npts - 1)
+            j0, j1 = max(rows[0] - 1, 0), min(rows[-1] + 1, npts - 1)
+            area = (float(xs[i0]), float(xs[i1]), float(ys[j0]), float(ys[j1]))
+        else:
+            area = None
+        undeformed = UndeformedDistance(x_m=xs, y_m=ys, distance_m=field, exact=gap_of, potential_area_m=area)
+        convex = a_rel > 0 and b_rel > 0
+        if not convex or len(group) > 1:
+            # the curvatures at one point do not describe a joined or conformal patch: the analytic rungs get the
+            # quadric with the same rigid-overlap extents (an equivalent ellipse; is_elliptic False)
+            fitted = _overlap_ellipse(xs, ys, field, approach)
+            if fitted is not None:
+                a_rel, b_rel, ell_angle = fitted
+        a_use, b_use = max(a_rel, 1e-6), max(b_rel, 1e-6)
+        elliptic = convex and len(group) == 1
+        if elliptic:
+            elliptic = ellipticity_error(undeformed, a_use, b_use, ell_angle, approach) <= opts["ellipticity_tolerance"]
+        rail_profile = (math.nan, math.nan)
+        if hasattr(exact_rail, "to_profile_coordinates"):
+            rail_profile = tuple(float(v) for v in exact_rail.to_profile_coordinates(y_c, z_c))
+        wheel_profile = (math.nan, math.nan)
+        if hasattr(exact_wheel, "to_profile_coordinates"):
+            wheel_profile = tuple(float(v) for v in exact_wheel.to_profile_coordinates(lat0, radius))
+        geometry = ContactGeometry(
+            curvature_long_1_per_m=a_use,
+            curvature_lat_1_per_m=b_use,
+            approach_m=approach,
+            side=side,
+            point_m=origin,
+            frame=frame,
+            contact_angle_rad=float(delta),
+            contact_point_rail_m=rail_profile,
+            contact_point_wheel_m=wheel_profile,
+            rolling_radius_m=radius,
+            ellipse_angle_rad=ell_angle,
+            undeformed=undeformed,
+            is_elliptic=bool(elliptic),
+        )
+        deepest = min(group, key=lambda r: r.min_gap_m)
+        p_deep = locus.point_m[deepest.deepest_index].copy()
+        p_deep[2] = locus.rail_z_m[deepest.deepest_index]
+        deep_profile = (math.nan, math.nan)
+        if hasattr(exact_rail, "to_profile_coordinates"):
+            deep_profile = tuple(float(v) for v in exact_rail.to_profile_coordinates(p_deep[1], p_deep[2]))
+        wheel_point = geo.wheel_point(np.array([alpha0]), np.array([lat0]))[0][0]
+        patches.append(WheelPatch(geometry, group, how, p_deep, deep_profile, deepest.min_gap_m, wheel_point))
+    return patches, locus

@@ -1,0 +1,86 @@
+"""Atomic file writes: the one helper every file of a run goes through (data, summaries, plots).
+
+:func:`atomic_write` calls a writer on a temporary name in the target's folder (a hidden name ending in
+``.part`` plus the target's suffix, so matplotlib and numpy still see the format), flushes it to disk and
+renames it onto the final name (``os.replace``, atomic on POSIX). A run that is killed, or a writer that
+fails (full disk, file-size limit, read-only folder), therefore never leaves a file under its final name
+that is not whole. The file gets the permissions of a normally created file (0666 minus the umask), not
+the 0600 of a temporary file.
+
+It lives in the lowest layer (stdlib only) so that every package can use it: ``wheelrail.output``
+re-exports it, the plots of ``comparisons`` and ``fea`` save through :func:`save_figure`.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+
+class WriteError(OSError):
+    """Writing a file failed; ``filename`` is the final path, ``strerror`` the reason (no partial file is left)."""
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> Path:
+    """Call ``writer(tmp_path)``, then rename the temporary file to ``path`` only if it succeeded.
+
+    Args:
+        path: final path; its folder is created if missing.
+        writer: writes the whole file at the path it is given.
+
+    Returns:
+        ``path`` as a Path.
+
+    Raises:
+        WriteError: an OSError while writing or renaming (the temporary file is removed).
+        Any other exception of ``writer`` (the temporary file is removed too).
+    """
+    path = Path(path)
+    tmp_path = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".part{path.suffix}", dir=path.parent)
+        os.close(fd)
+        tmp_path = Path(tmp)
+        writer(tmp_path)
+        with open(tmp_path, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.chmod(tmp_path, 0o666 & ~_umask())
+        os.replace(tmp_path, path)
+    except OSError as exc:
+        _remove(tmp_path)
+        if isinstance(exc, WriteError):
+            raise
+        raise WriteError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+    except BaseException:
+        _remove(tmp_path)
+        raise
+    return path
+
+
+def _remove(tmp_path: Path | None) -> None:
+    if tmp_path is not None:
+        try:
+            tmp_path.unlink(missing_ok=True)
+        except OSError:
+            pass
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write text (UTF-8) atomically."""
+    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:
+    """Save a matplotlib figure atomically; the format comes from the suffix of ``path`` (PNG if none)."""
+    path = Path(path)
+    fmt = path.suffix.lstrip(".").lower() or "png"
+    return atomic_write(path, lambda tmp: fig.savefig(tmp, format=fmt, **savefig_kwargs))

@@ -1,0 +1,69 @@
+"""A run killed while it writes: no file under a final name that is not whole.
+
+SIGKILL in the middle of a slow write (nothing can clean up: the temporary name is all that is left), and
+SIGTERM to a ``wheelrail run`` (it unwinds: exit status 143, temporary files and lock removed, no summary).
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+from hardening_helpers import ROOT, assert_whole_files, cli_subprocess
+
+from wheelrail.output import LOCK_NAME
+
+
+def wait_for(predicate, timeout_s=120.0):
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if predicate():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_sigkill_during_a_write_leaves_no_final_file(tmp_path):
+    target = tmp_path / "data.npz"
+    code = textwrap.dedent(
+        f"""
+        import time
+        from rigid_dynamics.files import atomic_write
+
+        def slow(tmp):
+            with open(tmp, "wb") as handle:
+                for _ in range(1000):
+                    handle.write(b"x" * 100_000)
+                    handle.flush()
+                    time.sleep(0.01)
+
+        atomic_write({str(target)!r}, slow)
+        """
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    try:
+        assert wait_for(lambda: any(p.stat().st_size > 0 for p in tmp_path.glob(".data.npz.*.part.npz")))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=30)
+    finally:
+        proc.kill()
+    assert not target.exists()
+    assert [p.name for p in tmp_path.iterdir() if not p.name.startswith(".")] == []
+
+
+def test_sigterm_during_a_run_unwinds(tmp_path):
+    out = tmp_path / "o"
+    proc = cli_subprocess("run", "hunting-conical", "--out", out, "--quiet")
+    try:
+        assert wait_for(lambda: (out / LOCK_NAME).exists()), "the run never took its folder"
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGTERM)
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, stderr
+    assert "Traceback" not in stderr
+    assert not out.exists() or not any(p.name.startswith(".") for p in out.iterdir())  # no lock, no temporaries
+    assert "summary.json" not in assert_whole_files(out)
