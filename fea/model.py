@@ -174,6 +174,11 @@ OPTIONS = declare_dataclass(
         "output_dir": {"help": "folder for XDMF and PNG output"},
         "min_mesh_quality": {"help": "smallest accepted minSICN", "minimum": 0, "maximum": 1},
         "max_elements": {"help": "largest accepted element count", "minimum": 1},
+        "stress_points_m": {"help": "contact-frame points (x, y, z < 0) where the stress tensor is returned"},
+        "surface_traction": {
+            "help": "tangential tractions on the wheel on a grid (x_m, y_m, traction_long_Pa, traction_lat_Pa), "
+            "applied negated to the rail block's contact face"
+        },
     },
 )
 """Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``
