@@ -11,7 +11,7 @@ $(STAMP): pyproject.toml tools/setup_venv.sh
 setup: $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/wheelrail run
+	$(VENV)/bin/wheelrail demo
 
 test: $(STAMP)
 	$(VENV)/bin/python -m pytest -q $(PYTEST_ARGS)

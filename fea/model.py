@@ -66,6 +66,17 @@ class FeaOptions:
         stresses: compute subsurface stresses.
         output_dir: folder for the VTU grid and PNG output, or None.
         min_mesh_quality: smallest accepted minSICN. max_elements: largest accepted element count.
+        surface_traction: tangential tractions ON THE WHEEL on a grid of the contact plane, as a mapping with
+            ``x_m``, ``y_m`` (grid), ``traction_long_Pa``, ``traction_lat_Pa`` ([j][i] at (x_m[i], y_m[j]); e.g.
+            a BEM or FASTSIM solution's fields) and optionally ``source`` (a label); the block (the rail) is
+            loaded with minus these (bilinear, 0 outside the grid) as a surface load on its contact face, so
+            its subsurface stresses include the friction of that solution. Rigid formulation only; the model
+            becomes a full block (the load breaks the quarter symmetry). The creep forces of the result stay
+            None (prescribed, not solved). None: frictionless.
+        stress_points_m: points (x, y, z) of the contact frame (z < 0: in the body below the contact plane) at
+            which the recovered stress tensor is returned in ``extra["stress_points_Pa"]`` (a list of 3 x 3
+            tensors, Pa; None where a point lies outside the mesh), or None. Quarter models mirror the point
+            into x, y >= 0 and flip the shear components that are odd in x or y.
     """
 
     quick: bool = False
@@ -84,6 +95,8 @@ class FeaOptions:
     output_dir: str | None = None
     min_mesh_quality: float = 0.05
     max_elements: int = 2_000_000
+    stress_points_m: tuple | None = None
+    surface_traction: dict | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -104,6 +117,22 @@ class FeaOptions:
             raise ValueError(f"grid_points = {self.grid_points!r}: expected an integer >= 8")
         if not (math.isfinite(self.filter_radius_factor) and self.filter_radius_factor >= 0):
             raise ValueError(f"filter_radius_factor = {self.filter_radius_factor!r}: expected a number >= 0")
+        if self.surface_traction is not None:
+            t = self.surface_traction
+            missing = {"x_m", "y_m", "traction_long_Pa", "traction_lat_Pa"} - set(t)
+            if missing:
+                raise ValueError(f"surface_traction: missing {sorted(missing)}")
+            shape = (len(t["y_m"]), len(t["x_m"]))
+            for key in ("traction_long_Pa", "traction_lat_Pa"):
+                arr = np.asarray(t[key], dtype=float)
+                if arr.shape != shape or not np.all(np.isfinite(arr)):
+                    raise ValueError(f"surface_traction.{key}: expected finite values of shape {shape}")
+            if self.formulation != "rigid":
+                raise ValueError(f"surface_traction with formulation = {self.formulation!r}: expected 'rigid'")
+        if self.stress_points_m is not None:
+            pts = np.asarray(self.stress_points_m, dtype=float)
+            if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
+                raise ValueError("stress_points_m: expected a sequence of finite (x, y, z) points")
 
     @classmethod
     def from_mapping(cls, options: Mapping | None) -> FeaOptions:
@@ -145,6 +174,11 @@ OPTIONS = declare_dataclass(
         "output_dir": {"help": "folder for the VTU grid and PNG output"},
         "min_mesh_quality": {"help": "smallest accepted minSICN", "minimum": 0, "maximum": 1},
         "max_elements": {"help": "largest accepted element count", "minimum": 1},
+        "stress_points_m": {"help": "contact-frame points (x, y, z < 0) where the stress tensor is returned"},
+        "surface_traction": {
+            "help": "tangential tractions on the wheel on a grid (x_m, y_m, traction_long_Pa, traction_lat_Pa), "
+            "applied negated to the rail block's contact face"
+        },
     },
 )
 """Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``
@@ -269,7 +303,7 @@ class FeaModel:
             elements_per_semi_axis=opts.n_per_semi_axis,
             domain_factor=opts.block_factor,
             center_m=center,
-            symmetry="quarter" if quadric and opts.formulation != "profiles" else "full",
+            symmetry="quarter" if quadric and opts.formulation != "profiles" and not opts.surface_traction else "full",
         )
         t_mesh = time.perf_counter()
         limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
@@ -307,6 +341,7 @@ class FeaModel:
                 return ((x - center[0]) / semi[0]) ** 2 + ((y - center[1]) / semi[1]) ** 2 < 1.0
 
             young_body = e_star * (1.0 - nu**2)
+            traction = _traction_function(opts.surface_traction) if opts.surface_traction else None
             sol = solve_rigid_indenter(
                 domain,
                 gap0,
@@ -318,6 +353,7 @@ class FeaModel:
                 initial_active=initial_active if quadric else None,
                 length_scale_m=min(semi),
                 settings=settings,
+                surface_traction=traction,
             )
 
         extra = {
@@ -330,8 +366,13 @@ class FeaModel:
                 else "two elastic quadric bodies (quarter model), node-to-surface penalty"
                 if opts.formulation == "two-body"
                 else "quarter block, rigid quadric indenter"
-                if quadric
-                else "full block, rigid sampled indenter"
+                if spec.symmetry == "quarter"
+                else f"full block, rigid {'quadric' if quadric else 'sampled'} indenter"
+            ),
+            "surface_traction": (
+                f"minus the wheel tractions of {opts.surface_traction.get('source', 'the given fields')}"
+                if opts.surface_traction
+                else "none (frictionless)"
             ),
             "young_modulus_Pa": young_body,
             "element_size_m": spec.contact_size_m,
@@ -347,7 +388,7 @@ class FeaModel:
 
         # Pressure field (full patch).
         xy, force, weight = sol.node_xy_m, sol.node_force_N, sol.node_weight_m2
-        if quadric:
+        if spec.symmetry == "quarter":
             xy, force, weight = post.mirror_quarter(xy, force, weight)
         radius = opts.filter_radius_factor * spec.contact_size_m / opts.degree  # P2: nodes at h/2
         in_contact_nodes = np.tile(sol.active, 4) if len(xy) == 4 * len(sol.active) else sol.active.copy()
@@ -391,6 +432,10 @@ class FeaModel:
             stress_fn, coords, stress = post.recover_nodal_stress(sol.displacement, young_body, nu)
             lower = _lower_body_nodes(domain, stress_fn, len(coords), coords, spec)
             extra.update(_stress_maxima(comm, coords[lower], stress[lower], spec, quadric, post))
+            if opts.stress_points_m is not None:
+                extra["stress_points_Pa"] = _stress_at_points(
+                    comm, stress_fn, np.asarray(opts.stress_points_m, float), domain.symmetry == "quarter"
+                )
 
         if opts.output_dir is not None:
             from fea.output import write_outputs
@@ -440,6 +485,56 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra or {},
         )
+
+
+def _traction_function(traction: Mapping):
+    """(x, y) -> minus the wheel's tractions (the rail block's surface load), bilinear, 0 outside the grid."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    grid = (np.asarray(traction["y_m"], float), np.asarray(traction["x_m"], float))
+    parts = [
+        RegularGridInterpolator(grid, -np.asarray(traction[k], float), bounds_error=False, fill_value=0.0)
+        for k in ("traction_long_Pa", "traction_lat_Pa")
+    ]
+
+    def evaluate(x, y):
+        pts = np.column_stack([np.asarray(y, float), np.asarray(x, float)])
+        return parts[0](pts), parts[1](pts)
+
+    return evaluate
+
+
+def _stress_at_points(comm, stress_fn, points: np.ndarray, quarter: bool) -> list:
+    """Recovered (P1) stress tensors at ``points`` (contact frame), as nested lists; None outside the mesh."""
+    from dolfinx import geometry
+
+    query = points.copy()
+    if quarter:
+        query[:, :2] = np.abs(query[:, :2])
+    msh = stress_fn.function_space.mesh
+    tree = geometry.bb_tree(msh, msh.topology.dim)
+    candidates = geometry.compute_collisions_points(tree, query)
+    colliding = geometry.compute_colliding_cells(msh, candidates, query)
+    found, cells = [], []
+    for i in range(len(query)):
+        links = colliding.links(i)
+        if len(links):
+            found.append(i)
+            cells.append(links[0])
+    local = np.full((len(query), 9), np.nan)
+    if found:
+        local[found] = stress_fn.eval(query[found], np.asarray(cells, dtype=np.int32))
+    merged = np.full((len(query), 9), np.nan)
+    for part in comm.allgather(local):
+        take = np.isnan(merged[:, 0]) & ~np.isnan(part[:, 0])
+        merged[take] = part[take]
+    tensors = merged.reshape(-1, 3, 3)
+    if quarter:
+        sx, sy = np.where(points[:, 0] < 0, -1.0, 1.0), np.where(points[:, 1] < 0, -1.0, 1.0)
+        for (i, j), sign in (((0, 1), sx * sy), ((0, 2), sx), ((1, 2), sy)):
+            tensors[:, i, j] *= sign
+            tensors[:, j, i] *= sign
+    return [None if np.isnan(t[0, 0]) else t.tolist() for t in tensors]
 
 
 def _lower_body_nodes(domain, stress_fn, n, coords, spec):

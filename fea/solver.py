@@ -147,6 +147,7 @@ def solve_rigid_indenter(
     initial_active=None,
     length_scale_m: float = 1e-3,
     settings: SolverSettings | None = None,
+    surface_traction=None,
 ) -> ContactSolution:
     """Solve the contact of the elastic block ``domain`` with the rigid indenter of gap ``h``.
 
@@ -164,6 +165,10 @@ def solve_rigid_indenter(
             region (e.g. Hertz's ellipse); default: the rigid overlap h < q.
         length_scale_m: expected patch size (scales the active-set constant c = E/length), m.
         settings: :class:`SolverSettings`.
+        surface_traction: optional (x_m, y_m) -> (t_x, t_y), the tangential traction ON THE BLOCK's contact face,
+            Pa (e.g. minus a BEM solution's tractions on the wheel): a Neumann load sum_i int t_i v_i ds added to
+            the affine part of every solve (frictional tractions prescribed, not solved for; the normal contact
+            stays frictionless and is solved as before). None: no tangential load.
 
     Returns:
         :class:`ContactSolution`; non-convergence gives success False, never an exception.
@@ -223,6 +228,18 @@ def solve_rigid_indenter(
     K.assemble()
     w_vec = fem_petsc.assemble_vector(w_form)
     w_vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    load_vec = None
+    if surface_traction is not None:
+        t_fn = fem.Function(V, name="surface_traction")
+
+        def traction_values(x):
+            tx, ty = surface_traction(x[0], x[1])
+            return np.vstack([np.asarray(tx, float), np.asarray(ty, float), np.zeros(x.shape[1])])
+
+        t_fn.interpolate(traction_values)
+        load_vec = fem_petsc.assemble_vector(fem.form(ufl.inner(t_fn, v) * ds(groups["contact"])))
+        load_vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        fem_petsc.set_bc(load_vec, bcs)
     timings["assembly_s"] = time.perf_counter() - t_start
 
     cdofs = fem.locate_dofs_topological(V.sub(2), tdim - 1, tags.find(groups["contact"]))
@@ -268,12 +285,16 @@ def solve_rigid_indenter(
     w_test = weights if settings.degree == 1 else np.full_like(weights, w_ref)
     sum_all = comm.allreduce
 
-    def solve_with(active, values):
-        """Solve for u with u_z = values at the active contact nodes (other contact nodes free)."""
+    def solve_with(active, values, loaded=True):
+        """Solve for u with u_z = values at the active contact nodes (other contact nodes free); ``loaded`` adds
+        the tangential surface load (the affine part; not for the unit-approach solve of load control).
+        """
         prescribed.set(0.0)
         prescribed.array[cdofs[active]] = values
         K.mult(prescribed, b)
         b.scale(-1.0)
+        if loaded and load_vec is not None:
+            b.axpy(1.0, load_vec)
         b.array[cdofs[active]] = values
         out = K.createVecRight()
         ksp.solve(b, out)
@@ -321,7 +342,7 @@ def solve_rigid_indenter(
             x_h.copy(uh.x.petsc_vec)
         else:
             x_h, r1 = solve_with(active, h[active])
-            x_1, r2 = solve_with(active, -np.ones(int(active.sum())))
+            x_1, r2 = solve_with(active, -np.ones(int(active.sum())), loaded=False)
             if min(r1, r2) < 0:
                 status, message = "not-converged", f"linear solver failed (PETSc reason {min(r1, r2)})"
                 break
@@ -364,6 +385,8 @@ def solve_rigid_indenter(
     ksp.destroy()
     K_A.destroy()
     K.destroy()
+    if load_vec is not None:
+        load_vec.destroy()
     return ContactSolution(
         success=success,
         status=status,

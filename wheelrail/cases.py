@@ -46,6 +46,15 @@ from wheelrail.config import ConfigError, check_keys, get_number, get_table, rea
 
 TOP_LEVEL_TABLES = {"name", "description", "material", "geometry", "loading", "kinematics", "solver", "irregularities"}
 QUADRIC_GEOMETRY_KEYS = {"kind", "radius_long_m", "radius_lat_m"}
+IRREGULARITY_KEYS = {
+    "wheel_flat_length_m",
+    "wheel_flat_depth_m",
+    "wheel_flat_shape",
+    "wheel_flat_offset_m",
+    "corrugation_wavelength_m",
+    "corrugation_amplitude_m",
+    "corrugation_phase_rad",
+}
 WHEELSET_GEOMETRY_KEYS = {
     "kind",
     "wheel_profile",
@@ -161,7 +170,7 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
     name = str(doc.get("name", name))
     kind = geometry_table.get("kind")
     if kind == "quadric":
-        check_keys(geometry_table, QUADRIC_GEOMETRY_KEYS, "geometry")
+        check_keys(geometry_table, QUADRIC_GEOMETRY_KEYS | IRREGULARITY_KEYS, "geometry")
         radius_long = get_number(geometry_table, "radius_long_m", "geometry", positive=True)
         radius_lat = get_number(geometry_table, "radius_lat_m", "geometry", positive=True)
         force, approach = _read_loading(get_table(doc, "loading"), "normal_force_N")
@@ -173,8 +182,19 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
             get_number(kinematics, "rolling_speed_m_per_s", "kinematics", positive=True, default=1.0),
         )
         if "irregularities" in doc:
-            raise ConfigError("table [irregularities]: expected only in a wheelset case (geometry.kind = 'wheelset')")
-        geometry = ContactGeometry.quadric(radius_long, radius_lat, approach if approach is not None else 0.0)
+            raise ConfigError(
+                "table [irregularities]: expected only in a wheelset case (geometry.kind = 'wheelset'); a quadric "
+                "takes wheel_flat_* / corrugation_* keys in [geometry]"
+            )
+        if IRREGULARITY_KEYS & set(geometry_table):
+            if approach is not None:
+                raise ConfigError(
+                    "table [loading]: a quadric with a wheel flat or corrugation expects 'normal_force_N' "
+                    "(its sampled gap has no approach to prescribe)"
+                )
+            geometry = _irregular_geometry(geometry_table, radius_long, radius_lat)
+        else:
+            geometry = ContactGeometry.quadric(radius_long, radius_lat, approach if approach is not None else 0.0)
         return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
     if kind == "wheelset":
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
@@ -266,6 +286,42 @@ def read_wheel_irregularities(table: dict, nominal_radius_m: float, smoothing_wa
             ) from None
     sides = ("right", "left") if side == "both" else (side,)
     return {f"wheel_irregularities_{s}": tuple(wheel) for s in sides}
+
+
+def _irregular_geometry(table: dict, radius_long: float, radius_lat: float) -> ContactGeometry:
+    """The sampled gap of a quadric with a wheel flat and/or rail corrugation (ConfigError naming the key)."""
+    from rigid_dynamics.contact.irregular_patch import irregular_quadric_geometry
+    from rigid_dynamics.geometry.irregularities import RailCorrugation, WheelFlat
+
+    flat = corrugation = None
+    offset = get_number(table, "wheel_flat_offset_m", "geometry", default=0.0)
+    if "wheel_flat_length_m" in table:
+        length = get_number(table, "wheel_flat_length_m", "geometry", positive=True)
+        depth = None
+        if "wheel_flat_depth_m" in table:
+            depth = get_number(table, "wheel_flat_depth_m", "geometry", positive=True)
+        shape = table.get("wheel_flat_shape", "rounded")
+        if shape not in ("rounded", "new"):
+            raise ConfigError(f"key 'geometry.wheel_flat_shape' = {shape!r}: expected 'rounded' or 'new'")
+        try:
+            flat = WheelFlat(length, radius_long, depth, shape=shape)
+        except ValueError as exc:
+            raise ConfigError(f"key 'geometry.wheel_flat_length_m' = {length!r}: {exc}") from None
+    elif {"wheel_flat_depth_m", "wheel_flat_shape", "wheel_flat_offset_m"} & set(table):
+        raise ConfigError("table [geometry]: wheel-flat keys given without 'wheel_flat_length_m'")
+    if "corrugation_wavelength_m" in table or "corrugation_amplitude_m" in table:
+        wavelength = get_number(table, "corrugation_wavelength_m", "geometry", positive=True)
+        amplitude = get_number(table, "corrugation_amplitude_m", "geometry", positive=True)
+        phase = get_number(table, "corrugation_phase_rad", "geometry", default=0.0)
+        corrugation = RailCorrugation(wavelength, amplitude, phase, half_width_m=1.0)
+    elif "corrugation_phase_rad" in table:
+        raise ConfigError("table [geometry]: 'corrugation_phase_rad' given without the corrugation's wavelength")
+    try:
+        return irregular_quadric_geometry(
+            radius_long, radius_lat, flat=flat, flat_offset_m=offset, corrugation=corrugation
+        )
+    except ValueError as exc:
+        raise ConfigError(f"table [geometry]: {exc}") from None
 
 
 def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: dict, irregularities=None):

@@ -11,6 +11,9 @@ Commands:
     wheelrail stress                 numerical-stability stress sweep of a scene
     wheelrail sweep SWEEP.toml       parameter study on dask.distributed (wheelrail.sweep)
     wheelrail critical-speed SCENE   linear and nonlinear (limit-cycle) critical speed (wheelrail.critical)
+    wheelrail bench                  run time against error of every rung on the named cases
+    wheelrail compare CASE           one named case through the rungs side by side (maps, stresses, report)
+    wheelrail demo                   the default demo (make demo): a run, its peak contact through every rung
 
 Exit statuses (README, "What a run tells you"): 0 every result ok; 1 the work ran but a result is not ok
 (its status and message say why; the outputs are written); 2 bad input, found before any work: one line
@@ -508,7 +511,11 @@ COMMANDS: list = [_add_listings, _add_run, _add_contact, _add_conicity, _add_man
 A new subcommand in its own module: write ``cmd_x(args) -> int`` and ``add_x(sub)`` there, and add
 ``"package.module:add_x"`` to :data:`COMMAND_MODULES` (imported only when the parser is built)."""
 
-COMMAND_MODULES: list[str] = ["wheelrail.sweep:register", "wheelrail.critical:register"]
+COMMAND_MODULES: list[str] = [
+    "wheelrail.sweep:register",
+    "wheelrail.critical:register",
+    "wheelrail.comparison_commands:register",  # bench, compare, demo
+]
 """``"module:function"`` strings of subcommands defined in other modules (see :data:`COMMANDS`)."""
 
 

@@ -1,0 +1,469 @@
+"""Run time against error for every named case and every applicable rung at several resolutions.
+
+For each named case (:mod:`comparisons.named_cases`) and each model of the ladder at each of its resolutions
+(FASTSIM grid, BEM elements per side, FEA elements per semi-axis) the case is solved once (fast runs are
+repeated up to 5 times within 0.2 s and the shortest wall time kept) and compared with the case's reference:
+
+* relative errors of the normal force, the max pressure and the contact area: |v / v_ref - 1|;
+* the creep-force error |F - F_ref| / max(|F_ref|, 0.01 mu N_ref) with F = (Fx, Fy) (None where the model gives
+  no creep forces, e.g. FEA, which is frictionless);
+* the pressure-field error ||p - p_ref||_2 / ||p_ref||_2 on the reference's grid (model field bilinear, 0
+  outside its grid) where both fields exist and the side has one patch;
+* ``error``: the largest of these (field excluded) over the quantities the reference has; None when the model
+  cannot give one of them (then the run meets no tolerance).
+
+A wheelset case is solved as a whole (search, equilibrium, both wheels; the time is the whole case's) and
+compared on the reference's side (:mod:`comparisons.named_cases` on patch sums). A run that raises or does not
+succeed keeps its status and message; its numbers are not used as a result (no error, no tolerance).
+
+Outputs (:func:`write_bench`): ``bench.csv``, ``bench.md`` (per-case tables, the tolerance table: for 10, 5,
+2, 1 % the fastest run meeting it), ``bench.json`` and ``time_vs_error-<case>.png`` (log-log, one line per
+model, the Pareto front marked).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import platform
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+MODELS = ("hertz", "linear", "vermeulen-johnson", "fastsim", "bem", "fea")
+TANGENTIAL_MODELS = ("linear", "vermeulen-johnson", "fastsim")
+RESOLUTIONS: dict[str, list[tuple[str, dict]]] = {
+    "hertz": [("-", {})],
+    "linear": [("-", {})],
+    "vermeulen-johnson": [("-", {})],
+    "fastsim": [(f"{n}x{n}", {"nx": n, "ny": n}) for n in (5, 10, 20, 40)],
+    "bem": [(f"{n}x{n}", {"nx": n, "ny": n}) for n in (16, 32, 64)],
+    "fea": [(f"n{n}", {"elements_per_semi_axis": float(n)}) for n in (3, 6)],
+}
+"""model -> [(resolution label, model options)], full bench."""
+QUICK_RESOLUTIONS = {"fastsim": ("10x10", "20x20"), "bem": ("16x16", "32x32"), "fea": ("n3",)}
+"""model -> labels kept by ``--quick`` (models not listed keep all)."""
+TOLERANCES = (0.10, 0.05, 0.02, 0.01)
+QUANTITIES = ("normal_force_N", "creep_force_long_N", "creep_force_lat_N", "max_pressure_Pa", "contact_area_m2")
+ERROR_KEYS = ("err_normal_force", "err_creep_force", "err_max_pressure", "err_area")
+
+
+@dataclass
+class BenchRun:
+    """One (case, model, resolution) run: status, wall time, the compared values and their errors."""
+
+    case: str
+    source: str
+    model: str
+    resolution: str
+    status: str
+    message: str
+    wall_time_s: float
+    n_patches: int = 0
+    values: dict = field(default_factory=dict)
+    errors: dict = field(default_factory=dict)
+    error: float | None = None
+
+    def row(self) -> dict:
+        out = {
+            "case": self.case,
+            "source": self.source,
+            "model": self.model,
+            "resolution": self.resolution,
+            "status": self.status,
+            "wall_time_s": self.wall_time_s,
+            "n_patches": self.n_patches,
+        }
+        out.update({k: self.values.get(k) for k in QUANTITIES})
+        out.update({k: self.errors.get(k) for k in (*ERROR_KEYS, "err_field")})
+        out["error"] = self.error
+        out["message"] = self.message
+        return out
+
+
+def solve_contact_case(case, model: str, options: dict):
+    """Solve a validated contact case (``wheelrail.cases.ContactCase``) with ``model`` and extra model options.
+
+    Returns:
+        (patches, success, message): patches as (side, geometry, creepage, result) tuples.
+    """
+    from rigid_dynamics.contact.registry import get_model
+
+    if case.kind == "quadric":
+        opts = {**case.solver_options, **options}
+        result = get_model(model).solve(
+            case.geometry, case.creepage, case.material, normal_force_N=case.normal_force_N, options=opts or None
+        )
+        return [("single", case.geometry, case.creepage, result)], result.success, result.message
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    case_options = dict(case.solver_options)
+    case_options["model"] = {**(case_options.get("model") or {}), **options} or None
+    solution = solve_wheelset_case(case.wheelset, case.material, model, options=case_options)
+    patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
+    return patches, solution.success, solution.message
+
+
+def side_values(patches, side: str) -> dict:
+    """N, Fx, Fy summed over the side's patches, the largest max pressure and the summed area (None if absent)."""
+    results = [p[3] for p in patches if p[0] == side]
+
+    def total(name):
+        values = [getattr(r, name) for r in results]
+        return None if not values or any(v is None for v in values) else float(sum(values))
+
+    pressures = [r.max_pressure_Pa for r in results]
+    return {
+        "normal_force_N": total("normal_force_N"),
+        "creep_force_long_N": total("creep_force_long_N"),
+        "creep_force_lat_N": total("creep_force_lat_N"),
+        "max_pressure_Pa": None if not pressures or None in pressures else float(max(pressures)),
+        "contact_area_m2": total("contact_area_m2"),
+    }
+
+
+def case_errors(named, values: dict) -> tuple[dict, float | None]:
+    """Relative errors against the named case's reference (module docstring) and the headline error."""
+    ref = named.reference
+    errors: dict = {}
+    for key, name in (
+        ("normal_force_N", "err_normal_force"),
+        ("max_pressure_Pa", "err_max_pressure"),
+        ("contact_area_m2", "err_area"),
+    ):
+        if key in ref:
+            value = values.get(key)
+            errors[name] = None if value is None else abs(value / ref[key] - 1.0)
+    if "creep_force_long_N" in ref and "creep_force_lat_N" in ref:
+        fx, fy = values.get("creep_force_long_N"), values.get("creep_force_lat_N")
+        if fx is None or fy is None:
+            errors["err_creep_force"] = None
+        else:
+            mu = named.case.material.friction_coefficient
+            scale = max(
+                math.hypot(ref["creep_force_long_N"], ref["creep_force_lat_N"]), 0.01 * mu * ref["normal_force_N"]
+            )
+            errors["err_creep_force"] = (
+                math.hypot(fx - ref["creep_force_long_N"], fy - ref["creep_force_lat_N"]) / scale
+            )
+    headline = None if any(v is None for v in errors.values()) or not errors else max(errors.values())
+    return errors, headline
+
+
+def field_error(named, patches) -> float | None:
+    """||p - p_ref|| / ||p_ref|| on the reference grid (one patch on the side, both fields present), else None."""
+    on_side = [p[3] for p in patches if p[0] == named.side]
+    if len(on_side) != 1 or on_side[0].fields is None:
+        return None
+    grid = named.reference_grid()
+    if grid is None:
+        return None
+    from comparisons.named_cases import grid_interpolate
+
+    xx, yy = np.meshgrid(*grid)
+    p_ref = named.reference_pressure(xx, yy)
+    f = on_side[0].fields
+    p = grid_interpolate(f.x_m, f.y_m, np.asarray(f.pressure_Pa, float), xx, yy)
+    norm = float(np.linalg.norm(p_ref))
+    return float(np.linalg.norm(p - p_ref) / norm) if norm > 0 else None
+
+
+def applicable(named, model: str) -> bool:
+    """Tangential rungs (linear, VJ, FASTSIM) only where the reference has creep forces (else they equal hertz)."""
+    if model in TANGENTIAL_MODELS:
+        return "creep_force_long_N" in named.reference
+    return True
+
+
+def run_one(named, model: str, resolution: str, options: dict) -> BenchRun:
+    """Solve one named case with one model at one resolution and compare it with the reference."""
+    elapsed = []
+    patches, success, message = [], False, ""
+    try:
+        while True:
+            start = time.perf_counter()
+            patches, success, message = solve_contact_case(named.case, model, options)
+            elapsed.append(time.perf_counter() - start)
+            if len(elapsed) >= 5 or sum(elapsed) > 0.2 or not success:
+                break
+    except Exception as exc:  # a numerical failure is a status (the bench goes on with the next run)
+        return BenchRun(
+            named.name,
+            named.source,
+            model,
+            resolution,
+            "error",
+            f"{type(exc).__name__}: {exc}",
+            sum(elapsed) if elapsed else math.nan,
+        )
+    run = BenchRun(
+        named.name,
+        named.source,
+        model,
+        resolution,
+        "ok" if success else "failed",
+        message,
+        min(elapsed),
+        n_patches=sum(1 for p in patches if p[0] == named.side),
+    )
+    if not success:
+        return run
+    run.values = side_values(patches, named.side)
+    run.errors, run.error = case_errors(named, run.values)
+    run.errors["err_field"] = field_error(named, patches)
+    return run
+
+
+def bench_plan(cases, models=MODELS, quick: bool = False) -> list[tuple]:
+    """[(named case, model, resolution label, options)] in run order."""
+    plan = []
+    for named in cases:
+        for model in models:
+            if not applicable(named, model):
+                continue
+            for label, options in RESOLUTIONS[model]:
+                if quick and model in QUICK_RESOLUTIONS and label not in QUICK_RESOLUTIONS[model]:
+                    continue
+                plan.append((named, model, label, options))
+    return plan
+
+
+def warm_up(model: str) -> None:
+    """Solve one small quadric patch with ``model`` untimed: loads numba's cache / JIT-compiles the FEA forms, so
+    that the first timed run measures the solve and not the compilation.
+    """
+    from rigid_dynamics.contact.registry import get_model
+    from rigid_dynamics.contact.types import ContactGeometry, Creepage
+    from rigid_dynamics.materials import Material
+
+    options = {"fea": {"quick": True}, "bem": {"nx": 8, "ny": 8}, "fastsim": {"nx": 5, "ny": 5}}.get(model)
+    get_model(model).solve(
+        ContactGeometry.quadric(0.46, 0.30),
+        Creepage(1e-4, 0.0, 0.1),
+        Material(82e9, 0.28, 0.3),
+        normal_force_N=1e4,
+        options=options,
+    )
+
+
+def run_bench(cases, models=MODELS, quick: bool = False, progress=None) -> list[BenchRun]:
+    """Run the plan; ``progress(done, total, label)`` is called after each run (e.g. a tqdm bar)."""
+    plan = bench_plan(cases, models, quick)
+    for model in dict.fromkeys(p[1] for p in plan):
+        warm_up(model)
+    runs = []
+    for i, (named, model, label, options) in enumerate(plan):
+        runs.append(run_one(named, model, label, options))
+        if progress is not None:
+            progress(i + 1, len(plan), f"{named.name} {model} {label}")
+    return runs
+
+
+def machine() -> str:
+    """One line on the machine (platform, CPUs, Python, load average)."""
+    load = os.getloadavg() if hasattr(os, "getloadavg") else ("n/a",)
+    return (
+        f"{platform.platform()}, {platform.machine()}, {os.cpu_count()} CPUs (one process, shared machine), "
+        f"Python {platform.python_version()}; load average {tuple(round(v, 2) for v in load)}"
+    )
+
+
+def tolerance_table(runs: list[BenchRun]) -> dict:
+    """The tolerance table: case -> {tolerance: fastest successful run with error <= tolerance (or None)}."""
+    table: dict = {}
+    for run in runs:
+        table.setdefault(run.case, {t: None for t in TOLERANCES})
+        if run.status != "ok" or run.error is None:
+            continue
+        for tol in TOLERANCES:
+            best = table[run.case][tol]
+            if run.error <= tol and (best is None or run.wall_time_s < best.wall_time_s):
+                table[run.case][tol] = run
+    return table
+
+
+def pareto_front(runs: list[BenchRun]) -> list[BenchRun]:
+    """Runs with an error not beaten by any faster run (sorted by time)."""
+    ok = sorted((r for r in runs if r.status == "ok" and r.error is not None), key=lambda r: (r.wall_time_s, r.error))
+    front, best = [], math.inf
+    for run in ok:
+        if run.error < best:
+            front.append(run)
+            best = run.error
+    return front
+
+
+def _fmt(value, scale=1.0, digits=4) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "-"
+    return f"{value * scale:.{digits}g}"
+
+
+def _pct(value) -> str:
+    if value is None:
+        return "-"
+    return f"{100 * value:.2g} %" if value >= 1e-4 else "<0.01 %"
+
+
+def _time(seconds) -> str:
+    if seconds is None or not math.isfinite(seconds):
+        return "-"
+    return f"{seconds * 1e3:.3g} ms" if seconds < 1 else f"{seconds:.3g} s"
+
+
+def markdown(runs: list[BenchRun], cases, quick: bool, wall_s: float, plots: dict) -> str:
+    """The bench report (tolerance table first, then one table per case)."""
+    lines = [
+        "# Contact bench: run time against error",
+        "",
+        f"{'Quick' if quick else 'Full'} run, {len(runs)} runs in {wall_s:.0f} s. Machine: {machine()}.",
+        "",
+        "Errors against each case's reference (closed form, CONTACT's published solution, or the BEM Richardson "
+        "limit: column `source`). `error` is the largest of the normal-force, creep-force, max-pressure and area "
+        "errors; `-` where a model gives no such number (FEA is frictionless, Hertz has no creep forces: 100 %). "
+        "Times are wall times of one case solve (a wheelset case includes the contact search and equilibrium).",
+        "",
+        "## Tolerance table: the fastest run meeting each tolerance",
+        "",
+        "| case | source | " + " | ".join(f"{int(t * 100)} %" for t in TOLERANCES) + " |",
+        "|---|---|" + "---|" * len(TOLERANCES),
+    ]
+    table = tolerance_table(runs)
+    sources = {c.name: c.source for c in cases}
+    for case, row in table.items():
+        cells = []
+        for tol in TOLERANCES:
+            run = row[tol]
+            cells.append("none" if run is None else f"{run.model} {run.resolution} ({_time(run.wall_time_s)})")
+        lines.append(f"| {case} | {sources.get(case, '')} | " + " | ".join(cells) + " |")
+    lines += ["", "## Per case", ""]
+    for named in cases:
+        case_runs = [r for r in runs if r.case == named.name]
+        if not case_runs:
+            continue
+        lines += [f"### {named.name}", "", f"{named.note} (reference: {named.source}).", ""]
+        if named.uncertainty:
+            own = ", ".join(f"{k} {_pct(v)}" for k, v in named.uncertainty.items() if v > 1e-9)
+            lines += [f"The reference's own error estimate: {own or 'below 1e-9'}.", ""]
+        if named.name in plots:
+            lines += [f"![time vs error]({plots[named.name]})", ""]
+        lines += [
+            "| model | res | status | time | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm2] | err N | err F "
+            "| err p | err area | err field | error |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        ]
+        ref = named.reference
+        lines.append(
+            f"| reference | | {named.source} | | {_fmt(ref.get('normal_force_N'))} | "
+            f"{_fmt(ref.get('creep_force_long_N'))} | {_fmt(ref.get('creep_force_lat_N'))} | "
+            f"{_fmt(ref.get('max_pressure_Pa'), 1e-6)} | {_fmt(ref.get('contact_area_m2'), 1e6)} | | | | | | |"
+        )
+        for r in case_runs:
+            v, e = r.values, r.errors
+            status = r.status if r.status == "ok" else f"{r.status}: {r.message[:60]}"
+            lines.append(
+                f"| {r.model} | {r.resolution} | {status} | {_time(r.wall_time_s)} | {_fmt(v.get('normal_force_N'))} | "
+                f"{_fmt(v.get('creep_force_long_N'))} | {_fmt(v.get('creep_force_lat_N'))} | "
+                f"{_fmt(v.get('max_pressure_Pa'), 1e-6)} | {_fmt(v.get('contact_area_m2'), 1e6)} | "
+                f"{_pct(e.get('err_normal_force'))} | {_pct(e.get('err_creep_force'))} | "
+                f"{_pct(e.get('err_max_pressure'))} | {_pct(e.get('err_area'))} | {_pct(e.get('err_field'))} | "
+                f"{_pct(r.error)} |"
+            )
+        lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def plot_case(runs: list[BenchRun], case: str, path) -> bool:
+    """Log-log wall time vs error for one case: one line per model, the Pareto front marked. False if no data."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from comparisons.files import save_figure_atomic
+
+    floor = 1e-6
+    ok = [r for r in runs if r.case == case and r.status == "ok" and r.error is not None]
+    if not ok:
+        return False
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for model in MODELS:
+        pts = sorted((r.wall_time_s, max(r.error, floor), r.resolution) for r in ok if r.model == model)
+        if not pts:
+            continue
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label=model)
+        for t, e, label in pts:
+            if label != "-":
+                ax.annotate(label, (t, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    front = pareto_front(ok)
+    ax.plot(
+        [r.wall_time_s for r in front],
+        [max(r.error, floor) for r in front],
+        "k--",
+        marker="o",
+        markerfacecolor="none",
+        markersize=11,
+        label="Pareto front",
+    )
+    for tol in TOLERANCES:
+        ax.axhline(tol, color="0.8", lw=0.8, zorder=0)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time of one case solve [s]")
+    ax.set_ylabel(f"error against the reference (floor {floor:g})")
+    ax.set_title(case)
+    ax.legend(fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def _run_brief(run: BenchRun | None) -> dict | None:
+    if run is None:
+        return None
+    return {"model": run.model, "resolution": run.resolution, "wall_time_s": run.wall_time_s, "error": run.error}
+
+
+def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float) -> dict:
+    """Write bench.csv, bench.json, bench.md and the per-case plots into ``out_dir``; return the summary."""
+    import csv
+    import io
+    from pathlib import Path
+
+    from comparisons.files import write_json_atomic, write_text_atomic
+
+    out_dir = Path(out_dir)
+    rows = [r.row() for r in runs]
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(rows[0]) if rows else ["case"])
+    writer.writeheader()
+    writer.writerows(rows)
+    write_text_atomic(out_dir / "bench.csv", buffer.getvalue())
+    plots = {}
+    for named in cases:
+        name = f"time_vs_error-{named.name}.png"
+        if plot_case(runs, named.name, out_dir / name):
+            plots[named.name] = name
+    from comparisons.claims import claims_markdown, evaluate_claims
+
+    claims = evaluate_claims(runs)
+    table = tolerance_table(runs)
+    summary = {
+        "quick": quick,
+        "machine": machine(),
+        "wall_time_s": wall_s,
+        "runs": rows,
+        "tolerance_table": {
+            case: {f"{int(t * 100)}%": _run_brief(r) for t, r in row.items()} for case, row in table.items()
+        },
+        "plots": plots,
+        "claims": [{k: v for k, v in c.items()} for c in claims],
+    }
+    write_json_atomic(out_dir / "bench.json", summary)
+    text = markdown(runs, cases, quick, wall_s, plots)
+    head, sep, rest = text.partition("## Per case")
+    write_text_atomic(out_dir / "bench.md", head + claims_markdown(claims) + "\n" + sep + rest)
+    return summary

@@ -1,0 +1,94 @@
+"""wheelrail bench on a tiny plan (two cases, cheap rungs): files, errors, tolerance table, bad input.
+
+The error metrics are checked on synthetic numbers; the bench run itself is a smoke/regression test of the
+driver (its physics is the models', verified in their own tests).
+"""
+
+import csv
+import json
+import math
+
+import pytest
+
+from comparisons import bench
+from comparisons.bench import BenchRun, case_errors, pareto_front, tolerance_table
+from wheelrail.cli import main
+from wheelrail.named_cases import load_named_case
+
+
+def test_case_errors_on_synthetic_numbers():
+    named = load_named_case("creep-long-mid")
+    ref = named.reference
+    values = dict(ref)
+    values["max_pressure_Pa"] = ref["max_pressure_Pa"] * 1.03
+    values["creep_force_long_N"] = ref["creep_force_long_N"] * 0.9
+    errors, headline = case_errors(named, values)
+    assert errors["err_max_pressure"] == pytest.approx(0.03)
+    assert errors["err_creep_force"] == pytest.approx(0.1)
+    assert headline == pytest.approx(0.1)
+    values["creep_force_lat_N"] = None  # a frictionless model meets no tolerance on a creep case
+    assert case_errors(named, values)[1] is None
+
+
+def test_pareto_front_and_tolerance_table():
+    runs = [
+        BenchRun("c", "s", "a", "-", "ok", "", 1e-3, error=0.2),
+        BenchRun("c", "s", "b", "1", "ok", "", 1e-2, error=0.04),
+        BenchRun("c", "s", "b", "2", "ok", "", 2e-2, error=0.05),
+        BenchRun("c", "s", "c", "-", "ok", "", 1e-1, error=0.005),
+        BenchRun("c", "s", "d", "-", "failed", "", 1e-4, error=None),
+    ]
+    assert [r.model + r.resolution for r in pareto_front(runs)] == ["a-", "b1", "c-"]
+    table = tolerance_table(runs)["c"]
+    assert table[0.10].resolution == "1" and table[0.05].resolution == "1"
+    assert table[0.02].model == "c" and table[0.01].model == "c"
+
+
+def test_tiny_bench_writes_csv_markdown_plots(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(bench.RESOLUTIONS, "bem", [("8x8", {"nx": 8, "ny": 8}), ("16x16", {"nx": 16, "ny": 16})])
+    monkeypatch.setitem(bench.RESOLUTIONS, "fastsim", [("5x5", {"nx": 5, "ny": 5})])
+    code = main(
+        ["bench", "--cases", "hertz-ab-1", "creep-long-mid", "--models", "hertz", "vermeulen-johnson", "fastsim",
+         "bem", "--out", str(tmp_path)]
+    )  # fmt: skip
+    assert code == 0
+    rows = list(csv.DictReader(open(tmp_path / "bench.csv")))
+    assert {r["model"] for r in rows} == {"hertz", "vermeulen-johnson", "fastsim", "bem"}
+    # tangential rungs only where the reference has creep forces
+    assert not [r for r in rows if r["case"] == "hertz-ab-1" and r["model"] == "fastsim"]
+    assert all(r["status"] == "ok" for r in rows)
+    hertz = next(r for r in rows if r["case"] == "hertz-ab-1" and r["model"] == "hertz")
+    assert float(hertz["error"]) < 1e-9  # Hertz against its closed form
+    summary = json.loads((tmp_path / "bench.json").read_text())
+    assert summary["tolerance_table"]["hertz-ab-1"]["1%"]["model"] == "hertz"
+    text = (tmp_path / "bench.md").read_text()
+    assert "Tolerance table" in text and "| creep-long-mid |" in text
+    assert (tmp_path / "time_vs_error-creep-long-mid.png").stat().st_size > 1000
+    assert "fastest within 5 %" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["bench", "--cases", "nope"], "case 'nope': expected one of"),
+        (["bench", "--models", "magic"], "--models 'magic': expected some of"),
+        (["compare", "nope"], "case 'nope': expected one of"),
+        (["compare", "hertz-ab-1", "--models", "linear2"], "--models 'linear2'"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(argv, match, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wheelrail: error:") and match in err and "Traceback" not in err
+
+
+def test_failed_run_is_a_status_not_a_number(monkeypatch):
+    named = load_named_case("hertz-ab-1")
+
+    def boom(*args, **kwargs):
+        raise FloatingPointError("diverged")
+
+    monkeypatch.setattr(bench, "solve_contact_case", boom)
+    run = bench.run_one(named, "bem", "8x8", {})
+    assert run.status == "error" and "diverged" in run.message and run.error is None and not run.values
+    assert math.isnan(run.wall_time_s) or run.wall_time_s >= 0

@@ -1,0 +1,87 @@
+"""wheelrail compare on the Hertz circle (coarse settings): report, maps, and the subsurface check.
+
+Verification: on the Hertz circle the maximum shear below the patch from the half-space solution of the BEM
+pressure and from FEA must both be Johnson's 0.31 p0 at 0.48 a (nu = 0.3; Johnson 1985 fig. 3.9), here with
+nu = 0.28 of the case: the closed-form axis stresses (Johnson eq 3.45) give the target for that nu.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from comparisons import compare
+from rigid_dynamics.contact.subsurface import hertz_axis_stresses
+from wheelrail.cli import main
+from wheelrail.named_cases import load_named_case
+
+
+def _johnson_max_shear(nu):
+    t = np.linspace(0.3, 0.7, 4001)
+    s_r, s_z = hertz_axis_stresses(t, nu)
+    tau = 0.5 * (s_r - s_z)
+    return float(tau.max()), float(t[np.argmax(tau)])
+
+
+@pytest.mark.fea
+def test_compare_hertz_circle_report_and_subsurface_check(tmp_path, monkeypatch):
+    monkeypatch.setattr(compare, "CUT_POINTS", (21, 25))
+    monkeypatch.setitem(compare.DEFAULT_OPTIONS, "bem", {"nx": 40, "ny": 40})
+    out = tmp_path / "cmp"
+    code = main(["compare", "hertz-ab-1", "--models", "hertz", "bem", "fea", "--out", str(out)])
+    assert code == 0
+    for name in ("report.md", "report.html", "pressure.png", "pressure_difference.png", "subsurface.png"):
+        assert (out / name).stat().st_size > 500, name
+    summary = json.loads((out / "compare.json").read_text())
+    named = load_named_case("hertz-ab-1")
+    p0, a = named.reference["max_pressure_Pa"], named.reference["semi_axis_long_m"]
+    target, depth = _johnson_max_shear(named.case.material.poisson_ratio)
+    assert target == pytest.approx(0.31, abs=0.01) and depth == pytest.approx(0.48, abs=0.03)
+    by_source = {s["source"]: s for s in summary["subsurface"]}
+    bem = by_source["BEM pressure, half-space"]
+    fea = by_source["FEA (frictionless)"]
+    # cut grid: 25 depths down to ~1.2 a, so the depth is resolved to ~0.05 a
+    assert bem["max_shear_Pa"] / p0 == pytest.approx(target, rel=0.03)
+    assert bem["max_shear_depth_m"] / a == pytest.approx(depth, abs=0.1)
+    assert fea["max_shear_Pa"] / p0 == pytest.approx(target, rel=0.06)  # FEA default mesh, nodal recovery
+    assert fea["max_shear_depth_m"] / a == pytest.approx(depth, abs=0.1)
+    # orthogonal shear s_xd (odd in x: the quarter model's mirrored points flip its sign): FEA against the half-space
+    assert fea["max_orthogonal_shear_Pa"] == pytest.approx(bem["max_orthogonal_shear_Pa"], rel=0.1)
+    html = (out / "report.html").read_text()
+    assert "<table>" in html and 'src="subsurface.png"' in html
+
+
+@pytest.mark.fea
+def test_fea_with_bem_tractions_matches_the_half_space_solution(monkeypatch):
+    """Full slip (mu = 0.3): the BEM tractions applied to the FE block raise its von Mises maximum as in the
+    half-space solution of the same tractions (second method), and agree with it. The maximum moves up by
+    ~0.16 mm in the half-space solution, less than the FE element size (a/6 = 0.55 mm): the FE depth is only
+    checked to that size."""
+    monkeypatch.setattr(compare, "CUT_POINTS", (15, 40))
+    named = load_named_case("creep-long-saturated")
+    from comparisons.bench import solve_contact_case
+
+    patches, ok, _ = solve_contact_case(named.case, "bem", {"nx": 40, "ny": 40})
+    assert ok
+    cuts, sources, fea = compare.subsurface(named, patches[0], {})
+    by = {s["source"]: s for s in sources}
+    frictionless, with_t = by["BEM pressure, half-space"], by["BEM pressure + tractions, half-space"]
+    fe = by["FEA (BEM tractions applied)"]
+    assert "minus the wheel tractions of the BEM" in fea.extra["surface_traction"]
+    assert with_t["max_von_mises_depth_m"] < frictionless["max_von_mises_depth_m"]
+    rise = with_t["max_von_mises_Pa"] - frictionless["max_von_mises_Pa"]
+    assert rise > 0.03 * frictionless["max_von_mises_Pa"]
+    assert fe["max_von_mises_Pa"] - frictionless["max_von_mises_Pa"] > 0.5 * rise
+    assert fe["max_von_mises_Pa"] == pytest.approx(with_t["max_von_mises_Pa"], rel=0.03)
+    assert abs(fe["max_von_mises_depth_m"] - with_t["max_von_mises_depth_m"]) < fea.extra["element_size_m"]
+
+
+def test_fea_surface_traction_option_is_validated():
+    from fea.model import FeaOptions
+
+    with pytest.raises(ValueError, match="surface_traction.traction_lat_Pa: expected finite values of shape"):
+        FeaOptions.from_mapping(
+            {"surface_traction": {"x_m": [0, 1], "y_m": [0], "traction_long_Pa": [[0, 0]], "traction_lat_Pa": [[0]]}}
+        )
+    with pytest.raises(ValueError, match="missing"):
+        FeaOptions.from_mapping({"surface_traction": {"x_m": [0.0]}})

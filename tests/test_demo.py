@@ -1,0 +1,26 @@
+"""The demo on a short run (0.1 s of the polygonal-wheel scene, no FEA): the peak patch and the report.
+
+Smoke/regression test of the demo driver; the physics of each step is tested elsewhere.
+"""
+
+import pytest
+
+from comparisons import compare
+from wheelrail.cli import main
+from wheelrail.scenes import resolve_scene_path
+
+
+@pytest.mark.slow
+def test_short_demo_writes_the_report(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(compare, "CUT_POINTS", (11, 7))
+    text = resolve_scene_path("polygonal-wheel").read_text().replace("duration_s = 2.0", "duration_s = 0.1")
+    scene = tmp_path / "short.toml"
+    scene.write_text(text)
+    out = tmp_path / "demo"
+    assert main(["demo", str(scene), "--models", "hertz", "fastsim", "bem", "--out", str(out)]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[-4].startswith("report: ") and lines[-3].startswith("run: 0.1 s")
+    assert "max pressure [MPa] Hertz" in lines[-2] and "subsurface max von Mises" in lines[-1]
+    report = (out / "report.md").read_text()
+    assert "## Time series" in report and "compare/pressure.png" in report
+    assert (out / "report.html").exists() and (out / "compare" / "subsurface.png").exists()

@@ -1,0 +1,202 @@
+"""The ``bench`` and ``compare`` commands (registered in :mod:`wheelrail.cli` by :func:`register`).
+
+    wheelrail bench [--quick] [--cases NAME ...] [--models NAME ...] [--out DIR]
+    wheelrail compare CASE [--models NAME ...] [--out DIR]
+
+CASE / NAME: a named case of ``comparisons/cases/`` (``wheelrail bench --list``) or a folder holding
+``case.toml`` and ``reference.toml``. Bad names end with ``wheelrail: error: ...`` (exit 2).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+from wheelrail.config import ConfigError
+
+
+def _check_models(models, allowed) -> list[str]:
+    models = list(models or allowed)
+    for name in models:
+        if name not in allowed:
+            raise ConfigError(f"--models {name!r}: expected some of {', '.join(allowed)}")
+    return models
+
+
+def _bar(total: int, label: str):
+    """A tqdm bar on a terminal (None elsewhere) and a callback advancing it."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=label, unit="run", leave=False, disable=not sys.stderr.isatty())
+
+    def update(done: int, total: int, text: str) -> None:
+        bar.set_postfix_str(text[:40], refresh=False)
+        bar.update(done - bar.n)
+
+    return bar, update
+
+
+def cmd_bench(args) -> int:
+    from comparisons.bench import MODELS, bench_plan, run_bench, write_bench
+    from wheelrail.named_cases import load_named_cases, named_case_names
+    from wheelrail.output import new_output_dir
+
+    if args.list:
+        for name in named_case_names():
+            print(name)
+        return 0
+    models = _check_models(args.models, MODELS)
+    cases = load_named_cases(args.cases)
+    out_dir = new_output_dir(args.out, "bench-quick" if args.quick else "bench")
+    bar, update = _bar(len(bench_plan(cases, models, args.quick)), "bench")
+    start = time.perf_counter()
+    try:
+        runs = run_bench(cases, models, args.quick, progress=update)
+    finally:
+        bar.close()
+    summary = write_bench(runs, cases, out_dir, args.quick, time.perf_counter() - start)
+    failed = [r for r in runs if r.status != "ok"]
+    print(f"bench: {len(runs)} runs over {len(cases)} cases in {summary['wall_time_s']:.0f} s, {len(failed)} not ok")
+    for case, row in summary["tolerance_table"].items():
+        best = row["5%"]
+        text = "none" if best is None else f"{best['model']} {best['resolution']} ({best['wall_time_s'] * 1e3:.3g} ms)"
+        print(f"  {case:<22} fastest within 5 %: {text}")
+    print(f"output written to {out_dir} (bench.md, bench.csv, time_vs_error-*.png)")
+    return 0
+
+
+def cmd_compare(args) -> int:
+    from comparisons.compare import COMPARE_MODELS, run_compare
+    from wheelrail.named_cases import load_named_case
+    from wheelrail.output import copy_input, new_output_dir
+
+    models = _check_models(args.models, COMPARE_MODELS)
+    named = load_named_case(args.case)
+    out_dir = new_output_dir(args.out, f"compare-{named.name}")
+    copy_input(named.case_path, out_dir, "case.toml")
+    report = run_compare(named, out_dir, models=models)
+    for line in report["headlines"]:
+        print(line)
+    print(f"report: {Path(out_dir) / 'report.md'} (and report.html)")
+    return 0 if report["success"] else 1
+
+
+def cmd_demo(args) -> int:
+    """The default demo (``make demo``): polygonal-wheel run, compare at the peak normal force, report."""
+    from comparisons.compare import COMPARE_MODELS, _html, run_compare
+    from comparisons.demo import peak_patch_case
+    from comparisons.files import write_text_atomic
+    from comparisons.named_cases import NamedCase
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.output import new_output_dir
+    from wheelrail.scenes import load_scene, resolve_scene_path, write_run_outputs
+
+    models = _check_models(args.models, COMPARE_MODELS)
+    source = resolve_scene_path(args.scene)
+    scene = load_scene(source)
+    out_dir = new_output_dir(args.out, f"demo-{source.stem}")
+    start = time.perf_counter()
+    print(f"demo 1/3: {source.stem}, {scene.duration_s:g} s with {scene.contact_model} (3-D contact search)")
+    result = simulate(scene)
+    summary = write_run_outputs(result, source, out_dir / "run")
+    if not result.success:
+        print(f"demo: the run ended with {result.status}: {result.message}")
+        return 1
+    patch = peak_patch_case(result)
+    print(
+        f"demo 2/3: peak normal force {patch.normal_force_N / 1e3:.1f} kN on the {patch.side} wheel at "
+        f"t = {patch.time_s:.3f} s: re-solved by {', '.join(models)}"
+    )
+    note = (
+        f"{source.stem}: the patch of the largest normal force of the run ({patch.side} wheel, slot {patch.slot}, "
+        f"t = {patch.time_s:.3f} s, N = {patch.normal_force_N / 1e3:.2f} kN; the first quarter of the run, at most "
+        "0.3 s, is left out: the transient from the static equilibrium), re-solved under that force"
+    )
+    named = NamedCase("peak-contact", out_dir, "none (no reference: the BEM is the most exact rung here)", "single",
+                      {}, note=note, case=patch)  # fmt: skip
+    compare = run_compare(named, out_dir / "compare", models=models)
+    print("demo 3/3: report")
+    models = compare["models"]
+
+    def p0(model):
+        value = models.get(model, {}).get("values", {}).get("max_pressure_Pa")
+        return "-" if value is None else f"{value / 1e6:.0f}"
+
+    def creep(model):
+        v = models.get(model, {}).get("values", {})
+        fx, fy = v.get("creep_force_long_N"), v.get("creep_force_lat_N")
+        return "-" if fx is None or fy is None else f"{math.hypot(fx, fy) / 1e3:.2f}"
+
+    stresses = {s["source"]: s for s in compare["subsurface"]}
+    with_t = stresses.get("BEM pressure + tractions, half-space", {})
+    fea = next((v for k, v in stresses.items() if k.startswith("FEA")), {})
+    headlines = [
+        f"run: {result.simulated_time_s:g} s of {source.stem} in {summary['wall_time_s']:.1f} s wall "
+        f"(real-time factor {summary['real_time_factor']:.2g}); peak wheel-rail normal force "
+        f"{patch.normal_force_N / 1e3:.1f} kN at t = {patch.time_s:.3f} s ({patch.side} wheel)",
+        f"at the peak, max pressure [MPa] Hertz {p0('hertz')}, FASTSIM {p0('fastsim')}, BEM {p0('bem')}, "
+        f"FEA {p0('fea')}; creep force [kN] FASTSIM {creep('fastsim')}, BEM {creep('bem')}",
+        "subsurface max von Mises: "
+        + (
+            f"BEM + tractions (half-space) {with_t['max_von_mises_Pa'] / 1e6:.0f} MPa at "
+            f"{with_t['max_von_mises_depth_m'] * 1e3:.2f} mm"
+            if with_t.get("max_von_mises_Pa")
+            else "n/a"
+        )
+        + (
+            f", {fea['source']} {fea['max_von_mises_Pa'] / 1e6:.0f} MPa at {fea['max_von_mises_depth_m'] * 1e3:.2f} mm"
+            if fea.get("max_von_mises_Pa")
+            else ", FEA n/a"
+        ),
+    ]
+    run_pngs = sorted(p.name for p in (out_dir / "run").glob("*.png"))
+    compare_md = (out_dir / "compare" / "report.md").read_text()
+    compare_md = compare_md.replace("](", "](compare/").replace("# peak-contact", "## Contact at the peak", 1)
+    lines = [
+        f"# wheelrail demo: {source.stem}",
+        "",
+        *[f"- {h}" for h in headlines],
+        "",
+        f"Total wall time {time.perf_counter() - start:.0f} s. Run folder: run/ (scene.toml, summary.json, "
+        "timeseries.npz); comparison folder: compare/.",
+        "",
+        "## Time series",
+        "",
+        *[f"![{name}](run/{name})" for name in run_pngs],
+        "",
+        compare_md,
+    ]
+    text = "\n".join(lines) + "\n"
+    write_text_atomic(out_dir / "report.md", text)
+    write_text_atomic(out_dir / "report.html", _html(text, f"wheelrail demo: {source.stem}"))
+    print(f"report: {out_dir / 'report.md'} (and report.html)")
+    for line in headlines:
+        print(line)
+    return 0 if compare["success"] else 1
+
+
+def register(sub) -> None:
+    """Add the ``bench``, ``compare`` and ``demo`` sub-commands to the CLI's subparsers."""
+    from wheelrail.cli import out_path
+
+    bench = sub.add_parser("bench", help="run time against error of every rung on the named cases")
+    bench.add_argument("--quick", action="store_true", help="fewer resolutions (a few minutes on 2 cores)")
+    bench.add_argument("--cases", nargs="+", metavar="NAME", help="named cases (default: all)")
+    bench.add_argument("--models", nargs="+", metavar="NAME", help="models (default: all rungs)")
+    bench.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/bench-<time>)")
+    bench.add_argument("--list", action="store_true", help="list the named cases")
+    bench.set_defaults(func=cmd_bench)
+
+    compare = sub.add_parser("compare", help="one case through Hertz, FASTSIM, BEM and FEA side by side")
+    compare.add_argument("case", help="named case (see `wheelrail bench --list`) or case folder")
+    compare.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
+    compare.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/compare-<case>-<time>)")
+    compare.set_defaults(func=cmd_compare)
+
+    demo = sub.add_parser("demo", help="the default demo: a run, the contact at its peak through every rung, report")
+    demo.add_argument("scene", nargs="?", default="polygonal-wheel", help="scene with the 3-D contact search")
+    demo.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
+    demo.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
+    demo.set_defaults(func=cmd_demo)

@@ -1,0 +1,75 @@
+"""Reading the named benchmark cases of ``comparisons/cases/<name>/`` (layout: :mod:`comparisons.named_cases`).
+
+Bad names or files raise :class:`~wheelrail.config.ConfigError` naming the case, the key and the value.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import tomllib
+from pathlib import Path
+
+from comparisons.named_cases import CASES_ROOT, SOURCES, NamedCase, contact_row_reference
+from wheelrail.config import ConfigError
+
+
+def named_case_names() -> list[str]:
+    """Names of the named cases (folders with a reference.toml), sorted."""
+    return sorted(p.parent.name for p in CASES_ROOT.glob("*/reference.toml"))
+
+
+def _contact_reference(folder: Path) -> dict:
+    """Sum of the published CONTACT rows of ``contact_reference.csv`` (N, Fx, Fy summed; max p; summed area)."""
+    with open(folder / "contact_reference.csv", newline="") as handle:
+        rows = list(csv.DictReader(line for line in handle if not line.startswith("#")))
+    if not rows:
+        raise ConfigError(f"{folder / 'contact_reference.csv'}: no data row")
+    parts = [contact_row_reference(r) for r in rows]
+    out = {k: sum(p[k] for p in parts) for k in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")}
+    out["max_pressure_Pa"] = max(p["max_pressure_Pa"] for p in parts)
+    out["contact_area_m2"] = sum(p["contact_area_m2"] for p in parts)
+    return out
+
+
+def load_named_case(name_or_folder: str | Path) -> NamedCase:
+    """Read a named case: a name under ``comparisons/cases`` or a folder path holding case.toml + reference.toml."""
+    from wheelrail.cases import load_case
+
+    folder = Path(name_or_folder)
+    if not (folder / "reference.toml").is_file():
+        folder = CASES_ROOT / str(name_or_folder)
+    if not (folder / "reference.toml").is_file():
+        raise ConfigError(f"case {str(name_or_folder)!r}: expected one of {', '.join(named_case_names())}")
+    path = folder / "reference.toml"
+    try:
+        with open(path, "rb") as handle:
+            doc = tomllib.load(handle)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    source = doc.get("source")
+    if source not in SOURCES:
+        raise ConfigError(f"key 'source' = {source!r} in {path}: expected one of {', '.join(SOURCES)}")
+    reference = {}
+    for key, value in doc.get("reference", {}).items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ConfigError(f"key 'reference.{key}' = {value!r} in {path}: expected a finite number")
+        reference[key] = float(value)
+    if source == "contact-published":
+        reference = {**_contact_reference(folder), **reference}
+    return NamedCase(
+        name=folder.name,
+        folder=folder,
+        source=source,
+        side=str(doc.get("side", "single")),
+        reference=reference,
+        uncertainty={k: float(v) for k, v in doc.get("uncertainty", {}).items()},
+        note=str(doc.get("note", "")),
+        tags=tuple(doc.get("tags", ())),
+        case=load_case(folder / "case.toml"),
+    )
+
+
+def load_named_cases(names=None) -> list[NamedCase]:
+    """The named cases ``names`` (all when None or empty), in the given order."""
+    return [load_named_case(n) for n in (names or named_case_names())]
