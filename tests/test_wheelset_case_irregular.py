@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 import pytest
+from hardening_helpers import QUADRIC
 
 from rigid_dynamics.contact.search import WheelsetPose, _SideGeometry
 from rigid_dynamics.contact.track import build_track
@@ -275,20 +276,13 @@ def test_bad_irregularity_keys_fail_with_one_line(tmp_path, capsys, old, new, pa
 
 
 def test_irregularities_table_is_refused_in_a_quadric_case():
-    text = """
-[material]
-shear_modulus_Pa = 82e9
-poisson_ratio = 0.28
-friction_coefficient = 0.3
-[geometry]
-kind = "quadric"
-radius_long_m = 0.46
-radius_lat_m = 0.3
-[loading]
-normal_force_N = 1e5
+    text = (
+        QUADRIC
+        + """
 [irregularities]
 flat_length_m = 0.05
 """
+    )
     with pytest.raises(ConfigError, match=r"table \[irregularities\]: expected only in a wheelset case"):
         _parse(text)
 
