@@ -50,6 +50,7 @@ from numba import njit
 
 from rigid_dynamics.contact.fastsim import effective_flexibilities
 from rigid_dynamics.contact.kalker import kalker_coefficients
+from rigid_dynamics.contact.models import HertzianModel
 from rigid_dynamics.contact.options import Option, declare
 
 
@@ -264,7 +265,7 @@ def _rolling_sign(rolling_direction_rad: float) -> float:
     return 1.0 if c > 0 else -1.0
 
 
-class FastripModel:
+class FastripModel(HertzianModel):
     """Hertz + FaStrip (module docstring): the registered model ``fastrip``.
 
     Options (``OPTIONS``): ``nx`` (elements per strip, int >= 1), ``ny`` (strips, int >= 1),
@@ -275,24 +276,16 @@ class FastripModel:
 
     name = "fastrip"
     description = "Hertz + FaStrip (strip theory with spin; Sichani et al. 2016)"
+    SATURATING = True
     OPTIONS = declare(
         Option("nx", int, 40, "elements per strip (along x)", minimum=1, maximum=4096),
         Option("ny", int, 40, "strips (along y)", minimum=1, maximum=4096),
         Option("rolling_direction_rad", float, 0.0, "direction of rolling in the contact frame: 0 or pi, rad"),
     )
 
-    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
-        """One Hertzian patch; forces on the wheel in the contact frame (:class:`~.types.ContactResult`)."""
-        import time
-
-        from rigid_dynamics.contact.models import _base_result, _hertz, _options
-
-        start = time.perf_counter()
-        opts = _options(options, self.OPTIONS, self.name)
+    def tangential(self, hertz, creepage, material, opts):
+        """FaStrip on one Hertz ellipse; forces on the wheel in the contact frame (models.HertzianModel)."""
         _rolling_sign(opts["rolling_direction_rad"])
-        hertz, reason = _hertz(geometry, material, normal_force_N)
-        if hertz is None:
-            return _base_result(self.name, geometry, creepage, None, reason, start)
         (fx, fy, mz, slip_fraction), _, _, _ = fastrip(
             float(hertz.semi_axis_long_m),
             float(hertz.semi_axis_lat_m),
@@ -307,23 +300,11 @@ class FastripModel:
             ny=opts["ny"],
             rolling_direction_rad=opts["rolling_direction_rad"],
         )
-        result = _base_result(
-            self.name,
-            geometry,
-            creepage,
-            hertz,
-            reason,
-            start,
-            creep_force_long_N=fx,
-            creep_force_lat_N=fy,
-            spin_moment_Nm=mz,
-        )
-        result.extra.update(
-            {
-                "slip_fraction": slip_fraction,
-                "nx": int(opts["nx"]),
-                "ny": int(opts["ny"]),
-                "rolling_direction_rad": float(opts["rolling_direction_rad"]),
-            }
-        )
-        return result
+        forces = {"creep_force_long_N": fx, "creep_force_lat_N": fy, "spin_moment_Nm": mz}
+        extra = {
+            "slip_fraction": slip_fraction,
+            "nx": int(opts["nx"]),
+            "ny": int(opts["ny"]),
+            "rolling_direction_rad": float(opts["rolling_direction_rad"]),
+        }
+        return forces, extra

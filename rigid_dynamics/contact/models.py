@@ -179,12 +179,23 @@ def _base_result(name, geometry, creepage, hertz: HertzBatch | None, reason: str
     return ContactResult(**fields)
 
 
-class HertzModel:
-    """Hertz normal contact only (seed eq 32-38); creep forces and spin moment 0.0."""
+class HertzianModel:
+    """The registry's Hertzian models in one frame: options, the Hertz normal problem, then one tangential law.
 
-    name = "hertz"
-    description = "Hertz normal contact only; creep forces 0"
+    A subclass sets ``name``, ``description``, ``OPTIONS`` and ``SATURATING`` (True: a saturating law, False:
+    full adhesion, None: no creep forces, so no friction-bound check; see :func:`_friction_bound`) and
+    implements ``tangential(hertz, creepage, material, opts) -> (forces, extra)``: ``forces`` the keyword
+    fields of :class:`~.types.ContactResult` it sets (creep forces, spin moment, fields), ``extra`` what it
+    adds to ``result.extra``. Forces act on the wheel, contact frame.
+    """
+
+    name = ""
+    description = ""
     OPTIONS: dict = declare()
+    SATURATING: bool | None = None
+
+    def tangential(self, hertz: HertzBatch, creepage: Creepage, material: Material, opts: dict):
+        raise NotImplementedError(f"{type(self).__name__} defines no tangential law")
 
     def solve(
         self,
@@ -196,19 +207,26 @@ class HertzModel:
         options: Mapping | None = None,
     ) -> ContactResult:
         start = time.perf_counter()
-        _options(options, self.OPTIONS, self.name)
+        opts = _options(options, self.OPTIONS, self.name)
         hertz, reason = _hertz(geometry, material, normal_force_N)
-        return _base_result(
-            self.name,
-            geometry,
-            creepage,
-            hertz,
-            reason,
-            start,
-            creep_force_long_N=0.0,
-            creep_force_lat_N=0.0,
-            spin_moment_Nm=0.0,
-        )
+        if hertz is None:
+            return _base_result(self.name, geometry, creepage, None, reason, start)
+        forces, extra = self.tangential(hertz, creepage, material, opts)
+        result = _base_result(self.name, geometry, creepage, hertz, reason, start, **forces)
+        result.extra.update(extra)
+        if self.SATURATING is None:
+            return result
+        return _friction_bound(result, material, saturating=self.SATURATING)
+
+
+class HertzModel(HertzianModel):
+    """Hertz normal contact only (seed eq 32-38); creep forces and spin moment 0.0."""
+
+    name = "hertz"
+    description = "Hertz normal contact only; creep forces 0"
+
+    def tangential(self, hertz, creepage, material, opts):
+        return {"creep_force_long_N": 0.0, "creep_force_lat_N": 0.0, "spin_moment_Nm": 0.0}, {}
 
 
 def _linear_forces(hertz, creepage, material):
@@ -224,64 +242,32 @@ def _linear_forces(hertz, creepage, material):
     )
 
 
-class LinearModel:
+class LinearModel(HertzianModel):
     """Hertz + Kalker's linear theory (full adhesion; seed eq 50-52)."""
 
     name = "linear"
     description = "Hertz + Kalker's linear theory (full adhesion)"
-    OPTIONS: dict = declare()
+    SATURATING = False
 
-    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
-        start = time.perf_counter()
-        _options(options, self.OPTIONS, self.name)
-        hertz, reason = _hertz(geometry, material, normal_force_N)
-        if hertz is None:
-            return _base_result(self.name, geometry, creepage, None, reason, start)
+    def tangential(self, hertz, creepage, material, opts):
         fx, fy, mz = _linear_forces(hertz, creepage, material)
-        result = _base_result(
-            self.name,
-            geometry,
-            creepage,
-            hertz,
-            reason,
-            start,
-            creep_force_long_N=float(fx),
-            creep_force_lat_N=float(fy),
-            spin_moment_Nm=float(mz),
-        )
-        return _friction_bound(result, material, saturating=False)
+        return {"creep_force_long_N": float(fx), "creep_force_lat_N": float(fy), "spin_moment_Nm": float(mz)}, {}
 
 
-class VermeulenJohnsonModel:
+class VermeulenJohnsonModel(HertzianModel):
     """Hertz + linear theory saturated by Vermeulen-Johnson's cubic law (seed eq 53-58, cube)."""
 
     name = "vermeulen-johnson"
     description = "Hertz + Vermeulen-Johnson saturation (no spin)"
-    OPTIONS: dict = declare()
+    SATURATING = True
 
-    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
-        start = time.perf_counter()
-        _options(options, self.OPTIONS, self.name)
-        hertz, reason = _hertz(geometry, material, normal_force_N)
-        if hertz is None:
-            return _base_result(self.name, geometry, creepage, None, reason, start)
+    def tangential(self, hertz, creepage, material, opts):
         tx, ty, _ = _linear_forces(hertz, creepage, material)
         fx, fy = vermeulen_johnson_saturation(tx, ty, hertz.normal_force_N, material.friction_coefficient)
-        result = _base_result(
-            self.name,
-            geometry,
-            creepage,
-            hertz,
-            reason,
-            start,
-            creep_force_long_N=float(fx),
-            creep_force_lat_N=float(fy),
-            spin_moment_Nm=None,
-        )
-        return _friction_bound(result, material, saturating=True)
+        return {"creep_force_long_N": float(fx), "creep_force_lat_N": float(fy), "spin_moment_Nm": None}, {}
 
 
-class FastsimModel:
+class FastsimModel(HertzianModel):
     """Hertz + Kalker's FASTSIM (simplified theory), with traction and slip fields.
 
     Options: ``nx``, ``ny`` (elements per strip, strips; default 20 x 20), ``traction_bound``
@@ -291,6 +277,7 @@ class FastsimModel:
 
     name = "fastsim"
     description = "Hertz + Kalker's FASTSIM (simplified theory)"
+    SATURATING = True
     OPTIONS: dict = declare(
         Option("nx", int, 20, "elements per strip (along the rolling direction)", minimum=1, maximum=1000),
         Option("ny", int, 20, "strips across the patch", minimum=1, maximum=1000),
@@ -299,12 +286,7 @@ class FastsimModel:
         Option("fields", bool, True, "return the traction and slip fields"),
     )
 
-    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
-        start = time.perf_counter()
-        opts = _options(options, self.OPTIONS, self.name)
-        hertz, reason = _hertz(geometry, material, normal_force_N)
-        if hertz is None:
-            return _base_result(self.name, geometry, creepage, None, reason, start)
+    def tangential(self, hertz, creepage, material, opts):
         (fx, fy, mz, slip_fraction), fields = fastsim_fields(
             float(hertz.semi_axis_long_m),
             float(hertz.semi_axis_lat_m),
@@ -321,28 +303,20 @@ class FastsimModel:
             traction_bound=opts["traction_bound"],
             flexibility=opts["flexibility"],
         )
-        result = _base_result(
-            self.name,
-            geometry,
-            creepage,
-            hertz,
-            reason,
-            start,
-            creep_force_long_N=fx,
-            creep_force_lat_N=fy,
-            spin_moment_Nm=mz,
-            fields=fields if opts["fields"] else None,
-        )
-        result.extra.update(
-            {
-                "slip_fraction": slip_fraction,
-                "nx": int(opts["nx"]),
-                "ny": int(opts["ny"]),
-                "traction_bound": opts["traction_bound"],
-                "flexibility": opts["flexibility"],
-            }
-        )
-        return _friction_bound(result, material, saturating=True)
+        forces = {
+            "creep_force_long_N": fx,
+            "creep_force_lat_N": fy,
+            "spin_moment_Nm": mz,
+            "fields": fields if opts["fields"] else None,
+        }
+        extra = {
+            "slip_fraction": slip_fraction,
+            "nx": int(opts["nx"]),
+            "ny": int(opts["ny"]),
+            "traction_bound": opts["traction_bound"],
+            "flexibility": opts["flexibility"],
+        }
+        return forces, extra
 
 
 AUTO_CHOICES = ("linear", "vermeulen-johnson", "fastsim", "bem")
