@@ -138,22 +138,14 @@ def _base_result(name, geometry, creepage, hertz: HertzBatch | None, reason: str
     if abs(math.sin(2.0 * geometry.ellipse_angle_rad)) > 1e-9:
         note = " (ellipse_angle_rad != 0: the ellipse is treated as aligned with the rolling direction)"
     if hertz is None:
-        return ContactResult(
-            method=name,
-            success=True,
-            status="no-contact",
-            message=reason,
-            normal_force_N=0.0,
-            creep_force_long_N=0.0,
-            creep_force_lat_N=0.0,
-            spin_moment_Nm=0.0,
-            max_pressure_Pa=0.0,
+        return ContactResult.no_contact(
+            name,
+            reason,
+            creepage,
+            approach_m=max(geometry.approach_m, 0.0) if reason.startswith("approach") else 0.0,
+            wall_time_s=time.perf_counter() - start,
             semi_axis_long_m=0.0,
             semi_axis_lat_m=0.0,
-            contact_area_m2=0.0,
-            approach_m=max(geometry.approach_m, 0.0) if reason.startswith("approach") else 0.0,
-            creepage=creepage,
-            wall_time_s=time.perf_counter() - start,
             extra=extra,
         )
     a = float(hertz.semi_axis_long_m)

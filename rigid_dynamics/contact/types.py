@@ -221,6 +221,34 @@ class ContactResult:
     wall_time_s: float = 0.0
     extra: dict = field(default_factory=dict)
 
+    @classmethod
+    def no_contact(
+        cls, method: str, message: str, creepage: Creepage | None, *, approach_m: float | None, wall_time_s: float, **kw
+    ) -> ContactResult:
+        """A result without contact: ``success`` True, status "no-contact", every force, moment, pressure and area 0.
+
+        ``kw``: further fields (e.g. the semi-axes 0.0 of an elliptic model, ``extra``).
+        """
+        fields = {
+            "creep_force_long_N": 0.0,
+            "creep_force_lat_N": 0.0,
+            "spin_moment_Nm": 0.0,
+            "max_pressure_Pa": 0.0,
+            "contact_area_m2": 0.0,
+        }
+        fields.update(kw)
+        return cls(
+            method=method,
+            success=True,
+            status="no-contact",
+            message=message,
+            normal_force_N=0.0,
+            approach_m=approach_m,
+            creepage=creepage,
+            wall_time_s=wall_time_s,
+            **fields,
+        )
+
     def to_dict(self) -> dict:
         """Every number of the result by name (creepages flattened, ``extra`` kept, fields as arrays or None)."""
         out = {

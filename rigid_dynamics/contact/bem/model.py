@@ -261,20 +261,8 @@ class BemModel:
         nx, ny = int(opts["nx"]), int(opts["ny"])
 
         def no_contact(message: str) -> ContactResult:
-            return ContactResult(
-                method=self.name,
-                success=True,
-                status="no-contact",
-                message=message,
-                normal_force_N=0.0,
-                creep_force_long_N=0.0,
-                creep_force_lat_N=0.0,
-                spin_moment_Nm=0.0,
-                max_pressure_Pa=0.0,
-                contact_area_m2=0.0,
-                approach_m=geometry.approach_m,
-                creepage=creepage,
-                wall_time_s=time.perf_counter() - start,
+            return ContactResult.no_contact(
+                self.name, message, creepage, approach_m=geometry.approach_m, wall_time_s=time.perf_counter() - start
             )
 
         # 1. potential contact area
