@@ -21,23 +21,29 @@ from wheelrail.cli import main
 ROOT = Path(__file__).resolve().parents[1]
 PYTHON = sys.executable
 
-QUADRIC = """
-[material]
-shear_modulus_Pa = 82e9
-poisson_ratio = 0.28
-friction_coefficient = 0.3
-[geometry]
-kind = "quadric"
-radius_long_m = 0.46
-radius_lat_m = 0.3
-[loading]
-normal_force_N = 1e4
-[kinematics]
-creepage_long = 0.001
-creepage_lat = 0.0
-spin_creepage_1_per_m = 0.0
-rolling_speed_m_per_s = 20.0
-"""
+
+def quadric_case(
+    *, normal_force_N: str = "1e4", creepage_long: str = "0.001", geometry_extra: str = "", kinematics: bool = True
+) -> str:
+    """The TOML text of the tests' quadric contact case (steel, R 0.46 / 0.3 m; numbers given as TOML text).
+
+    ``geometry_extra``: lines added to ``[geometry]``; ``kinematics`` False leaves ``[kinematics]`` out.
+    """
+    text = (
+        "\n[material]\nshear_modulus_Pa = 82e9\npoisson_ratio = 0.28\nfriction_coefficient = 0.3\n"
+        '[geometry]\nkind = "quadric"\nradius_long_m = 0.46\nradius_lat_m = 0.3\n'
+        + (geometry_extra + "\n" if geometry_extra else "")
+        + f"[loading]\nnormal_force_N = {normal_force_N}\n"
+    )
+    if kinematics:
+        text += (
+            f"[kinematics]\ncreepage_long = {creepage_long}\ncreepage_lat = 0.0\n"
+            "spin_creepage_1_per_m = 0.0\nrolling_speed_m_per_s = 20.0\n"
+        )
+    return text
+
+
+QUADRIC = quadric_case()
 
 
 def run(capsys, *argv) -> tuple[int, str, str]:

@@ -1,28 +1,13 @@
 """Bad input to the CLI and the case/scene loaders: one clear message, exit status 2, no traceback."""
 
 import pytest
+from hardening_helpers import quadric_case
 
 from wheelrail.cases import parse_case
 from wheelrail.cli import main
 from wheelrail.config import ConfigError
 
-GOOD_QUADRIC = """
-[material]
-shear_modulus_Pa = 82e9
-poisson_ratio = 0.28
-friction_coefficient = 0.3
-[geometry]
-kind = "quadric"
-radius_long_m = 0.46
-radius_lat_m = 0.3
-[loading]
-normal_force_N = 1e5
-[kinematics]
-creepage_long = 0.0
-creepage_lat = 0.0
-spin_creepage_1_per_m = 0.0
-rolling_speed_m_per_s = 20.0
-"""
+GOOD_QUADRIC = quadric_case(normal_force_N="1e5", creepage_long="0.0")
 
 
 def run_cli(capsys, *argv):

@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from hardening_helpers import quadric_case
 
 from comparisons.named_cases import SOURCES, named_case_names
 from rigid_dynamics.contact.hertz import hertz_solve_batch
@@ -93,26 +94,15 @@ def test_a22_references_are_contacts_printed_numbers_on_the_wheel():
     assert load_named_case("a22-flange").reference["normal_force_N"] == 12720.0
 
 
-FLAT = """
-[material]
-shear_modulus_Pa = 82e9
-poisson_ratio = 0.28
-friction_coefficient = 0.3
-[geometry]
-kind = "quadric"
-radius_long_m = 0.46
-radius_lat_m = 0.3
-{extra}
-[loading]
-normal_force_N = 1e4
-"""
-
-
 def test_flat_and_corrugation_give_a_sampled_gap_with_local_curvature():
     import tomllib
 
     case = parse_case(
-        tomllib.loads(FLAT.format(extra="corrugation_wavelength_m = 0.02\ncorrugation_amplitude_m = 1e-5"))
+        tomllib.loads(
+            quadric_case(
+                geometry_extra="corrugation_wavelength_m = 0.02\ncorrugation_amplitude_m = 1e-5", kinematics=False
+            )
+        )
     )
     g = case.geometry
     assert g.undeformed is not None and not g.is_elliptic
@@ -135,7 +125,7 @@ def test_bad_irregularity_keys_name_the_key(extra, match):
     import tomllib
 
     with pytest.raises(ConfigError, match=match):
-        parse_case(tomllib.loads(FLAT.format(extra=extra)))
+        parse_case(tomllib.loads(quadric_case(geometry_extra=extra, kinematics=False)))
 
 
 def test_unknown_named_case_lists_the_choices():
