@@ -154,25 +154,64 @@ def whole_process():
                 if name == "manchester_bem":
                     args[-1] = str(Path(tmp) / f"m{k}")
                 t0 = time.perf_counter()
-                subprocess.run([str(exe), *args], check=False, capture_output=True)
+                done = subprocess.run([str(exe), *args], check=False, capture_output=True, text=True)
                 times.append(time.perf_counter() - t0)
+                if done.returncode != 0:
+                    raise RuntimeError(f"wheelrail {' '.join(args)} ended with {done.returncode}: {done.stderr[-500:]}")
             out[name] = {"cold_s": times[0], "warm_s": times[1]}
             print(name, out[name], flush=True)
     exe_contact, decks = os.environ.get("CONTACT_EXE"), os.environ.get("CONTACT_DECKS")
     if exe_contact and decks:
-        times = {}
-        for deck in ("mbench_a22_right", "mbench_a22_left"):
-            with tempfile.TemporaryDirectory() as tmp:
-                shutil.copy(Path(decks) / f"{deck}.inp", tmp)
-                for profile in Path(decks).glob("*.pr?"):
-                    shutil.copy(profile, tmp)
-                t0 = time.perf_counter()
-                subprocess.run([exe_contact, f"{deck}.inp"], cwd=tmp, check=False, capture_output=True)
-                times[deck] = time.perf_counter() - t0
-        out["contact_program_s"] = times
+        out["contact_program_s"] = contact_program(exe_contact, Path(decks))
     else:
         out["contact_program_s"] = None
     return out
+
+
+def contact_program(exe: str, decks: Path) -> dict:
+    """Whole-process time of the CONTACT program (IMODE 2) on its A-2.2 decks, and its right-wheel numbers.
+
+    Each deck runs twice in a fresh folder (the second run is kept: warm file cache). The right deck's FN, FX and
+    PMAX per case are read back from its .out file and compared with the published values of
+    comparisons/data/contact_reference, so the timing is of a build that reproduces the published solution.
+    """
+    times = {}
+    for deck in ("mbench_a22_right", "mbench_a22_left"):
+        for _ in range(2):
+            with tempfile.TemporaryDirectory() as tmp:
+                shutil.copy(decks / f"{deck}.inp", tmp)
+                for profile in decks.glob("*.pr?"):
+                    shutil.copy(profile, tmp)
+                t0 = time.perf_counter()
+                done = subprocess.run([exe, "2", deck], cwd=tmp, check=False, capture_output=True, text=True)
+                elapsed = time.perf_counter() - t0
+                text = (Path(tmp) / f"{deck}.out").read_text() if (Path(tmp) / f"{deck}.out").exists() else ""
+            if done.returncode != 0 or "ended succesfully" not in done.stdout:
+                raise RuntimeError(f"CONTACT on {deck} failed ({done.returncode}): {done.stdout[-300:]}")
+        times[deck] = {"whole_process_s": elapsed, "cases": text.count(" Case ")}
+        if deck == "mbench_a22_right":
+            times[deck]["largest_difference_to_published"] = _contact_out_vs_published(text)
+    return times
+
+
+def _contact_out_vs_published(text: str) -> dict:
+    """Largest relative differences of FN and PMAX, and of FX in % of mu FN, of a CONTACT .out to the published rows."""
+    import csv
+
+    rows = list(csv.DictReader((ROOT / "comparisons/data/contact_reference/mbench_a22_right.csv").open()))
+    lines = text.splitlines()
+    found = []
+    for i, line in enumerate(lines):
+        if line.split()[:2] == ["FN", "FX"] and i + 3 < len(lines):
+            fn, fx = (float(v) for v in lines[i + 1].split()[:2])
+            pmax = float(lines[i + 3].split()[4])
+            found.append((fn, fx, pmax))
+    if len(found) != len(rows):
+        return {"patches_read": len(found), "patches_published": len(rows)}
+    d_fn = max(abs(f[0] / float(r["fn_N"]) - 1) for f, r in zip(found, rows, strict=True))
+    d_fx = max(abs(f[1] - float(r["fx_N"])) / (0.3 * float(r["fn_N"])) for f, r in zip(found, rows, strict=True))
+    d_p = max(abs(f[2] / float(r["pmax_N_per_mm2"]) - 1) for f, r in zip(found, rows, strict=True))
+    return {"patches": len(found), "fn": d_fn, "fx_over_mu_fn": d_fx, "pmax": d_p}
 
 
 def markdown(result) -> str:
@@ -180,7 +219,9 @@ def markdown(result) -> str:
         "# Wheelset contact case against CONTACT's Manchester A-2.2 (benchmarks/bench_wheelset_case.py)",
         "",
         f"Machine: {result['machine']['platform']}, {result['machine']['cpu_count']} cores (shared, noisy); "
-        f"python {result['machine']['python']}.",
+        f"python {result['machine']['python']}; load average at the start "
+        f"{result['machine'].get('load_average_1min', float('nan')):.1f}. Times of one run are comparable with each "
+        "other, not across runs.",
         "",
         "## Per case (right wheel, CONTACT's deck kinematics), in-process",
         "",
@@ -227,7 +268,23 @@ def markdown(result) -> str:
     for key in ("manchester_bem", "contact_fastsim"):
         lines.append(f"- `{key}`: {w[key]['cold_s']:.1f} s / {w[key]['warm_s']:.1f} s")
     if w["contact_program_s"]:
-        lines.append(f"- CONTACT's two decks: {w['contact_program_s']}")
+        for deck, c in w["contact_program_s"].items():
+            lines.append(
+                f"- CONTACT program, `{deck}.inp` ({c['cases']} cases, whole process): {c['whole_process_s']:.2f} s, "
+                f"{1e3 * c['whole_process_s'] / max(c['cases'], 1):.0f} ms per case"
+            )
+            if "largest_difference_to_published" in c:
+                d = c["largest_difference_to_published"]
+                lines.append(
+                    f"  - its right-wheel numbers against the published solution ({d.get('patches')} patches): "
+                    f"FN {100 * d.get('fn', math.nan):.2g} %, FX {100 * d.get('fx_over_mu_fn', math.nan):.2g} % of "
+                    f"mu FN, PMAX {100 * d.get('pmax', math.nan):.2g} %"
+                )
+        lines.append(
+            "  - CONTACT built locally (outside this repository) with gfortran -O3 -march=native and without the "
+            "MKL FFT option (its FFT path needs Intel's compiler here), so its NORM runs without the FFT "
+            "preconditioner; the build and the decks are not part of this repository."
+        )
     else:
         lines.append("- CONTACT itself was not timed on this run (CONTACT_EXE / CONTACT_DECKS not set).")
     return "\n".join(lines) + "\n"
@@ -235,7 +292,12 @@ def markdown(result) -> str:
 
 def main():
     result = {
-        "machine": {"platform": platform.platform(), "cpu_count": os.cpu_count(), "python": platform.python_version()},
+        "machine": {
+            "platform": platform.platform(),
+            "cpu_count": os.cpu_count(),
+            "python": platform.python_version(),
+            "load_average_1min": os.getloadavg()[0],
+        },
         "per_case": per_case(),
         "geometry": geometry_cost(),
         "whole_process": whole_process(),
