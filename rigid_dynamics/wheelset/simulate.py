@@ -266,6 +266,12 @@ class SimulationResult:
             "contact_model": self.contact_model,
             "method": self.method,
             "compiled": self.compiled,
+            "track_model": self.scene.track_dynamics.model if self.scene is not None else None,
+            "peak_rail_deflection_m": (
+                {side: num(np.max(self.track_states[:, i])) for i, side in enumerate(SIDES)}
+                if self.track_states is not None and len(self.track_states)
+                else None
+            ),
             **self._error_summary(num),
         }
 
@@ -1317,7 +1323,8 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
 
     Arrays: ``t`` (n,), ``states`` (n, 12) with ``state_names``, ``patch_<field>`` (n, 2, 2) for every
     PATCH_FIELDS entry (sides left/right, slots tread/flange), ``contact_force_N`` (n, 2, 3),
-    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult),
+    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult), ``track_states`` (n, 8) with
+    ``track_state_names`` for the elastic track,
     ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
     ``status``/``message``/``sides`` as strings. NaN marks candidates without contact, never a failed number:
     a failed run stops at its last good sample and says so in ``status``.
@@ -1337,6 +1344,9 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
     }
     if result.force_error_estimate is not None:
         arrays["force_error_estimate"] = result.force_error_estimate
+    if result.track_states is not None:
+        arrays["track_states"] = result.track_states
+        arrays["track_state_names"] = np.array(TRACK_STATE_NAMES)
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
     return arrays
