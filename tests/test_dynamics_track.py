@@ -264,3 +264,35 @@ def test_wheel_flat_first_impact_elastic_against_rigid():
     print(f"first impact: elastic {peak_e / 1e3:.1f} kN, rigid {peak_r / 1e3:.1f} kN, static {n0 / 1e3:.1f} kN")
     assert 2.5 * n0 < peak_e < 0.7 * peak_r
     assert 0.6e-3 < np.max(elastic.track_states[:, 0:2]) < 2e-3
+
+
+def test_p2_frequency_of_the_default_track_against_the_linear_three_mass_model():
+    """The default UIC60 track under a dipped joint at 20 m/s: the frequency of the ballast force's oscillation after
+    the joint (mean of 4 half periods between zero crossings of its dynamic part) against the damped eigenfrequency of
+    the linear model wheel (half the wheelset) - Hertz spring (linearised at the static approach, 3 N / (2 q)) - rail
+    - pad - sleeper - ballast (measured 57.8 Hz against 57.7 Hz; 60.0 Hz with a rigid contact and no damping), inside
+    the 50-100 Hz usually quoted for the P2 resonance."""
+    scene = replace(dipped_joint_scene(20.0), track_dynamics=TrackDynamics(model="lumped"), duration_s=7.2 / 20.0)
+    result = simulate(scene)
+    assert result.status == "ok"
+    tr = scene.track_dynamics
+    track = result.track_states
+    ballast = tr.ballast_stiffness_N_per_m * track[:, 2] + tr.ballast_damping_N_s_per_m * track[:, 6]
+    after = result.states[:, 0] > 6.0
+    dynamic = ballast[after] - scene.static_wheel_load_N
+    times = result.t[after]
+    crossings = times[np.flatnonzero(np.sign(dynamic[1:]) != np.sign(dynamic[:-1]))]
+    simulated = 1.0 / (2.0 * np.mean(np.diff(crossings[:5])))
+    load = scene.static_wheel_load_N
+    k_hertz = 1.5 * load / float(result.patches["approach_m"][0, 0, 0])
+    mu = 0.5 * scene.wheelset.mass_kg
+    kp, cp, kb, cb = (tr.pad_stiffness_N_per_m, tr.pad_damping_N_s_per_m, tr.ballast_stiffness_N_per_m,
+                      tr.ballast_damping_N_s_per_m)  # fmt: skip
+    mass = np.diag([mu, tr.rail_mass_kg, tr.sleeper_mass_kg])
+    stiff = np.array([[k_hertz, -k_hertz, 0.0], [-k_hertz, k_hertz + kp, -kp], [0.0, -kp, kp + kb]])
+    damp = np.array([[0.0, 0.0, 0.0], [0.0, cp, -cp], [0.0, -cp, cp + cb]])
+    system = np.block([[np.zeros((3, 3)), np.eye(3)], [-np.linalg.solve(mass, stiff), -np.linalg.solve(mass, damp)]])
+    linear = _eigenfrequencies_hz(system)[0]
+    print(f"P2 frequency: simulated {simulated:.2f} Hz, linear three-mass model {linear:.2f} Hz")
+    assert simulated == pytest.approx(linear, rel=0.02)
+    assert 50.0 < simulated < 100.0
