@@ -216,6 +216,10 @@ def test_track_model_is_validated(capsys, tmp_path):
     text += '\n[track_dynamics]\nmodel = "lumped"\nrail_mass_kg = -1.0\n'
     code, _, err = run(capsys, "run", write(tmp_path, text, "scene2.toml"), "--out", tmp_path / "o2", "--quiet")
     assert_error(code, err, "rail_mass_kg", "-1.0")
+    text = resolve_scene_path("hunting-conical").read_text(encoding="utf-8")
+    text += '\n[track_dynamics]\nmodel = "lumped"\npad_stiffness_N_per_m = 1e20\n'
+    code, _, err = run(capsys, "run", write(tmp_path, text, "scene3.toml"), "--out", tmp_path / "o3", "--quiet")
+    assert_error(code, err, "track_dynamics.pad_stiffness_N_per_m", "1e+20", "1e+12")
 
 
 def test_dipped_joint_refused_on_the_search():
