@@ -300,3 +300,19 @@ def test_p2_frequency_of_the_default_track_against_the_linear_three_mass_model()
     print(f"P2 frequency: simulated {simulated:.2f} Hz, linear three-mass model {linear:.2f} Hz")
     assert simulated == pytest.approx(linear, rel=0.02)
     assert 50.0 < simulated < 100.0
+
+
+def test_track_states_reach_the_table_and_the_npz(tmp_path):
+    from rigid_dynamics.wheelset import save_timeseries
+    from rigid_dynamics.wheelset.equations import TRACK_STATE_NAMES
+
+    result = simulate(_scene(duration_s=0.002))
+    table = result.to_dataframe()
+    for name in TRACK_STATE_NAMES:
+        assert name in table.columns
+    np.testing.assert_array_equal(table["rail_left_m"].to_numpy(), result.track_states[:, 0])
+    with np.load(save_timeseries(result, tmp_path / "run.npz")) as data:
+        assert data["track_states"].shape == (len(result.t), 8)
+        assert list(data["track_state_names"]) == list(TRACK_STATE_NAMES)
+    summary = result.summary()
+    assert summary["track_model"] == "lumped" and summary["peak_rail_deflection_m"]["left"] > 5e-4
