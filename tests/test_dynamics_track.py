@@ -316,3 +316,26 @@ def test_track_states_reach_the_table_and_the_npz(tmp_path):
         assert list(data["track_state_names"]) == list(TRACK_STATE_NAMES)
     summary = result.summary()
     assert summary["track_model"] == "lumped" and summary["peak_rail_deflection_m"]["left"] > 5e-4
+
+
+def test_dipped_joint_geometry():
+    """N_irr of the dipped joint: about alpha L deep at the joint, slopes +alpha before and -alpha after it (z down),
+    level far away; the compiled formula (compiled._dip) gives the same numbers."""
+    from rigid_dynamics.wheelset import compiled
+    from rigid_dynamics.wheelset.irregular import rail_irregularity
+
+    irr = Irregularities(joint_dip_angle_rad=0.01, joint_position_m=5.0, joint_ramp_length_m=3.0)
+    alpha = 0.005
+    value, first, second = rail_irregularity(irr, np.array([5.0, 4.8, 5.2, -20.0, 30.0]))
+    # depth alpha (sqrt(L^2 + e^2) - e_j): alpha L = 15 mm deepened by the entry rounding e = 1 m
+    assert value[0] == pytest.approx(alpha * (math.sqrt(9.0 + 1.0) - irr.joint_rounding_m), rel=1e-12)
+    # slopes next to the joint (0.2 m away): alpha within 1 % (the entry rounding bends the ramps slightly)
+    assert first[1] == pytest.approx(alpha, rel=1e-2) and first[2] == pytest.approx(-alpha, rel=1e-2)
+    assert abs(value[3]) < 1.5e-4 and abs(value[4]) < 1.5e-4  # alpha e^2 / (2 |u|) far away
+    assert abs(first[3]) < 1e-5 and abs(first[4]) < 1e-5
+    assert second[0] == pytest.approx(-alpha / irr.joint_rounding_m, rel=1e-3)  # concave bottom, 1/(0.5 m) < 1/r0
+    par = np.zeros(compiled.N_PAR)
+    par[compiled.P_DIP_A], par[compiled.P_DIP_X], par[compiled.P_DIP_L] = 0.01, 5.0, 3.0
+    par[compiled.P_DIP_E], par[compiled.P_DIP_EJ] = irr.joint_entry_rounding_m, irr.joint_rounding_m
+    for k, x in enumerate((5.0, 4.8, 5.2, -20.0, 30.0)):
+        np.testing.assert_allclose(compiled._dip(par, x), (value[k], first[k], second[k]), rtol=1e-12, atol=1e-15)

@@ -66,8 +66,9 @@ def wheel_radius_irregularity(irregularities: Irregularities, nominal_radius_m: 
 
 
 def dip_depth_m(irregularities: Irregularities) -> float:
-    """Depth of the dipped joint below the rail's level, alpha L (0 without a dip), m."""
-    return 0.5 * irregularities.joint_dip_angle_rad * irregularities.joint_ramp_length_m
+    """Depth of the dipped joint below the rail's level far away, at most alpha sqrt(L^2 + e^2) (0 without a dip), m."""
+    irr = irregularities
+    return 0.5 * irr.joint_dip_angle_rad * math.hypot(irr.joint_ramp_length_m, irr.joint_entry_rounding_m)
 
 
 def rail_irregularity(irregularities: Irregularities, x_m):

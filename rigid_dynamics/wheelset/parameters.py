@@ -327,7 +327,8 @@ class Irregularities:
             rises at alpha after it, N_irr = alpha (S(u - L)/2 + S(u + L)/2 - S_j(u)) with u = x - x_joint,
             L the ramp length, S(v) = sqrt(v^2 + e^2) a rounded |v| (e = ``joint_entry_rounding_m`` at the ramps'
             ends, a gentle entry that leaves the response to the joint alone; e = ``joint_rounding_m`` at the joint,
-            above alpha r0 so that the wheel touches the rounded bottom at one point). 0 = none. Evaluated by the
+            above alpha r0 so that the wheel touches the rounded bottom at one point). The slope changes by 2 alpha at
+            the joint; the depth there is alpha (sqrt(L^2 + e^2) - e_j), about alpha L. 0 = none. Evaluated by the
             tables and conical providers (Python and compiled), not by the 3-D search.
         Harmonics and measured grids are evaluated by the 3-D contact search (``contact_provider`` "search", the
         choice of "auto" for them); measured grids run on the Python path.
