@@ -9,7 +9,8 @@
 # # A dynamics run with a wheel flat
 #
 # The embedded scene `wheel-flat`: S1002 wheels on UIC60 rails, both wheels with a 50 mm rounded flat
-# (depth L²/(16 r0) = 0.34 mm) that reaches the rail after about 0.2 m, 60 km/h, Hertz + FASTSIM, RK4.
+# (depth L²/(16 r0) = 0.34 mm) that reaches the rail after about 0.2 m, 60 km/h, Hertz + FASTSIM, RK4, on the
+# elastic track (rail, pad, sleeper and ballast under each wheel; `[track_dynamics] model = "rigid"` for a rigid one).
 # As the flat passes, the wheel drops into it: the normal force first falls (the wheel unloads, it may
 # lift off) and then rises to an impact peak well above the static load.
 
@@ -26,7 +27,7 @@ OUT.mkdir(parents=True, exist_ok=True)
 
 scene = wr.load_scene("wheel-flat")
 if QUICK:  # the flat's first passage only, at a coarser step, on the Python path (no compilation)
-    step = dataclasses.replace(scene.integrator, fixed_step_s=2e-4, output_step_s=2e-4)
+    step = dataclasses.replace(scene.integrator, fixed_step_s=1e-4, output_step_s=2e-4)
     scene = dataclasses.replace(scene, duration_s=0.014, integrator=step)
 run = wr.simulate(scene, compiled=False if QUICK else None)
 print(run)

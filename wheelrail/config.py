@@ -64,6 +64,12 @@ PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
     "rail_head_radius_m": (1.0e-3, 10.0, "m"),
     "amplitude_m": (1.0e-5, 0.02, "m: EN 15302 uses 3 mm; the flangeway clearance is about 10 mm"),
     "rail_inclination_rad": (-0.2, 0.2, "rad: 1:40 is 0.025, 1:20 is 0.05"),
+    "rail_mass_kg": (1.0, 1.0e4, "kg per wheel: the UIC60 default is 84 kg"),
+    "sleeper_mass_kg": (1.0, 1.0e5, "kg per wheel: the default is 291 kg"),
+    "pad_stiffness_N_per_m": (1.0e5, 1.0e12, "N/m per wheel: the default is 2.79e8"),
+    "ballast_stiffness_N_per_m": (1.0e5, 1.0e12, "N/m per wheel: the default is 3.26e8"),
+    "pad_damping_N_s_per_m": (0.0, 1.0e9, "N s/m per wheel: the default is 6.98e4"),
+    "ballast_damping_N_s_per_m": (0.0, 1.0e9, "N s/m per wheel: the default is 1.86e5"),
 }
 """Key name -> (lowest, highest, why): numbers outside are bad input however well typed (the range and
 the reason are in the message). Applied to every key of that name in scene and case files."""

@@ -22,6 +22,7 @@ from rigid_dynamics.wheelset.parameters import (
     Irregularities,
     LoadParameters,
     SuspensionParameters,
+    TrackDynamics,
     TrackGeometry,
     WheelsetParameters,
 )
@@ -48,6 +49,7 @@ __all__ = [
     "LoadParameters",
     "SimulationResult",
     "SuspensionParameters",
+    "TrackDynamics",
     "TrackGeometry",
     "WheelsetParameters",
     "build_provider",

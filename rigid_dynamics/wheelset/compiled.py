@@ -20,6 +20,12 @@ irregularities) with one of MODEL_CODES from the registry (``compiled=False`` fo
 scipy methods, the conical and search providers, ``auto``, ``bem`` and user models stay on the Python path.
 tests/test_dynamics_compiled.py checks that it reproduces the Python path (states to ~1e-14 relative).
 
+Elastic track (scene ``track_dynamics.model = "lumped"``): the 8 track states follow the two work integrals
+(equations.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
+deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the
+creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
+equations.WheelsetModel._track_derivative (tests/test_dynamics_track.py compares the two paths).
+
 Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined.
 """
 
@@ -31,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact.fastsim import _fastsim_one
-from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry
+from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry, search_geometry_on_track
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
@@ -44,8 +50,10 @@ N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
     P_NX, P_NY, P_PARAB, P_FLEX,
     P_IRR, P_R0, P_POLY_N, P_POLY_A, P_POLY_PH, P_FLAT_L, P_FLAT_D, P_FLAT_ANG, P_CORR_W, P_CORR_A,
     P_IRR_LEFT, P_IRR_RIGHT, P_REACH, P_HALF,
-) = range(43)  # fmt: skip
-N_PAR = 43
+    P_TRACK, P_MR, P_KP, P_CP, P_MS, P_KB, P_CB,
+    P_DIP_A, P_DIP_X, P_DIP_L, P_DIP_E, P_DIP_EJ,
+) = range(55)  # fmt: skip
+N_PAR = 55
 IRR_GRID = 81  # grid points of the running-direction section (providers._running_irregularity)
 IRR_NEWTON = 3  # Newton steps after the grid (same as providers._running_irregularity)
 MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
@@ -76,6 +84,28 @@ def _uniform(x, x0, step, n):
         f = n - 1.0
     i = min(int(f), n - 2)
     return i, f - i
+
+
+@njit(cache=True, _nrt=False)
+def _dip(par, x):
+    """The dipped joint's N_irr(x) and two derivatives (irregular.rail_irregularity, same formula)."""
+    alpha = 0.5 * par[P_DIP_A]
+    u = x - par[P_DIP_X]
+    length = par[P_DIP_L]
+    n0, n1, n2 = 0.0, 0.0, 0.0
+    for k in range(3):
+        if k == 0:
+            shift, weight, e = length, 0.5, par[P_DIP_E]
+        elif k == 1:
+            shift, weight, e = -length, 0.5, par[P_DIP_E]
+        else:
+            shift, weight, e = 0.0, -1.0, par[P_DIP_EJ]
+        v = u - shift
+        root = math.sqrt(v * v + e * e)
+        n0 += alpha * weight * root
+        n1 += alpha * weight * v / root
+        n2 += alpha * weight * e * e / root**3
+    return n0, n1, n2
 
 
 @njit(cache=True, _nrt=False)
@@ -110,6 +140,11 @@ def _irr_parts(par, radius, x0, spin, beta, res):
         kc, amp = 2 * math.pi / par[P_CORR_W], par[P_CORR_A]
         xx = x0 + xo
         n0, n1, n2 = amp * math.cos(kc * xx), -amp * kc * math.sin(kc * xx), -amp * kc * kc * math.cos(kc * xx)
+    if par[P_DIP_A] > 0:
+        d0, d1, d2 = _dip(par, x0 + xo)
+        n0 += d0
+        n1 += d1
+        n2 += d2
     res[0] = r * cb - radius - n0
     res[1] = r1 * cb - r * sb - n1 * x1
     res[2] = r2 * cb - 2 * r1 * sb - r * cb - n2 * x1 * x1 - n1 * x2
@@ -135,6 +170,8 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
     n0 = 0.0
     if par[P_CORR_A] > 0:
         n0 = par[P_CORR_A] * math.cos(2 * math.pi / par[P_CORR_W] * (x0 - r * sin_beta))
+    if par[P_DIP_A] > 0:
+        n0 += _dip(par, x0 - r * sin_beta)[0]
     return r * cos_beta - radius - n0
 
 
@@ -211,9 +248,11 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
     sps = math.sin(y[3])
     _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, y[4], work)
     zref = par[P_ZREF]
+    elastic = par[P_TRACK] > 0
     for c in range(table.shape[1]):
-        q = work[0, c] + (zc - zref) * work[1, c]
-        if slots[c] > 0 and work[11, c] + (zc - zref) * work[1, c] > 0:
+        zs = zc - y[14 + sides[c]] if elastic else zc  # the rail lowered by z_r: the centre raised for this side
+        q = work[0, c] + (zs - zref) * work[1, c]
+        if slots[c] > 0 and work[11, c] + (zs - zref) * work[1, c] > 0:
             q = -0.01
         ny_, nz_ = work[4, c], work[5, c]
         nn = math.sqrt(ny_ * ny_ + nz_ * nz_)
@@ -256,6 +295,8 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
     om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
     p_con = 0.0
+    elastic = par[P_TRACK] > 0
+    rail_f0, rail_f1 = 0.0, 0.0
     ncand = cg.shape[0]
     for c in range(ncand):
         g = cg[c]
@@ -278,6 +319,8 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
         vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
         vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
+        if elastic:
+            vel[2] -= y[18 + sides[c]]  # relative to the rail
         nv = n[0] * vx
         vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
         speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
@@ -339,6 +382,10 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         moment[1] += lever[2] * fc[0] - lever[0] * fc[2] + mc[1]
         moment[2] += lever[0] * fc[1] - lever[1] * fc[0] + mc[2]
         p_con += fc[0] * vel[0] + fc[1] * vel[1] + fc[2] * vel[2] + mc[0] * om[0] + mc[1] * om[1] + mc[2] * om[2]
+        if sides[c] == 0:
+            rail_f0 -= fc[2]
+        else:
+            rail_f1 -= fc[2]
         if record:
             for k in range(3):
                 side_force[sides[c], k] += fc[k]
@@ -408,6 +455,15 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     out[9] = (al0 * sps * sth - al1 * cps * sth + al2 * cth + yr * rr * sth + rr * sr) / cth
     out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
     out[10] = al0 * cps + al1 * sps - yr * sr * cth
+    if elastic:
+        for sd in range(2):
+            zr, zs_, vr, vs = y[14 + sd], y[16 + sd], y[18 + sd], y[20 + sd]
+            pad = par[P_KP] * (zr - zs_) + par[P_CP] * (vr - vs)
+            ballast = par[P_KB] * zs_ + par[P_CB] * vs
+            out[14 + sd], out[16 + sd] = vr, vs
+            out[18 + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par[P_MR]
+            out[20 + sd] = (pad - ballast) / par[P_MS]
+            p_ext -= par[P_CP] * (vr - vs) ** 2 + par[P_CB] * vs * vs
     out[12], out[13] = p_con, p_ext
     if record:
         for sd in range(2):
@@ -427,7 +483,10 @@ def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
         _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg)
     else:
         sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = sargs
-        search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
+        if par[P_TRACK] > 0:
+            search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15])
+        else:
+            search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
     return _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out)
 
 
@@ -444,7 +503,7 @@ def _workspace(par, n_rows, ncand, rec):
         bg[1, g] = math.sin(bg[0, g])
         bg[2, g] = math.cos(bg[0, g])
     return (
-        np.empty((n_rows, ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((15, 3)), bg,
+        np.empty((n_rows, ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((16, 3)), bg,
         np.zeros((ncand, N_GEO)),
     )  # fmt: skip
 
@@ -586,7 +645,7 @@ def load(packed) -> None:
     search memory, whose warm starts are its only state).
     """
     par, hz, kk, sides, _, mode, targs, sargs = packed
-    y = np.zeros(14)
+    y = np.zeros(22 if par[P_TRACK] > 0 else 14)
     rec = np.zeros((len(sides) + 2, N_FIELDS))
     rk4_run(
         y,
@@ -602,12 +661,12 @@ def load(packed) -> None:
         mode,
         targs,
         sargs,
-        np.zeros((0, 14)),
+        np.zeros((0, len(y))),
         np.zeros((0, len(sides) + 2, N_FIELDS)),
         np.zeros(0),
         0,
     )
-    rhs_once(0.0, y, par, hz, kk, sides, mode, targs, sargs, np.zeros(14), rec)
+    rhs_once(0.0, y, par, hz, kk, sides, mode, targs, sargs, np.zeros(len(y)), rec)
 
 
 def supported(scene, provider, model) -> bool:
@@ -665,6 +724,12 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
     par[P_PARAB] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
     par[P_FLEX] = FLEX_CODES[opts["flexibility"]]
     par[P_R0] = provider.r0
+    track = scene.track_dynamics
+    if track.elastic:
+        par[P_TRACK] = 1.0
+        par[P_MR], par[P_KP], par[P_CP] = track.rail_mass_kg, track.pad_stiffness_N_per_m, track.pad_damping_N_s_per_m
+        par[P_MS], par[P_KB] = track.sleeper_mass_kg, track.ballast_stiffness_N_per_m
+        par[P_CB] = track.ballast_damping_N_s_per_m
     irr = None if search else provider.irregularities
     if irr is not None:
         from rigid_dynamics.wheelset.irregular import flat_depth_m
@@ -683,6 +748,16 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
         if irr.corrugation_amplitude_m > 0:
             par[P_CORR_W], par[P_CORR_A] = irr.corrugation_wavelength_m, irr.corrugation_amplitude_m
             half = max(half, 0.6 * irr.corrugation_wavelength_m / provider.r0)
+        if irr.joint_dip_angle_rad > 0:
+            from rigid_dynamics.wheelset.irregular import dip_depth_m
+
+            par[P_DIP_A], par[P_DIP_X], par[P_DIP_L] = (
+                irr.joint_dip_angle_rad,
+                irr.joint_position_m,
+                irr.joint_ramp_length_m,
+            )
+            par[P_DIP_E], par[P_DIP_EJ] = irr.joint_entry_rounding_m, irr.joint_rounding_m
+            reach += 2.0 * dip_depth_m(irr)
         par[P_REACH], par[P_HALF] = reach, half
     hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
     hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]

@@ -441,6 +441,20 @@ def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, c
     return failed
 
 
+@njit(cache=True, _nrt=False)
+def search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, centre):
+    """search_geometry with the rails lowered by the elastic track's rail deflections y[14], y[15] (left, right):
+    each side is searched at the wheelset centre raised by its rail's deflection (centre: a scratch 3-vector), and
+    the levers (contact point - centre) are those of the raised pose (a rigid vertical shift of the rail).
+    """
+    rotation(y[3], y[4], y[5], rot)
+    failed = 0
+    for s in range(2):
+        centre[0], centre[1], centre[2] = y[0], y[1], y[2] - y[14 + s]
+        failed += search_side(s, centre, rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
+    return failed
+
+
 def _convex_along_the_rail(wheel_rows, rail_rows, radius) -> bool:
     """Whether the gap along the rolling direction stays convex (one minimum over the wheel angle): no flat, and
     the curvature the polygons (n^2 A / r^2) and corrugations (A k^2) add stays below half the wheel's 1/r.

@@ -23,9 +23,21 @@ normal and curvatures; creepages by eq 39-49, rigid_dynamics.contact.creepage):
   couples yaw and roll.
 * alpha -> (psi'', theta'', phi'') by eq 68-70 (kinematics.euler_accelerations).
 
+Elastic track (scene ``track_dynamics.model = "lumped"``, seed eq 6's rail deflection N_d,t): 8 more states
+after the two work integrals, :data:`TRACK` = [z_r, z_s per side (left, right), then their rates], z down, from
+the unloaded track. Per wheel m_r z_r'' = F_r - k_p (z_r - z_s) - c_p (z_r' - z_s') and
+m_s z_s'' = k_p (z_r - z_s) + c_p (z_r' - z_s') - k_b z_s - c_b z_s', with F_r = -sum F_con,z over that wheel's
+patches (the vertical component of the contact forces, on the rail). The rail mass's displacement z_r lowers that
+rail's surface: the contact geometry is evaluated with the wheelset centre raised by z_r for that side (a rigid
+vertical shift of the rail, exact for every provider), and the creepages use the wheel's velocity relative to the
+rail (v_w - z_r' e_z). The contact power then is F_con . (v_w - v_r): the work on wheel and rail together.
+
 Energy: T = m |x_t'|^2 / 2 + omega . J omega / 2, V_g = -m g z; then
 d(T + V_g)/dt = P_contact + P_exterior with P = sum F . v_point + M . omega (v_point the velocity of
 the material point the force acts on). The appended states integrate P_contact and P_exterior.
+With the elastic track T adds m_r z_r'^2/2 + m_s z_s'^2/2, the potential adds k_p (z_r - z_s)^2/2 + k_b z_s^2/2
+(the track masses' own weight is balanced in the unloaded track), and P_exterior adds the track dampers' power
+-c_p (z_r' - z_s')^2 - c_b z_s'^2.
 """
 
 from __future__ import annotations
@@ -77,6 +89,21 @@ PATCH_FIELDS = (
 
 MAX_SLOTS = 2
 
+TRACK_STATE_NAMES = (
+    "rail_left_m",
+    "rail_right_m",
+    "sleeper_left_m",
+    "sleeper_right_m",
+    "rail_left_velocity_m_per_s",
+    "rail_right_velocity_m_per_s",
+    "sleeper_left_velocity_m_per_s",
+    "sleeper_right_velocity_m_per_s",
+)
+"""Names of the elastic track's states (z down, from the unloaded track), in order."""
+
+TRACK = slice(14, 22)
+"""Where the elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
+
 
 class ContactFailure(RuntimeError):
     """A contact model did not converge or the kinematics became undefined (reported, not raised out)."""
@@ -122,7 +149,7 @@ def _cross3(a, b):
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _creepages(lever, normal, omega, v_c):
+def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     """Contact frames and creepages of many points (eq 39-49; same formulas as contact.creepage).
 
     e_x = v_p/|v_p| with v_p the rolling velocity v_rol = [x', 0, 0] projected on the contact plane,
@@ -139,6 +166,8 @@ def _creepages(lever, normal, omega, v_c):
         e_x = v_p / speed[:, None]
         e_y = _cross_pairs(normal, e_x)
         velocity = v_c + _cross_rows(omega, lever)
+        if rail_velocity is not None:
+            velocity = velocity - rail_velocity
         xi = np.einsum("ij,ij->i", velocity, e_x) / speed
         eta = np.einsum("ij,ij->i", velocity, e_y) / speed
         spin = (normal @ omega) / speed
@@ -346,28 +375,104 @@ class WheelsetModel:
         self.speed = scene.speed_m_per_s
         self.axle_load = scene.loads.axle_load_N
         self.torque = scene.loads.traction_torque_N_m
+        self.track = scene.track_dynamics
+        self.elastic = self.track.elastic
+        self.n_state = 22 if self.elastic else 14
+        self.track_rest = np.zeros(8)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
 
+    def full_state(self, state: np.ndarray) -> np.ndarray:
+        """The full state of a 12-state: work integrals 0 and, with the elastic track, ``track_rest``."""
+        parts = [np.asarray(state, float)[:12], [0.0, 0.0]]
+        if self.elastic:
+            parts.append(self.track_rest)
+        return np.concatenate(parts)
+
+    def static_track(self, rail_force_N) -> np.ndarray:
+        """Track states at rest under the vertical rail forces (left, right), N: z_s = F / k_b, z_r = z_s + F / k_p."""
+        force = np.asarray(rail_force_N, float)
+        out = np.zeros(8)
+        out[2:4] = force / self.track.ballast_stiffness_N_per_m
+        out[0:2] = out[2:4] + force / self.track.pad_stiffness_N_per_m
+        return out
+
+    def patches_on_track(self, centre, yaw, roll, spin, shift=None):
+        """The provider's patches with the rails lowered by ``shift`` (left, right), m (None: rigid track).
+
+        A rail lowered by w is the wheelset raised by w for that side's contact: the provider is asked at the centre
+        raised by w per side and the contact points are moved back down by w (levers unchanged).
+        """
+        if shift is None or (shift[0] == 0.0 and shift[1] == 0.0):
+            return self.provider.patches(centre, yaw, roll, spin)
+        from dataclasses import replace
+
+        from rigid_dynamics.wheelset.providers import PatchSet
+
+        sets = []
+        for w in (shift[0],) if shift[0] == shift[1] else (shift[0], shift[1]):
+            raised = np.array(centre, float)
+            raised[2] -= w
+            sets.append(self.provider.patches(raised, yaw, roll, spin))
+        pick = [np.arange(len(sets[0]))] if len(sets) == 1 else [np.flatnonzero(sets[i].side == i) for i in (0, 1)]
+        fields = {}
+        for name in (
+            "side", "slot", "point_m", "normal", "curvature_long_1_per_m", "curvature_lat_1_per_m", "approach_m",
+            "rolling_radius_m", "contact_angle_rad", "wheel_lateral_m", "merge_approach_m",
+        ):  # fmt: skip
+            parts = [getattr(p, name) for p in sets]
+            if parts[0] is None:
+                fields[name] = None
+                continue
+            fields[name] = np.concatenate([np.array(v)[k] for v, k in zip(parts, pick, strict=True)])
+        moved = np.asarray(shift, float)[fields["side"]]
+        fields["point_m"][:, 2] += moved
+        geometries = None
+        if sets[0].geometries is not None:
+            geometries = []
+            for p, k in zip(sets, pick, strict=True):
+                for i in k:
+                    g = p.geometries[i]
+                    point = np.array(g.point_m, float)
+                    point[2] += shift[int(p.side[i])]
+                    geometries.append(replace(g, point_m=point))
+        return PatchSet(geometries=geometries, **fields)
+
     # ----------------------------------------------------------------------------------------------
-    def contact(self, state: np.ndarray, record: bool = False) -> ContactState:
+    def contact(self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None) -> ContactState:
         """Contact forces of every candidate in contact (approach > 0) for a 12-state.
 
-        With ``record`` the per-patch values (PATCH_FIELDS) are filled, else ``values`` is None.
+        With ``record`` the per-patch values (PATCH_FIELDS) are filled, else ``values`` is None. ``track``: the
+        elastic track's 8 states (TRACK_STATE_NAMES); None: ``track_rest`` (rigid track: ignored).
         """
         x, y, z, yaw, roll, spin = state[:6]
         centre = state[0:3]
         v_c = state[6:9]
         c_d, _, omega = rotation_and_rates(yaw, roll, spin, state[9], state[10], state[11])
-        patches = self.provider.patches(centre, yaw, roll, spin)
+        rail_velocity = None
+        if self.elastic:
+            track = self.track_rest if track is None else track
+            patches = self.patches_on_track(centre, yaw, roll, spin, track[0:2])
+        else:
+            patches = self.provider.patches(centre, yaw, roll, spin)
         n = len(patches)
         values = None
         force = np.zeros((n, 3))
         moment = np.zeros((n, 3))
         lever = patches.point_m - centre
         velocity = v_c + _cross_rows(omega, lever)
+        if self.elastic:
+            rail_velocity = np.zeros((n, 3))
+            rail_velocity[:, 2] = track[4:6][patches.side]
+            velocity = velocity - rail_velocity  # relative to the rail (power on wheel and rail together)
         active = np.flatnonzero(patches.approach_m > 0)
         if len(active):
-            frames, speed, xi, eta, spin = _creepages(lever[active], patches.normal[active], omega, v_c)
+            frames, speed, xi, eta, spin = _creepages(
+                lever[active],
+                patches.normal[active],
+                omega,
+                v_c,
+                None if rail_velocity is None else rail_velocity[active],
+            )
             if not np.all(speed > 0) or not np.all(np.isfinite(speed)):
                 raise ContactFailure(f"rolling speed {speed.min()!r} m/s at a contact: creepages undefined")
             elliptic = patches.geometries is None or all(patches.geometries[k].is_elliptic for k in active)
@@ -456,13 +561,14 @@ class WheelsetModel:
         return force, moment, power
 
     def derivative(self, t: float, state: np.ndarray, contact: ContactState | None = None) -> np.ndarray:
-        """d/dt of the 14-state (12 mechanical + 2 work integrals)."""
+        """d/dt of the full state (12 mechanical + 2 work integrals [+ 8 track states, TRACK])."""
         self.rhs_evaluations += 1
         yaw, roll, spin = state[3], state[4], state[5]
         yaw_rate, roll_rate, spin_rate = state[9], state[10], state[11]
         c_d, rzx, omega = rotation_and_rates(yaw, roll, spin, yaw_rate, roll_rate, spin_rate)
+        track = state[TRACK] if self.elastic else None
         if contact is None:
-            contact = self.contact(state[:12])
+            contact = self.contact(state[:12], track=track)
         f_con = contact.force_N.sum(axis=0)
         m_con = _cross_pairs(contact.lever_m, contact.force_N).sum(axis=0) + contact.moment_Nm.sum(axis=0)
         p_con = float(np.sum(contact.force_N * contact.point_velocity_m_per_s) + contact.moment_Nm.sum(axis=0) @ omega)
@@ -477,13 +583,41 @@ class WheelsetModel:
         yaw_acc = (ax * sp * st - ay * cp * st + az * ct + yaw_rate * roll_rate * st + roll_rate * spin_rate) / ct
         spin_acc = (ax * sp - ay * cp + yaw_rate * roll_rate + roll_rate * spin_rate * st) / ct
         roll_acc = ax * cp + ay * sp - yaw_rate * spin_rate * ct
-        out = np.empty(14)
+        out = np.empty(self.n_state)
+        if self.elastic:
+            rail_force = np.zeros(2)
+            np.add.at(rail_force, contact.side, -contact.force_N[:, 2])
+            p_ext += self._track_derivative(track, rail_force, out[TRACK])
         out[0:3] = state[6:9]
         out[3:6] = state[9:12]
         out[6:9] = acc
         out[9], out[10], out[11] = yaw_acc, roll_acc, spin_acc
         out[12], out[13] = p_con, p_ext
         return out
+
+    def _track_derivative(self, track, rail_force, out) -> float:
+        """d/dt of the 8 track states into ``out`` under the rail forces (left, right); returns the dampers' power."""
+        tr = self.track
+        z_r, z_s, v_r, v_s = track[0:2], track[2:4], track[4:6], track[6:8]
+        pad = tr.pad_stiffness_N_per_m * (z_r - z_s) + tr.pad_damping_N_s_per_m * (v_r - v_s)
+        ballast = tr.ballast_stiffness_N_per_m * z_s + tr.ballast_damping_N_s_per_m * v_s
+        out[0:2], out[2:4] = v_r, v_s
+        out[4:6] = (rail_force - pad) / tr.rail_mass_kg
+        out[6:8] = (pad - ballast) / tr.sleeper_mass_kg
+        return -float(np.sum(tr.pad_damping_N_s_per_m * (v_r - v_s) ** 2 + tr.ballast_damping_N_s_per_m * v_s**2))
+
+    def track_energy_J(self, track) -> tuple:
+        """(kinetic, potential) energy of the elastic track's states (n, 8) or (8,), J (0 for the rigid track)."""
+        if not self.elastic:
+            return 0.0, 0.0
+        tr = self.track
+        t = np.asarray(track, float)
+        z_r, z_s, v_r, v_s = t[..., 0:2], t[..., 2:4], t[..., 4:6], t[..., 6:8]
+        kinetic = 0.5 * np.sum(tr.rail_mass_kg * v_r**2 + tr.sleeper_mass_kg * v_s**2, axis=-1)
+        potential = 0.5 * np.sum(
+            tr.pad_stiffness_N_per_m * (z_r - z_s) ** 2 + tr.ballast_stiffness_N_per_m * z_s**2, axis=-1
+        )
+        return kinetic, potential
 
     # ----------------------------------------------------------------------------------------------
     def kinetic_energy_J(self, state: np.ndarray) -> float:
@@ -495,6 +629,10 @@ class WheelsetModel:
     def potential_energy_J(self, state: np.ndarray) -> float:
         """Gravity potential V_g = -m g z (z down), J."""
         return -self.mass * self.gravity * float(state[2])
+
+    def _rest_shift(self):
+        """The rails' deflection in ``track_rest`` (None for the rigid track)."""
+        return self.track_rest[0:2] if self.elastic else None
 
     def static_state(self, state: np.ndarray, derivative=None, deepest_approach=None) -> tuple[np.ndarray, bool, str]:
         """Adjust z and theta of ``state`` so that vertical force and roll moment balance (t = 0).
@@ -516,7 +654,7 @@ class WheelsetModel:
         def residual(v):
             trial = work.copy()
             trial[2], trial[4] = v
-            full = np.concatenate([trial, [0.0, 0.0]])
+            full = self.full_state(trial)
             try:
                 d = derivative(0.0, full)
             except ContactFailure:
@@ -530,7 +668,7 @@ class WheelsetModel:
             if deepest_approach is not None:
                 deepest = deepest_approach(work)
             else:
-                patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
+                patches = self.patches_on_track(work[0:3], work[3], work[4], work[5], self._rest_shift())
                 deepest = [
                     np.max(patches.approach_m[patches.side == i]) if np.any(patches.side == i) else 0.0 for i in (0, 1)
                 ]
@@ -573,7 +711,7 @@ class WheelsetModel:
         work[2], work[4] = best[0]
         # accept a residual acceleration below 1e-3 m/s^2 (vertical) / 1e-2 rad/s^2 (roll)
         ok = best[1] < 1e-3
-        patches = self.provider.patches(work[0:3], work[3], work[4], work[5])
+        patches = self.patches_on_track(work[0:3], work[3], work[4], work[5], self._rest_shift())
         touching = [bool(np.any((patches.side == i) & (patches.approach_m > 0))) for i in (0, 1)]
         if ok and not all(touching):
             ok, message = False, "the equilibrium found has a wheel off its rail (no contact at rest)"

@@ -65,16 +65,36 @@ def wheel_radius_irregularity(irregularities: Irregularities, nominal_radius_m: 
     return value, first, second
 
 
+def dip_depth_m(irregularities: Irregularities) -> float:
+    """Depth of the dipped joint below the rail's level far away, at most alpha sqrt(L^2 + e^2) (0 without a dip), m."""
+    irr = irregularities
+    return 0.5 * irr.joint_dip_angle_rad * math.hypot(irr.joint_ramp_length_m, irr.joint_entry_rounding_m)
+
+
 def rail_irregularity(irregularities: Irregularities, x_m):
     """N_irr(x) and its first two derivatives with respect to x (m, 1, 1/m)."""
     x = np.asarray(x_m, float)
     irr = irregularities
-    if irr.corrugation_amplitude_m <= 0:
-        zero = np.zeros_like(x)
-        return zero, zero, zero
-    k = 2 * math.pi / irr.corrugation_wavelength_m
-    amp = irr.corrugation_amplitude_m
-    return amp * np.cos(k * x), -amp * k * np.sin(k * x), -amp * k * k * np.cos(k * x)
+    value, first, second = np.zeros_like(x), np.zeros_like(x), np.zeros_like(x)
+    if irr.corrugation_amplitude_m > 0:
+        k = 2 * math.pi / irr.corrugation_wavelength_m
+        amp = irr.corrugation_amplitude_m
+        value, first, second = amp * np.cos(k * x), -amp * k * np.sin(k * x), -amp * k * k * np.cos(k * x)
+    if irr.joint_dip_angle_rad > 0:
+        alpha = 0.5 * irr.joint_dip_angle_rad
+        u = x - irr.joint_position_m
+        length = irr.joint_ramp_length_m
+        for shift, weight, e in (
+            (length, 0.5, irr.joint_entry_rounding_m),
+            (-length, 0.5, irr.joint_entry_rounding_m),
+            (0.0, -1.0, irr.joint_rounding_m),
+        ):
+            v = u - shift
+            root = np.sqrt(v * v + e * e)
+            value = value + alpha * weight * root
+            first = first + alpha * weight * v / root
+            second = second + alpha * weight * e * e / root**3
+    return value, first, second
 
 
 def applies_to(irregularities: Irregularities, side: str) -> bool:

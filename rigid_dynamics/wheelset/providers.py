@@ -59,7 +59,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from rigid_dynamics.wheelset.irregular import applies_to, rail_irregularity, wheel_radius_irregularity
+from rigid_dynamics.wheelset.irregular import applies_to, dip_depth_m, rail_irregularity, wheel_radius_irregularity
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
 
 SIDES = ("left", "right")
@@ -137,15 +137,15 @@ def _running_irregularity(patches: PatchSet, sides_mask, centre_m, spin_rad, irr
     left alone (the irregularity cannot close it).
     """
     wheel_on = (irr.polygon_order > 0 and irr.polygon_amplitude_m > 0) or irr.flat_length_m > 0
-    rail_on = irr.corrugation_amplitude_m > 0
-    reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
+    rail_on = irr.corrugation_amplitude_m > 0 or irr.joint_dip_angle_rad > 0
+    reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m + dip_depth_m(irr)) + 1e-4
     half = 0.02
     if irr.flat_length_m > 0:
         from rigid_dynamics.wheelset.irregular import flat_depth_m
 
         reach += 2.0 * flat_depth_m(irr, r0)
         half = max(half, 1.5 * irr.flat_length_m / r0)
-    if rail_on:
+    if irr.corrugation_amplitude_m > 0:
         half = max(half, 0.6 * irr.corrugation_wavelength_m / r0)
     sel = np.flatnonzero(sides_mask[patches.side] & (patches.approach_m > -reach))
     if len(sel) == 0:

@@ -42,6 +42,8 @@ from rigid_dynamics.wheelset.equations import (
     MAX_SLOTS,
     PATCH_FIELDS,
     STATE_NAMES,
+    TRACK,
+    TRACK_STATE_NAMES,
     ContactFailure,
     WheelsetModel,
 )
@@ -86,9 +88,13 @@ class SimulationResult:
         patches: PATCH_FIELDS -> array (n, 2 sides [left, right], 2 slots [tread, flange/second]);
             NaN where a candidate does not exist or is not in contact (normal_force_N is 0 there).
         contact_force_N: sum of the contact forces on each wheel, main frame, shape (n, 2, 3).
-        kinetic_energy_J, potential_energy_J: T and V_g = -m g z at the output times, (n,).
+        kinetic_energy_J, potential_energy_J: T and V_g = -m g z at the output times, (n,); with the elastic track
+            they include the track masses' kinetic energy and the pad and ballast springs' energy.
         work_contact_J, work_exterior_J: work done on the wheelset since t = 0 by contact forces and
-            by exterior forces (suspension, axle load, torque), (n,).
+            by exterior forces (suspension, axle load, torque), (n,); with the elastic track the contact work is
+            that on wheel and rail together and the exterior work includes the track dampers'.
+        track_states: the elastic track's states (TRACK_STATE_NAMES, z down) at the output times, (n, 8); None
+            for the rigid track.
         events: tuples (kind, side, time_s): "wheel-lift", "contact-restored", "flange-contact".
         rhs_evaluations, steps: counters. wall_time_s: wall time of the run (static equilibrium, integration,
             recording), s; loading the compiled code from numba's cache (once per process, ~0.1 s) is not counted.
@@ -127,6 +133,7 @@ class SimulationResult:
     force_error_estimate: np.ndarray | None = None
     half_step_peak_difference: float | None = None
     scene: DynamicsScene | None = field(default=None, repr=False)
+    track_states: np.ndarray | None = None
 
     @property
     def success(self) -> bool:
@@ -259,6 +266,12 @@ class SimulationResult:
             "contact_model": self.contact_model,
             "method": self.method,
             "compiled": self.compiled,
+            "track_model": self.scene.track_dynamics.model if self.scene is not None else None,
+            "peak_rail_deflection_m": (
+                {side: num(np.max(self.track_states[:, i])) for i, side in enumerate(SIDES)}
+                if self.track_states is not None and len(self.track_states)
+                else None
+            ),
             **self._error_summary(num),
         }
 
@@ -331,6 +344,8 @@ def build_provider(scene: DynamicsScene):
     if choice == "auto":
         if track.is_conical and not irr.needs_search:
             choice = "conical"
+        elif irr.joint_dip_angle_rad > 0:  # the 3-D search does not evaluate the dipped joint
+            choice = "tables"
         elif irr.any:
             choice = "search"
         else:
@@ -404,7 +419,7 @@ def _side_force_sums(table: dict) -> np.ndarray:
 
 def _contact_force_sums(model: WheelsetModel, state: np.ndarray) -> np.ndarray:
     """:func:`_side_force_sums` of the contact at a 12-state (the Python path's force error estimate)."""
-    contact = model.contact(state[:12], record=True)
+    contact = model.contact(state[:12], record=True, track=state[TRACK] if model.elastic else None)
     table = {
         name: np.full((2, MAX_SLOTS), np.nan) for name in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")
     }
@@ -431,6 +446,42 @@ def _rolling_radii(sides, normal_N, radius_m) -> np.ndarray:
     return out
 
 
+def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deepest=None, rolling=None):
+    """:func:`consistent_start` with the elastic track at rest under the wheels (the rigid track: that alone).
+
+    The track starts deflected by the static wheel load (``model.track_rest``), then wheelset equilibrium and
+    track deflection under the contact forces found are alternated until the rail forces change by < 1e-6 of the
+    static wheel load (at most 8 rounds; each round solves the wheelset's equilibrium on a fixed track).
+    """
+    if not model.elastic:
+        return consistent_start(model, state, derivative, deepest, rolling)
+    load = model.scene.static_wheel_load_N
+    model.track_rest = model.static_track([load, load])
+    derivative_ = model.derivative if derivative is None else derivative
+    out = (state, False, "no rounds")
+    for _ in range(8):
+        out = consistent_start(model, state, derivative, deepest, rolling)
+        if not out[1]:
+            return out
+        force = _rail_forces(model, out[0], derivative_)
+        before = model.track_rest.copy()
+        model.track_rest = model.static_track(force)
+        state = out[0]
+        if np.max(np.abs(model.track_rest[0:2] - before[0:2])) * model.track.static_stiffness_N_per_m < 1e-6 * load:
+            break
+    return consistent_start(model, state, derivative, deepest, rolling)
+
+
+def _rail_forces(model: WheelsetModel, state: np.ndarray, derivative) -> np.ndarray:
+    """Vertical contact force on each rail (left, right) at a 12-state on ``track_rest``, N, from the track
+    acceleration the right-hand side gives (m_r z_r'' = F_r - pad force; the pad is at rest: F_r = m_r z_r'' +
+    k_p (z_r - z_s)).
+    """
+    d = derivative(0.0, model.full_state(state))
+    tr, rest = model.track, model.track_rest
+    return tr.rail_mass_kg * d[TRACK][4:6] + tr.pad_stiffness_N_per_m * (rest[0:2] - rest[2:4])
+
+
 def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, deepest=None, rolling=None):
     """A consistent rolling start from the 12-state of :func:`initial_state`: (state, success, message).
 
@@ -452,7 +503,7 @@ def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, d
     if not ok:
         return state, ok, why
     if rolling is None:
-        contact = model.contact(state[:12], record=True)
+        contact = model.contact(state[:12], record=True)  # on model.track_rest
         radii = _rolling_radii(contact.side, contact.values["normal_force_N"], contact.values["rolling_radius_m"])
     else:
         radii = rolling(state)
@@ -465,7 +516,7 @@ def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, d
     rolling_rate = model.scene.speed_m_per_s / float(np.mean(radii))
 
     def residual(rates):
-        trial = np.concatenate([state, [0.0, 0.0]])
+        trial = model.full_state(state)
         trial[11] = rates[0]
         if solve_yaw:
             trial[9] = rates[1]
@@ -521,6 +572,7 @@ class _Recorder:
         self.work_contact: list[np.ndarray] = []
         self.work_exterior: list[np.ndarray] = []
         self.errors: list[np.ndarray] = []
+        self.track: list[np.ndarray] = []
         self.events: list[tuple] = []
         self.in_contact = None
         self.flange = None
@@ -535,7 +587,7 @@ class _Recorder:
         state = full_state[:12]
         if not np.all(np.isfinite(full_state)):
             raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, state)
-        contact = self.model.contact(state, record=True)
+        contact = self.model.contact(state, record=True, track=full_state[TRACK] if self.model.elastic else None)
         table = {name: np.full((2, MAX_SLOTS), np.nan) for name in PATCH_FIELDS}
         for k in range(len(contact.side)):
             side, slot = int(contact.side[k]), int(contact.slot[k])
@@ -590,8 +642,11 @@ class _Recorder:
         for name in PATCH_FIELDS:
             self.patches[name].append(np.asarray(table[name], float)[None])
         self.forces.append(np.asarray(forces, float)[None])
-        self.kinetic.append(np.array([self.model.kinetic_energy_J(state)], float))
-        self.potential.append(np.array([self.model.potential_energy_J(state)], float))
+        track_kinetic, track_potential = self.model.track_energy_J(full_state[TRACK])
+        self.kinetic.append(np.array([self.model.kinetic_energy_J(state) + track_kinetic], float))
+        self.potential.append(np.array([self.model.potential_energy_J(state) + track_potential], float))
+        if self.model.elastic:
+            self.track.append(np.asarray(full_state[TRACK], float)[None].copy())
         self.work_contact.append(np.array([full_state[12]], float))
         self.work_exterior.append(np.array([full_state[13]], float))
         self.errors.append(np.array([error], float))
@@ -668,8 +723,11 @@ class _Recorder:
         body = np.einsum("nji,nj->ni", rzx, omega)
         j_diag = np.diag(self.model.j_body)
         kinetic = 0.5 * self.model.mass * np.sum(states[:, 6:9] ** 2, axis=1) + 0.5 * np.sum(j_diag * body**2, axis=1)
-        self.kinetic.append(kinetic)
-        self.potential.append(-self.model.mass * self.model.gravity * states[:, 2])
+        track_kinetic, track_potential = self.model.track_energy_J(full_states[:, TRACK])
+        self.kinetic.append(kinetic + track_kinetic)
+        self.potential.append(-self.model.mass * self.model.gravity * states[:, 2] + track_potential)
+        if self.model.elastic:
+            self.track.append(np.asarray(full_states[:, TRACK], float).copy())
         self.work_contact.append(full_states[:, 12].copy())
         self.work_exterior.append(full_states[:, 13].copy())
         self.errors.append(np.asarray(errors, float).copy())
@@ -689,6 +747,7 @@ class _Recorder:
             joined(self.work_contact, (0,)),
             joined(self.work_exterior, (0,)),
             joined(self.errors, (0,)),
+            joined(self.track, (0, 8)) if self.model.elastic else None,
         )
 
 
@@ -740,17 +799,17 @@ def simulate(
 
     try:
         if use_compiled:
-            derivative, deepest, rolling = _compiled_static_functions(packed)
-            state0, ok, why = consistent_start(model, initial_state(scene), derivative, deepest, rolling)
+            derivative, deepest, rolling = _compiled_static_functions(packed, model)
+            state0, ok, why = elastic_start(model, initial_state(scene), derivative, deepest, rolling)
         else:
-            state0, ok, why = consistent_start(model, initial_state(scene))
+            state0, ok, why = elastic_start(model, initial_state(scene))
     except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
         state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
     if packed is not None:
         packed[0][_compiled.P_XF0] = model.frame_x0  # the suspension frame starts where the wheelset does
     model.rhs_evaluations = 0
-    full0 = np.concatenate([state0, [0.0, 0.0]])
+    full0 = model.full_state(state0)
     last_fraction = [-1.0]
 
     def report(t):
@@ -814,7 +873,7 @@ def simulate(
     except NUMERICAL_ERRORS as exc:  # raised below the driver (e.g. the curvature code for a huge stiffness with RK4)
         status, message = "solver-failed", f"numerical failure: {type(exc).__name__}: {exc}"
     wall = time.perf_counter() - start
-    t, states, patches, forces, kin, pot, wc, we, errors = recorder.arrays()
+    t, states, patches, forces, kin, pot, wc, we, errors, track_states = recorder.arrays()
     fixed_step = settings.method == "RK4"
     if fixed_step:
         errors = errors / scene.static_wheel_load_N
@@ -844,6 +903,7 @@ def simulate(
         compiled=use_compiled,
         force_error_estimate=errors if fixed_step else None,
         scene=scene,
+        track_states=track_states,
     )
     if fixed_step and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
         result = _half_step_check(result, provider, model_obj, compiled)
@@ -954,11 +1014,12 @@ def _tolerances(settings, scene):
     tolerance 1e4-fold or tightening it to atol (m g + axle load) changes the steps of RK45, BDF, Radau and
     LSODA on hunting-conical by under 2 %: the mechanical states set the steps).
     """
-    atol = np.full(14, settings.absolute_tolerance)
+    atol = np.full(22 if scene.track_dynamics.elastic else 14, settings.absolute_tolerance)
     atol[6:12] = settings.absolute_tolerance * 100.0
     atol[5] = settings.absolute_tolerance * 100.0
     atol[11] = settings.absolute_tolerance * 1e3
-    atol[12:] = 1e-3
+    atol[12:14] = 1e-3
+    atol[18:] = settings.absolute_tolerance * 100.0  # the track's rates (absent for the rigid track)
     return atol
 
 
@@ -1003,7 +1064,9 @@ def _state_jacobian(fun: Callable) -> Callable:
             raise _Stop("solver-failed", f"no Jacobian: the state function is not finite at t = {t:.6g} s", t, y)
         jac_matrix = np.zeros((n, n))
         jac_matrix[0:6, 6:12] = np.eye(6)
-        for j in range(12):
+        if n > 14:
+            jac_matrix[14:18, 18:22] = np.eye(4)
+        for j in [*range(12), *range(14, n)]:  # not the work integrals
             for sign in (1.0, -1.0):
                 trial = y.copy()
                 trial[j] += sign * _JACOBIAN_RELATIVE_STEP * max(abs(y[j]), 1.0)
@@ -1015,7 +1078,7 @@ def _state_jacobian(fun: Callable) -> Callable:
                 raise _Stop(
                     "solver-failed",
                     f"no Jacobian: the state function is not finite next to the state at t = {t:.6g} s "
-                    f"(column {j}, {STATE_NAMES[j]})",
+                    f"(column {j}, {(STATE_NAMES + ('', '') + TRACK_STATE_NAMES)[j]})",
                     t,
                     y,
                 )
@@ -1084,7 +1147,7 @@ def _run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scen
 _COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed"}
 
 
-def _compiled_static_functions(packed):
+def _compiled_static_functions(packed, model):
     """(derivative, deepest approach per wheel, rolling radius per wheel) by the compiled right-hand side, for
     :func:`consistent_start`.
     """
@@ -1095,7 +1158,7 @@ def _compiled_static_functions(packed):
     rec = np.zeros((ncand + 2, compiled.N_FIELDS))
 
     def derivative(t, full_state):
-        out = np.zeros(14)
+        out = np.zeros(len(full_state))
         status = compiled.rhs_once(
             float(t), np.asarray(full_state, float), par, hz, kk, sides, mode, targs, sargs, out, rec
         )
@@ -1104,12 +1167,12 @@ def _compiled_static_functions(packed):
         return out
 
     def deepest(state):
-        derivative(0.0, np.concatenate([state, [0.0, 0.0]]))
+        derivative(0.0, model.full_state(state))
         approach = np.nan_to_num(rec[:ncand, 7], nan=-np.inf)
         return [float(np.max(approach[sides == i])) if np.any(sides == i) else 0.0 for i in (0, 1)]
 
     def rolling(state):
-        derivative(0.0, np.concatenate([state, [0.0, 0.0]]))
+        derivative(0.0, model.full_state(state))
         return _rolling_radii(sides, rec[:ncand, 0], rec[:ncand, 10])
 
     return derivative, deepest, rolling
@@ -1126,7 +1189,7 @@ def _run_compiled(model, packed, y0, duration, settings, recorder, report, start
     check_every = _check_every(settings, h)
     n_out = n_steps // out_every
     ncand = len(sides)
-    states = np.zeros((n_out, 14))
+    states = np.zeros((n_out, len(y0)))
     recs = np.zeros((n_out, ncand + 2, compiled.N_FIELDS))
     errs = np.full(n_out, np.nan)
     y, t, done, k_out = y0.copy(), 0.0, 0, 0
@@ -1260,7 +1323,8 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
 
     Arrays: ``t`` (n,), ``states`` (n, 12) with ``state_names``, ``patch_<field>`` (n, 2, 2) for every
     PATCH_FIELDS entry (sides left/right, slots tread/flange), ``contact_force_N`` (n, 2, 3),
-    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult),
+    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult), ``track_states`` (n, 8) with
+    ``track_state_names`` for the elastic track,
     ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
     ``status``/``message``/``sides`` as strings. NaN marks candidates without contact, never a failed number:
     a failed run stops at its last good sample and says so in ``status``.
@@ -1280,6 +1344,9 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
     }
     if result.force_error_estimate is not None:
         arrays["force_error_estimate"] = result.force_error_estimate
+    if result.track_states is not None:
+        arrays["track_states"] = result.track_states
+        arrays["track_state_names"] = np.array(TRACK_STATE_NAMES)
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
     return arrays

@@ -76,7 +76,14 @@ def result_columns(result) -> dict[str, np.ndarray]:
         name: getattr(result, name)
         for name in ("kinetic_energy_J", "potential_energy_J", "work_contact_J", "work_exterior_J")
     }
-    return timeseries_columns(result.t, result.states, result.patches, result.contact_force_N, energies)
+    columns = timeseries_columns(result.t, result.states, result.patches, result.contact_force_N, energies)
+    track = getattr(result, "track_states", None)
+    if track is not None:  # the elastic track's states (equations.TRACK_STATE_NAMES), after the others
+        from rigid_dynamics.wheelset.equations import TRACK_STATE_NAMES
+
+        for k, name in enumerate(TRACK_STATE_NAMES):
+            columns[name] = np.asarray(track, float)[:, k]
+    return columns
 
 
 def to_dataframe(result):
