@@ -72,7 +72,9 @@ def case_features(named) -> dict | None:
     on_side = [p for p in patches if p[0] == named.side and (p[3].normal_force_N or 0) > 0]
     if not success or not on_side:
         return None
-    feats = [patch_features(g, c, case.material, _hertz_of(g, case.material, r.normal_force_N)) for _, g, c, r in on_side]
+    feats = [
+        patch_features(g, c, case.material, _hertz_of(g, case.material, r.normal_force_N)) for _, g, c, r in on_side
+    ]
     return max_features(feats)
 
 
@@ -152,7 +154,9 @@ def run_sweep(quick: bool = False, progress=None) -> tuple[list[dict], dict]:
         for coarse, fine in SWEEP_REFERENCE:
             f = []
             for n in (coarse, fine):
-                r = bem.solve(geometry, creepage, material, normal_force_N=SWEEP_NORMAL_FORCE_N, options={"nx": n, "ny": n})
+                r = bem.solve(
+                    geometry, creepage, material, normal_force_N=SWEEP_NORMAL_FORCE_N, options={"nx": n, "ny": n}
+                )
                 if not r.success:
                     raise RuntimeError(f"sweep reference {point['name']} BEM {n}x{n}: {r.status}: {r.message}")
                 f.append(np.array([r.creep_force_long_N, r.creep_force_lat_N]))
@@ -245,7 +249,7 @@ def this_run_identity(command: str) -> dict:
 
     dirty = _git("status", "--porcelain", "--untracked-files=no")
     return {
-        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
         "commit": _git("rev-parse", "HEAD") + (" (with uncommitted changes)" if dirty not in ("", "unknown") else ""),
         "machine": machine(),
         "command": command,
@@ -291,7 +295,9 @@ def thresholds_document(bench_csv=None, quick: bool = False, progress=None, comm
                 "cases": sorted(sweep_features),
                 "quick": quick,
                 "max_reference_error": max(
-                    float(r["source"].split("own error ")[1].rstrip(")")) for r in sweep_rows if "own error" in r["source"]
+                    float(r["source"].split("own error ")[1].rstrip(")"))
+                    for r in sweep_rows
+                    if "own error" in r["source"]
                 ),
             },
         },

@@ -215,7 +215,9 @@ def derive_thresholds(rows: Iterable[Mapping], features: Mapping[str, Mapping], 
             missed = [c for c, e in results if c not in met]
             # grow along the primary feature; ties (e.g. the quadric cases' ellipticity 0) by the largest other
             # feature relative to its range over the cases
-            span = {f: max([features[c][f] for c in features if math.isfinite(features[c][f])] + [0.0]) for f in FEATURES}
+            span = {
+                f: max([features[c][f] for c in features if math.isfinite(features[c][f])] + [0.0]) for f in FEATURES
+            }
             met.sort(
                 key=lambda c: (
                     features[c][primary],
