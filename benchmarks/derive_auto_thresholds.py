@@ -30,9 +30,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=THRESHOLDS_PATH)
     args = parser.parse_args(argv)
     if not args.run_bench and not args.bench_csv.is_file():
-        print(
-            f"derive_auto_thresholds: error: --bench-csv = {args.bench_csv}: expected a bench CSV file", file=sys.stderr
-        )
+        print(f"wheelrail: error: --bench-csv = {args.bench_csv}: expected a bench CSV file", file=sys.stderr)
         return 2
     csv_arg = None if args.run_bench else args.bench_csv
     if csv_arg is not None:

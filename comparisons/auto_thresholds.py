@@ -303,6 +303,8 @@ def thresholds_document(bench_csv=None, quick: bool = False, progress=None, comm
         },
     }
     doc.update(derive(bench_rows, named_features, sweep_rows, sweep_features))
+    keep = ("case", "model", "resolution", "status", "error", "wall_time_s")
+    doc["bench_rows"] = [{k: r[k] for k in keep} for r in bench_rows if r["model"] in RUNG_MODELS]
     doc["sweep_rows"] = [
         {k: r[k] for k in ("case", "model", "resolution", "status", "error", "wall_time_s")} for r in sweep_rows
     ]

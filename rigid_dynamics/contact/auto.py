@@ -48,6 +48,8 @@ AUTO_RUNGS = ("linear", "vermeulen-johnson", "fastsim", "bem")
 PRIMARY_FEATURE = {"linear": "saturation", "vermeulen-johnson": "spin_share", "fastsim": "ellipticity_residual"}
 """The feature along which a rung's box is grown (the error mechanism the rung neglects)."""
 LEVELS = (0.10, 0.05, 0.02, 0.01)
+GEOMETRY_FLOOR = 1.0e-6
+"""Ellipticity residuals and curvature changes below this are round-off of a sampled quadric: 0."""
 THRESHOLDS_PATH = Path(__file__).parent / "data" / "auto_thresholds.json"
 
 
@@ -142,6 +144,9 @@ def patch_features(geometry, creepage, material, hertz) -> dict:
             field, xs, ys, geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m
         )
         features["second_patch_nearness"] = _second_patch_nearness(field, ys)
+        for name in ("ellipticity_residual", "curvature_change"):
+            if features[name] < GEOMETRY_FLOOR:
+                features[name] = 0.0  # round-off of a sampled quadric
     return features
 
 

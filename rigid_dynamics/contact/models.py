@@ -356,10 +356,10 @@ def thresholds_identity(data: Mapping) -> str:
     """One line naming the thresholds data: when and from which bench run it was derived."""
     bench = data.get("sources", {}).get("bench", {})
     derived = data.get("derived", {})
+    run = bench.get("csv") or bench.get("command", "?")
     return (
-        f"derived {derived.get('date', '?')} at {str(derived.get('commit', '?'))[:12]} from bench "
-        f"{bench.get('csv', 'run in process')} (sha256 {str(bench.get('sha256', '-'))[:12]}, commit "
-        f"{str(bench.get('commit', '?'))[:12]}) + creep sweep"
+        f"derived {derived.get('date', '?')} at commit {str(derived.get('commit', '?'))[:12]} from the bench run "
+        f"{run} ({bench.get('date', '?')}, commit {str(bench.get('commit', '?'))[:12]}) + creep sweep"
     )
 
 

@@ -77,6 +77,22 @@ PATCH_FIELDS = (
 
 MAX_SLOTS = 2
 
+AUTO_PATCH_FIELDS = (
+    "auto_rung",
+    "auto_level",
+    "auto_deciding_feature",
+    "auto_deciding_threshold",
+    "auto_saturation",
+    "auto_spin_share",
+    "auto_ellipticity_residual",
+    "auto_curvature_change",
+    "auto_second_patch_nearness",
+)
+"""Per-patch record of the ``auto`` model's choice (runs with contact_model "auto" only): ``auto_rung`` the index of
+the chosen rung in rigid_dynamics.contact.auto.AUTO_RUNGS, ``auto_level`` the tolerance level used (NaN: below every
+level), ``auto_deciding_feature`` the index in auto.FEATURES of the feature whose threshold decided (-1: none) and
+that threshold, then the patch's features (rigid_dynamics.contact.auto.patch_features)."""
+
 
 class ContactFailure(RuntimeError):
     """A contact model did not converge or the kinematics became undefined (reported, not raised out)."""
@@ -278,6 +294,25 @@ def batch_contact_function(name: str, material, options=None):
     return solve
 
 
+def _auto_record(extra: dict) -> np.ndarray:
+    """AUTO_PATCH_FIELDS values of one ``auto`` result's ``extra``."""
+    from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES
+
+    model = extra.get("selected_model", "")
+    feats = extra.get("auto_features") or {}
+    deciding = extra.get("auto_deciding_feature")
+    return np.array(
+        [
+            AUTO_RUNGS.index(model) if model in AUTO_RUNGS else np.nan,
+            np.nan if extra.get("auto_level") is None else extra["auto_level"],
+            FEATURES.index(deciding) if deciding in FEATURES else -1,
+            np.nan if extra.get("auto_deciding_threshold") is None else extra["auto_deciding_threshold"],
+            *(feats.get(f, np.nan) for f in FEATURES),
+        ],
+        float,
+    )
+
+
 def _patch_values(patches) -> dict:
     """PATCH_FIELDS arrays of a PatchSet: geometry filled in, forces 0 / creepages NaN until solved."""
     n = len(patches)
@@ -347,6 +382,7 @@ class WheelsetModel:
         self.axle_load = scene.loads.axle_load_N
         self.torque = scene.loads.traction_torque_N_m
         self.rhs_evaluations = 0
+        self.last_auto = None  # AUTO_PATCH_FIELDS of the last contact() that ran "auto", (n_active, fields)
 
     # ----------------------------------------------------------------------------------------------
     def contact(self, state: np.ndarray, record: bool = False) -> ContactState:
@@ -366,6 +402,7 @@ class WheelsetModel:
         lever = patches.point_m - centre
         velocity = v_c + _cross_rows(omega, lever)
         active = np.flatnonzero(patches.approach_m > 0)
+        self.last_auto = None
         if len(active):
             frames, speed, xi, eta, spin = _creepages(lever[active], patches.normal[active], omega, v_c)
             if not np.all(speed > 0) or not np.all(np.isfinite(speed)):
@@ -394,6 +431,10 @@ class WheelsetModel:
                     ("spin_creepage_1_per_m", spin), ("semi_axis_long_m", semi_a), ("semi_axis_lat_m", semi_b),
                 ):  # fmt: skip
                     values[key][active] = val
+                if self.last_auto is not None:
+                    for j, key in enumerate(AUTO_PATCH_FIELDS):
+                        values[key] = np.full(n, np.nan)
+                        values[key][active] = self.last_auto[:, j]
         elif record:
             values = _patch_values(patches)
         return ContactState(patches.side, patches.slot, force, moment, lever, velocity, values)
@@ -427,6 +468,10 @@ class WheelsetModel:
             out[3][i] = result.spin_moment_Nm or 0.0
             out[4][i] = result.semi_axis_long_m or np.nan
             out[5][i] = result.semi_axis_lat_m or np.nan
+            if "auto_rung" in result.extra:
+                if self.last_auto is None:
+                    self.last_auto = np.full((n, len(AUTO_PATCH_FIELDS)), np.nan)
+                self.last_auto[i] = _auto_record(result.extra)
         return out
 
     def exterior(self, t: float, state: np.ndarray, c_d: np.ndarray, omega: np.ndarray):

@@ -1,0 +1,176 @@
+"""``auto`` against always-BEM on embedded dynamics scenes: wall time and force error.
+
+For each scene (shortened: SCENES gives the duration) the run is made twice, with ``contact_model = "auto"``
+(the scene's ``contact_tolerance``) and with ``contact_model = "bem"`` (default BEM options), everything else as
+in the scene file. Each run is made in its own process (``--one``): the whole-process time (interpreter start,
+imports, numba cache loading, scene set-up, run) is measured from outside, the in-process time is
+``SimulationResult.wall_time_s`` (static equilibrium, integration, recording).
+
+Force error of auto relative to BEM: per wheel and output sample the contact force sums (normal, longitudinal,
+lateral; main frame), max over samples of |F_auto - F_bem| divided by the static wheel load, and the same for
+the creep (tangential) components divided by the largest BEM creep force of the run. Both runs sample the same
+output grid (same scene, fixed-step RK4 or the same adaptive tolerances); a run that does not end "ok" is
+reported as such.
+
+Writes benchmarks/results/auto_vs_bem.md and auto_vs_bem.json.
+Run: PYTHONPATH=. .venv/bin/python benchmarks/bench_auto.py
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+SCENES = {"hunting-conical": 0.1, "polygonal-wheel": 0.04, "wheel-flat": 0.0135}
+"""Embedded scene -> shortened duration, s (wheel-flat: through the first impact at 0.2 m, 12 ms)."""
+OUT = ROOT / "benchmarks" / "results"
+
+
+def run_one(scene_name: str, duration: float, model: str, npz: Path) -> dict:
+    """Run one scene with one contact model in this process; save the time series; return the numbers."""
+    from rigid_dynamics.wheelset.simulate import save_timeseries, simulate
+    from wheelrail.config import read_toml
+    from wheelrail.scenes import parse_scene, resolve_scene_path
+
+    path = resolve_scene_path(scene_name)
+    doc = read_toml(path, "scene file")
+    doc["duration_s"] = duration
+    doc["contact_model"] = model
+    scene = parse_scene(doc, base_dir=path.parent)
+    start = time.perf_counter()
+    result = simulate(scene)
+    wall = time.perf_counter() - start
+    save_timeseries(result, npz)
+    out = {
+        "scene": scene_name,
+        "model": model,
+        "duration_s": duration,
+        "status": result.status,
+        "message": result.message,
+        "wall_time_s": result.wall_time_s,
+        "simulate_call_s": wall,
+        "compiled": result.compiled,
+        "steps": result.steps,
+        "tolerance": scene.contact_tolerance,
+        "static_wheel_load_N": scene.static_wheel_load_N,
+        "provider": result.provider,
+    }
+    if "auto_rung" in result.patches:
+        from rigid_dynamics.contact.auto import AUTO_RUNGS
+
+        codes = result.patches["auto_rung"]
+        codes = codes[np.isfinite(codes)].astype(int)
+        out["rung_share"] = {r: float(np.mean(codes == i)) if len(codes) else 0.0 for i, r in enumerate(AUTO_RUNGS)}
+    return out
+
+
+def compare(auto_npz: Path, bem_npz: Path, load_N: float) -> dict:
+    a, b = np.load(auto_npz), np.load(bem_npz)
+    n = min(len(a["t"]), len(b["t"]))
+    same_grid = bool(np.allclose(a["t"][:n], b["t"][:n]))
+    fa, fb = a["contact_force_N"][:n], b["contact_force_N"][:n]
+    diff = np.abs(fa - fb)
+    creep_b = np.hypot(fb[..., 0], fb[..., 1])
+    creep_diff = np.hypot(fa[..., 0] - fb[..., 0], fa[..., 1] - fb[..., 1])
+    peak_creep = float(np.max(creep_b)) if creep_b.size else 0.0
+    return {
+        "samples_compared": int(n),
+        "same_time_grid": same_grid,
+        "max_force_diff_over_wheel_load": float(np.max(diff) / load_N) if n else None,
+        "max_normal_diff_over_wheel_load": float(np.max(diff[..., 2]) / load_N) if n else None,
+        "max_creep_diff_over_peak_bem_creep": float(np.max(creep_diff) / peak_creep) if n and peak_creep > 0 else None,
+        "peak_bem_creep_force_N": peak_creep,
+    }
+
+
+def main() -> int:
+    if len(sys.argv) >= 2 and sys.argv[1] == "--one":
+        scene, duration, model, npz = sys.argv[2], float(sys.argv[3]), sys.argv[4], Path(sys.argv[5])
+        print(json.dumps(run_one(scene, duration, model, npz)))
+        return 0
+    from comparisons.bench import machine
+    from comparisons.files import write_json_atomic, write_text_atomic
+
+    scratch = OUT / "auto_vs_bem_runs"
+    scratch.mkdir(parents=True, exist_ok=True)
+    names = sys.argv[1:] or list(SCENES)
+    rows = []
+    for scene in names:
+        per = {}
+        for model in ("auto", "bem"):
+            npz = scratch / f"{scene}-{model}.npz"
+            start = time.perf_counter()
+            proc = subprocess.run(
+                [sys.executable, __file__, "--one", scene, str(SCENES[scene]), model, str(npz)],
+                capture_output=True,
+                text=True,
+                env={**os.environ, "PYTHONPATH": str(ROOT)},
+            )
+            whole = time.perf_counter() - start
+            if proc.returncode != 0:
+                raise SystemExit(f"{scene} {model}: {proc.stderr.strip().splitlines()[-1]}")
+            info = json.loads(proc.stdout.strip().splitlines()[-1])
+            info["whole_process_s"] = whole
+            per[model] = info
+            print(f"{scene} {model}: {info['status']}, in-process {info['wall_time_s']:.1f} s, whole {whole:.1f} s")
+        err = compare(scratch / f"{scene}-auto.npz", scratch / f"{scene}-bem.npz", per["bem"]["static_wheel_load_N"])
+        rows.append({"scene": scene, "auto": per["auto"], "bem": per["bem"], "error": err})
+    write_json_atomic(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})
+    lines = [
+        "# `auto` against always-BEM on embedded scenes",
+        "",
+        f"Machine: {machine()}. Command: `PYTHONPATH=. .venv/bin/python benchmarks/bench_auto.py` "
+        "(benchmarks/bench_auto.py). Each run in its own process; in-process time = SimulationResult.wall_time_s "
+        "(equilibrium, integration, recording), whole-process = interpreter start to exit (imports, numba cache, "
+        "set-up). Durations shortened so that always-BEM finishes in minutes; everything else as in the scene file. "
+        "Thresholds: rigid_dynamics/contact/data/auto_thresholds.json.",
+        "",
+        "| scene | duration | tolerance | auto status | BEM status | auto in-process | BEM in-process | ratio | "
+        "auto whole | BEM whole | ratio | max dF / Q0 | max dN / Q0 | max dF_creep / peak BEM creep | auto's rungs |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        a, b, e = r["auto"], r["bem"], r["error"]
+        share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in a.get("rung_share", {}).items() if v > 0)
+        lines.append(
+            f"| {r['scene']} | {a['duration_s']:g} s | {a['tolerance']:g} | {a['status']} | {b['status']} | "
+            f"{a['wall_time_s']:.2f} s | {b['wall_time_s']:.2f} s | {a['wall_time_s'] / b['wall_time_s']:.3f} | "
+            f"{a['whole_process_s']:.1f} s | {b['whole_process_s']:.1f} s | "
+            f"{a['whole_process_s'] / b['whole_process_s']:.3f} | {e['max_force_diff_over_wheel_load']:.2%} | "
+            f"{e['max_normal_diff_over_wheel_load']:.2%} | "
+            + (
+                "-"
+                if e["max_creep_diff_over_peak_bem_creep"] is None
+                else f"{e['max_creep_diff_over_peak_bem_creep']:.1%}"
+            )
+            + f" | {share} |"
+        )
+    lines += [
+        "",
+        "Q0: static wheel load. Force differences are per wheel and sample, main frame, max over the run; the creep "
+        "column compares the tangential (x, y) force sums with the largest BEM one of the run. Neither run is "
+        "the exact solution: the column is auto's departure from always-BEM (default BEM grid), not an error "
+        "against a reference.",
+        "",
+    ]
+    write_text_atomic(OUT / "auto_vs_bem.md", "\n".join(lines))
+    print(f"written {OUT / 'auto_vs_bem.md'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
