@@ -12,8 +12,9 @@ the creep (tangential) components divided by the largest BEM creep force of the 
 output grid (same scene, fixed-step RK4 or the same adaptive tolerances); a run that does not end "ok" is
 reported as such.
 
-Writes benchmarks/results/auto_vs_bem.md and auto_vs_bem.json.
-Run: PYTHONPATH=. .venv/bin/python benchmarks/bench_auto.py
+Writes benchmarks/results/auto_vs_bem.md and auto_vs_bem.json (time series in benchmarks/results/auto_vs_bem_runs/).
+Run: PYTHONPATH=. .venv/bin/python benchmarks/bench_auto.py [SCENE ...] [--reuse-bem]
+(``--reuse-bem``: keep the always-BEM runs of the last report and their time series; only auto is run again).
 """
 
 from __future__ import annotations
@@ -107,12 +108,21 @@ def main() -> int:
 
     scratch = OUT / "auto_vs_bem_runs"
     scratch.mkdir(parents=True, exist_ok=True)
-    names = sys.argv[1:] or list(SCENES)
+    args = sys.argv[1:]
+    reuse_bem = "--reuse-bem" in args
+    names = [a for a in args if a != "--reuse-bem"] or list(SCENES)
+    previous = {}
+    if reuse_bem:
+        # the always-BEM runs of the last report (the BEM path does not read auto's thresholds)
+        previous = {r["scene"]: r["bem"] for r in json.loads((OUT / "auto_vs_bem.json").read_text())["rows"]}
     rows = []
     for scene in names:
         per = {}
         for model in ("auto", "bem"):
             npz = scratch / f"{scene}-{model}.npz"
+            if model == "bem" and scene in previous and npz.exists():
+                per[model] = {**previous[scene], "reused": True}
+                continue
             start = time.perf_counter()
             proc = subprocess.run(
                 [sys.executable, __file__, "--one", scene, str(SCENES[scene]), model, str(npz)],
@@ -125,6 +135,10 @@ def main() -> int:
                 raise SystemExit(f"{scene} {model}: {proc.stderr.strip().splitlines()[-1]}")
             info = json.loads(proc.stdout.strip().splitlines()[-1])
             info["whole_process_s"] = whole
+            info["commit"] = subprocess.run(
+                ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT
+            ).stdout.strip()
+            info["machine"] = machine()
             per[model] = info
             print(f"{scene} {model}: {info['status']}, in-process {info['wall_time_s']:.1f} s, whole {whole:.1f} s")
         err = compare(scratch / f"{scene}-auto.npz", scratch / f"{scene}-bem.npz", per["bem"]["static_wheel_load_N"])
@@ -138,6 +152,14 @@ def main() -> int:
         "(equilibrium, integration, recording), whole-process = interpreter start to exit (imports, numba cache, "
         "set-up). Durations shortened so that always-BEM finishes in minutes; everything else as in the scene file. "
         "Thresholds: rigid_dynamics/contact/data/auto_thresholds.json.",
+        "",
+        "Runs: "
+        + "; ".join(
+            f"{r['scene']} auto at {r['auto'].get('commit', '?')}, BEM at {r['bem'].get('commit', '?')}"
+            + (" (reused from the previous report: `--reuse-bem`)" if r["bem"].get("reused") else "")
+            for r in rows
+        )
+        + ".",
         "",
         "| scene | duration | tolerance | auto status | BEM status | auto in-process | BEM in-process | ratio | "
         "auto whole | BEM whole | ratio | max dF / Q0 | max dN / Q0 | max dF_creep / peak BEM creep | auto's rungs |",

@@ -184,8 +184,13 @@ def _box_of(points: list[dict]) -> dict:
     return {f: max(p[f] for p in points) for f in FEATURES}
 
 
+ROUND_OFF = 1.0e-9
+"""Relative slack of the derivation's conflict test: a missed case whose features equal a box corner to round-off
+(e.g. a sweep point's spin share 0.3 and another's 0.29999999999999993) is inside the box."""
+
+
 def _inside(point: dict, box: dict) -> bool:
-    return all(point[f] <= box[f] for f in FEATURES)
+    return all(point[f] <= box[f] * (1.0 + ROUND_OFF) + 1e-15 for f in FEATURES)
 
 
 def derive_thresholds(rows: Iterable[Mapping], features: Mapping[str, Mapping], levels=LEVELS) -> dict:
