@@ -155,7 +155,7 @@ def main() -> int:
             scratch / f"{scene}-auto.npz",
             scratch / f"{scene}-bem.npz",
             per["bem"]["static_wheel_load_N"],
-            per["bem"]["mu"],
+            per["auto"]["mu"],
         )
         rows.append({"scene": scene, "auto": per["auto"], "bem": per["bem"], "error": err})
     write_json_atomic(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})

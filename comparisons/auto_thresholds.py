@@ -33,7 +33,7 @@ SWEEP_RADII_M = (0.46, 0.30)
 SWEEP_NORMAL_FORCE_N = 1.0e4
 SWEEP_MATERIAL = (82.0e9, 0.28, 0.3)
 SWEEP_SATURATIONS = (0.005, 0.01, 0.02, 0.035, 0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 1.0, 1.5)
-SWEEP_SPIN_SHARES = (0.01, 0.03, 0.1, 0.3, 0.6)
+SWEEP_SPIN_SHARES = (0.01, 0.03, 0.1, 0.15, 0.2, 0.3, 0.6)
 SWEEP_SPIN_SATURATIONS = (0.02, 0.1, 0.3, 0.7)
 SWEEP_REFERENCE = ((48, 96), (32, 64))
 """BEM grids of the reference (Richardson limit) and of its error estimate."""
