@@ -96,7 +96,8 @@ def compare(auto_npz: Path, bem_npz: Path, load_N: float, mu: float) -> dict:
     creep_diff = np.hypot(xa - xb, ya - yb)
     both = (na > 0) & (nb > 0)
     peak = float(np.max(creep_b)) if creep_b.size else 0.0
-    bench_error = creep_diff / np.maximum(creep_b, 0.01 * mu * nb)
+    with np.errstate(divide="ignore", invalid="ignore"):  # 0 / 0 where neither run has contact
+        bench_error = creep_diff / np.maximum(creep_b, 0.01 * mu * nb)
     return {
         "samples_compared": int(n),
         "same_time_grid": same_grid,
