@@ -502,7 +502,7 @@ def solve_batch(
     array of the result has the broadcast shape. Options: those of the chosen model (fastsim: nx, ny,
     traction_bound, flexibility; auto: tolerance and the fastsim options). ``auto`` chooses per patch as
     :class:`AutoModel` does (the geometric features are 0: quadric patches) and solves the patches it sends to
-    ``bem`` one by one with the BEM model (default options).
+    ``bem`` one by one with the BEM model (default options; their semi-axes and max pressure are then BEM's).
 
     Raises:
         ValueError: unknown method or option, or bad input.
@@ -540,6 +540,10 @@ def solve_batch(
         poisson_ratio=material.poisson_ratio,
     )
     xi, eta, phi = (full(v) for v in (longitudinal, lateral, spin_1_per_m))
+    # Hertz's, except on the patches auto sends to bem (then the BEM solution's)
+    patch_values = {
+        name: np.array(getattr(hz, name), float) for name in ("semi_axis_long_m", "semi_axis_lat_m", "max_pressure_Pa")
+    }
     contact = hz.normal_force_N > 0
     a = np.where(contact, hz.semi_axis_long_m, 1.0)
     b = np.where(contact, hz.semi_axis_lat_m, 1.0)
@@ -608,6 +612,8 @@ def solve_batch(
                     if not r.success:
                         raise ValueError(f"auto: bem failed on patch {idx}: {r.status}: {r.message}")
                     fx[idx], fy[idx], mz[idx] = r.creep_force_long_N, r.creep_force_lat_N, r.spin_moment_Nm or 0.0
+                    for name in ("semi_axis_long_m", "semi_axis_lat_m", "max_pressure_Pa"):
+                        patch_values[name][idx] = getattr(r, name)
             fs = used == "fastsim"
             if np.any(fs & contact):
                 sel = fs & contact
@@ -623,9 +629,9 @@ def solve_batch(
     return AnalyticBatch(
         normal_force_N=hz.normal_force_N,
         approach_m=hz.approach_m,
-        semi_axis_long_m=hz.semi_axis_long_m,
-        semi_axis_lat_m=hz.semi_axis_lat_m,
-        max_pressure_Pa=hz.max_pressure_Pa,
+        semi_axis_long_m=patch_values["semi_axis_long_m"],
+        semi_axis_lat_m=patch_values["semi_axis_lat_m"],
+        max_pressure_Pa=patch_values["max_pressure_Pa"],
         creep_force_long_N=np.where(contact, fx, zero),
         creep_force_lat_N=np.where(contact, fy, zero),
         spin_moment_Nm=np.where(contact, mz, zero),
