@@ -499,8 +499,7 @@ class CaseSolution:
 WARM_UP_OPTIONS = {"hertz": None, "linear": None, "vermeulen-johnson": None, "fastsim": None, "bem": {"nx": 8, "ny": 8}}
 """Models whose numba kernels :func:`solve_case` compiles (or loads from the cache) on a small patch before its
 clock starts, with the options of that small solve. ``auto`` warms up every rung it may choose (bem, its fallback,
-included); ``fea`` has no numba
-kernels (DOLFINx caches its compiled forms itself)."""
+included); ``fea`` has no numba kernels (DOLFINx caches its compiled forms itself)."""
 
 
 def warm_up(method: str, material: Material) -> float:
