@@ -498,8 +498,8 @@ class CaseSolution:
 
 WARM_UP_OPTIONS = {"hertz": None, "linear": None, "vermeulen-johnson": None, "fastsim": None, "bem": {"nx": 8, "ny": 8}}
 """Models whose numba kernels :func:`solve_case` compiles (or loads from the cache) on a small patch before its
-clock starts, with the options of that small solve. ``auto`` warms up the analytic ones; ``fea`` has no numba
-kernels (DOLFINx caches its compiled forms itself)."""
+clock starts, with the options of that small solve. ``auto`` warms up every rung it may choose (bem, its fallback,
+included); ``fea`` has no numba kernels (DOLFINx caches its compiled forms itself)."""
 
 
 def warm_up(method: str, material: Material) -> float:
@@ -507,7 +507,7 @@ def warm_up(method: str, material: Material) -> float:
     from rigid_dynamics.contact.registry import get_model
 
     start = time.perf_counter()
-    names = ("hertz", "linear", "vermeulen-johnson", "fastsim") if method == "auto" else (method,)
+    names = ("hertz", "linear", "vermeulen-johnson", "fastsim", "bem") if method == "auto" else (method,)
     geometry = ContactGeometry.quadric(0.46, 0.3)
     for name in names:
         if name in WARM_UP_OPTIONS:

@@ -15,27 +15,19 @@ Tangential problem: ``hertz`` none (creep forces 0.0); ``linear`` Kalker's linea
 (:mod:`.linear`, eq 50-52); ``vermeulen-johnson`` (:mod:`.vermeulen_johnson`, eq 53-58 with the
 cube; no spin moment: None); ``fastsim`` (:mod:`.fastsim`). Forces act on the wheel, contact frame.
 
-``auto`` picks the cheapest model whose expected relative error in the creep force is below the
-option ``tolerance`` (default 0.05):
+``auto`` picks, per patch, the cheapest rung whose error was measured below the option ``tolerance`` (default
+0.05) on patches like this one (:mod:`rigid_dynamics.contact.auto`): the patch's features (saturation
+w' = T_lin/(3 mu N), spin share, ellipticity residual of the sampled undeformed distance, curvature change across
+the patch, nearness of a second patch) against the thresholds derived from the bench and a creep sweep
+(``data/auto_thresholds.json``, with the bench run that produced them); the first of linear, vermeulen-johnson,
+fastsim (at its configured grid) whose measured box holds the features, else ``bem`` (imported lazily; if it
+cannot be imported the result has ``success=False``, ``status="unavailable"``). A cheaper rung whose own result
+is not ok (e.g. FASTSIM above the friction bound) is replaced by ``bem`` too.
 
-1. non-elliptic geometry (``geometry.is_elliptic`` False: sampled, two-point or flange patches)
-   -> ``bem`` (imported lazily; if it cannot be imported the result has ``success=False``,
-   ``status="unavailable"``);
-2. elliptic, with the linear-theory force T_lin and w' = T_lin/(3 mu N) (eq 55): the linear theory
-   differs from the saturating law by 1 - T_bar/T = w' - w'^2/3 (eq 56 with the cube), so
-   ``linear`` when w' < tolerance;
-3. otherwise ``vermeulen-johnson`` when the spin's share of the creep force is small, measured by
-   s = G (ab)^1.5 C23 |phi| / max(|T_lin|, mu N) (the spin's linear lateral force against the
-   force level of the patch): Vermeulen-Johnson treats spin only through that linear term, so its
-   error is bounded by this share; ``vermeulen-johnson`` when s < tolerance, else ``fastsim``.
-   (Calibration, benchmarks/results/analytic.md: for the CONTACT large-spin case s = 1.0 and VJ's
-   lateral force is 12.5 % off the exact value, FASTSIM's 2.5 %. Over 2000 random patches VJ and
-   FASTSIM differ by ~5 % (median) without spin, two approximations of the exact theory; the spread
-   grows to ~11 % (95th percentile) at s = 0.1-0.2 and ~18 % (median) at s > 0.5. The thresholds
-   are the user's tolerance applied to these error estimates, not fitted constants.)
-
-The result of ``auto`` is the chosen model's result (``method`` is its name) with
-``extra["selected_model"]`` and ``extra["selection_reason"]``.
+The result of ``auto`` is the chosen model's result (``method`` is its name) with ``extra`` keys
+``selected_model``, ``selection_reason`` (features, thresholds, the rejected rungs), ``auto_features``,
+``auto_rung`` (e.g. "fastsim 20x20"), ``auto_level`` (the tolerance level used), ``auto_deciding_feature`` and
+``auto_deciding_threshold`` (the threshold that decided) and ``auto_thresholds`` (the identity of the data).
 
 :func:`solve_batch` is the vectorised entry point for many patches at once (the dynamics):
 Hertz + one law (or the auto choice per patch) on arrays, returning :class:`AnalyticBatch`.
@@ -277,6 +269,7 @@ class FastsimModel(HertzianModel):
         Option("flexibility", str, "three", "Kalker's flexibility: one or three (L1, L2, L3)", choices=FLEXIBILITIES),
         Option("fields", bool, True, "return the traction and slip fields"),
     )
+    OPTIONS_DEFAULTS = {"nx": 20, "ny": 20}
 
     def tangential(self, hertz, creepage, material, opts):
         (fx, fy, mz, slip_fraction), fields = fastsim_fields(
@@ -325,39 +318,24 @@ def _check_model_options(value: Mapping, key: str) -> None:
         validate_options(model_options(name), options, name, prefix=f"{key}.{name}.")
 
 
-def auto_choice(
-    geometry: ContactGeometry, creepage: Creepage, material: Material, hertz: HertzBatch, tolerance: float
-) -> tuple[str, str]:
-    """(model name, reason) by the criterion of the module docstring (elliptic patches)."""
-    a, b = float(hertz.semi_axis_long_m), float(hertz.semi_axis_lat_m)
-    coef = kalker_coefficients(a / b, material.poisson_ratio)
-    tx, ty, _ = linear_creep_forces(
-        a,
-        b,
-        creepage.longitudinal,
-        creepage.lateral,
-        creepage.spin_1_per_m,
-        shear_modulus_Pa=material.shear_modulus_Pa,
-        poisson_ratio=material.poisson_ratio,
-        coefficients=coef,
+def thresholds_identity(data: Mapping) -> str:
+    """One line naming the thresholds data: when and from which bench run it was derived."""
+    bench = data.get("sources", {}).get("bench", {})
+    derived = data.get("derived", {})
+    run = bench.get("csv") or bench.get("command", "?")
+    return (
+        f"derived {derived.get('date', '?')} at commit {str(derived.get('commit', '?'))[:12]} from the bench run "
+        f"{run} ({bench.get('date', '?')}, commit {str(bench.get('commit', '?'))[:12]}) + creep sweep"
     )
-    t_lin = math.hypot(float(tx), float(ty))
-    mu_n = material.friction_coefficient * float(hertz.normal_force_N)
-    w = t_lin / (3.0 * mu_n) if mu_n > 0 else math.inf
-    if w < tolerance:
-        return "linear", f"w' = T_lin/(3 mu N) = {w:.3g} < tolerance {tolerance:g}"
-    spin_force = material.shear_modulus_Pa * (a * b) ** 1.5 * float(coef.c23) * abs(creepage.spin_1_per_m)
-    share = spin_force / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0
-    if share < tolerance:
-        return "vermeulen-johnson", f"spin share {share:.3g} < tolerance {tolerance:g} (w' = {w:.3g})"
-    return "fastsim", f"spin share {share:.3g} >= tolerance {tolerance:g}"
 
 
 class AutoModel:
-    """The cheapest model whose expected error is under ``tolerance`` (criterion: module docstring).
+    """The cheapest rung measured within ``tolerance`` on patches like this one (module docstring).
 
-    Options: ``tolerance`` (relative creep-force error, default 0.05) and ``model_options`` (a
-    mapping name -> options passed to the chosen model, e.g. {"fastsim": {"nx": 40}}).
+    Options: ``tolerance`` (relative force error, default 0.05; the thresholds of the largest measured level
+    10/5/2/1 % not above it apply; below 1 %: bem) and ``model_options`` (a mapping name -> options passed to
+    the chosen model, e.g. {"fastsim": {"nx": 40}, "bem": {"nx": 32, "ny": 32}}; FASTSIM's grid also selects
+    the thresholds used for it).
     """
 
     name = "auto"
@@ -375,12 +353,44 @@ class AutoModel:
     )
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+        from rigid_dynamics.contact.auto import choose_rung, load_thresholds, patch_features
+
         start = time.perf_counter()
         opts = _options(options, self.OPTIONS, self.name)
         tol = opts["tolerance"]
         per_model = dict(opts["model_options"] or {})
-        if not geometry.is_elliptic:
-            chosen, reason = "bem", "non-elliptic geometry (is_elliptic False)"
+        hertz, why = _hertz(geometry, material, normal_force_N)
+        if hertz is None:
+            result = _base_result(self.name, geometry, creepage, None, why, start)
+            result.extra["selected_model"] = "hertz"
+            return result
+        features = patch_features(geometry, creepage, material, hertz)
+        fs_opts = {**FastsimModel.OPTIONS_DEFAULTS, **(per_model.get("fastsim") or {})}
+        data = load_thresholds()
+        choice = choose_rung(features, tol, fastsim_grid=(fs_opts["nx"], fs_opts["ny"]), data=data)
+        record = {
+            "selected_model": choice["model"],
+            "selection_reason": choice["reason"],
+            "auto_features": features,
+            "auto_rung": choice["rung"],
+            "auto_level": choice["level"],
+            "auto_deciding_feature": choice["deciding_feature"],
+            "auto_deciding_threshold": choice["deciding_threshold"],
+            "auto_thresholds": thresholds_identity(data),
+        }
+        result = None
+        if choice["model"] != "bem":
+            model = {"linear": LinearModel, "vermeulen-johnson": VermeulenJohnsonModel, "fastsim": FastsimModel}[
+                choice["model"]
+            ]()
+            result = model.solve(
+                geometry, creepage, material, normal_force_N=normal_force_N, options=per_model.get(choice["model"])
+            )
+            if not result.success:
+                record["selection_reason"] += f"; its result is not ok ({result.status}: {result.message}): bem instead"
+                record["selected_model"] = record["auto_rung"] = "bem"
+                result = None
+        if result is None:
             try:
                 from rigid_dynamics.contact.registry import get_model
 
@@ -390,25 +400,17 @@ class AutoModel:
                     method=self.name,
                     success=False,
                     status="unavailable",
-                    message=f"auto chose 'bem' ({reason}) but it cannot be imported: {exc}",
+                    message=f"auto chose 'bem' ({record['selection_reason']}) but it cannot be imported: {exc}",
                     normal_force_N=0.0,
                     creepage=creepage,
                     wall_time_s=time.perf_counter() - start,
-                    extra={"selected_model": chosen},
+                    extra=record,
                 )
-        else:
-            hertz, why = _hertz(geometry, material, normal_force_N)
-            if hertz is None:
-                result = _base_result(self.name, geometry, creepage, None, why, start)
-                result.extra["selected_model"] = "hertz"
-                return result
-            chosen, reason = auto_choice(geometry, creepage, material, hertz, tol)
-            model = {"linear": LinearModel, "vermeulen-johnson": VermeulenJohnsonModel, "fastsim": FastsimModel}[
-                chosen
-            ]()
-        result = model.solve(geometry, creepage, material, normal_force_N=normal_force_N, options=per_model.get(chosen))
-        result.extra.update({"selected_model": chosen, "selection_reason": reason})
-        return result
+            result = model.solve(
+                geometry, creepage, material, normal_force_N=normal_force_N, options=per_model.get("bem")
+            )
+        result.extra.update(record)
+        return dataclasses.replace(result, wall_time_s=time.perf_counter() - start)
 
 
 @dataclass(frozen=True, eq=False)
@@ -416,7 +418,7 @@ class AnalyticBatch:
     """Results of :func:`solve_batch` for many elliptic patches (arrays of one shape).
 
     Forces act on the wheel, contact frame (x rolling, y lateral, z normal). ``method`` holds the
-    model used per patch (for ``auto``: its choice; "none" where there is no contact).
+    model used per patch (for ``auto``: its choice, "bem" included; "none" where there is no contact).
     ``spin_moment_Nm`` is 0 for ``hertz`` and ``vermeulen-johnson`` (which have none).
     """
 
@@ -464,7 +466,9 @@ def solve_batch(
     Exactly one of ``normal_force_N`` / ``approach_m``. Curvatures, creepages and the load are
     broadcast together (numpy rules; e.g. scalar curvatures with arrays of creepages), and every
     array of the result has the broadcast shape. Options: those of the chosen model (fastsim: nx, ny,
-    traction_bound, flexibility; auto: tolerance and the fastsim options).
+    traction_bound, flexibility; auto: tolerance and the fastsim options). ``auto`` chooses per patch as
+    :class:`AutoModel` does (the geometric features are 0: quadric patches) and solves the patches it sends to
+    ``bem`` one by one with the BEM model (default options; their semi-axes and max pressure are then BEM's).
 
     Raises:
         ValueError: unknown method or option, or bad input.
@@ -492,15 +496,20 @@ def solve_batch(
     def full(value):
         return None if value is None else np.array(np.broadcast_to(np.asarray(value, dtype=float), shape))
 
+    curv_a, curv_b = full(curvature_long_1_per_m), full(curvature_lat_1_per_m)
     hz = hertz_solve_batch(
-        full(curvature_long_1_per_m),
-        full(curvature_lat_1_per_m),
+        curv_a,
+        curv_b,
         normal_force_N=full(normal_force_N),
         approach_m=full(approach_m),
         shear_modulus_Pa=material.shear_modulus_Pa,
         poisson_ratio=material.poisson_ratio,
     )
     xi, eta, phi = (full(v) for v in (longitudinal, lateral, spin_1_per_m))
+    # Hertz's, except on the patches auto sends to bem (then the BEM solution's)
+    patch_values = {
+        name: np.array(getattr(hz, name), float) for name in ("semi_axis_long_m", "semi_axis_lat_m", "max_pressure_Pa")
+    }
     contact = hz.normal_force_N > 0
     a = np.where(contact, hz.semi_axis_long_m, 1.0)
     b = np.where(contact, hz.semi_axis_lat_m, 1.0)
@@ -520,19 +529,23 @@ def solve_batch(
             poisson_ratio=material.poisson_ratio,
             coefficients=coef,
         )
-        mu_n = material.friction_coefficient * hz.normal_force_N
         vx, vy = vermeulen_johnson_saturation(tx, ty, hz.normal_force_N, material.friction_coefficient)
         fs_kw = (
             {k: opts[k] for k in ("nx", "ny", "traction_bound", "flexibility")} if method in ("fastsim", "auto") else {}
         )
         if method == "auto":
-            tol = opts["tolerance"]
-            t_lin = np.hypot(tx, ty)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                w = np.where(mu_n > 0, t_lin / (3.0 * mu_n), np.inf)
-                share = material.shear_modulus_Pa * (a * b) ** 1.5 * coef.c23 * np.abs(phi) / np.maximum(t_lin, mu_n)
-            share = np.nan_to_num(share)
-            used = np.where(w < tol, "linear", np.where(share < tol, "vermeulen-johnson", "fastsim")).astype(object)
+            from rigid_dynamics.contact.auto import FEATURES, batch_features, choose_rung, load_thresholds
+
+            feats = batch_features(a, b, hz.normal_force_N, xi, eta, phi, material, coef)
+            data = load_thresholds()
+            grid = (opts["nx"], opts["ny"])
+            used = np.full(shape, "", dtype=object)
+            for idx in np.ndindex(shape):
+                if contact[idx]:
+                    choice = choose_rung(
+                        {f: float(feats[f][idx]) for f in FEATURES}, opts["tolerance"], fastsim_grid=grid, data=data
+                    )
+                    used[idx] = choice["model"]
         if method == "linear":
             fx, fy, mz = tx, ty, tz
         elif method == "vermeulen-johnson":
@@ -550,6 +563,23 @@ def solve_batch(
             fx = np.where(lin, tx, np.where(vj, vx, 0.0))
             fy = np.where(lin, ty, np.where(vj, vy, 0.0))
             mz = np.where(lin, tz, 0.0)
+            bem = (used == "bem") & contact
+            if np.any(bem):
+                from rigid_dynamics.contact.registry import get_model
+
+                bem_model = get_model("bem")
+                for idx in zip(*np.nonzero(bem), strict=True):
+                    r = bem_model.solve(
+                        ContactGeometry(float(curv_a[idx]), float(curv_b[idx]), float(hz.approach_m[idx])),
+                        Creepage(float(xi[idx]), float(eta[idx]), float(phi[idx])),
+                        material,
+                        normal_force_N=float(hz.normal_force_N[idx]),
+                    )
+                    if not r.success:
+                        raise ValueError(f"auto: bem failed on patch {idx}: {r.status}: {r.message}")
+                    fx[idx], fy[idx], mz[idx] = r.creep_force_long_N, r.creep_force_lat_N, r.spin_moment_Nm or 0.0
+                    for name in ("semi_axis_long_m", "semi_axis_lat_m", "max_pressure_Pa"):
+                        patch_values[name][idx] = getattr(r, name)
             fs = used == "fastsim"
             if np.any(fs & contact):
                 sel = fs & contact
@@ -565,9 +595,9 @@ def solve_batch(
     return AnalyticBatch(
         normal_force_N=hz.normal_force_N,
         approach_m=hz.approach_m,
-        semi_axis_long_m=hz.semi_axis_long_m,
-        semi_axis_lat_m=hz.semi_axis_lat_m,
-        max_pressure_Pa=hz.max_pressure_Pa,
+        semi_axis_long_m=patch_values["semi_axis_long_m"],
+        semi_axis_lat_m=patch_values["semi_axis_lat_m"],
+        max_pressure_Pa=patch_values["max_pressure_Pa"],
         creep_force_long_N=np.where(contact, fx, zero),
         creep_force_lat_N=np.where(contact, fy, zero),
         spin_moment_Nm=np.where(contact, mz, zero),

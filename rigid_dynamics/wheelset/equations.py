@@ -104,6 +104,22 @@ TRACK_STATE_NAMES = (
 TRACK = slice(14, 22)
 """Where the elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
 
+AUTO_PATCH_FIELDS = (
+    "auto_rung",
+    "auto_level",
+    "auto_deciding_feature",
+    "auto_deciding_threshold",
+    "auto_saturation",
+    "auto_spin_share",
+    "auto_ellipticity_residual",
+    "auto_curvature_change",
+    "auto_second_patch_nearness",
+)
+"""Per-patch record of the ``auto`` model's choice (runs with contact_model "auto" only): ``auto_rung`` the index of
+the chosen rung in rigid_dynamics.contact.auto.AUTO_RUNGS, ``auto_level`` the tolerance level used (NaN: below every
+level), ``auto_deciding_feature`` the index in auto.FEATURES of the feature whose threshold decided (-1: none) and
+that threshold, then the patch's features (rigid_dynamics.contact.auto.patch_features)."""
+
 
 class ContactFailure(RuntimeError):
     """A contact model did not converge or the kinematics became undefined (reported, not raised out)."""
@@ -307,6 +323,25 @@ def batch_contact_function(name: str, material, options=None):
     return solve
 
 
+def _auto_record(extra: dict) -> np.ndarray:
+    """AUTO_PATCH_FIELDS values of one ``auto`` result's ``extra``."""
+    from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES
+
+    model = extra.get("selected_model", "")
+    feats = extra.get("auto_features") or {}
+    deciding = extra.get("auto_deciding_feature")
+    return np.array(
+        [
+            AUTO_RUNGS.index(model) if model in AUTO_RUNGS else np.nan,
+            np.nan if extra.get("auto_level") is None else extra["auto_level"],
+            FEATURES.index(deciding) if deciding in FEATURES else -1,
+            np.nan if extra.get("auto_deciding_threshold") is None else extra["auto_deciding_threshold"],
+            *(feats.get(f, np.nan) for f in FEATURES),
+        ],
+        float,
+    )
+
+
 def _patch_values(patches) -> dict:
     """PATCH_FIELDS arrays of a PatchSet: geometry filled in, forces 0 / creepages NaN until solved."""
     n = len(patches)
@@ -380,6 +415,7 @@ class WheelsetModel:
         self.n_state = 22 if self.elastic else 14
         self.track_rest = np.zeros(8)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
+        self.last_auto = None  # AUTO_PATCH_FIELDS of the last contact() that ran "auto", (n_active, fields)
 
     def full_state(self, state: np.ndarray) -> np.ndarray:
         """The full state of a 12-state: work integrals 0 and, with the elastic track, ``track_rest``."""
@@ -465,6 +501,7 @@ class WheelsetModel:
             rail_velocity[:, 2] = track[4:6][patches.side]
             velocity = velocity - rail_velocity  # relative to the rail (power on wheel and rail together)
         active = np.flatnonzero(patches.approach_m > 0)
+        self.last_auto = None
         if len(active):
             frames, speed, xi, eta, spin = _creepages(
                 lever[active],
@@ -499,6 +536,10 @@ class WheelsetModel:
                     ("spin_creepage_1_per_m", spin), ("semi_axis_long_m", semi_a), ("semi_axis_lat_m", semi_b),
                 ):  # fmt: skip
                     values[key][active] = val
+                if self.last_auto is not None:
+                    for j, key in enumerate(AUTO_PATCH_FIELDS):
+                        values[key] = np.full(n, np.nan)
+                        values[key][active] = self.last_auto[:, j]
         elif record:
             values = _patch_values(patches)
         return ContactState(patches.side, patches.slot, force, moment, lever, velocity, values)
@@ -532,6 +573,10 @@ class WheelsetModel:
             out[3][i] = result.spin_moment_Nm or 0.0
             out[4][i] = result.semi_axis_long_m or np.nan
             out[5][i] = result.semi_axis_lat_m or np.nan
+            if "auto_rung" in result.extra:
+                if self.last_auto is None:
+                    self.last_auto = np.full((n, len(AUTO_PATCH_FIELDS)), np.nan)
+                self.last_auto[i] = _auto_record(result.extra)
         return out
 
     def exterior(self, t: float, state: np.ndarray, c_d: np.ndarray, omega: np.ndarray):

@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from rigid_dynamics.wheelset.equations import (
+    AUTO_PATCH_FIELDS,
     MAX_SLOTS,
     PATCH_FIELDS,
     STATE_NAMES,
@@ -86,7 +87,8 @@ class SimulationResult:
         t: output times, s, shape (n,).
         states: the 12 states (STATE_NAMES) at the output times, shape (n, 12).
         patches: PATCH_FIELDS -> array (n, 2 sides [left, right], 2 slots [tread, flange/second]);
-            NaN where a candidate does not exist or is not in contact (normal_force_N is 0 there).
+            NaN where a candidate does not exist or is not in contact (normal_force_N is 0 there); with
+            contact_model "auto" also AUTO_PATCH_FIELDS (equations.py: the rung chosen per patch and why).
         contact_force_N: sum of the contact forces on each wheel, main frame, shape (n, 2, 3).
         kinetic_energy_J, potential_energy_J: T and V_g = -m g z at the output times, (n,); with the elastic track
             they include the track masses' kinetic energy and the pad and ballast springs' energy.
@@ -565,7 +567,9 @@ class _Recorder:
         self.scene = scene
         self.t: list[np.ndarray] = []
         self.states: list[np.ndarray] = []
-        self.patches = {name: [] for name in PATCH_FIELDS}
+        auto = getattr(model.model, "name", "") == "auto"
+        self.fields = PATCH_FIELDS + (AUTO_PATCH_FIELDS if auto else ())
+        self.patches = {name: [] for name in self.fields}
         self.forces: list[np.ndarray] = []
         self.kinetic: list[np.ndarray] = []
         self.potential: list[np.ndarray] = []
@@ -588,13 +592,14 @@ class _Recorder:
         if not np.all(np.isfinite(full_state)):
             raise _Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, state)
         contact = self.model.contact(state, record=True, track=full_state[TRACK] if self.model.elastic else None)
-        table = {name: np.full((2, MAX_SLOTS), np.nan) for name in PATCH_FIELDS}
+        table = {name: np.full((2, MAX_SLOTS), np.nan) for name in self.fields}
         for k in range(len(contact.side)):
             side, slot = int(contact.side[k]), int(contact.slot[k])
             if slot >= MAX_SLOTS:
                 continue
-            for name in PATCH_FIELDS:
-                table[name][side, slot] = contact.values[name][k]
+            for name in self.fields:
+                if name in contact.values:
+                    table[name][side, slot] = contact.values[name][k]
         forces = np.zeros((2, 3))
         np.add.at(forces, contact.side, contact.force_N)
         self.append(t, full_state, table, forces, error)
@@ -639,8 +644,8 @@ class _Recorder:
         self.in_contact, self.flange = touching, flange
         self.t.append(np.array([t], float))
         self.states.append(state[None].copy())
-        for name in PATCH_FIELDS:
-            self.patches[name].append(np.asarray(table[name], float)[None])
+        for name in self.fields:
+            self.patches[name].append(np.asarray(table.get(name, np.full((2, MAX_SLOTS), np.nan)), float)[None])
         self.forces.append(np.asarray(forces, float)[None])
         track_kinetic, track_potential = self.model.track_energy_J(full_state[TRACK])
         self.kinetic.append(np.array([self.model.kinetic_energy_J(state) + track_kinetic], float))
@@ -704,8 +709,8 @@ class _Recorder:
         states = full_states[:, :12]
         self.t.append(np.asarray(times, float).copy())
         self.states.append(states.copy())
-        for name in PATCH_FIELDS:
-            self.patches[name].append(np.asarray(tables[name], float).copy())
+        for name in self.fields:
+            self.patches[name].append(np.asarray(tables.get(name, np.full((n, 2, MAX_SLOTS), np.nan)), float).copy())
         self.forces.append(np.asarray(forces, float).copy())
         # kinetic energy m|v|^2/2 + omega.J omega/2, J = R diag(Jt, Ja, Jt) R^T (R = R_z R_x), vectorised
         psi, theta = states[:, 3], states[:, 4]
@@ -1322,7 +1327,9 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
     """The time series of a result as named arrays (what :func:`save_timeseries` writes).
 
     Arrays: ``t`` (n,), ``states`` (n, 12) with ``state_names``, ``patch_<field>`` (n, 2, 2) for every
-    PATCH_FIELDS entry (sides left/right, slots tread/flange), ``contact_force_N`` (n, 2, 3),
+    PATCH_FIELDS entry (sides left/right, slots tread/flange) and, for contact_model "auto", every
+    AUTO_PATCH_FIELDS entry (the choice per patch) with ``auto_rung_names`` and ``auto_feature_names`` (what
+    the codes of ``patch_auto_rung`` and ``patch_auto_deciding_feature`` index), ``contact_force_N`` (n, 2, 3),
     ``force_error_estimate`` (n,) for RK4 runs (SimulationResult), ``track_states`` (n, 8) with
     ``track_state_names`` for the elastic track,
     ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
@@ -1349,6 +1356,11 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
         arrays["track_state_names"] = np.array(TRACK_STATE_NAMES)
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
+    if "auto_rung" in result.patches:
+        from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES
+
+        arrays["auto_rung_names"] = np.array(AUTO_RUNGS)
+        arrays["auto_feature_names"] = np.array(FEATURES)
     return arrays
 
 
