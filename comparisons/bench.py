@@ -46,6 +46,11 @@ QUICK_RESOLUTIONS = {"fastsim": ("10x10", "20x20"), "bem": ("16x16", "32x32"), "
 """model -> labels kept by ``--quick`` (models not listed keep all)."""
 TOLERANCES = (0.10, 0.05, 0.02, 0.01)
 QUANTITIES = ("normal_force_N", "creep_force_long_N", "creep_force_lat_N", "max_pressure_Pa", "contact_area_m2")
+FEA_FORCE_TOLERANCE = 2e-3
+"""Wheelset cases with ``fea``: the equilibrium's tolerance on each wheel's vertical load (relative; the case's
+own ``force_tolerance`` wins). The FEA force is not reproducible below ~1e-3 under approach control: every
+evaluation meshes the patch anew, and approaches 1e-9 m apart gave loads 0.1-0.7 % apart (a22-tread, n3), so
+the default 1e-6 was never met (40 iterations, then failed). 0.2 % is far below FEA's own error (4 % at n3)."""
 ERROR_KEYS = ("err_normal_force", "err_creep_force", "err_max_pressure", "err_area")
 
 
@@ -100,6 +105,8 @@ def solve_contact_case(case, model: str, options: dict):
 
     case_options = dict(case.solver_options)
     case_options["model"] = {**(case_options.get("model") or {}), **options} or None
+    if model == "fea":
+        case_options.setdefault("force_tolerance", FEA_FORCE_TOLERANCE)
     solution = solve_wheelset_case(case.wheelset, case.material, model, options=case_options)
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     return patches, solution.success, solution.message

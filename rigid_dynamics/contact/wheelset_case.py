@@ -315,9 +315,13 @@ class PatchSolution:
 
     @property
     def force_main_N(self) -> np.ndarray:
-        """Contact force on the wheel in the main (track) frame, N, shape (3,)."""
+        """Contact force on the wheel in the main (track) frame, N, shape (3,).
+
+        A model that gives no creep forces (None: frictionless, e.g. ``fea``) transmits no tangential force: 0.
+        """
         r = self.result
-        local = np.array([r.creep_force_long_N, r.creep_force_lat_N, r.normal_force_N], float)
+        fx, fy = (0.0 if v is None else v for v in (r.creep_force_long_N, r.creep_force_lat_N))
+        local = np.array([fx, fy, r.normal_force_N], float)
         return self.geometry.frame @ local
 
     @property
@@ -670,8 +674,8 @@ def solve_wheelset_case(
         previous = None
         for _ in range(12):
             creep = [p.result.creep_force_long_N for st in states.values() for p in st.patches]
-            if not any(c != 0.0 for c in creep):
-                break  # no creep forces (hertz): the pitch rate changes nothing; V / r0 is kept
+            if not any(c is not None and c != 0.0 for c in creep):
+                break  # no creep forces (hertz, frictionless fea): the pitch rate changes nothing; V / r0 is kept
             moment = sum(s.axle_moment_Nm for s in states.values())
             if abs(moment) <= opts["axle_moment_tolerance"] * scale / case.rolling_speed_m_per_s:
                 break
