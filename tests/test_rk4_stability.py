@@ -61,3 +61,16 @@ def test_jacobian_of_a_nonlinear_function():
     y = np.array([1.5, 0.3])
     exact = np.array([[2 * 1.5 * 0.3, 1.5**2], [0.0, math.cos(0.3)]])
     assert np.allclose(jacobian(fun, y), exact, rtol=1e-7, atol=1e-9)
+
+
+def test_judge_fixed_step():
+    from rigid_dynamics.wheelset.stability import StepLimit, judge_fixed_step
+
+    limit = StepLimit(5.68e-4, 822.0, 0.08, complex(-400.0, 5165.0))
+    assert judge_fixed_step("ok", "reached t = 1 s", 1e-4, limit) == ("ok", "reached t = 1 s")
+    status, message = judge_fixed_step("derailed", "|y| = 0.06 m exceeds 0.05 m", 5e-3, limit)
+    assert status == "step-unstable"
+    assert "derailed" in message and "5 ms" in message and "822 Hz" in message and "0.00057" in message
+    status, message = judge_fixed_step("ok", "reached t = 1 s", 1e-3, limit)
+    assert status == "warning" and "reached t = 1 s" in message and "stability limit" in message
+    assert judge_fixed_step("wheel-lift", "lift", 1e-3, limit)[0] == "wheel-lift"

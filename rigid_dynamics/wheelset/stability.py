@@ -98,3 +98,28 @@ def rk4_stable_step(fun: Callable[[np.ndarray], np.ndarray], y: np.ndarray, floo
         if step < best.max_step_s:
             best = StepLimit(float(step), float(abs(lam.imag)) / (2.0 * math.pi), float(-lam.real / size), complex(lam))
     return best
+
+
+NUMERICAL_LOOKING = ("blow-up", "force-anomaly", "derailed", "solver-failed")
+"""Run statuses that an unstable fixed step produces without any physics behind them."""
+
+
+def judge_fixed_step(status: str, message: str, step_s: float, limit: StepLimit) -> tuple[str, str]:
+    """(status, message) of a fixed-step run given its step and its :class:`StepLimit`.
+
+    A step within the limit changes nothing. Beyond it: a blow-up, force anomaly, derailment or solver failure
+    becomes ``"step-unstable"`` (the integrator, not the wheelset, diverged; the original status is kept in the
+    message); an ``ok`` run becomes ``"warning"`` (a stiff mode is integrated outside RK4's stability region, so
+    its numbers are not to be trusted even when nothing grew); any other status keeps its name and gets the note.
+    """
+    if not step_s > limit.max_step_s:
+        return status, message
+    note = (
+        f"the fixed step {1e3 * step_s:.3g} ms is {step_s / limit.max_step_s:.2g} x {limit.describe()}; "
+        f"use fixed_step_s <= {limit.max_step_s:.2g} s"
+    )
+    if status in NUMERICAL_LOOKING:
+        return "step-unstable", f"{status} ({message}) is numerical: {note}"
+    if status == "ok":
+        return "warning", f"{message}; {note}" if message else note
+    return status, f"{message}; {note}"
