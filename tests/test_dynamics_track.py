@@ -343,7 +343,7 @@ def test_dipped_joint_geometry():
 
 @pytest.mark.parametrize("method", ["RK45", "Radau"])
 def test_adaptive_methods_carry_the_track(method):
-    """Regression: the scipy methods (Python path; Radau with simulate._state_jacobian's track columns) on the
+    """Regression: the scipy methods (Python path; Radau with drivers.state_jacobian's track columns) on the
     elastic track with a 1 mm offset give RK4's rail deflections (compiled loop) and close the energy balance."""
     scene = _scene(contact_provider="conical", duration_s=0.02)
     scene = replace(scene, initial=replace(scene.initial, lateral_displacement_m=1e-3))

@@ -10,7 +10,7 @@ integrated by the classical RK4 method with a fixed step, all inside one compile
 
 Running-direction irregularities of the TableProvider (polygonal wheel R_irr = A cos(n alpha + phase), rounded
 flat, rail corrugation N_irr(x); irregular.py) are evaluated in the loop exactly as
-providers._running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
+providers.running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
 angle beta from the lowest point (81-point grid, then 3 limited Newton steps), the extra overlap projected on the
 normal, the normal tilted by N_irr', the longitudinal curvature from the polar curvature of r(beta) (floored for a
 concave flat); candidates whose gap exceeds the provider's reach are left alone.
@@ -54,8 +54,8 @@ N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
     P_DIP_A, P_DIP_X, P_DIP_L, P_DIP_E, P_DIP_EJ,
 ) = range(55)  # fmt: skip
 N_PAR = 55
-IRR_GRID = 81  # grid points of the running-direction section (providers._running_irregularity)
-IRR_NEWTON = 3  # Newton steps after the grid (same as providers._running_irregularity)
+IRR_GRID = 81  # grid points of the running-direction section (providers.running_irregularity)
+IRR_NEWTON = 3  # Newton steps after the grid (same as providers.running_irregularity)
 MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
 
 
@@ -110,7 +110,7 @@ def _dip(par, x):
 
 @njit(cache=True, _nrt=False)
 def _irr_parts(par, radius, x0, spin, beta, res):
-    """providers._running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
+    """providers.running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
     (q, q', q'', r, r', r'', x offset, N_irr', N_irr'').
     """
     rv, r1, r2 = 0.0, 0.0, 0.0
@@ -177,7 +177,7 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
 
 @njit(cache=True, _nrt=False)
 def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
-    """Running-direction irregularity of one candidate (providers._running_irregularity, same steps: a grid of
+    """Running-direction irregularity of one candidate (providers.running_irregularity, same steps: a grid of
     IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
     rolling radius, A) for the candidate. bg: the grid angles (as np.linspace(-half, half, IRR_GRID)), their sines
     and cosines (3, IRR_GRID).
@@ -675,8 +675,7 @@ def supported(scene, provider, model) -> bool:
     SearchProvider on tabulated surfaces (ideal profiles with polygon, flats or corrugation).
     """
     from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
-    from rigid_dynamics.wheelset.profiles import SearchProvider
-    from rigid_dynamics.wheelset.providers import TableProvider
+    from rigid_dynamics.wheelset.providers import SearchProvider, TableProvider
 
     if not (
         scene.integrator.method == "RK4"
@@ -698,7 +697,7 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
     """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
     Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
     """
-    from rigid_dynamics.wheelset.profiles import SearchProvider
+    from rigid_dynamics.wheelset.providers import SearchProvider
 
     search = type(provider) is SearchProvider
     m = model_wheelset
@@ -734,7 +733,7 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
     if irr is not None:
         from rigid_dynamics.wheelset.irregular import flat_depth_m
 
-        # the same selection constants as providers._running_irregularity
+        # the same selection constants as providers.running_irregularity
         par[P_IRR] = 1.0
         par[P_IRR_LEFT], par[P_IRR_RIGHT] = (float(v) for v in provider._irr_sides)
         par[P_POLY_N], par[P_POLY_A], par[P_POLY_PH] = irr.polygon_order, irr.polygon_amplitude_m, irr.polygon_phase_rad

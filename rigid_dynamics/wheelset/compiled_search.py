@@ -1,6 +1,6 @@
 """Compiled (numba) 3-D contact search for the compiled RK4 loop: the patches of both wheels at one pose.
 
-The same search as rigid_dynamics.contact.search.search_side with the SearchProvider of profiles.py, on the
+The same search as rigid_dynamics.contact.search.search_side with the SearchProvider of providers/search.py, on the
 same surfaces (the TabulatedWheel/TabulatedRail stand-ins: Hermite tables of the ideal profiles plus the closed-
 form irregularities of contact._search_kernels), with two changes that make it cheap enough to run at every
 right-hand side:
@@ -46,7 +46,7 @@ from rigid_dynamics.contact._search_kernels import (
 N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
 MAX_START = 8  # starts refined per side and evaluation
 MAX_MEMORY = 4  # candidates kept per side for the next evaluation
-ABSENT_GAP_M = 0.01  # profiles.ABSENT_GAP_M
+ABSENT_GAP_M = 0.01  # providers.ABSENT_GAP_M
 COS_STEEPEST = math.cos(math.radians(75.0))
 
 # layout of the per-side rows of ``sp`` (search parameters), shape (2, SP_LEN)
