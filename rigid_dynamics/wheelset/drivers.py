@@ -12,15 +12,22 @@ from collections.abc import Callable
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import (
-    MAX_SLOTS,
-    PATCH_FIELDS,
-    STATE_NAMES,
-    TRACK_STATE_NAMES,
-    ContactFailure,
-)
+from rigid_dynamics.wheelset.equations import MAX_SLOTS, PATCH_FIELDS, ContactFailure
 from rigid_dynamics.wheelset.equilibrium import COMPILED_STATUS, contact_force_sums
 from rigid_dynamics.wheelset.recorder import Stop
+from rigid_dynamics.wheelset.state import (
+    N_MECHANICAL,
+    N_RIGID,
+    POSITIONS,
+    SPIN,
+    SPIN_RATE,
+    TRACK_POSITIONS,
+    TRACK_VELOCITIES,
+    VELOCITIES,
+    WORK,
+    n_states,
+    state_names,
+)
 
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -68,12 +75,12 @@ def tolerances(settings, scene):
     tolerance 1e4-fold or tightening it to atol (m g + axle load) changes the steps of RK45, BDF, Radau and
     LSODA on hunting-conical by under 2 %: the mechanical states set the steps).
     """
-    atol = np.full(22 if scene.track_dynamics.elastic else 14, settings.absolute_tolerance)
-    atol[6:12] = settings.absolute_tolerance * 100.0
-    atol[5] = settings.absolute_tolerance * 100.0
-    atol[11] = settings.absolute_tolerance * 1e3
-    atol[12:14] = 1e-3
-    atol[18:] = settings.absolute_tolerance * 100.0  # the track's rates (absent for the rigid track)
+    atol = np.full(n_states(scene.track_dynamics.elastic), settings.absolute_tolerance)
+    atol[VELOCITIES] = settings.absolute_tolerance * 100.0
+    atol[SPIN] = settings.absolute_tolerance * 100.0
+    atol[SPIN_RATE] = settings.absolute_tolerance * 1e3
+    atol[WORK] = 1e-3
+    atol[TRACK_VELOCITIES] = settings.absolute_tolerance * 100.0  # the track's rates (absent for the rigid track)
     return atol
 
 
@@ -117,10 +124,10 @@ def state_jacobian(fun: Callable) -> Callable:
                 return last[0]
             raise Stop("solver-failed", f"no Jacobian: the state function is not finite at t = {t:.6g} s", t, y)
         jac_matrix = np.zeros((n, n))
-        jac_matrix[0:6, 6:12] = np.eye(6)
-        if n > 14:
-            jac_matrix[14:18, 18:22] = np.eye(4)
-        for j in [*range(12), *range(14, n)]:  # not the work integrals
+        jac_matrix[POSITIONS, VELOCITIES] = np.eye(6)
+        if n > N_RIGID:
+            jac_matrix[TRACK_POSITIONS, TRACK_VELOCITIES] = np.eye(4)
+        for j in [*range(N_MECHANICAL), *range(N_RIGID, n)]:  # not the work integrals
             for sign in (1.0, -1.0):
                 trial = y.copy()
                 trial[j] += sign * _JACOBIAN_RELATIVE_STEP * max(abs(y[j]), 1.0)
@@ -132,7 +139,7 @@ def state_jacobian(fun: Callable) -> Callable:
                 raise Stop(
                     "solver-failed",
                     f"no Jacobian: the state function is not finite next to the state at t = {t:.6g} s "
-                    f"(column {j}, {(STATE_NAMES + ('', '') + TRACK_STATE_NAMES)[j]})",
+                    f"(column {j}, {state_names(True)[j]})",
                     t,
                     y,
                 )

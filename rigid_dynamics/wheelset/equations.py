@@ -52,22 +52,13 @@ from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
-
-STATE_NAMES = (
-    "x_m",
-    "y_m",
-    "z_m",
-    "yaw_rad",
-    "roll_rad",
-    "spin_rad",
-    "x_velocity_m_per_s",
-    "y_velocity_m_per_s",
-    "z_velocity_m_per_s",
-    "yaw_rate_rad_per_s",
-    "roll_rate_rad_per_s",
-    "spin_rate_rad_per_s",
+from rigid_dynamics.wheelset.state import (
+    MECHANICAL,
+    TRACK,
+    WORK_CONTACT,
+    WORK_EXTERIOR,
+    n_states,
 )
-"""Names of the 12 states, in order."""
 
 PATCH_FIELDS = (
     "normal_force_N",
@@ -88,21 +79,6 @@ PATCH_FIELDS = (
 """Per-patch quantities recorded in the results, each of shape (n_out, 2 sides, 2 slots)."""
 
 MAX_SLOTS = 2
-
-TRACK_STATE_NAMES = (
-    "rail_left_m",
-    "rail_right_m",
-    "sleeper_left_m",
-    "sleeper_right_m",
-    "rail_left_velocity_m_per_s",
-    "rail_right_velocity_m_per_s",
-    "sleeper_left_velocity_m_per_s",
-    "sleeper_right_velocity_m_per_s",
-)
-"""Names of the elastic track's states (z down, from the unloaded track), in order."""
-
-TRACK = slice(14, 22)
-"""Where the elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
 
 AUTO_PATCH_FIELDS = (
     "auto_rung",
@@ -412,7 +388,7 @@ class WheelsetModel:
         self.torque = scene.loads.traction_torque_N_m
         self.track = scene.track_dynamics
         self.elastic = self.track.elastic
-        self.n_state = 22 if self.elastic else 14
+        self.n_state = n_states(self.elastic)
         self.track_rest = np.zeros(8)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
         self.last_auto = None  # AUTO_PATCH_FIELDS of the last contact() that ran "auto", (n_active, fields)
@@ -613,7 +589,7 @@ class WheelsetModel:
         c_d, rzx, omega = rotation_and_rates(yaw, roll, spin, yaw_rate, roll_rate, spin_rate)
         track = state[TRACK] if self.elastic else None
         if contact is None:
-            contact = self.contact(state[:12], track=track)
+            contact = self.contact(state[MECHANICAL], track=track)
         f_con = contact.force_N.sum(axis=0)
         m_con = _cross_pairs(contact.lever_m, contact.force_N).sum(axis=0) + contact.moment_Nm.sum(axis=0)
         p_con = float(np.sum(contact.force_N * contact.point_velocity_m_per_s) + contact.moment_Nm.sum(axis=0) @ omega)
@@ -637,7 +613,7 @@ class WheelsetModel:
         out[3:6] = state[9:12]
         out[6:9] = acc
         out[9], out[10], out[11] = yaw_acc, roll_acc, spin_acc
-        out[12], out[13] = p_con, p_ext
+        out[WORK_CONTACT], out[WORK_EXTERIOR] = p_con, p_ext
         return out
 
     def _track_derivative(self, track, rail_force, out) -> float:

@@ -7,13 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import (
-    MAX_SLOTS,
-    TRACK,
-    ContactFailure,
-    WheelsetModel,
-)
+from rigid_dynamics.wheelset.equations import MAX_SLOTS, ContactFailure, WheelsetModel
 from rigid_dynamics.wheelset.parameters import DynamicsScene
+from rigid_dynamics.wheelset.state import TRACK
 
 COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed"}
 """Status codes of the compiled loop (compiled.rk4_run) -> run statuses."""

@@ -9,15 +9,10 @@ import math
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import (
-    AUTO_PATCH_FIELDS,
-    MAX_SLOTS,
-    PATCH_FIELDS,
-    TRACK,
-    WheelsetModel,
-)
+from rigid_dynamics.wheelset.equations import AUTO_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS, WheelsetModel
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES
+from rigid_dynamics.wheelset.state import TRACK
 
 NUMERICAL_ERRORS = (ValueError, ArithmeticError, np.linalg.LinAlgError)
 """Exceptions that the static equilibrium or the integration can raise from below for numerical trouble: turned

@@ -10,12 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import (
-    STATE_NAMES,
-    TRACK_STATE_NAMES,
-)
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES
+from rigid_dynamics.wheelset.state import STATE_NAMES, TRACK_STATE_NAMES
 
 STATUSES = (
     "ok",

@@ -188,7 +188,7 @@ def simulate(
         state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
     if packed is not None:
-        packed[0][_compiled.P_XF0] = model.frame_x0  # the suspension frame starts where the wheelset does
+        packed[0]["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
     model.rhs_evaluations = 0
     full0 = model.full_state(state0)
     last_fraction = [-1.0]
