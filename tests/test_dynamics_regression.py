@@ -7,7 +7,15 @@ cases below (``python tests/test_dynamics_regression.py --write`` writes them wi
 case runs through ``simulate``: the default path of each scene (compiled 3-D search for the irregular scenes,
 scipy's RK45 on the conical provider for hunting-conical) and the table provider with each compiled creep law on
 both the compiled RK4 loop and the Python right-hand side. States must agree to 1e-10 of each state's largest
-magnitude over the run (measured: bit-identical after the restructuring).
+magnitude over the run, except where the Python right-hand side changed its arithmetic (:data:`PYTHON_PATH`).
+
+The compiled cases are bit-identical. The Python right-hand side (equations.WheelsetModel.derivative) now ends in
+the compiled equations of motion, suspension and track (compiled._assemble: J^-1 by the rotation instead of
+np.linalg.solve, scalar sums), so its states move by rounding, amplified by the motion: hunting-conical (growing
+hunting) turns 1e-16 into up to 8e-8 of the largest state over 0.3-0.5 s. That is the size by which the former
+Python and compiled paths already differed on the same cases (before the change: 6.0e-8, 9.0e-8, 7.4e-8 on the
+hunting-conical table cases with linear, FASTSIM, Vermeulen-Johnson), and with linear creep (whose law is the same
+in both) the new Python path agrees with the former compiled path to 6.3e-11 instead.
 """
 
 from __future__ import annotations
@@ -23,6 +31,15 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "dynamics_regression"
 RELATIVE = 1e-10
+PYTHON_PATH = {
+    # measured after the change (largest difference / largest magnitude of the state, over the run)
+    "hunting-conical-default": 2e-7,  # 7.0e-8
+    "hunting-conical-tables-fastsim-python": 2e-7,  # 7.8e-8
+    "hunting-conical-tables-linear-python": 2e-7,  # 6.0e-8
+    "hunting-conical-tables-vermeulen-johnson-python": 2e-7,  # 2.0e-8
+    "polygonal-wheel-python": 1e-8,  # 7.2e-10
+}
+"""Cases on the Python right-hand side whose rounding changed (module docstring): tolerance instead of 1e-10."""
 
 
 def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None):
@@ -75,7 +92,8 @@ def test_same_states_as_before(name):
     np.testing.assert_array_equal(result.t, ref["t"])
     scale = np.maximum(np.max(np.abs(ref["states"]), axis=0), 1e-30)
     worst = np.max(np.abs(result.states - ref["states"]) / scale)
-    assert worst <= RELATIVE, f"{name}: states differ by {worst:.3g} of their largest magnitude"
+    tolerance = PYTHON_PATH.get(name, RELATIVE)
+    assert worst <= tolerance, f"{name}: states differ by {worst:.3g} of their largest magnitude"
 
 
 if __name__ == "__main__" and "--write" in sys.argv:

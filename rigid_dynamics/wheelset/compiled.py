@@ -1,6 +1,9 @@
 """Compiled (numba) fixed-step path of the wheelset simulation for contact-geometry tables.
 
-The same equations as rigid_dynamics.wheelset.equations (eq 59-71 with the gyroscopic term), the same table
+The equations of motion (eq 59-71 with the gyroscopic term), the primary suspension and the elastic track are
+written once, here (:func:`_assemble`, :func:`_track_rates`): the compiled loop's right-hand side ends in them and
+so does the Python one (equations.WheelsetModel.derivative through :func:`derivative_from_contact`, after any
+provider and contact model gave the contact forces). The same table
 look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
 creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
 contact/linear.py), ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py) and ``fastsim``
@@ -24,7 +27,7 @@ Elastic track (scene ``track_dynamics.model = "lumped"``): the 8 track states fo
 (state.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
 deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the
 creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
-equations.WheelsetModel._track_derivative (tests/test_dynamics_track.py compares the two paths).
+:func:`_track_rates` (the Python path uses the same function).
 
 Parameters: one record with named fields (:data:`PARAMETERS`, a numpy structured dtype that numba compiles;
 ``par.mass_kg``), built by :func:`pack`. Chosen by measured overhead: a kernel reading 16 parameters, called 2e7
@@ -351,6 +354,128 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
 
 
 @njit(cache=True, _nrt=False)
+def _track_rates(par, y, rail_f0, rail_f1, out, p_ext):
+    """The elastic track (state.TRACK; a rail mass on a pad on a sleeper mass on the ballast, per wheel) under the
+    vertical contact forces on the rails (left, right), N: its rates into ``out``. Returns ``p_ext`` less the power
+    of the pad and ballast dampers.
+    """
+    for sd in range(2):
+        zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
+        pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
+        ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
+        out[RAIL + sd], out[SLEEPER + sd] = vr, vs
+        out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
+        out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
+        p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
+    return p_ext
+
+
+@njit(cache=True, _nrt=False)
+def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
+    """The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track: d/dt of the full
+    state into ``out`` from the summed contact force and moment about the centre (main frame, N and N m), the
+    contact power ``p_con`` (W), the vertical contact forces on the rails (left, right; elastic track) and the
+    angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: the compiled
+    right-hand side (:func:`_forces`) and the Python one (equations.WheelsetModel.derivative through
+    :func:`derivative_from_contact`) both end here.
+    """
+    xc, yc, zc = y[0], y[1], y[2]
+    yaw, roll = y[3], y[4]
+    vx, vy, vz = y[6], y[7], y[8]
+    yr, rr, sr = y[9], y[10], y[11]
+    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
+    # exterior forces: axle load, primary suspension to the frame moving at the speed, yaw springs, torque
+    fe0, fe1, fe2 = 0.0, 0.0, par.axle_load_N
+    me0, me1, me2 = 0.0, 0.0, 0.0
+    p_ext = par.axle_load_N * vz
+    ax0, ax1, ax2 = -sps * cth, cps * cth, sth
+    x_frame = par.frame_x0_m + par.speed_m_per_s * t
+    for s in (-1.0, 1.0):
+        sb_ = s * par.suspension_half_spacing_m
+        a0, a1, a2 = ax0 * sb_, ax1 * sb_, ax2 * sb_
+        v0 = vx + om[1] * a2 - om[2] * a1
+        v1 = vy + om[2] * a0 - om[0] * a2
+        v2 = vz + om[0] * a1 - om[1] * a0
+        f0 = -par.suspension_kx_N_per_m * (xc + a0 - x_frame) - par.suspension_cx_N_s_per_m * (v0 - par.speed_m_per_s)
+        f1 = -par.suspension_ky_N_per_m * (yc + a1 - sb_) - par.suspension_cy_N_s_per_m * (v1 - 0.0)
+        f2 = -par.suspension_kz_N_per_m * (zc + a2 - par.frame_z_m) - par.suspension_cz_N_s_per_m * (v2 - 0.0)
+        fe0 += f0
+        fe1 += f1
+        fe2 += f2
+        me0 += a1 * f2 - a2 * f1
+        me1 += a2 * f0 - a0 * f2
+        me2 += a0 * f1 - a1 * f0
+        p_ext += f0 * v0 + f1 * v1 + f2 * v2
+    myaw = -2.0 * (par.yaw_stiffness_N_m_per_rad * yaw + par.yaw_damping_N_m_s_per_rad * yr)
+    me2 += myaw
+    p_ext += myaw * om[2]
+    if par.torque_N_m != 0.0:
+        mt0, mt1, mt2 = -par.torque_N_m * ax0, -par.torque_N_m * ax1, -par.torque_N_m * ax2
+        me0 += mt0
+        me1 += mt1
+        me2 += mt2
+        p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
+    acc0 = (force[0] + fe0) / par.mass_kg
+    acc1 = (force[1] + fe1) / par.mass_kg
+    acc2 = (force[2] + fe2) / par.mass_kg + par.gravity_m_per_s2
+    # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
+    jb0, jb1, jb2 = par.inertia_transverse_kg_m2, par.inertia_axial_kg_m2, par.inertia_transverse_kg_m2
+    b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
+    b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
+    b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
+    jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
+    jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
+    jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
+    t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
+    t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
+    t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
+    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
+    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
+    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
+    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
+    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
+    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
+    out[0], out[1], out[2] = vx, vy, vz
+    out[3], out[4], out[5] = yr, rr, sr
+    out[6], out[7], out[8] = acc0, acc1, acc2
+    out[9] = (al0 * sps * sth - al1 * cps * sth + al2 * cth + yr * rr * sth + rr * sr) / cth
+    out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
+    out[10] = al0 * cps + al1 * sps - yr * sr * cth
+    if par.elastic_track > 0:
+        p_ext = _track_rates(par, y, rail_f0, rail_f1, out, p_ext)
+    out[WORK_CONTACT], out[WORK_EXTERIOR] = p_con, p_ext
+
+
+@njit(cache=True, _nrt=False)
+def _rotation(y, om, rzx):
+    """R_z(yaw) R_x(roll) into ``rzx`` (3, 3) and the angular velocity (main frame, eq 68-70) into ``om`` (3)."""
+    yaw, roll = y[3], y[4]
+    yr, rr, sr = y[9], y[10], y[11]
+    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
+    rzx[0, 0], rzx[0, 1], rzx[0, 2] = cps, -sps * cth, sps * sth
+    rzx[1, 0], rzx[1, 1], rzx[1, 2] = sps, cps * cth, -cps * sth
+    rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
+    om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
+
+
+@njit(cache=True)
+def derivative_from_contact(t, y, par, force, moment, p_con, rail_force, out):
+    """:func:`_assemble` for the Python right-hand side (equations.WheelsetModel.derivative): the contact sums
+    come from any contact model (the callback boundary: patches and creepages out, forces back, in Python).
+    """
+    om = np.empty(3)
+    rzx = np.empty((3, 3))
+    _rotation(y, om, rzx)
+    _assemble(t, y, par, force, moment, p_con, rail_force[0], rail_force[1], om, rzx, out)
+
+
+@njit(cache=True)
+def track_rates(par, y, rail_force, out):
+    """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``); returns the dampers' power."""
+    return _track_rates(par, y, rail_force[0], rail_force[1], out, 0.0)
+
+
+@njit(cache=True, _nrt=False)
 def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     """d/dt of the 14-state into ``out`` from the candidate geometry cg (ncand, N_GEO) (see _table_geometry;
     a candidate with q = NaN is absent: recorded as NaN); fills rec (ncand + 2, N_FIELDS) and the side forces
@@ -364,15 +489,9 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     force[:] = 0.0
     moment[:] = 0.0
     side_force[:, :] = 0.0
-    xc, yc, zc = y[0], y[1], y[2]
-    yaw, roll = y[3], y[4]
+    yc = y[1]
     vx, vy, vz = y[6], y[7], y[8]
-    yr, rr, sr = y[9], y[10], y[11]
-    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
-    rzx[0, 0], rzx[0, 1], rzx[0, 2] = cps, -sps * cth, sps * sth
-    rzx[1, 0], rzx[1, 1], rzx[1, 2] = sps, cps * cth, -cps * sth
-    rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
-    om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
+    _rotation(y, om, rzx)
     p_con = 0.0
     elastic = par.elastic_track > 0
     rail_f0, rail_f1 = 0.0, 0.0
@@ -477,73 +596,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
             rec[c, 6] = spin
             rec[c, 12] = sa
             rec[c, 13] = sb
-    # exterior forces (equations.WheelsetModel.exterior), scalar arithmetic
-    fe0, fe1, fe2 = 0.0, 0.0, par.axle_load_N
-    me0, me1, me2 = 0.0, 0.0, 0.0
-    p_ext = par.axle_load_N * vz
-    ax0, ax1, ax2 = -sps * cth, cps * cth, sth
-    x_frame = par.frame_x0_m + par.speed_m_per_s * t
-    for s in (-1.0, 1.0):
-        sb_ = s * par.suspension_half_spacing_m
-        a0, a1, a2 = ax0 * sb_, ax1 * sb_, ax2 * sb_
-        v0 = vx + om[1] * a2 - om[2] * a1
-        v1 = vy + om[2] * a0 - om[0] * a2
-        v2 = vz + om[0] * a1 - om[1] * a0
-        f0 = -par.suspension_kx_N_per_m * (xc + a0 - x_frame) - par.suspension_cx_N_s_per_m * (v0 - par.speed_m_per_s)
-        f1 = -par.suspension_ky_N_per_m * (yc + a1 - sb_) - par.suspension_cy_N_s_per_m * (v1 - 0.0)
-        f2 = -par.suspension_kz_N_per_m * (zc + a2 - par.frame_z_m) - par.suspension_cz_N_s_per_m * (v2 - 0.0)
-        fe0 += f0
-        fe1 += f1
-        fe2 += f2
-        me0 += a1 * f2 - a2 * f1
-        me1 += a2 * f0 - a0 * f2
-        me2 += a0 * f1 - a1 * f0
-        p_ext += f0 * v0 + f1 * v1 + f2 * v2
-    myaw = -2.0 * (par.yaw_stiffness_N_m_per_rad * yaw + par.yaw_damping_N_m_s_per_rad * yr)
-    me2 += myaw
-    p_ext += myaw * om[2]
-    if par.torque_N_m != 0.0:
-        mt0, mt1, mt2 = -par.torque_N_m * ax0, -par.torque_N_m * ax1, -par.torque_N_m * ax2
-        me0 += mt0
-        me1 += mt1
-        me2 += mt2
-        p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
-    acc0 = (force[0] + fe0) / par.mass_kg
-    acc1 = (force[1] + fe1) / par.mass_kg
-    acc2 = (force[2] + fe2) / par.mass_kg + par.gravity_m_per_s2
-    # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
-    jb0, jb1, jb2 = par.inertia_transverse_kg_m2, par.inertia_axial_kg_m2, par.inertia_transverse_kg_m2
-    b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
-    b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
-    b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
-    jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
-    jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
-    jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
-    t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
-    t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
-    t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
-    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
-    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
-    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
-    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
-    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
-    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
-    out[0], out[1], out[2] = vx, vy, vz
-    out[3], out[4], out[5] = yr, rr, sr
-    out[6], out[7], out[8] = acc0, acc1, acc2
-    out[9] = (al0 * sps * sth - al1 * cps * sth + al2 * cth + yr * rr * sth + rr * sr) / cth
-    out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
-    out[10] = al0 * cps + al1 * sps - yr * sr * cth
-    if elastic:
-        for sd in range(2):
-            zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
-            pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
-            ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
-            out[RAIL + sd], out[SLEEPER + sd] = vr, vs
-            out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
-            out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
-            p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
-    out[WORK_CONTACT], out[WORK_EXTERIOR] = p_con, p_ext
+    _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out)
     if record:
         for sd in range(2):
             for k in range(3):
@@ -772,13 +825,10 @@ def supported(scene, provider, model) -> bool:
     return False
 
 
-def pack(model_wheelset, provider, tables, model_name, options=None):
-    """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
-    Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
+def model_parameters(model_wheelset):
+    """The parameter record's fields of the equations of motion, the suspension, the run's limits and the elastic
+    track, from a WheelsetModel (the contact fields stay zero: :func:`pack` adds them for the compiled loop).
     """
-    from rigid_dynamics.wheelset.providers import SearchProvider
-
-    search = type(provider) is SearchProvider
     m = model_wheelset
     scene = m.scene
     par = new_parameters()
@@ -794,19 +844,8 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
         m.speed,
     )
     par["axle_load_N"], par["torque_N_m"] = m.axle_load, m.torque
-    par["shear_modulus_Pa"] = scene.material.shear_modulus_Pa
-    par["contact_modulus_Pa"] = tables.e_star
-    par["friction_coefficient"] = scene.material.friction_coefficient
-    par["model_code"] = MODEL_CODES[model_name]
-    par["z_ref_m"] = 0.0 if search else provider.z_ref
     par["max_force_N"] = scene.integrator.max_force_factor * scene.static_wheel_load_N
     par["max_lateral_m"] = scene.integrator.max_lateral_displacement_m
-    opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
-    opts.update(options or {})
-    par["fastsim_nx"], par["fastsim_ny"] = int(opts["nx"]), int(opts["ny"])
-    par["fastsim_parabolic"] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
-    par["flexibility_code"] = FLEX_CODES[opts["flexibility"]]
-    par["nominal_radius_m"] = provider.r0
     track = scene.track_dynamics
     if track.elastic:
         par["elastic_track"] = 1.0
@@ -820,6 +859,30 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
             track.ballast_stiffness_N_per_m,
         )
         par["ballast_damping_N_s_per_m"] = track.ballast_damping_N_s_per_m
+    return par
+
+
+def pack(model_wheelset, provider, tables, model_name, options=None):
+    """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
+    Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
+    """
+    from rigid_dynamics.wheelset.providers import SearchProvider
+
+    search = type(provider) is SearchProvider
+    m = model_wheelset
+    scene = m.scene
+    par = model_parameters(m)
+    par["shear_modulus_Pa"] = scene.material.shear_modulus_Pa
+    par["contact_modulus_Pa"] = tables.e_star
+    par["friction_coefficient"] = scene.material.friction_coefficient
+    par["model_code"] = MODEL_CODES[model_name]
+    par["z_ref_m"] = 0.0 if search else provider.z_ref
+    opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
+    opts.update(options or {})
+    par["fastsim_nx"], par["fastsim_ny"] = int(opts["nx"]), int(opts["ny"])
+    par["fastsim_parabolic"] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
+    par["flexibility_code"] = FLEX_CODES[opts["flexibility"]]
+    par["nominal_radius_m"] = provider.r0
     irr = None if search else provider.irregularities
     if irr is not None:
         from rigid_dynamics.wheelset.irregular import flat_depth_m
