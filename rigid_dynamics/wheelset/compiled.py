@@ -354,6 +354,51 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
 
 
 @njit(cache=True, _nrt=False)
+def _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey):
+    """Contact frame and creepages of one patch (eq 39-49; the formulas of contact.creepage): e_x = v_p/|v_p| with
+    v_p the rolling velocity [x', 0, 0] projected on the contact plane, e_y = n x e_x; V = |v_p|; xi = v_w . e_x / V,
+    eta = v_w . e_y / V, spin = omega . n / V with v_w = x_t' + omega x r_con (eq 44) less the rail's vertical
+    velocity ``rail_vz``. Fills vel (v_w), ex, ey; returns (V, xi, eta, spin); V not > 0: creepages undefined
+    (xi, eta, spin 0, ex, ey not set).
+    """
+    vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
+    vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
+    vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
+    vel[2] -= rail_vz
+    nv = n[0] * vx
+    vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
+    speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
+    if not speed > 0.0:
+        return speed, 0.0, 0.0, 0.0
+    ex[0], ex[1], ex[2] = vp0 / speed, vp1 / speed, vp2 / speed
+    ey[0] = n[1] * ex[2] - n[2] * ex[1]
+    ey[1] = n[2] * ex[0] - n[0] * ex[2]
+    ey[2] = n[0] * ex[1] - n[1] * ex[0]
+    xi = (vel[0] * ex[0] + vel[1] * ex[1] + vel[2] * ex[2]) / speed
+    eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
+    spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
+    return speed, xi, eta, spin
+
+
+@njit(cache=True)
+def patch_creepages(lever, normal, om, v_c, rail_vz, frames, out):
+    """:func:`_patch_creepages` of n patches for the Python right-hand side: lever, normal (n, 3), angular velocity
+    om (3), centre velocity v_c (3), rail vertical velocity per patch (n); frames (n, 3, 3) get the columns e_x,
+    e_y, n, out (4, n) the rows V, xi, eta, spin (NaN where V is not > 0).
+    """
+    vel, ex, ey = np.empty(3), np.empty(3), np.empty(3)
+    for k in range(lever.shape[0]):
+        speed, xi, eta, spin = _patch_creepages(
+            lever[k], normal[k], om, v_c[0], v_c[1], v_c[2], rail_vz[k], vel, ex, ey
+        )
+        if not speed > 0.0:
+            xi = eta = spin = ex[0] = ex[1] = ex[2] = ey[0] = ey[1] = ey[2] = np.nan
+        out[0, k], out[1, k], out[2, k], out[3, k] = speed, xi, eta, spin
+        for i in range(3):
+            frames[k, i, 0], frames[k, i, 1], frames[k, i, 2] = ex[i], ey[i], normal[k, i]
+
+
+@njit(cache=True, _nrt=False)
 def _track_rates(par, y, rail_f0, rail_f1, out, p_ext):
     """The elastic track (state.TRACK; a rail mass on a pad on a sleeper mass on the ballast, per wheel) under the
     vertical contact forces on the rails (left, right), N: its rates into ``out``. Returns ``p_ext`` less the power
@@ -514,23 +559,10 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
                 rec[c, 11] = g[11]
         if not q > 0.0:
             continue
-        vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
-        vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
-        vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
-        if elastic:
-            vel[2] -= y[RAIL_VELOCITY + sides[c]]  # relative to the rail
-        nv = n[0] * vx
-        vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
-        speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
+        rail_vz = y[RAIL_VELOCITY + sides[c]] if elastic else 0.0  # creepages relative to the rail
+        speed, xi, eta, spin = _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
-        ex[0], ex[1], ex[2] = vp0 / speed, vp1 / speed, vp2 / speed
-        ey[0] = n[1] * ex[2] - n[2] * ex[1]
-        ey[1] = n[2] * ex[0] - n[0] * ex[2]
-        ey[2] = n[0] * ex[1] - n[1] * ex[0]
-        xi = (vel[0] * ex[0] + vel[1] * ex[1] + vel[2] * ex[2]) / speed
-        eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
-        spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
         # Hertz, approach control (tables of the axial function)
         amin, amax = min(ca, cb), max(ca, cb)
         i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])

@@ -50,7 +50,7 @@ import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
-from rigid_dynamics.wheelset.compiled import derivative_from_contact, model_parameters, track_rates
+from rigid_dynamics.wheelset.compiled import derivative_from_contact, model_parameters, patch_creepages, track_rates
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
 from rigid_dynamics.wheelset.state import (
@@ -141,29 +141,20 @@ def _cross3(a, b):
 
 
 def _creepages(lever, normal, omega, v_c, rail_velocity=None):
-    """Contact frames and creepages of many points (eq 39-49; same formulas as contact.creepage).
-
-    e_x = v_p/|v_p| with v_p the rolling velocity v_rol = [x', 0, 0] projected on the contact plane,
-    e_y = n x e_x, e_z = n; V = |v_p|; xi = v_w . e_x / V, eta = v_w . e_y / V, spin = omega . n / V with
-    v_w = x_t' + omega x r_con the velocity of the wheel's material point (eq 44).
+    """Contact frames and creepages of many points (eq 39-49) by the compiled kernel (compiled.patch_creepages, the
+    one used by the compiled right-hand side).
 
     Returns:
         (frames (n, 3, 3), V (n,), xi, eta, spin (n,)).
     """
-    v_rol = np.array([v_c[0], 0.0, 0.0])
-    v_p = v_rol - (normal @ v_rol)[:, None] * normal
-    speed = np.sqrt(np.einsum("ij,ij->i", v_p, v_p))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        e_x = v_p / speed[:, None]
-        e_y = _cross_pairs(normal, e_x)
-        velocity = v_c + _cross_rows(omega, lever)
-        if rail_velocity is not None:
-            velocity = velocity - rail_velocity
-        xi = np.einsum("ij,ij->i", velocity, e_x) / speed
-        eta = np.einsum("ij,ij->i", velocity, e_y) / speed
-        spin = (normal @ omega) / speed
-    frames = np.stack([e_x, e_y, normal], axis=-1)
-    return frames, speed, xi, eta, spin
+    lever = np.ascontiguousarray(lever, float)
+    normal = np.ascontiguousarray(normal, float)
+    n = len(lever)
+    rail_vz = np.zeros(n) if rail_velocity is None else np.ascontiguousarray(np.asarray(rail_velocity, float)[:, 2])
+    frames = np.empty((n, 3, 3))
+    out = np.empty((4, n))
+    patch_creepages(lever, normal, np.asarray(omega, float), np.asarray(v_c, float), rail_vz, frames, out)
+    return frames, out[0], out[1], out[2], out[3]
 
 
 BATCH_MODELS = ("hertz", "linear", "vermeulen-johnson", "fastsim")
