@@ -7,10 +7,10 @@ classical RK4 with a 0.5 ms step as in the scene file unless the case name gives
   reuse at all (the unmodified path, the reference of the search cases);
 * ``search-reuse``: the same with SearchProvider(reuse_m=1e-5): an identical pose reuses the last search, a pose
   within 10 um (RK4's two stages at t + h/2, the last stage and the next step's first) reuses it with the
-  first-order rigid-body correction (profiles.py);
+  first-order rigid-body correction (providers/search.py);
 * ``search-ideal``: the 3-D search without the polygon;
 * ``tables-ideal``, ``tables-polygon``: contact-geometry tables over lateral shift and roll (ideal geometry; with
-  the polygon by the running-direction section of providers.py), the Python right-hand side;
+  the polygon by the running-direction section of providers/running_irregularity.py), the Python right-hand side;
 * ``*-compiled-*``: the same tables in the compiled RK4 loop (rigid_dynamics.wheelset.compiled; FASTSIM by the
   contact package's strip kernel, the polygon evaluated in the loop), 2 s simulated; ``-vj``: Vermeulen-Johnson,
   ``-fastsim15x10``: FASTSIM on 15 x 10 elements (creep forces within 1 % of a 200 x 200 grid,
@@ -49,7 +49,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from rigid_dynamics.wheelset import DynamicsScene, Irregularities, simulate  # noqa: E402
-from rigid_dynamics.wheelset.profiles import SearchProvider  # noqa: E402
+from rigid_dynamics.wheelset.providers import SearchProvider  # noqa: E402
 from rigid_dynamics.wheelset.simulate import build_provider  # noqa: E402
 from wheelrail.config import build_dataclass  # noqa: E402
 
@@ -81,7 +81,7 @@ Notes.
 * The Python paths, for reference: the search at every RHS (search) costs ~3.5 ms per call (search-reuse halves
   the searches by the first-order rigid-body update between close stages), the Python table RHS 0.35-0.6 ms.
   tables-polygon-compiled treats the polygon by a running-direction section of the table candidates
-  (providers.py) instead of the 3-D search (22x / 38x).
+  (providers/running_irregularity.py) instead of the 3-D search (22x / 38x).
 * Compiled table path: ~1 us per RHS with Vermeulen-Johnson, ~2.5 us with FASTSIM 20 x 20 (the strip kernel
   ~0.8 us per patch), ~1.6 us with 15 x 10. It equals the Python path to ~1e-14 (tests/test_dynamics_compiled.py).
 """

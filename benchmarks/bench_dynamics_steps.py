@@ -110,7 +110,7 @@ def doubling_estimate(scene, result, samples=100):
     par, hz, kk, sides, _, mode, targs, sargs = compiled.pack(
         model, provider, model.batch.tables, law.name, model.batch.options
     )
-    par[compiled.P_XF0] = result.states[0, 0]
+    par["frame_x0_m"] = result.states[0, 0]
     rec = np.zeros((len(sides) + 2, compiled.N_FIELDS))
     h = scene.integrator.fixed_step_s
 

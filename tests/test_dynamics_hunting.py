@@ -30,7 +30,7 @@ R0, E0, LAM = 0.46, 0.75, 0.05
 def test_klingel_wavelength():
     """No suspension, Kalker linear creep, 20 m/s, 3 mm start: wavelength within 1 % of 2 pi sqrt(r0 e0/lambda).
 
-    The rail head radius is 50 mm, so the roll correction of the conicity (providers.py) is 0.3 %.
+    The rail head radius is 50 mm, so the roll correction of the conicity (providers/conical.py) is 0.3 %.
     """
     scene = DynamicsScene(
         track=TrackGeometry(conicity=LAM, rail_head_radius_m=0.05),

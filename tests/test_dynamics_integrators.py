@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from rigid_dynamics.contact.types import ContactResult
+from rigid_dynamics.wheelset.drivers import state_jacobian
 from rigid_dynamics.wheelset.equations import WheelsetModel
 from rigid_dynamics.wheelset.linear import creep_coefficients, linear_model_for_scene
 from rigid_dynamics.wheelset.parameters import (
@@ -26,9 +27,8 @@ from rigid_dynamics.wheelset.parameters import (
     TrackGeometry,
 )
 from rigid_dynamics.wheelset.providers import PatchSet
+from rigid_dynamics.wheelset.recorder import Stop
 from rigid_dynamics.wheelset.simulate import (
-    _state_jacobian,
-    _Stop,
     build_provider,
     dominant_wavelength_m,
     get_contact_model,
@@ -100,7 +100,7 @@ def _jacobian_setup(scene):
 
 
 def test_state_jacobian_of_the_implicit_methods():
-    """The Jacobian handed to Radau and BDF (simulate._state_jacobian) against independent references.
+    """The Jacobian handed to Radau and BDF (drivers.state_jacobian) against independent references.
 
     Suspended conical wheelset with a 3rd-order wheel polygon, so that every mechanical state enters the
     right-hand side (x through the longitudinal springs, the spin angle through the polygon):
@@ -128,7 +128,7 @@ def test_state_jacobian_of_the_implicit_methods():
         initial=InitialConditions(),
     )
     fun, y0 = _jacobian_setup(scene)
-    jac = _state_jacobian(fun)(0.0, y0)
+    jac = state_jacobian(fun)(0.0, y0)
     assert jac.shape == (14, 14)
     np.testing.assert_array_equal(jac[0:6], np.hstack([np.zeros((6, 6)), np.eye(6), np.zeros((6, 2))]))
     np.testing.assert_array_equal(jac[:, 12:], 0.0)
@@ -159,7 +159,7 @@ def test_state_jacobian_of_the_implicit_methods():
     far[0] += scene.speed_m_per_s * duration
     far[5] += 2 * math.pi * 3183
     far[12:] = [-1e5, 3e4]
-    jac_far = _state_jacobian(fun)(duration, far)
+    jac_far = state_jacobian(fun)(duration, far)
     assert np.all(np.isfinite(jac_far))
     error = column_error(jac_far, jac, rows=slice(None))
     print(f"far along the track vs start: {error}")
@@ -167,7 +167,7 @@ def test_state_jacobian_of_the_implicit_methods():
 
     plain = replace(scene, irregularities=Irregularities())
     fun, y0 = _jacobian_setup(plain)
-    eigenvalues = np.linalg.eigvals(_state_jacobian(fun)(0.0, y0))
+    eigenvalues = np.linalg.eigvals(state_jacobian(fun)(0.0, y0))
     f11, f22 = creep_coefficients(plain)
     linear = linear_model_for_scene(plain, f11, f22).eigenvalues(plain.speed_m_per_s)
     hunting = linear[np.argmin(np.abs(linear.real))]  # the oscillatory pair; the others are real, ~ -500 1/s
@@ -192,7 +192,7 @@ def test_state_jacobian_around_rejected_states():
     exact = np.zeros((14, 14))
     exact[0:6, 6:12] = np.eye(6)
     exact[6:, :12] = b
-    jac = _state_jacobian(fun)
+    jac = state_jacobian(fun)
     y = rng.uniform(-1.0, 1.0, 14)
     np.testing.assert_allclose(jac(0.0, y), exact, atol=1e-7)
     wall[0] = y[2]  # z + h is rejected: backward difference
@@ -200,16 +200,16 @@ def test_state_jacobian_around_rejected_states():
     beyond = y.copy()
     beyond[2] += 1.0
     np.testing.assert_allclose(jac(0.0, beyond), exact, atol=1e-7)  # the last one
-    with pytest.raises(_Stop) as stop:
-        _state_jacobian(fun)(0.0, beyond)  # no last one
+    with pytest.raises(Stop) as stop:
+        state_jacobian(fun)(0.0, beyond)  # no last one
     assert stop.value.status == "solver-failed"
 
     def spiky(t, y):  # rejects both neighbours of y[4] = 0.5
         return np.full(14, np.nan) if y[4] != 0.5 else fun(t, y)
 
     y[4] = 0.5
-    with pytest.raises(_Stop) as stop:
-        _state_jacobian(spiky)(0.0, y)
+    with pytest.raises(Stop) as stop:
+        state_jacobian(spiky)(0.0, y)
     assert stop.value.status == "solver-failed" and "roll_rad" in stop.value.message
 
 

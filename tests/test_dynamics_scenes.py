@@ -63,7 +63,7 @@ def test_hunting_scene_with_bdf():
 
     With scipy's own finite-difference Jacobian this run stopped at t = 1.58 s ("solver-failed": the steps of the
     columns that are zero, the spin angle and the work integrals, had grown to inf); the Jacobian of
-    simulate._state_jacobian keeps them fixed. Checked against Klingel's wavelength 2 pi sqrt(r0 e0 / lambda)
+    drivers.state_jacobian keeps them fixed. Checked against Klingel's wavelength 2 pi sqrt(r0 e0 / lambda)
     (within 1 %, as tests/test_dynamics_hunting.py; measured -0.007 %) and the energy balance (below 1e-8 of the
     kinetic energy; measured 5e-10, RK45 at the scene's tolerances 1.8e-7).
     """

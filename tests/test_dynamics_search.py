@@ -18,8 +18,7 @@ from rigid_dynamics.wheelset.parameters import (
     TrackGeometry,
     WheelsetParameters,
 )
-from rigid_dynamics.wheelset.profiles import SearchProvider
-from rigid_dynamics.wheelset.providers import ConicalProvider
+from rigid_dynamics.wheelset.providers import ConicalProvider, SearchProvider
 from rigid_dynamics.wheelset.simulate import simulate
 
 TRACK = TrackGeometry(conicity=0.05, rail_head_radius_m=0.05)
@@ -75,7 +74,7 @@ def test_profile_section_agrees_with_search_on_s1002_uic60():
     Same patches in contact per side (a connected overlap is one patch for both) and the same approach, rolling
     radius and contact angle of the deepest patch.
     """
-    from rigid_dynamics.wheelset.profiles import ProfileSectionProvider, build_surfaces
+    from rigid_dynamics.wheelset.providers import ProfileSectionProvider, build_surfaces
 
     ws = WheelsetParameters()
     track = TrackGeometry(wheel_profile="S1002", rail_profile="UIC60", rail_inclination_rad=0.025)

@@ -22,12 +22,12 @@ import pytest
 from hardening_helpers import assert_error, run, write
 
 from rigid_dynamics.wheelset import DynamicsScene, IntegratorSettings, Irregularities, TrackDynamics, simulate
-from rigid_dynamics.wheelset.equations import TRACK
 from rigid_dynamics.wheelset.parameters import (
     UIC60_RAIL_SEAT,
     SuspensionParameters,
     lumped_track_equivalent,
 )
+from rigid_dynamics.wheelset.state import TRACK
 from wheelrail.scenes import resolve_scene_path
 
 # Jenkins et al. (1974) equivalent track per wheel (UK concrete-sleepered CWR), as quoted with the P2 formula
@@ -304,7 +304,7 @@ def test_p2_frequency_of_the_default_track_against_the_linear_three_mass_model()
 
 def test_track_states_reach_the_table_and_the_npz(tmp_path):
     from rigid_dynamics.wheelset import save_timeseries
-    from rigid_dynamics.wheelset.equations import TRACK_STATE_NAMES
+    from rigid_dynamics.wheelset.state import TRACK_STATE_NAMES
 
     result = simulate(_scene(duration_s=0.002))
     table = result.to_dataframe()
@@ -334,16 +334,16 @@ def test_dipped_joint_geometry():
     assert abs(value[3]) < 1.5e-4 and abs(value[4]) < 1.5e-4  # alpha e^2 / (2 |u|) far away
     assert abs(first[3]) < 1e-5 and abs(first[4]) < 1e-5
     assert second[0] == pytest.approx(-alpha / irr.joint_rounding_m, rel=1e-3)  # concave bottom, 1/(0.5 m) < 1/r0
-    par = np.zeros(compiled.N_PAR)
-    par[compiled.P_DIP_A], par[compiled.P_DIP_X], par[compiled.P_DIP_L] = 0.01, 5.0, 3.0
-    par[compiled.P_DIP_E], par[compiled.P_DIP_EJ] = irr.joint_entry_rounding_m, irr.joint_rounding_m
+    par = compiled.new_parameters()
+    par["dip_angle_rad"], par["dip_position_m"], par["dip_ramp_length_m"] = 0.01, 5.0, 3.0
+    par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
     for k, x in enumerate((5.0, 4.8, 5.2, -20.0, 30.0)):
         np.testing.assert_allclose(compiled._dip(par, x), (value[k], first[k], second[k]), rtol=1e-12, atol=1e-15)
 
 
 @pytest.mark.parametrize("method", ["RK45", "Radau"])
 def test_adaptive_methods_carry_the_track(method):
-    """Regression: the scipy methods (Python path; Radau with simulate._state_jacobian's track columns) on the
+    """Regression: the scipy methods (Python path; Radau with drivers.state_jacobian's track columns) on the
     elastic track with a 1 mm offset give RK4's rail deflections (compiled loop) and close the energy balance."""
     scene = _scene(contact_provider="conical", duration_s=0.02)
     scene = replace(scene, initial=replace(scene.initial, lateral_displacement_m=1e-3))

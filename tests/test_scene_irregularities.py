@@ -13,7 +13,7 @@ import pytest
 
 from rigid_dynamics.geometry.measured import write_grid_csv
 from rigid_dynamics.wheelset import simulate
-from rigid_dynamics.wheelset.profiles import build_surfaces, geometry_irregularities
+from rigid_dynamics.wheelset.providers import build_surfaces, geometry_irregularities
 from wheelrail.cli import main
 from wheelrail.scenes import embedded_scenes, load_scene
 

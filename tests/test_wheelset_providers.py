@@ -19,8 +19,7 @@ from rigid_dynamics.kinematics import angular_velocity, wheelset_rotation
 from rigid_dynamics.materials import STEEL
 from rigid_dynamics.wheelset.equations import _creepages, batch_contact_function, rotation_and_rates
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
-from rigid_dynamics.wheelset.profiles import ProfileSectionProvider
-from rigid_dynamics.wheelset.providers import ConicalProvider, TableProvider
+from rigid_dynamics.wheelset.providers import ConicalProvider, ProfileSectionProvider, TableProvider
 
 R0, E0, LAM = 0.46, 0.75, 0.05
 

@@ -8,7 +8,7 @@ Public API::
     save_timeseries(result, "out/series.npz")      # atomic NPZ
 
 Parameters are frozen dataclasses with SI units in the field names (parameters.py); contact geometry comes
-from a provider (providers.py, profiles.py: conical analytic, tables, 3-D search); the contact model is any
+from a provider (the providers package: conical analytic, tables, profile section, 3-D search); the contact model is any
 registered one (rigid_dynamics.contact.registry).
 """
 

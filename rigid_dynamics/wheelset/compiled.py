@@ -1,6 +1,9 @@
 """Compiled (numba) fixed-step path of the wheelset simulation for contact-geometry tables.
 
-The same equations as rigid_dynamics.wheelset.equations (eq 59-71 with the gyroscopic term), the same table
+The equations of motion (eq 59-71 with the gyroscopic term), the primary suspension and the elastic track are
+written once, here (:func:`_assemble`, :func:`_track_rates`): the compiled loop's right-hand side ends in them and
+so does the Python one (equations.WheelsetModel.derivative through :func:`derivative_from_contact`, after any
+provider and contact model gave the contact forces). The same table
 look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
 creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
 contact/linear.py), ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py) and ``fastsim``
@@ -10,7 +13,7 @@ integrated by the classical RK4 method with a fixed step, all inside one compile
 
 Running-direction irregularities of the TableProvider (polygonal wheel R_irr = A cos(n alpha + phase), rounded
 flat, rail corrugation N_irr(x); irregular.py) are evaluated in the loop exactly as
-providers._running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
+providers.running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
 angle beta from the lowest point (81-point grid, then 3 limited Newton steps), the extra overlap projected on the
 normal, the normal tilted by N_irr', the longitudinal curvature from the polar curvature of r(beta) (floored for a
 concave flat); candidates whose gap exceeds the provider's reach are left alone.
@@ -21,10 +24,18 @@ scipy methods, the conical and search providers, ``auto``, ``bem`` and user mode
 tests/test_dynamics_compiled.py checks that it reproduces the Python path (states to ~1e-14 relative).
 
 Elastic track (scene ``track_dynamics.model = "lumped"``): the 8 track states follow the two work integrals
-(equations.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
+(state.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
 deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the
 creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
-equations.WheelsetModel._track_derivative (tests/test_dynamics_track.py compares the two paths).
+:func:`_track_rates` (the Python path uses the same function).
+
+Parameters: one record with named fields (:data:`PARAMETERS`, a numpy structured dtype that numba compiles;
+``par.mass_kg``), built by :func:`pack`. Chosen by measured overhead: a kernel reading 16 parameters, called 2e7
+times in a compiled loop, took 49.8 ns per call with the former float vector and index constants, 49.2 ns with the
+structured record, 48.2 ns with a jitclass and 51.7 ns with a structref (one session, noise ~5 %): no difference.
+The record keeps numba's on-disk cache working (with a jitclass or structref argument every new process missed the
+cache, recompiled and appended a cache entry: numba 0.68, measured here) and is a plain numpy array (set from
+Python as ``par["frame_x0_m"] = ...``). The state is indexed by the names of state.py (``y[RAIL_VELOCITY + side]``).
 
 Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined.
 """
@@ -38,24 +49,91 @@ from numba import njit
 
 from rigid_dynamics.contact.fastsim import _fastsim_one
 from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry, search_geometry_on_track
+from rigid_dynamics.wheelset.state import (
+    RAIL,
+    RAIL_VELOCITY,
+    SLEEPER,
+    SLEEPER_VELOCITY,
+    WORK_CONTACT,
+    WORK_EXTERIOR,
+    n_states,
+)
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
 N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
 
-# indices into the parameter vector
-(
-    P_MASS, P_JT, P_JA, P_G, P_KX, P_KY, P_KZ, P_CX, P_CY, P_CZ, P_KYAW, P_CYAW, P_BS, P_ZF, P_XF0, P_V, P_AXLE,
-    P_TORQUE, P_SHEAR, P_ESTAR, P_MU, P_MODEL, P_ZREF, P_FMAX, P_YMAX,
-    P_NX, P_NY, P_PARAB, P_FLEX,
-    P_IRR, P_R0, P_POLY_N, P_POLY_A, P_POLY_PH, P_FLAT_L, P_FLAT_D, P_FLAT_ANG, P_CORR_W, P_CORR_A,
-    P_IRR_LEFT, P_IRR_RIGHT, P_REACH, P_HALF,
-    P_TRACK, P_MR, P_KP, P_CP, P_MS, P_KB, P_CB,
-    P_DIP_A, P_DIP_X, P_DIP_L, P_DIP_E, P_DIP_EJ,
-) = range(55)  # fmt: skip
-N_PAR = 55
-IRR_GRID = 81  # grid points of the running-direction section (providers._running_irregularity)
-IRR_NEWTON = 3  # Newton steps after the grid (same as providers._running_irregularity)
+PARAMETER_FIELDS = (
+    ("mass_kg", "wheelset mass"),
+    ("inertia_transverse_kg_m2", "roll/yaw moment of inertia (body frame)"),
+    ("inertia_axial_kg_m2", "spin moment of inertia"),
+    ("gravity_m_per_s2", "gravity, z down"),
+    ("suspension_kx_N_per_m", "primary stiffness x per side"),
+    ("suspension_ky_N_per_m", "primary stiffness y per side"),
+    ("suspension_kz_N_per_m", "primary stiffness z per side"),
+    ("suspension_cx_N_s_per_m", "primary damping x per side"),
+    ("suspension_cy_N_s_per_m", "primary damping y per side"),
+    ("suspension_cz_N_s_per_m", "primary damping z per side"),
+    ("yaw_stiffness_N_m_per_rad", "yaw stiffness per side"),
+    ("yaw_damping_N_m_s_per_rad", "yaw damping per side"),
+    ("suspension_half_spacing_m", "lateral half spacing of the springs"),
+    ("frame_z_m", "frame height (spring attachment)"),
+    ("frame_x0_m", "frame x at t = 0 (moves at speed_m_per_s)"),
+    ("speed_m_per_s", "running speed"),
+    ("axle_load_N", "axle load, z down"),
+    ("torque_N_m", "driving/braking torque about the axle"),
+    ("shear_modulus_Pa", "combined shear modulus G"),
+    ("contact_modulus_Pa", "E* of Hertz"),
+    ("friction_coefficient", "friction coefficient"),
+    ("model_code", "MODEL_CODES value"),
+    ("z_ref_m", "table reference centre height"),
+    ("max_force_N", "force anomaly limit"),
+    ("max_lateral_m", "derailment limit |y|"),
+    ("fastsim_nx", "FASTSIM elements per strip"),
+    ("fastsim_ny", "FASTSIM strips"),
+    ("fastsim_parabolic", "1: parabolic traction bound"),
+    ("flexibility_code", "FLEX_CODES value"),
+    ("irregular", "1: running-direction irregularities on"),
+    ("nominal_radius_m", "nominal rolling radius"),
+    ("polygon_order", "polygon order"),
+    ("polygon_amplitude_m", "polygon amplitude"),
+    ("polygon_phase_rad", "polygon phase"),
+    ("flat_length_m", "flat length"),
+    ("flat_depth_m", "flat depth"),
+    ("flat_angle_rad", "flat position"),
+    ("corrugation_wavelength_m", "corrugation wavelength"),
+    ("corrugation_amplitude_m", "corrugation amplitude"),
+    ("irregular_left", "1: left side irregular"),
+    ("irregular_right", "1: right side irregular"),
+    ("irregularity_reach_m", "gap beyond which a candidate is left alone"),
+    ("section_half_angle_rad", "half range of the running-direction section"),
+    ("elastic_track", "1: elastic track"),
+    ("rail_mass_kg", "rail mass per wheel"),
+    ("pad_stiffness_N_per_m", "pad stiffness"),
+    ("pad_damping_N_s_per_m", "pad damping"),
+    ("sleeper_mass_kg", "sleeper mass per wheel"),
+    ("ballast_stiffness_N_per_m", "ballast stiffness"),
+    ("ballast_damping_N_s_per_m", "ballast damping"),
+    ("dip_angle_rad", "joint dip angle"),
+    ("dip_position_m", "joint position"),
+    ("dip_ramp_length_m", "joint ramp length"),
+    ("dip_entry_rounding_m", "joint entry rounding"),
+    ("dip_rounding_m", "joint rounding"),
+)
+"""The parameter record of the compiled right-hand side: (field, meaning); every field float64, SI units."""
+
+PARAMETERS = np.dtype([(n, np.float64) for n, _ in PARAMETER_FIELDS])
+"""numpy structured dtype of the parameter record: numba compiles ``par.mass_kg`` to a load at a fixed offset
+(measured: no slower than the former index constants into a float vector; see :func:`new_parameters`)."""
+
+
+def new_parameters():
+    """A zeroed parameter record (a numpy record of :data:`PARAMETERS`; set fields as ``par["mass_kg"] = ...``)."""
+    return np.zeros(1, PARAMETERS)[0]
+
+
+IRR_GRID = 81  # grid points of the running-direction section (providers.running_irregularity)
+IRR_NEWTON = 3  # Newton steps after the grid (same as providers.running_irregularity)
 MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
 
 
@@ -89,17 +167,17 @@ def _uniform(x, x0, step, n):
 @njit(cache=True, _nrt=False)
 def _dip(par, x):
     """The dipped joint's N_irr(x) and two derivatives (irregular.rail_irregularity, same formula)."""
-    alpha = 0.5 * par[P_DIP_A]
-    u = x - par[P_DIP_X]
-    length = par[P_DIP_L]
+    alpha = 0.5 * par.dip_angle_rad
+    u = x - par.dip_position_m
+    length = par.dip_ramp_length_m
     n0, n1, n2 = 0.0, 0.0, 0.0
     for k in range(3):
         if k == 0:
-            shift, weight, e = length, 0.5, par[P_DIP_E]
+            shift, weight, e = length, 0.5, par.dip_entry_rounding_m
         elif k == 1:
-            shift, weight, e = -length, 0.5, par[P_DIP_E]
+            shift, weight, e = -length, 0.5, par.dip_entry_rounding_m
         else:
-            shift, weight, e = 0.0, -1.0, par[P_DIP_EJ]
+            shift, weight, e = 0.0, -1.0, par.dip_rounding_m
         v = u - shift
         root = math.sqrt(v * v + e * e)
         n0 += alpha * weight * root
@@ -110,20 +188,20 @@ def _dip(par, x):
 
 @njit(cache=True, _nrt=False)
 def _irr_parts(par, radius, x0, spin, beta, res):
-    """providers._running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
+    """providers.running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
     (q, q', q'', r, r', r'', x offset, N_irr', N_irr'').
     """
     rv, r1, r2 = 0.0, 0.0, 0.0
     alpha = 0.5 * math.pi + beta - spin
-    if par[P_POLY_N] > 0 and par[P_POLY_A] > 0:
-        n, amp = par[P_POLY_N], par[P_POLY_A]
-        arg = n * alpha + par[P_POLY_PH]
+    if par.polygon_order > 0 and par.polygon_amplitude_m > 0:
+        n, amp = par.polygon_order, par.polygon_amplitude_m
+        arg = n * alpha + par.polygon_phase_rad
         rv += amp * math.cos(arg)
         r1 += -amp * n * math.sin(arg)
         r2 += -amp * n * n * math.cos(arg)
-    if par[P_FLAT_L] > 0:
-        length, depth, r0 = par[P_FLAT_L], par[P_FLAT_D], par[P_R0]
-        u = alpha - par[P_FLAT_ANG] + math.pi
+    if par.flat_length_m > 0:
+        length, depth, r0 = par.flat_length_m, par.flat_depth_m, par.nominal_radius_m
+        u = alpha - par.flat_angle_rad + math.pi
         s = r0 * ((u - 2 * math.pi * math.floor(u / (2 * math.pi))) - math.pi)
         if abs(s) < 0.5 * length:
             k = 2 * math.pi / length
@@ -136,11 +214,11 @@ def _irr_parts(par, radius, x0, spin, beta, res):
     x1 = -(r1 * sb + r * cb)
     x2 = -(r2 * sb + 2 * r1 * cb - r * sb)
     n0, n1, n2 = 0.0, 0.0, 0.0
-    if par[P_CORR_A] > 0:
-        kc, amp = 2 * math.pi / par[P_CORR_W], par[P_CORR_A]
+    if par.corrugation_amplitude_m > 0:
+        kc, amp = 2 * math.pi / par.corrugation_wavelength_m, par.corrugation_amplitude_m
         xx = x0 + xo
         n0, n1, n2 = amp * math.cos(kc * xx), -amp * kc * math.sin(kc * xx), -amp * kc * kc * math.cos(kc * xx)
-    if par[P_DIP_A] > 0:
+    if par.dip_angle_rad > 0:
         d0, d1, d2 = _dip(par, x0 + xo)
         n0 += d0
         n1 += d1
@@ -158,31 +236,31 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
     """
     rv = 0.0
     alpha = 0.5 * math.pi + beta - spin
-    if par[P_POLY_N] > 0 and par[P_POLY_A] > 0:
-        rv += par[P_POLY_A] * math.cos(par[P_POLY_N] * alpha + par[P_POLY_PH])
-    if par[P_FLAT_L] > 0:
-        length, depth, r0 = par[P_FLAT_L], par[P_FLAT_D], par[P_R0]
-        u = alpha - par[P_FLAT_ANG] + math.pi
+    if par.polygon_order > 0 and par.polygon_amplitude_m > 0:
+        rv += par.polygon_amplitude_m * math.cos(par.polygon_order * alpha + par.polygon_phase_rad)
+    if par.flat_length_m > 0:
+        length, depth, r0 = par.flat_length_m, par.flat_depth_m, par.nominal_radius_m
+        u = alpha - par.flat_angle_rad + math.pi
         s = r0 * ((u - 2 * math.pi * math.floor(u / (2 * math.pi))) - math.pi)
         if abs(s) < 0.5 * length:
             rv += -0.5 * depth * (1 + math.cos(2 * math.pi / length * s))
     r = radius + rv
     n0 = 0.0
-    if par[P_CORR_A] > 0:
-        n0 = par[P_CORR_A] * math.cos(2 * math.pi / par[P_CORR_W] * (x0 - r * sin_beta))
-    if par[P_DIP_A] > 0:
+    if par.corrugation_amplitude_m > 0:
+        n0 = par.corrugation_amplitude_m * math.cos(2 * math.pi / par.corrugation_wavelength_m * (x0 - r * sin_beta))
+    if par.dip_angle_rad > 0:
         n0 += _dip(par, x0 - r * sin_beta)[0]
     return r * cos_beta - radius - n0
 
 
 @njit(cache=True, _nrt=False)
 def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
-    """Running-direction irregularity of one candidate (providers._running_irregularity, same steps: a grid of
+    """Running-direction irregularity of one candidate (providers.running_irregularity, same steps: a grid of
     IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
     rolling radius, A) for the candidate. bg: the grid angles (as np.linspace(-half, half, IRR_GRID)), their sines
     and cosines (3, IRR_GRID).
     """
-    half = par[P_HALF]
+    half = par.section_half_angle_rad
     radius = work[8, c]
     best, beta = -np.inf, 0.0
     for g in range(IRR_GRID):
@@ -208,17 +286,17 @@ def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
     geo[2] = r * math.cos(beta) - radius
     geo[3], geo[4], geo[5] = n1 / norm, slope_y / norm, -1.0 / norm
     geo[6] = r
-    geo[7] = max(a_long, MIN_LONG_CURV_FRACTION * 0.5 / par[P_R0])
+    geo[7] = max(a_long, MIN_LONG_CURV_FRACTION * 0.5 / par.nominal_radius_m)
 
 
 @njit(cache=True, _nrt=False)
 def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
     """fastsim.effective_flexibilities for one patch (variants three / single / three-unblended)."""
-    g = par[P_SHEAR]
+    g = par.shear_modulus_Pa
     l1 = 8.0 * a / (3.0 * c11 * g)
     l2 = 8.0 * a / (3.0 * c22 * g)
     l3 = math.pi * a * math.sqrt(a / b) / (4.0 * c23 * g)
-    flex = par[P_FLEX]
+    flex = par.flexibility_code
     if flex == 2:
         return l1, l2, l3
     ab = a * b
@@ -232,7 +310,7 @@ def _flexibilities(par, a, b, normal, xi, eta, spin, c11, c22, c23):
     num = xi**2 + eta**2 + cp2
     den = xi**2 / l1 + eta**2 / l2 + cp2 / l3
     l_comb = num / den if den > 0 else l1
-    force = par[P_MU] * normal
+    force = par.friction_coefficient * normal
     ch2 = (force / (g * ab * c11)) ** 2 + (force / (g * ab * c22)) ** 2 + (force / (g * ab**1.5 * c23)) ** 2
     f_crp = math.sqrt((xi**2 + eta**2 + spin**2) / ch2) if ch2 > 0 else np.inf
     w = min(max(f_crp / 3.0, 0.0), 1.0)
@@ -247,10 +325,10 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
     xc, yc, zc = y[0], y[1], y[2]
     sps = math.sin(y[3])
     _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, y[4], work)
-    zref = par[P_ZREF]
-    elastic = par[P_TRACK] > 0
+    zref = par.z_ref_m
+    elastic = par.elastic_track > 0
     for c in range(table.shape[1]):
-        zs = zc - y[14 + sides[c]] if elastic else zc  # the rail lowered by z_r: the centre raised for this side
+        zs = zc - y[RAIL + sides[c]] if elastic else zc  # the rail lowered by z_r: the centre raised for this side
         q = work[0, c] + (zs - zref) * work[1, c]
         if slots[c] > 0 and work[11, c] + (zs - zref) * work[1, c] > 0:
             q = -0.01
@@ -261,7 +339,11 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
         g[1], g[2], g[3] = -sps * work[10, c], work[2, c], work[3, c]
         g[7], g[8], g[9] = work[6, c], work[7, c], work[8, c]
         g[10], g[11] = work[10, c], work[9, c]
-        if par[P_IRR] > 0 and q > -par[P_REACH] and par[P_IRR_LEFT + sides[c]] > 0:
+        if (
+            par.irregular > 0
+            and q > -par.irregularity_reach_m
+            and (par.irregular_right if sides[c] == 1 else par.irregular_left) > 0
+        ):
             _irregularity(par, work, c, q, xc + g[1], y[5], res, geo, bg)
             q = geo[0]
             g[1] += geo[1]
@@ -269,6 +351,173 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
             g[4], g[5], g[6] = geo[3], geo[4], geo[5]
             g[9], g[7] = geo[6], geo[7]
         g[0] = q
+
+
+@njit(cache=True, _nrt=False)
+def _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey):
+    """Contact frame and creepages of one patch (eq 39-49; the formulas of contact.creepage): e_x = v_p/|v_p| with
+    v_p the rolling velocity [x', 0, 0] projected on the contact plane, e_y = n x e_x; V = |v_p|; xi = v_w . e_x / V,
+    eta = v_w . e_y / V, spin = omega . n / V with v_w = x_t' + omega x r_con (eq 44) less the rail's vertical
+    velocity ``rail_vz``. Fills vel (v_w), ex, ey; returns (V, xi, eta, spin); V not > 0: creepages undefined
+    (xi, eta, spin 0, ex, ey not set).
+    """
+    vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
+    vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
+    vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
+    vel[2] -= rail_vz
+    nv = n[0] * vx
+    vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
+    speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
+    if not speed > 0.0:
+        return speed, 0.0, 0.0, 0.0
+    ex[0], ex[1], ex[2] = vp0 / speed, vp1 / speed, vp2 / speed
+    ey[0] = n[1] * ex[2] - n[2] * ex[1]
+    ey[1] = n[2] * ex[0] - n[0] * ex[2]
+    ey[2] = n[0] * ex[1] - n[1] * ex[0]
+    xi = (vel[0] * ex[0] + vel[1] * ex[1] + vel[2] * ex[2]) / speed
+    eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
+    spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
+    return speed, xi, eta, spin
+
+
+@njit(cache=True)
+def patch_creepages(lever, normal, om, v_c, rail_vz, frames, out):
+    """:func:`_patch_creepages` of n patches for the Python right-hand side: lever, normal (n, 3), angular velocity
+    om (3), centre velocity v_c (3), rail vertical velocity per patch (n); frames (n, 3, 3) get the columns e_x,
+    e_y, n, out (4, n) the rows V, xi, eta, spin (NaN where V is not > 0).
+    """
+    vel, ex, ey = np.empty(3), np.empty(3), np.empty(3)
+    for k in range(lever.shape[0]):
+        speed, xi, eta, spin = _patch_creepages(
+            lever[k], normal[k], om, v_c[0], v_c[1], v_c[2], rail_vz[k], vel, ex, ey
+        )
+        if not speed > 0.0:
+            xi = eta = spin = ex[0] = ex[1] = ex[2] = ey[0] = ey[1] = ey[2] = np.nan
+        out[0, k], out[1, k], out[2, k], out[3, k] = speed, xi, eta, spin
+        for i in range(3):
+            frames[k, i, 0], frames[k, i, 1], frames[k, i, 2] = ex[i], ey[i], normal[k, i]
+
+
+@njit(cache=True, _nrt=False)
+def _track_rates(par, y, rail_f0, rail_f1, out, p_ext):
+    """The elastic track (state.TRACK; a rail mass on a pad on a sleeper mass on the ballast, per wheel) under the
+    vertical contact forces on the rails (left, right), N: its rates into ``out``. Returns ``p_ext`` less the power
+    of the pad and ballast dampers.
+    """
+    for sd in range(2):
+        zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
+        pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
+        ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
+        out[RAIL + sd], out[SLEEPER + sd] = vr, vs
+        out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
+        out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
+        p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
+    return p_ext
+
+
+@njit(cache=True, _nrt=False)
+def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
+    """The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track: d/dt of the full
+    state into ``out`` from the summed contact force and moment about the centre (main frame, N and N m), the
+    contact power ``p_con`` (W), the vertical contact forces on the rails (left, right; elastic track) and the
+    angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: the compiled
+    right-hand side (:func:`_forces`) and the Python one (equations.WheelsetModel.derivative through
+    :func:`derivative_from_contact`) both end here.
+    """
+    xc, yc, zc = y[0], y[1], y[2]
+    yaw, roll = y[3], y[4]
+    vx, vy, vz = y[6], y[7], y[8]
+    yr, rr, sr = y[9], y[10], y[11]
+    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
+    # exterior forces: axle load, primary suspension to the frame moving at the speed, yaw springs, torque
+    fe0, fe1, fe2 = 0.0, 0.0, par.axle_load_N
+    me0, me1, me2 = 0.0, 0.0, 0.0
+    p_ext = par.axle_load_N * vz
+    ax0, ax1, ax2 = -sps * cth, cps * cth, sth
+    x_frame = par.frame_x0_m + par.speed_m_per_s * t
+    for s in (-1.0, 1.0):
+        sb_ = s * par.suspension_half_spacing_m
+        a0, a1, a2 = ax0 * sb_, ax1 * sb_, ax2 * sb_
+        v0 = vx + om[1] * a2 - om[2] * a1
+        v1 = vy + om[2] * a0 - om[0] * a2
+        v2 = vz + om[0] * a1 - om[1] * a0
+        f0 = -par.suspension_kx_N_per_m * (xc + a0 - x_frame) - par.suspension_cx_N_s_per_m * (v0 - par.speed_m_per_s)
+        f1 = -par.suspension_ky_N_per_m * (yc + a1 - sb_) - par.suspension_cy_N_s_per_m * (v1 - 0.0)
+        f2 = -par.suspension_kz_N_per_m * (zc + a2 - par.frame_z_m) - par.suspension_cz_N_s_per_m * (v2 - 0.0)
+        fe0 += f0
+        fe1 += f1
+        fe2 += f2
+        me0 += a1 * f2 - a2 * f1
+        me1 += a2 * f0 - a0 * f2
+        me2 += a0 * f1 - a1 * f0
+        p_ext += f0 * v0 + f1 * v1 + f2 * v2
+    myaw = -2.0 * (par.yaw_stiffness_N_m_per_rad * yaw + par.yaw_damping_N_m_s_per_rad * yr)
+    me2 += myaw
+    p_ext += myaw * om[2]
+    if par.torque_N_m != 0.0:
+        mt0, mt1, mt2 = -par.torque_N_m * ax0, -par.torque_N_m * ax1, -par.torque_N_m * ax2
+        me0 += mt0
+        me1 += mt1
+        me2 += mt2
+        p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
+    acc0 = (force[0] + fe0) / par.mass_kg
+    acc1 = (force[1] + fe1) / par.mass_kg
+    acc2 = (force[2] + fe2) / par.mass_kg + par.gravity_m_per_s2
+    # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
+    jb0, jb1, jb2 = par.inertia_transverse_kg_m2, par.inertia_axial_kg_m2, par.inertia_transverse_kg_m2
+    b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
+    b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
+    b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
+    jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
+    jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
+    jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
+    t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
+    t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
+    t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
+    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
+    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
+    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
+    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
+    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
+    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
+    out[0], out[1], out[2] = vx, vy, vz
+    out[3], out[4], out[5] = yr, rr, sr
+    out[6], out[7], out[8] = acc0, acc1, acc2
+    out[9] = (al0 * sps * sth - al1 * cps * sth + al2 * cth + yr * rr * sth + rr * sr) / cth
+    out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
+    out[10] = al0 * cps + al1 * sps - yr * sr * cth
+    if par.elastic_track > 0:
+        p_ext = _track_rates(par, y, rail_f0, rail_f1, out, p_ext)
+    out[WORK_CONTACT], out[WORK_EXTERIOR] = p_con, p_ext
+
+
+@njit(cache=True, _nrt=False)
+def _rotation(y, om, rzx):
+    """R_z(yaw) R_x(roll) into ``rzx`` (3, 3) and the angular velocity (main frame, eq 68-70) into ``om`` (3)."""
+    yaw, roll = y[3], y[4]
+    yr, rr, sr = y[9], y[10], y[11]
+    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
+    rzx[0, 0], rzx[0, 1], rzx[0, 2] = cps, -sps * cth, sps * sth
+    rzx[1, 0], rzx[1, 1], rzx[1, 2] = sps, cps * cth, -cps * sth
+    rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
+    om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
+
+
+@njit(cache=True)
+def derivative_from_contact(t, y, par, force, moment, p_con, rail_force, out):
+    """:func:`_assemble` for the Python right-hand side (equations.WheelsetModel.derivative): the contact sums
+    come from any contact model (the callback boundary: patches and creepages out, forces back, in Python).
+    """
+    om = np.empty(3)
+    rzx = np.empty((3, 3))
+    _rotation(y, om, rzx)
+    _assemble(t, y, par, force, moment, p_con, rail_force[0], rail_force[1], om, rzx, out)
+
+
+@njit(cache=True)
+def track_rates(par, y, rail_force, out):
+    """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``); returns the dampers' power."""
+    return _track_rates(par, y, rail_force[0], rail_force[1], out, 0.0)
 
 
 @njit(cache=True, _nrt=False)
@@ -285,17 +534,11 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     force[:] = 0.0
     moment[:] = 0.0
     side_force[:, :] = 0.0
-    xc, yc, zc = y[0], y[1], y[2]
-    yaw, roll = y[3], y[4]
+    yc = y[1]
     vx, vy, vz = y[6], y[7], y[8]
-    yr, rr, sr = y[9], y[10], y[11]
-    cps, sps, cth, sth = math.cos(yaw), math.sin(yaw), math.cos(roll), math.sin(roll)
-    rzx[0, 0], rzx[0, 1], rzx[0, 2] = cps, -sps * cth, sps * sth
-    rzx[1, 0], rzx[1, 1], rzx[1, 2] = sps, cps * cth, -cps * sth
-    rzx[2, 0], rzx[2, 1], rzx[2, 2] = 0.0, sth, cth
-    om[0], om[1], om[2] = rr * cps + sr * sps * cth, rr * sps - sr * cps * cth, yr - sr * sth
+    _rotation(y, om, rzx)
     p_con = 0.0
-    elastic = par[P_TRACK] > 0
+    elastic = par.elastic_track > 0
     rail_f0, rail_f1 = 0.0, 0.0
     ncand = cg.shape[0]
     for c in range(ncand):
@@ -316,23 +559,10 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
                 rec[c, 11] = g[11]
         if not q > 0.0:
             continue
-        vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
-        vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
-        vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
-        if elastic:
-            vel[2] -= y[18 + sides[c]]  # relative to the rail
-        nv = n[0] * vx
-        vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
-        speed = math.sqrt(vp0**2 + vp1**2 + vp2**2)
+        rail_vz = y[RAIL_VELOCITY + sides[c]] if elastic else 0.0  # creepages relative to the rail
+        speed, xi, eta, spin = _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
-        ex[0], ex[1], ex[2] = vp0 / speed, vp1 / speed, vp2 / speed
-        ey[0] = n[1] * ex[2] - n[2] * ex[1]
-        ey[1] = n[2] * ex[0] - n[0] * ex[2]
-        ey[2] = n[0] * ex[1] - n[1] * ex[0]
-        xi = (vel[0] * ex[0] + vel[1] * ex[1] + vel[2] * ex[2]) / speed
-        eta = (vel[0] * ey[0] + vel[1] * ey[1] + vel[2] * ey[2]) / speed
-        spin = (om[0] * n[0] + om[1] * n[1] + om[2] * n[2]) / speed
         # Hertz, approach control (tables of the axial function)
         amin, amax = min(ca, cb), max(ca, cb)
         i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
@@ -340,33 +570,33 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         kk_ = hz[2, i] * (1 - w) + hz[2, i + 1] * w
         dd = hz[3, i] * (1 - w) + hz[3, i + 1] * w
         major = math.sqrt(q * dd / (kk_ * amin))
-        normal = 2.0 * math.pi * major * par[P_ESTAR] * q / (3.0 * kk_)
+        normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
         minor = major * math.sqrt(pp)
         sa, sb = (major, minor) if ca <= cb else (minor, major)
         tx, ty, mz = 0.0, 0.0, 0.0
-        if par[P_MODEL] >= 1:
+        if par.model_code >= 1:
             i, w = _uniform(math.log(sa / sb), kk[0, 0], kk[0, 1], kk.shape[1])
             c11 = kk[1, i] * (1 - w) + kk[1, i + 1] * w
             c22 = kk[2, i] * (1 - w) + kk[2, i + 1] * w
             c23 = kk[3, i] * (1 - w) + kk[3, i + 1] * w
             c33 = kk[4, i] * (1 - w) + kk[4, i + 1] * w
             ab = sa * sb
-            gab = par[P_SHEAR] * ab
+            gab = par.shear_modulus_Pa * ab
             gab15 = gab * math.sqrt(ab)
-            if par[P_MODEL] == 3:
+            if par.model_code == 3:
                 l1, l2, l3 = _flexibilities(par, sa, sb, normal, xi, eta, spin, c11, c22, c23)
                 fs = _fastsim_one(
-                    sa, sb, par[P_MU], normal, xi, eta, spin, l1, l2, l3, int(par[P_NX]), int(par[P_NY]),
-                    par[P_PARAB] > 0, dummy, dummy, dummy, dummy, False,
+                    sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
+                    int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
                 )  # fmt: skip
                 tx, ty, mz = fs[0], fs[1], fs[2]
             else:
                 tx = -gab * c11 * xi
                 ty = -gab * c22 * eta - gab15 * c23 * spin
                 mz = gab15 * c23 * eta - gab * ab * c33 * spin
-            if par[P_MODEL] == 2:
+            if par.model_code == 2:
                 tt = math.hypot(tx, ty)
-                limit = par[P_MU] * normal
+                limit = par.friction_coefficient * normal
                 if tt > 0.0:
                     wprime = tt / (3.0 * limit) if limit > 0 else np.inf
                     one = max(1.0 - wprime, 0.0)
@@ -398,73 +628,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
             rec[c, 6] = spin
             rec[c, 12] = sa
             rec[c, 13] = sb
-    # exterior forces (equations.WheelsetModel.exterior), scalar arithmetic
-    fe0, fe1, fe2 = 0.0, 0.0, par[P_AXLE]
-    me0, me1, me2 = 0.0, 0.0, 0.0
-    p_ext = par[P_AXLE] * vz
-    ax0, ax1, ax2 = -sps * cth, cps * cth, sth
-    x_frame = par[P_XF0] + par[P_V] * t
-    for s in (-1.0, 1.0):
-        sb_ = s * par[P_BS]
-        a0, a1, a2 = ax0 * sb_, ax1 * sb_, ax2 * sb_
-        v0 = vx + om[1] * a2 - om[2] * a1
-        v1 = vy + om[2] * a0 - om[0] * a2
-        v2 = vz + om[0] * a1 - om[1] * a0
-        f0 = -par[P_KX] * (xc + a0 - x_frame) - par[P_CX] * (v0 - par[P_V])
-        f1 = -par[P_KY] * (yc + a1 - sb_) - par[P_CY] * (v1 - 0.0)
-        f2 = -par[P_KZ] * (zc + a2 - par[P_ZF]) - par[P_CZ] * (v2 - 0.0)
-        fe0 += f0
-        fe1 += f1
-        fe2 += f2
-        me0 += a1 * f2 - a2 * f1
-        me1 += a2 * f0 - a0 * f2
-        me2 += a0 * f1 - a1 * f0
-        p_ext += f0 * v0 + f1 * v1 + f2 * v2
-    myaw = -2.0 * (par[P_KYAW] * yaw + par[P_CYAW] * yr)
-    me2 += myaw
-    p_ext += myaw * om[2]
-    if par[P_TORQUE] != 0.0:
-        mt0, mt1, mt2 = -par[P_TORQUE] * ax0, -par[P_TORQUE] * ax1, -par[P_TORQUE] * ax2
-        me0 += mt0
-        me1 += mt1
-        me2 += mt2
-        p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
-    acc0 = (force[0] + fe0) / par[P_MASS]
-    acc1 = (force[1] + fe1) / par[P_MASS]
-    acc2 = (force[2] + fe2) / par[P_MASS] + par[P_G]
-    # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
-    jb0, jb1, jb2 = par[P_JT], par[P_JA], par[P_JT]
-    b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
-    b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
-    b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
-    jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
-    jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
-    jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
-    t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
-    t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
-    t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
-    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
-    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
-    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
-    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
-    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
-    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
-    out[0], out[1], out[2] = vx, vy, vz
-    out[3], out[4], out[5] = yr, rr, sr
-    out[6], out[7], out[8] = acc0, acc1, acc2
-    out[9] = (al0 * sps * sth - al1 * cps * sth + al2 * cth + yr * rr * sth + rr * sr) / cth
-    out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
-    out[10] = al0 * cps + al1 * sps - yr * sr * cth
-    if elastic:
-        for sd in range(2):
-            zr, zs_, vr, vs = y[14 + sd], y[16 + sd], y[18 + sd], y[20 + sd]
-            pad = par[P_KP] * (zr - zs_) + par[P_CP] * (vr - vs)
-            ballast = par[P_KB] * zs_ + par[P_CB] * vs
-            out[14 + sd], out[16 + sd] = vr, vs
-            out[18 + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par[P_MR]
-            out[20 + sd] = (pad - ballast) / par[P_MS]
-            p_ext -= par[P_CP] * (vr - vs) ** 2 + par[P_CB] * vs * vs
-    out[12], out[13] = p_con, p_ext
+    _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out)
     if record:
         for sd in range(2):
             for k in range(3):
@@ -483,7 +647,7 @@ def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
         _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg)
     else:
         sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = sargs
-        if par[P_TRACK] > 0:
+        if par.elastic_track > 0:
             search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15])
         else:
             search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
@@ -497,9 +661,9 @@ def _workspace(par, n_rows, ncand, rec):
     and cosines.
     """
     bg = np.empty((3, IRR_GRID))
-    step_b = 2.0 * par[P_HALF] / (IRR_GRID - 1)
+    step_b = 2.0 * par.section_half_angle_rad / (IRR_GRID - 1)
     for g in range(IRR_GRID):
-        bg[0, g] = g * step_b - par[P_HALF]
+        bg[0, g] = g * step_b - par.section_half_angle_rad
         bg[1, g] = math.sin(bg[0, g])
         bg[2, g] = math.cos(bg[0, g])
     return (
@@ -562,7 +726,7 @@ def rk4_run(
     t = t0
     k_out = out_start
     evals = 0
-    fmax, ymax = par[P_FMAX], par[P_YMAX]
+    fmax, ymax = par.max_force_N, par.max_lateral_m
     have_k1 = False  # k1 of the next step is the recorded sample's derivative (same t and y)
     for step in range(n_steps):
         if not have_k1:
@@ -645,7 +809,7 @@ def load(packed) -> None:
     search memory, whose warm starts are its only state).
     """
     par, hz, kk, sides, _, mode, targs, sargs = packed
-    y = np.zeros(22 if par[P_TRACK] > 0 else 14)
+    y = np.zeros(n_states(par["elastic_track"] > 0))
     rec = np.zeros((len(sides) + 2, N_FIELDS))
     rk4_run(
         y,
@@ -675,8 +839,7 @@ def supported(scene, provider, model) -> bool:
     SearchProvider on tabulated surfaces (ideal profiles with polygon, flats or corrugation).
     """
     from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
-    from rigid_dynamics.wheelset.profiles import SearchProvider
-    from rigid_dynamics.wheelset.providers import TableProvider
+    from rigid_dynamics.wheelset.providers import SearchProvider, TableProvider
 
     if not (
         scene.integrator.method == "RK4"
@@ -694,71 +857,104 @@ def supported(scene, provider, model) -> bool:
     return False
 
 
+def model_parameters(model_wheelset):
+    """The parameter record's fields of the equations of motion, the suspension, the run's limits and the elastic
+    track, from a WheelsetModel (the contact fields stay zero: :func:`pack` adds them for the compiled loop).
+    """
+    m = model_wheelset
+    scene = m.scene
+    par = new_parameters()
+    par["mass_kg"], par["inertia_transverse_kg_m2"], par["inertia_axial_kg_m2"] = m.mass, m.j_body[0, 0], m.j_body[1, 1]
+    par["gravity_m_per_s2"] = m.gravity
+    par["suspension_kx_N_per_m"], par["suspension_ky_N_per_m"], par["suspension_kz_N_per_m"] = m.k
+    par["suspension_cx_N_s_per_m"], par["suspension_cy_N_s_per_m"], par["suspension_cz_N_s_per_m"] = m.c
+    par["yaw_stiffness_N_m_per_rad"], par["yaw_damping_N_m_s_per_rad"] = m.k_yaw, m.c_yaw
+    par["suspension_half_spacing_m"], par["frame_z_m"], par["frame_x0_m"], par["speed_m_per_s"] = (
+        m.half_spacing,
+        m.z_frame,
+        m.frame_x0,
+        m.speed,
+    )
+    par["axle_load_N"], par["torque_N_m"] = m.axle_load, m.torque
+    par["max_force_N"] = scene.integrator.max_force_factor * scene.static_wheel_load_N
+    par["max_lateral_m"] = scene.integrator.max_lateral_displacement_m
+    track = scene.track_dynamics
+    if track.elastic:
+        par["elastic_track"] = 1.0
+        par["rail_mass_kg"], par["pad_stiffness_N_per_m"], par["pad_damping_N_s_per_m"] = (
+            track.rail_mass_kg,
+            track.pad_stiffness_N_per_m,
+            track.pad_damping_N_s_per_m,
+        )
+        par["sleeper_mass_kg"], par["ballast_stiffness_N_per_m"] = (
+            track.sleeper_mass_kg,
+            track.ballast_stiffness_N_per_m,
+        )
+        par["ballast_damping_N_s_per_m"] = track.ballast_damping_N_s_per_m
+    return par
+
+
 def pack(model_wheelset, provider, tables, model_name, options=None):
     """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
     Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
     """
-    from rigid_dynamics.wheelset.profiles import SearchProvider
+    from rigid_dynamics.wheelset.providers import SearchProvider
 
     search = type(provider) is SearchProvider
     m = model_wheelset
     scene = m.scene
-    par = np.zeros(N_PAR)
-    par[P_MASS], par[P_JT], par[P_JA] = m.mass, m.j_body[0, 0], m.j_body[1, 1]
-    par[P_G] = m.gravity
-    par[P_KX], par[P_KY], par[P_KZ] = m.k
-    par[P_CX], par[P_CY], par[P_CZ] = m.c
-    par[P_KYAW], par[P_CYAW] = m.k_yaw, m.c_yaw
-    par[P_BS], par[P_ZF], par[P_XF0], par[P_V] = m.half_spacing, m.z_frame, m.frame_x0, m.speed
-    par[P_AXLE], par[P_TORQUE] = m.axle_load, m.torque
-    par[P_SHEAR] = scene.material.shear_modulus_Pa
-    par[P_ESTAR] = tables.e_star
-    par[P_MU] = scene.material.friction_coefficient
-    par[P_MODEL] = MODEL_CODES[model_name]
-    par[P_ZREF] = 0.0 if search else provider.z_ref
-    par[P_FMAX] = scene.integrator.max_force_factor * scene.static_wheel_load_N
-    par[P_YMAX] = scene.integrator.max_lateral_displacement_m
+    par = model_parameters(m)
+    par["shear_modulus_Pa"] = scene.material.shear_modulus_Pa
+    par["contact_modulus_Pa"] = tables.e_star
+    par["friction_coefficient"] = scene.material.friction_coefficient
+    par["model_code"] = MODEL_CODES[model_name]
+    par["z_ref_m"] = 0.0 if search else provider.z_ref
     opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
     opts.update(options or {})
-    par[P_NX], par[P_NY] = int(opts["nx"]), int(opts["ny"])
-    par[P_PARAB] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
-    par[P_FLEX] = FLEX_CODES[opts["flexibility"]]
-    par[P_R0] = provider.r0
-    track = scene.track_dynamics
-    if track.elastic:
-        par[P_TRACK] = 1.0
-        par[P_MR], par[P_KP], par[P_CP] = track.rail_mass_kg, track.pad_stiffness_N_per_m, track.pad_damping_N_s_per_m
-        par[P_MS], par[P_KB] = track.sleeper_mass_kg, track.ballast_stiffness_N_per_m
-        par[P_CB] = track.ballast_damping_N_s_per_m
+    par["fastsim_nx"], par["fastsim_ny"] = int(opts["nx"]), int(opts["ny"])
+    par["fastsim_parabolic"] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
+    par["flexibility_code"] = FLEX_CODES[opts["flexibility"]]
+    par["nominal_radius_m"] = provider.r0
     irr = None if search else provider.irregularities
     if irr is not None:
         from rigid_dynamics.wheelset.irregular import flat_depth_m
 
-        # the same selection constants as providers._running_irregularity
-        par[P_IRR] = 1.0
-        par[P_IRR_LEFT], par[P_IRR_RIGHT] = (float(v) for v in provider._irr_sides)
-        par[P_POLY_N], par[P_POLY_A], par[P_POLY_PH] = irr.polygon_order, irr.polygon_amplitude_m, irr.polygon_phase_rad
+        # the same selection constants as providers.running_irregularity
+        par["irregular"] = 1.0
+        par["irregular_left"], par["irregular_right"] = (float(v) for v in provider._irr_sides)
+        par["polygon_order"], par["polygon_amplitude_m"], par["polygon_phase_rad"] = (
+            irr.polygon_order,
+            irr.polygon_amplitude_m,
+            irr.polygon_phase_rad,
+        )
         reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
         half = 0.02
         if irr.flat_length_m > 0:
             depth = flat_depth_m(irr, provider.r0)
-            par[P_FLAT_L], par[P_FLAT_D], par[P_FLAT_ANG] = irr.flat_length_m, depth, irr.flat_angle_rad
+            par["flat_length_m"], par["flat_depth_m"], par["flat_angle_rad"] = (
+                irr.flat_length_m,
+                depth,
+                irr.flat_angle_rad,
+            )
             reach += 2.0 * depth
             half = max(half, 1.5 * irr.flat_length_m / provider.r0)
         if irr.corrugation_amplitude_m > 0:
-            par[P_CORR_W], par[P_CORR_A] = irr.corrugation_wavelength_m, irr.corrugation_amplitude_m
+            par["corrugation_wavelength_m"], par["corrugation_amplitude_m"] = (
+                irr.corrugation_wavelength_m,
+                irr.corrugation_amplitude_m,
+            )
             half = max(half, 0.6 * irr.corrugation_wavelength_m / provider.r0)
         if irr.joint_dip_angle_rad > 0:
             from rigid_dynamics.wheelset.irregular import dip_depth_m
 
-            par[P_DIP_A], par[P_DIP_X], par[P_DIP_L] = (
+            par["dip_angle_rad"], par["dip_position_m"], par["dip_ramp_length_m"] = (
                 irr.joint_dip_angle_rad,
                 irr.joint_position_m,
                 irr.joint_ramp_length_m,
             )
-            par[P_DIP_E], par[P_DIP_EJ] = irr.joint_entry_rounding_m, irr.joint_rounding_m
+            par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
             reach += 2.0 * dip_depth_m(irr)
-        par[P_REACH], par[P_HALF] = reach, half
+        par["irregularity_reach_m"], par["section_half_angle_rad"] = reach, half
     hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
     hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
     kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])

@@ -1,6 +1,6 @@
 """Compiled (numba) 3-D contact search for the compiled RK4 loop: the patches of both wheels at one pose.
 
-The same search as rigid_dynamics.contact.search.search_side with the SearchProvider of profiles.py, on the
+The same search as rigid_dynamics.contact.search.search_side with the SearchProvider of providers/search.py, on the
 same surfaces (the TabulatedWheel/TabulatedRail stand-ins: Hermite tables of the ideal profiles plus the closed-
 form irregularities of contact._search_kernels), with two changes that make it cheap enough to run at every
 right-hand side:
@@ -42,11 +42,12 @@ from rigid_dynamics.contact._search_kernels import (
     refine_point,
     wheel_irregularity,
 )
+from rigid_dynamics.wheelset.state import RAIL
 
 N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
 MAX_START = 8  # starts refined per side and evaluation
 MAX_MEMORY = 4  # candidates kept per side for the next evaluation
-ABSENT_GAP_M = 0.01  # profiles.ABSENT_GAP_M
+ABSENT_GAP_M = 0.01  # providers.ABSENT_GAP_M
 COS_STEEPEST = math.cos(math.radians(75.0))
 
 # layout of the per-side rows of ``sp`` (search parameters), shape (2, SP_LEN)
@@ -443,14 +444,14 @@ def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, c
 
 @njit(cache=True, _nrt=False)
 def search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, centre):
-    """search_geometry with the rails lowered by the elastic track's rail deflections y[14], y[15] (left, right):
+    """search_geometry with the rails lowered by the elastic track's rail deflections y[RAIL + side] (state.py):
     each side is searched at the wheelset centre raised by its rail's deflection (centre: a scratch 3-vector), and
     the levers (contact point - centre) are those of the raised pose (a rigid vertical shift of the rail).
     """
     rotation(y[3], y[4], y[5], rot)
     failed = 0
     for s in range(2):
-        centre[0], centre[1], centre[2] = y[0], y[1], y[2] - y[14 + s]
+        centre[0], centre[1], centre[2] = y[0], y[1], y[2] - y[RAIL + s]
         failed += search_side(s, centre, rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
     return failed
 

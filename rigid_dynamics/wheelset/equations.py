@@ -50,24 +50,14 @@ import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
+from rigid_dynamics.wheelset.compiled import derivative_from_contact, model_parameters, patch_creepages, track_rates
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
-
-STATE_NAMES = (
-    "x_m",
-    "y_m",
-    "z_m",
-    "yaw_rad",
-    "roll_rad",
-    "spin_rad",
-    "x_velocity_m_per_s",
-    "y_velocity_m_per_s",
-    "z_velocity_m_per_s",
-    "yaw_rate_rad_per_s",
-    "roll_rate_rad_per_s",
-    "spin_rate_rad_per_s",
+from rigid_dynamics.wheelset.state import (
+    MECHANICAL,
+    TRACK,
+    n_states,
 )
-"""Names of the 12 states, in order."""
 
 PATCH_FIELDS = (
     "normal_force_N",
@@ -88,21 +78,6 @@ PATCH_FIELDS = (
 """Per-patch quantities recorded in the results, each of shape (n_out, 2 sides, 2 slots)."""
 
 MAX_SLOTS = 2
-
-TRACK_STATE_NAMES = (
-    "rail_left_m",
-    "rail_right_m",
-    "sleeper_left_m",
-    "sleeper_right_m",
-    "rail_left_velocity_m_per_s",
-    "rail_right_velocity_m_per_s",
-    "sleeper_left_velocity_m_per_s",
-    "sleeper_right_velocity_m_per_s",
-)
-"""Names of the elastic track's states (z down, from the unloaded track), in order."""
-
-TRACK = slice(14, 22)
-"""Where the elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
 
 AUTO_PATCH_FIELDS = (
     "auto_rung",
@@ -166,29 +141,20 @@ def _cross3(a, b):
 
 
 def _creepages(lever, normal, omega, v_c, rail_velocity=None):
-    """Contact frames and creepages of many points (eq 39-49; same formulas as contact.creepage).
-
-    e_x = v_p/|v_p| with v_p the rolling velocity v_rol = [x', 0, 0] projected on the contact plane,
-    e_y = n x e_x, e_z = n; V = |v_p|; xi = v_w . e_x / V, eta = v_w . e_y / V, spin = omega . n / V with
-    v_w = x_t' + omega x r_con the velocity of the wheel's material point (eq 44).
+    """Contact frames and creepages of many points (eq 39-49) by the compiled kernel (compiled.patch_creepages, the
+    one used by the compiled right-hand side).
 
     Returns:
         (frames (n, 3, 3), V (n,), xi, eta, spin (n,)).
     """
-    v_rol = np.array([v_c[0], 0.0, 0.0])
-    v_p = v_rol - (normal @ v_rol)[:, None] * normal
-    speed = np.sqrt(np.einsum("ij,ij->i", v_p, v_p))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        e_x = v_p / speed[:, None]
-        e_y = _cross_pairs(normal, e_x)
-        velocity = v_c + _cross_rows(omega, lever)
-        if rail_velocity is not None:
-            velocity = velocity - rail_velocity
-        xi = np.einsum("ij,ij->i", velocity, e_x) / speed
-        eta = np.einsum("ij,ij->i", velocity, e_y) / speed
-        spin = (normal @ omega) / speed
-    frames = np.stack([e_x, e_y, normal], axis=-1)
-    return frames, speed, xi, eta, spin
+    lever = np.ascontiguousarray(lever, float)
+    normal = np.ascontiguousarray(normal, float)
+    n = len(lever)
+    rail_vz = np.zeros(n) if rail_velocity is None else np.ascontiguousarray(np.asarray(rail_velocity, float)[:, 2])
+    frames = np.empty((n, 3, 3))
+    out = np.empty((4, n))
+    patch_creepages(lever, normal, np.asarray(omega, float), np.asarray(v_c, float), rail_vz, frames, out)
+    return frames, out[0], out[1], out[2], out[3]
 
 
 BATCH_MODELS = ("hertz", "linear", "vermeulen-johnson", "fastsim")
@@ -412,10 +378,11 @@ class WheelsetModel:
         self.torque = scene.loads.traction_torque_N_m
         self.track = scene.track_dynamics
         self.elastic = self.track.elastic
-        self.n_state = 22 if self.elastic else 14
+        self.n_state = n_states(self.elastic)
         self.track_rest = np.zeros(8)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
         self.last_auto = None  # AUTO_PATCH_FIELDS of the last contact() that ran "auto", (n_active, fields)
+        self.par = model_parameters(self)  # the compiled equations' parameter record (compiled.PARAMETERS)
 
     def full_state(self, state: np.ndarray) -> np.ndarray:
         """The full state of a 12-state: work integrals 0 and, with the elastic track, ``track_rest``."""
@@ -579,77 +546,40 @@ class WheelsetModel:
                 self.last_auto[i] = _auto_record(result.extra)
         return out
 
-    def exterior(self, t: float, state: np.ndarray, c_d: np.ndarray, omega: np.ndarray):
-        """Exterior force and moment (eq 63-64) about the centre, and their power (main frame)."""
-        force = np.array([0.0, 0.0, self.axle_load])
-        moment = np.zeros(3)
-        power = self.axle_load * state[8]
-        if self.has_suspension:
-            x_frame = self.frame_x0 + self.speed * t
-            for s in (-1.0, 1.0):
-                arm = c_d[:, 1] * (s * self.half_spacing)
-                point = state[0:3] + arm
-                vel = state[6:9] + _cross3(omega, arm)
-                rel = point - np.array([x_frame, s * self.half_spacing, self.z_frame])
-                rel_v = vel - np.array([self.speed, 0.0, 0.0])
-                f = -self.k * rel - self.c * rel_v
-                force += f
-                moment += _cross3(arm, f)
-                power += f @ vel
-            m_yaw = -2.0 * (self.k_yaw * state[3] + self.c_yaw * state[9])
-            moment[2] += m_yaw
-            power += m_yaw * omega[2]
-        if self.torque:
-            m_t = -self.torque * c_d[:, 1]
-            moment += m_t
-            power += m_t @ omega
-        return force, moment, power
-
     def derivative(self, t: float, state: np.ndarray, contact: ContactState | None = None) -> np.ndarray:
-        """d/dt of the full state (12 mechanical + 2 work integrals [+ 8 track states, TRACK])."""
+        """d/dt of the full state (12 mechanical + 2 work integrals [+ 8 track states, TRACK]).
+
+        The contact forces come from :meth:`contact` (any provider and contact model); the equations of motion,
+        the suspension and the track are the compiled ones (compiled.derivative_from_contact, the same code as the
+        compiled loop's right-hand side).
+        """
         self.rhs_evaluations += 1
-        yaw, roll, spin = state[3], state[4], state[5]
-        yaw_rate, roll_rate, spin_rate = state[9], state[10], state[11]
-        c_d, rzx, omega = rotation_and_rates(yaw, roll, spin, yaw_rate, roll_rate, spin_rate)
+        state = np.asarray(state, float)
         track = state[TRACK] if self.elastic else None
         if contact is None:
-            contact = self.contact(state[:12], track=track)
+            contact = self.contact(state[MECHANICAL], track=track)
+        _, _, omega = rotation_and_rates(*state[3:6], *state[9:12])
         f_con = contact.force_N.sum(axis=0)
         m_con = _cross_pairs(contact.lever_m, contact.force_N).sum(axis=0) + contact.moment_Nm.sum(axis=0)
         p_con = float(np.sum(contact.force_N * contact.point_velocity_m_per_s) + contact.moment_Nm.sum(axis=0) @ omega)
-        f_ext, m_ext, p_ext = self.exterior(t, state, c_d, omega)
-        acc = (f_con + f_ext) / self.mass
-        acc[2] += self.gravity
-        j_main = rzx @ self.j_body @ rzx.T
-        torque = m_con + m_ext - _cross3(omega, j_main @ omega)
-        alpha = np.linalg.solve(j_main, torque)
-        ax, ay, az = alpha
-        sp, cp, st, ct = math.sin(yaw), math.cos(yaw), math.sin(roll), math.cos(roll)
-        yaw_acc = (ax * sp * st - ay * cp * st + az * ct + yaw_rate * roll_rate * st + roll_rate * spin_rate) / ct
-        spin_acc = (ax * sp - ay * cp + yaw_rate * roll_rate + roll_rate * spin_rate * st) / ct
-        roll_acc = ax * cp + ay * sp - yaw_rate * spin_rate * ct
-        out = np.empty(self.n_state)
+        rail_force = np.zeros(2)
         if self.elastic:
-            rail_force = np.zeros(2)
             np.add.at(rail_force, contact.side, -contact.force_N[:, 2])
-            p_ext += self._track_derivative(track, rail_force, out[TRACK])
-        out[0:3] = state[6:9]
-        out[3:6] = state[9:12]
-        out[6:9] = acc
-        out[9], out[10], out[11] = yaw_acc, roll_acc, spin_acc
-        out[12], out[13] = p_con, p_ext
+        out = np.empty(self.n_state)
+        self.par["frame_x0_m"] = self.frame_x0
+        derivative_from_contact(float(t), state, self.par, f_con, m_con, p_con, rail_force, out)
         return out
 
     def _track_derivative(self, track, rail_force, out) -> float:
-        """d/dt of the 8 track states into ``out`` under the rail forces (left, right); returns the dampers' power."""
-        tr = self.track
-        z_r, z_s, v_r, v_s = track[0:2], track[2:4], track[4:6], track[6:8]
-        pad = tr.pad_stiffness_N_per_m * (z_r - z_s) + tr.pad_damping_N_s_per_m * (v_r - v_s)
-        ballast = tr.ballast_stiffness_N_per_m * z_s + tr.ballast_damping_N_s_per_m * v_s
-        out[0:2], out[2:4] = v_r, v_s
-        out[4:6] = (rail_force - pad) / tr.rail_mass_kg
-        out[6:8] = (pad - ballast) / tr.sleeper_mass_kg
-        return -float(np.sum(tr.pad_damping_N_s_per_m * (v_r - v_s) ** 2 + tr.ballast_damping_N_s_per_m * v_s**2))
+        """d/dt of the 8 track states into ``out`` under the rail forces (left, right) (compiled.track_rates);
+        returns the dampers' power.
+        """
+        full = np.zeros(self.n_state)
+        full[TRACK] = track
+        rates = np.zeros(self.n_state)
+        power = track_rates(self.par, full, np.asarray(rail_force, float), rates)
+        out[:] = rates[TRACK]
+        return float(power)
 
     def track_energy_J(self, track) -> tuple:
         """(kinetic, potential) energy of the elastic track's states (n, 8) or (8,), J (0 for the rigid track)."""

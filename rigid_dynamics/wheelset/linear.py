@@ -160,7 +160,7 @@ def linear_model_for_scene(
     """The linear model of a conical scene, given the creep coefficients f11, f22 per wheel (N).
 
     The conicity is the effective one of the analytic conical provider,
-    lambda / (1 - lambda R_r / e0) (providers.py), and W = m g + axle load. ``classic`` drops the
+    lambda / (1 - lambda R_r / e0) (providers/conical.py), and W = m g + axle load. ``classic`` drops the
     roll coupling (kappa = 0).
     """
     ws, susp, track = scene.wheelset, scene.suspension, scene.track

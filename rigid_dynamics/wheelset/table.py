@@ -3,7 +3,7 @@
 Columns (units in the names, SI):
 
 * ``time_s``;
-* the 12 states (:data:`~rigid_dynamics.wheelset.equations.STATE_NAMES`: ``x_m`` ... ``spin_rate_rad_per_s``;
+* the 12 states (:data:`~rigid_dynamics.wheelset.state.STATE_NAMES`: ``x_m`` ... ``spin_rate_rad_per_s``;
   position of the centre of mass and Euler angles in the track frame);
 * per wheel ``left`` / ``right`` and contact slot ``tread`` (first patch) / ``second`` (flange or second point):
   ``<side>_<slot>_<quantity>`` for every recorded patch quantity
@@ -46,8 +46,8 @@ def timeseries_columns(
     Returns:
         name -> (n,) float array, in column order.
     """
-    from rigid_dynamics.wheelset.equations import STATE_NAMES
     from rigid_dynamics.wheelset.providers import SIDES
+    from rigid_dynamics.wheelset.state import STATE_NAMES
 
     t = np.asarray(t, float)
     n = len(t)
@@ -78,8 +78,8 @@ def result_columns(result) -> dict[str, np.ndarray]:
     }
     columns = timeseries_columns(result.t, result.states, result.patches, result.contact_force_N, energies)
     track = getattr(result, "track_states", None)
-    if track is not None:  # the elastic track's states (equations.TRACK_STATE_NAMES), after the others
-        from rigid_dynamics.wheelset.equations import TRACK_STATE_NAMES
+    if track is not None:  # the elastic track's states (state.TRACK_STATE_NAMES), after the others
+        from rigid_dynamics.wheelset.state import TRACK_STATE_NAMES
 
         for k, name in enumerate(TRACK_STATE_NAMES):
             columns[name] = np.asarray(track, float)[:, k]

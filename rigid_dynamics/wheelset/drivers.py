@@ -1,0 +1,343 @@
+"""The integrators over the right-hand side: scipy's adaptive ``OdeSolver`` methods stepped one step at a time
+(:func:`run_adaptive`, with the Jacobian of :func:`state_jacobian` for Radau and BDF), the fixed-step RK4 on the
+Python right-hand side (:func:`run_rk4`) and the compiled RK4 loop (:func:`run_compiled`), with the RK4 force
+error estimate and its check (:func:`force_error_check`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from rigid_dynamics.wheelset.equations import MAX_SLOTS, PATCH_FIELDS, ContactFailure
+from rigid_dynamics.wheelset.equilibrium import COMPILED_STATUS, contact_force_sums
+from rigid_dynamics.wheelset.recorder import Stop
+from rigid_dynamics.wheelset.state import (
+    N_MECHANICAL,
+    N_RIGID,
+    POSITIONS,
+    SPIN,
+    SPIN_RATE,
+    TRACK_POSITIONS,
+    TRACK_VELOCITIES,
+    VELOCITIES,
+    WORK,
+    n_states,
+    state_names,
+)
+
+ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+
+
+def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, settings, message: str):
+    """(status, message) of a finished fixed-step run from its force error estimates (relative to the static wheel
+    load): "warning" when the largest after the settling distance (``settled``) exceeds ``settings.force_tolerance``
+    (or an estimate failed there), else "ok"; when only the start-up exceeds it, the message says that the
+    full-run peaks are not converged.
+
+    The estimate is the contact-force difference between RK4 and its embedded third-order solution over the step
+    ending at each recorded sample (compiled.rk4_run, :func:`run_rk4`). On the embedded scenes it separates the
+    steps whose force results move by more than a few per cent of the static load from those that do not, where the
+    contact-passage time against the step misses the creep-force bias of polygonal-wheel at 1 ms and step doubling
+    underestimates it (benchmarks/results/step_sensitivity.md).
+    """
+
+    def worst(mask):
+        values = np.where(mask & ~np.isnan(errors), errors, -np.inf)
+        k = int(np.argmax(values)) if len(values) else 0
+        return (values[k], k) if len(values) else (-np.inf, 0)
+
+    tol = settings.force_tolerance
+    value, k = worst(settled)
+    if value > tol:
+        what = f"{value:.3g}" if np.isfinite(value) else "not computable (the third-order state failed)"
+        return "warning", (
+            f"{message}; force error estimate {what} of the static wheel load at t = {t[k]:.6g} s exceeds "
+            f"force_tolerance = {tol:g}: reduce fixed_step_s = {settings.fixed_step_s:g} s"
+        )
+    value, k = worst(~settled)
+    if value > tol:
+        return "ok", (
+            f"{message}; the start-up before the settling distance has a force error estimate {value:.3g} at "
+            f"t = {t[k]:.6g} s above force_tolerance = {tol:g}: its peaks (full_run_peaks) are not converged"
+        )
+    return "ok", message
+
+
+def tolerances(settings, scene):
+    """Absolute tolerances per state (atol = ``absolute_tolerance``).
+
+    atol for x, y, z, yaw and roll; 100 atol for the spin angle and the rates; 1000 atol for the spin rate;
+    1e-3 J for the two work integrals (diagnostics that do not enter the right-hand side; loosening their
+    tolerance 1e4-fold or tightening it to atol (m g + axle load) changes the steps of RK45, BDF, Radau and
+    LSODA on hunting-conical by under 2 %: the mechanical states set the steps).
+    """
+    atol = np.full(n_states(scene.track_dynamics.elastic), settings.absolute_tolerance)
+    atol[VELOCITIES] = settings.absolute_tolerance * 100.0
+    atol[SPIN] = settings.absolute_tolerance * 100.0
+    atol[SPIN_RATE] = settings.absolute_tolerance * 1e3
+    atol[WORK] = 1e-3
+    atol[TRACK_VELOCITIES] = settings.absolute_tolerance * 100.0  # the track's rates (absent for the rigid track)
+    return atol
+
+
+_JACOBIAN_RELATIVE_STEP = math.sqrt(np.finfo(float).eps)
+
+
+def state_jacobian(fun: Callable) -> Callable:
+    """Jacobian d f / d y of the 14-state function ``fun`` for the implicit methods Radau and BDF.
+
+    scipy's own finite-difference Jacobian (``num_jac``) perturbs column j by ``factor_j max(atol_j, |y_j|)``
+    and multiplies ``factor_j`` by 10 at every evaluation where the column's difference is negligible, with no
+    upper bound. The right-hand side does not depend on the two work integrals at all, nor on the spin angle
+    without wheel irregularities, so their factors grow tenfold per Jacobian until the step overflows to inf
+    after about 300 Jacobians; the perturbed state is then not finite and the Jacobian NaN (BDF on the scene
+    hunting-conical stopped at t = 1.58 s with "array must not contain infs or NaNs").
+
+    This Jacobian uses the structure of the equations and steps that do not adapt:
+
+    * rows 0-5 are exact: d/dt (x, y, z, psi, theta, phi) = (x', y', z', psi', theta', phi'), so [0 I 0];
+    * columns 12-13 are zero: the work integrals do not enter the right-hand side;
+    * columns 0-11 by forward differences with the step sqrt(eps) max(|y_j|, 1) in SI units (1 m, 1 rad,
+      1 m/s, 1 rad/s). The step grows with |y_j| for the states that grow without bound (x, spin angle), so
+      that (y_j + h) - y_j keeps about half the digits, and does not depend on the tolerances.
+
+    A perturbed state that ``fun`` rejects (NaN, see ``trouble`` in :func:`simulate`) is retried with the
+    step reversed. When ``fun`` rejects the state itself (BDF asks for the Jacobian at its predicted state,
+    which can be wild after a failed Newton iteration) the last Jacobian is returned: the Newton iteration
+    then fails at that state too and the solver halves its step.
+
+    Raises:
+        Stop: "solver-failed" when a column cannot be differenced in either direction.
+    """
+    last = [None]
+
+    def jac(t, y):
+        y = np.asarray(y, float)
+        n = len(y)
+        f0 = fun(t, y)
+        if not np.all(np.isfinite(f0)):
+            if last[0] is not None:
+                return last[0]
+            raise Stop("solver-failed", f"no Jacobian: the state function is not finite at t = {t:.6g} s", t, y)
+        jac_matrix = np.zeros((n, n))
+        jac_matrix[POSITIONS, VELOCITIES] = np.eye(6)
+        if n > N_RIGID:
+            jac_matrix[TRACK_POSITIONS, TRACK_VELOCITIES] = np.eye(4)
+        for j in [*range(N_MECHANICAL), *range(N_RIGID, n)]:  # not the work integrals
+            for sign in (1.0, -1.0):
+                trial = y.copy()
+                trial[j] += sign * _JACOBIAN_RELATIVE_STEP * max(abs(y[j]), 1.0)
+                step = trial[j] - y[j]
+                f1 = fun(t, trial)
+                if np.all(np.isfinite(f1)):
+                    break
+            else:
+                raise Stop(
+                    "solver-failed",
+                    f"no Jacobian: the state function is not finite next to the state at t = {t:.6g} s "
+                    f"(column {j}, {state_names(True)[j]})",
+                    t,
+                    y,
+                )
+            jac_matrix[6:, j] = (f1[6:] - f0[6:]) / step
+        last[0] = jac_matrix
+        return jac_matrix
+
+    return jac
+
+
+def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
+    from scipy import integrate
+
+    cls = getattr(integrate, settings.method)
+    options = {"jac": state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
+    solver = cls(
+        fun,
+        0.0,
+        y0,
+        duration,
+        rtol=settings.relative_tolerance,
+        atol=tolerances(settings, scene),
+        max_step=settings.max_step_s,
+        **options,
+    )
+    steps = 0
+    next_out = 1
+    while solver.status == "running":
+        t_before = solver.t
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                message = solver.step()
+        except Stop as stop:
+            stop.steps = steps
+            raise
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            # e.g. a Jacobian with non-finite entries after a wild trial step of an implicit method
+            stop = Stop("solver-failed", f"{settings.method} failed at t = {solver.t:.6g} s: {exc}", solver.t, solver.y)
+            stop.steps = steps
+            raise stop from None
+        steps += 1
+        if solver.status == "failed":
+            exc = Stop("solver-failed", f"{settings.method}: {message} (t = {t_before:.6g} s)", t_before, solver.y)
+            exc.steps = steps
+            raise exc
+        if not np.all(np.isfinite(solver.y)):
+            exc = Stop("blow-up", f"non-finite state at t = {solver.t:.6g} s", solver.t, solver.y)
+            exc.steps = steps
+            raise exc
+        if next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
+            dense = solver.dense_output()
+            while next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
+                t_out = out_times[next_out]
+                try:
+                    recorder.record(t_out, dense(t_out) if t_out < solver.t else solver.y)
+                except Stop as stop:
+                    stop.steps = steps
+                    raise
+                next_out += 1
+        report(solver.t)
+    return steps
+
+
+def run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
+    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
+    from rigid_dynamics.wheelset import compiled
+
+    par, hz, kk, sides, slots, mode, targs, sargs = packed
+    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
+    h = duration / n_steps
+    out_every = max(1, int(round(settings.output_step_s / h)))
+    check_every = steps_between_checks(settings, h)
+    n_out = n_steps // out_every
+    ncand = len(sides)
+    states = np.zeros((n_out, len(y0)))
+    recs = np.zeros((n_out, ncand + 2, compiled.N_FIELDS))
+    errs = np.full(n_out, np.nan)
+    y, t, done, k_out = y0.copy(), 0.0, 0, 0
+    chunk = max(out_every, (2000 // out_every) * out_every)
+    fields_ = PATCH_FIELDS
+    while done < n_steps:
+        todo = min(chunk, n_steps - done)
+        status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
+            y, t, h, todo, out_every, check_every, par, hz, kk, sides, mode, targs, sargs, states, recs, errs, k_out
+        )
+        model.rhs_evaluations += int(evals)
+        if k_new > k_out:
+            block = recs[k_out:k_new]
+            tables = {name: np.full((k_new - k_out, 2, MAX_SLOTS), np.nan) for name in fields_}
+            for c in range(ncand):
+                if slots[c] < MAX_SLOTS:
+                    for f, name in enumerate(fields_):
+                        tables[name][:, sides[c], slots[c]] = block[:, c, f]
+            times = (done // out_every + np.arange(1, k_new - k_out + 1)) * out_every * h
+            recorder.append_many(
+                times, states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy(), errs[k_out:k_new]
+            )
+        k_out = k_new
+        if status != 0:
+            stop = Stop(
+                COMPILED_STATUS[int(status)],
+                f"compiled RK4 stopped ({COMPILED_STATUS[int(status)]}) at t = {t_end:.6g} s",
+                float(t_end),
+                np.array(y_end[:12]),
+            )
+            stop.steps = done + int(did)
+            raise stop
+        done += todo
+        y, t = y_end, t_end
+        if model.rhs_evaluations >= settings.max_rhs_evaluations:
+            stop = Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
+            stop.steps = done
+            raise stop
+        if time.perf_counter() - start > settings.max_wall_time_s:
+            stop = Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
+            stop.steps = done
+            raise stop
+        report(t)
+    return n_steps
+
+
+FORCE_CHECK_INTERVAL_S = 1e-3
+"""Largest simulated time between two force error checks of an RK4 run, s: with sparse output (say 10 ms) a
+wheel-flat impact (about 3 ms at 60 km/h) still meets a check."""
+
+
+def steps_between_checks(settings, step_s: float) -> int:
+    """Steps between force error checks: every output step, at most FORCE_CHECK_INTERVAL_S apart."""
+    out_every = max(1, int(round(settings.output_step_s / step_s)))
+    return max(1, min(out_every, int(round(FORCE_CHECK_INTERVAL_S / step_s))))
+
+
+def run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
+    """Classical RK4 with a fixed step on the Python right-hand side ``fun``, output by cubic Hermite interpolation.
+
+    Force error estimate (as compiled.rk4_run): every :func:`steps_between_checks` steps the step is also advanced
+    by the embedded third-order formula, y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) with k5 = f(t + h, y4) (the next
+    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept (two extra contact
+    evaluations per check). An output sample at the step's end carries the estimate of that step, other samples
+    the largest of the checks since the previous sample. The samples are recorded (and checked for anomalies)
+    before the estimate is evaluated; a third-order state whose contact cannot be evaluated gives an infinite one.
+    """
+    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
+    h = duration / n_steps
+    check_every = steps_between_checks(settings, h)
+    y = y0.copy()
+    t = 0.0
+    next_out = 1
+    k1 = None
+    pending = math.nan
+    for i in range(n_steps):
+        try:
+            k1 = fun(t, y) if k1 is None else k1
+            k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
+            k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
+            k4 = fun(t + h, y + h * k3)
+        except Stop as stop:
+            stop.steps = i
+            raise
+        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        t_new = (i + 1) * h
+        at_end = False
+        while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
+            t_out = out_times[next_out]
+            # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
+            s = (t_out - t) / h
+            if abs(s - 1.0) < 1e-9:
+                y_out, at_end = y_new, True
+            else:
+                h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+                h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+                y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
+            try:
+                recorder.record(t_out, y_out, math.nan if at_end else pending)
+            except Stop as stop:
+                stop.steps = i + 1
+                raise
+            if not at_end:
+                pending = math.nan
+            next_out += 1
+        k_next = None
+        if (i + 1) % check_every == 0 or at_end:
+            try:
+                k_next = fun(t_new, y_new)
+            except Stop as stop:
+                stop.steps = i + 1
+                raise
+            y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
+            try:
+                error = float(np.max(np.abs(contact_force_sums(model, y_new) - contact_force_sums(model, y3))))
+            except (ContactFailure, ValueError, ArithmeticError):
+                error = math.inf
+            if math.isnan(error):  # forces not computable at one of the two states
+                error = math.inf
+            pending = error if math.isnan(pending) else max(pending, error)
+        if at_end:
+            recorder.set_last_error(pending)
+            pending = math.nan
+        y, t, k1 = y_new, t_new, k_next
+        report(t)
+    return n_steps

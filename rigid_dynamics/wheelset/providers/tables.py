@@ -1,0 +1,130 @@
+"""Contact-geometry tables over lateral shift and roll for ideal geometry (:class:`TableProvider`), with the
+running-direction irregularities added per pose (running_irregularity.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rigid_dynamics.wheelset.irregular import applies_to
+from rigid_dynamics.wheelset.parameters import Irregularities
+from rigid_dynamics.wheelset.providers.patches import SIDES, ContactProvider, PatchSet, running_direction_only
+from rigid_dynamics.wheelset.providers.running_irregularity import running_irregularity
+
+
+class TableProvider:
+    """Contact-geometry tables over lateral shift y and roll theta for ideal geometry.
+
+    Built by sampling a *section* provider (any provider whose patches do not depend on x, yaw, spin)
+    at the nominal centre height z_ref = -r0 on a (theta, y) grid. For each side and candidate slot it
+    stores the approach q_ref, dq/dz = cos(gamma) = -n_z (exact for the conical provider and for the
+    profile section, whose approach is the vertical overlap times cos(gamma)), the contact point (y, z
+    relative to the centre), the normal,
+    the curvatures, rolling radius, contact angle and wheel lateral position. At run time all
+    quantities are interpolated bilinearly and q = q_ref + (z - z_ref) dq/dz. Yaw enters only the
+    kinematics (creepages) and the x offset of the contact point, -sin(psi) y_d. A second candidate whose
+    tabulated merge approach (PatchSet.merge_approach_m, shifted with z like q) is positive lies in the same
+    connected contact region as the first and is dropped.
+
+    Args:
+        section: the provider to tabulate.
+        nominal_radius_m: r0 (z_ref = -r0).
+        lateral_range_m: the table covers y in [-range, range].
+        lateral_step_m: grid spacing in y.
+        roll_range_rad, roll_points: theta grid.
+        irregularities: running-direction irregularities applied on top (optional).
+    """
+
+    name = "tables"
+
+    def __init__(
+        self,
+        section: ContactProvider,
+        nominal_radius_m: float,
+        *,
+        lateral_range_m: float = 0.02,
+        lateral_step_m: float = 2.5e-4,
+        roll_range_rad: float = 0.01,
+        roll_points: int = 11,
+        irregularities: Irregularities | None = None,
+    ):
+        for name, value in (
+            ("lateral_range_m", lateral_range_m),
+            ("lateral_step_m", lateral_step_m),
+            ("roll_range_rad", roll_range_rad),
+        ):
+            if not math.isfinite(value) or value <= 0:
+                raise ValueError(f"{name} = {value!r}: expected a finite number > 0")
+        if roll_points < 2:
+            raise ValueError(f"roll_points = {roll_points!r}: expected an integer >= 2")
+        self.r0 = nominal_radius_m
+        self.z_ref = -nominal_radius_m
+        self.y_grid = np.arange(-lateral_range_m, lateral_range_m + 0.5 * lateral_step_m, lateral_step_m)
+        self.roll_grid = np.linspace(-roll_range_rad, roll_range_rad, roll_points)
+        probe = section.patches(np.array([0.0, 0.0, self.z_ref]), 0.0, 0.0, 0.0)
+        self.side = probe.side.copy()
+        self.slot = probe.slot.copy()
+        n = len(probe)
+        # quantities: q, dq/dz, py, pz, ny, nz, A, B, radius, angle, y_d, merge approach (12)
+        table = np.empty((12, n, len(self.roll_grid), len(self.y_grid)))
+        for i, theta in enumerate(self.roll_grid):
+            for j, y in enumerate(self.y_grid):
+                p = section.patches(np.array([0.0, y, self.z_ref]), 0.0, theta, 0.0)
+                if len(p) != n:
+                    raise ValueError(f"section provider {section.name!r} changed its number of candidates")
+                table[0, :, i, j] = p.approach_m
+                table[1, :, i, j] = -p.normal[:, 2]
+                table[2, :, i, j] = p.point_m[:, 1] - y
+                table[3, :, i, j] = p.point_m[:, 2] - self.z_ref
+                table[4, :, i, j] = p.normal[:, 1]
+                table[5, :, i, j] = p.normal[:, 2]
+                table[6, :, i, j] = p.curvature_long_1_per_m
+                table[7, :, i, j] = p.curvature_lat_1_per_m
+                table[8, :, i, j] = p.rolling_radius_m
+                table[9, :, i, j] = p.contact_angle_rad
+                table[10, :, i, j] = p.wheel_lateral_m
+                merge = p.merge_approach_m if p.merge_approach_m is not None else np.full(n, -np.inf)
+                table[11, :, i, j] = np.maximum(merge, -1.0)  # finite, for the interpolation
+        self.table = table
+        self.irregularities = running_direction_only(irregularities, self.name)
+        if self.irregularities is not None:
+            self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
+
+    def patches(self, centre_m, yaw_rad, roll_rad, spin_rad=0.0) -> PatchSet:
+        x_c, y_c, z_c = float(centre_m[0]), float(centre_m[1]), float(centre_m[2])
+        yg, rg = self.y_grid, self.roll_grid
+        fy = (min(max(y_c, yg[0]), yg[-1]) - yg[0]) / (yg[1] - yg[0])
+        j = min(int(fy), len(yg) - 2)
+        wy = fy - j
+        fr = (min(max(roll_rad, rg[0]), rg[-1]) - rg[0]) / (rg[1] - rg[0])
+        i = min(int(fr), len(rg) - 2)
+        wr = fr - i
+        t = self.table
+        v = (1 - wr) * ((1 - wy) * t[:, :, i, j] + wy * t[:, :, i, j + 1]) + wr * (
+            (1 - wy) * t[:, :, i + 1, j] + wy * t[:, :, i + 1, j + 1]
+        )
+        approach = v[0] + (z_c - self.z_ref) * v[1]
+        merged = v[11] + (z_c - self.z_ref) * v[1] > 0
+        approach = np.where(merged & (self.slot > 0), -0.01, approach)
+        n_y, n_z = v[4], v[5]
+        norm = np.sqrt(n_y * n_y + n_z * n_z)
+        normal = np.stack([np.zeros_like(n_y), n_y / norm, n_z / norm], axis=-1)
+        x_off = -math.sin(yaw_rad) * v[10]
+        point = np.stack([x_c + x_off, y_c + v[2], z_c + v[3]], axis=-1)
+        patches = PatchSet(
+            side=self.side,
+            slot=self.slot,
+            point_m=point,
+            normal=normal,
+            curvature_long_1_per_m=v[6].copy(),
+            curvature_lat_1_per_m=v[7].copy(),
+            approach_m=approach,
+            rolling_radius_m=v[8].copy(),
+            contact_angle_rad=v[9].copy(),
+            wheel_lateral_m=v[10].copy(),
+        )
+        if self.irregularities is not None:
+            running_irregularity(patches, self._irr_sides, centre_m, spin_rad, self.irregularities, self.r0)
+        return patches
