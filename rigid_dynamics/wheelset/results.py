@@ -24,6 +24,7 @@ STATUSES = (
     "solver-failed",
     "budget-exceeded",
     "invalid-initial-state",
+    "step-unstable",
     "warning",
 )
 

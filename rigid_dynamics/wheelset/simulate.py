@@ -27,11 +27,15 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
 * ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
   raised one of :data:`NUMERICAL_ERRORS`, e.g. for a tiny shear modulus);
+* ``"step-unstable"``: a fixed-step RK4 run ended as a blow-up, force anomaly, derailment or solver failure and
+  its step is beyond RK4's stability limit of the run linearised at its start (:mod:`.stability`): the failure
+  is the integrator's, not the wheelset's (the message keeps the original status and gives the limit);
 
 ``"warning"`` when a fixed-step RK4 run reaches the end but its error estimate of the contact forces
-(:func:`force_error_check`) exceeds the scene's ``force_tolerance`` (the numbers are there, but the step is too
-coarse to trust them); and ``"ok"`` when it reaches the end without either. Events (wheel lift, contact
-restored, flange contact onset) are detected on the output samples, so their times are known to one output step.
+(:func:`force_error_check`) exceeds the scene's ``force_tolerance``, or its step is beyond that stability limit
+(the numbers are there, but the step is too coarse to trust them); and ``"ok"`` when it reaches the end without
+either. Events (wheel lift, contact restored, flange contact onset) are detected on the output samples, so their
+times are known to one output step.
 """
 
 from __future__ import annotations
@@ -56,6 +60,7 @@ from rigid_dynamics.wheelset.results import (
     save_timeseries,
     timeseries_arrays,
 )
+from rigid_dynamics.wheelset.stability import judge_fixed_step, rk4_stable_step
 
 __all__ = [
     "ADAPTIVE_METHODS",
@@ -261,6 +266,13 @@ def simulate(
         if status == "ok":
             settled = states[:, 0] - states[0, 0] >= scene.settling_distance_m if len(t) else np.zeros(0, bool)
             status, message = force_error_check(errors, t, settled, settings, message)
+        if ok:  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
+            try:
+                limit = rk4_stable_step(lambda y: model.derivative(0.0, y), full0)
+            except (ContactFailure, *NUMERICAL_ERRORS):
+                limit = None
+            if limit is not None:
+                status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit)
     result = SimulationResult(
         status=status,
         message=message,

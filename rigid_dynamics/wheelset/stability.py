@@ -60,10 +60,12 @@ class StepLimit:
     eigenvalue: complex
 
     def describe(self) -> str:
-        return (
-            f"RK4's stability limit is {1e3 * self.max_step_s:.3g} ms for the {self.frequency_hz:.0f} Hz mode "
-            f"(damping ratio {self.damping_ratio:.2g}) of the run linearised at its start"
-        )
+        """The limit and the mode that sets it, in words."""
+        if self.frequency_hz > 0.0:
+            mode = f"the {self.frequency_hz:.0f} Hz mode, damping ratio {self.damping_ratio:.2g}"
+        else:
+            mode = f"a non-oscillating mode decaying at {abs(self.eigenvalue.real):.3g} 1/s"
+        return f"RK4's stability limit {1e3 * self.max_step_s:.3g} ms (set by {mode}, linearised at the start)"
 
 
 def jacobian(fun: Callable[[np.ndarray], np.ndarray], y: np.ndarray, rel_step: float = 1e-8) -> np.ndarray:
