@@ -22,6 +22,20 @@ ROOT = Path(__file__).resolve().parents[1]
 PYTHON = sys.executable
 
 
+STEEL = "\n[material]\nshear_modulus_Pa = 82e9\npoisson_ratio = 0.28\nfriction_coefficient = 0.3\n"
+"""The tests' steel as a TOML ``[material]`` table."""
+
+
+def wheelset_case(tables: str) -> str:
+    """The TOML text of the tests' wheelset case (steel, S1002 on UIC60, 80 kN wheel load) followed by ``tables``."""
+    return (
+        STEEL
+        + '[geometry]\nkind = "wheelset"\nwheel_profile = "S1002"\nrail_profile = "UIC60"\n'
+        + "[loading]\nwheel_load_N = 8e4\n"
+        + tables
+    )
+
+
 def quadric_case(
     *, normal_force_N: str = "1e4", creepage_long: str = "0.001", geometry_extra: str = "", kinematics: bool = True
 ) -> str:
@@ -30,8 +44,8 @@ def quadric_case(
     ``geometry_extra``: lines added to ``[geometry]``; ``kinematics`` False leaves ``[kinematics]`` out.
     """
     text = (
-        "\n[material]\nshear_modulus_Pa = 82e9\npoisson_ratio = 0.28\nfriction_coefficient = 0.3\n"
-        '[geometry]\nkind = "quadric"\nradius_long_m = 0.46\nradius_lat_m = 0.3\n'
+        STEEL
+        + '[geometry]\nkind = "quadric"\nradius_long_m = 0.46\nradius_lat_m = 0.3\n'
         + (geometry_extra + "\n" if geometry_extra else "")
         + f"[loading]\nnormal_force_N = {normal_force_N}\n"
     )

@@ -68,26 +68,14 @@ def test_bad_slices_files_raise(tmp_path, header, pattern):
 
 
 def test_case_key_reads_a_slices_file(tmp_path):
+    from hardening_helpers import wheelset_case
+
     from wheelrail.cases import load_case
     from wheelrail.config import ConfigError
 
     flat = WheelFlat(0.05, R0, centre_angle_rad=0.5 * math.pi - THETA_FLAT)
     _write(tmp_path, flat)
-    text = """
-[material]
-shear_modulus_Pa = 82e9
-poisson_ratio = 0.28
-friction_coefficient = 0.3
-[geometry]
-kind = "wheelset"
-wheel_profile = "S1002"
-rail_profile = "UIC60"
-[loading]
-wheel_load_N = 8e4
-[irregularities]
-wheel_slices_file = "wheel.slcw"
-side = "right"
-"""
+    text = wheelset_case('[irregularities]\nwheel_slices_file = "wheel.slcw"\nside = "right"\n')
     (tmp_path / "case.toml").write_text(text)
     case = load_case(tmp_path / "case.toml").wheelset
     (irr,) = case.wheel_irregularities_right

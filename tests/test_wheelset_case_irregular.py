@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 import pytest
-from hardening_helpers import QUADRIC
+from hardening_helpers import QUADRIC, wheelset_case
 
 from rigid_dynamics.contact.search import WheelsetPose, _SideGeometry
 from rigid_dynamics.contact.track import build_track
@@ -193,24 +193,13 @@ def test_flat_rotated_to_the_contact_by_wheel_rotation():
 
 
 # ------------------------------------------------------------------------------------------------ case keys
-GOOD = """
-[material]
-shear_modulus_Pa = 82e9
-poisson_ratio = 0.28
-friction_coefficient = 0.3
-[geometry]
-kind = "wheelset"
-wheel_profile = "S1002"
-rail_profile = "UIC60"
-[loading]
-wheel_load_N = 8e4
-[kinematics]
+GOOD = wheelset_case("""[kinematics]
 wheel_rotation_rad = 0.3
 [irregularities]
 flat_length_m = 0.05
 flat_angle_rad = 1.2707963
 side = "right"
-"""
+""")
 
 
 def _parse(text):
