@@ -89,6 +89,20 @@ def test_wheel_flat_at_5_ms_is_not_ok():
     assert result.summary()["force_error_estimate"] > 1.0
 
 
+def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_is_ok():
+    """Issue 13's case on the scene as shipped (elastic track): at 5 ms the run fails numerically and says so
+    (status step-unstable, RK4's stability limit in the message); the first 0.03 s at its own step are ok."""
+    shipped = load_scene("wheel-flat")
+    coarse = replace(
+        shipped, duration_s=0.05, integrator=replace(shipped.integrator, fixed_step_s=5e-3, output_step_s=5e-3)
+    )
+    result = simulate(coarse)
+    assert result.status == "step-unstable" and not result.success
+    assert "stability limit" in result.message and "5 ms" in result.message
+    own = simulate(replace(shipped, duration_s=0.03))
+    assert own.status == "ok", own.message
+
+
 def test_python_rk4_path_gives_the_compiled_estimate():
     """Regression test of two of our own paths: the Python RK4 loop and the compiled one on the same tables."""
     scene = replace(_at_step("polygonal-wheel", 1e-3, 0.01), contact_provider="tables", settling_distance_m=0.0)
