@@ -78,6 +78,23 @@ def assert_error(code: int, err: str, *fragments: str, status: int = 2) -> None:
         assert fragment in lines[0], f"{fragment!r} not in {lines[0]!r}"
 
 
+def assert_bad_scene(tmp_path: Path, capsys, scene: str, old: str, new: str, pattern: str) -> None:
+    """The embedded ``scene`` with ``old`` replaced by ``new`` fails before any work: ``wheelrail run`` exits 2 with
+    one ``wheelrail: error:`` line matching the regular expression ``pattern``, and no output folder."""
+    import re
+
+    from wheelrail.scenes import embedded_scenes
+
+    text = embedded_scenes()[scene].read_text()
+    assert old in text
+    path = write(tmp_path, text.replace(old, new, 1), "bad.toml")
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "run", path, "--out", out, "--quiet")
+    assert_error(code, err)
+    assert re.search(pattern, err), err
+    assert not out.exists()
+
+
 def write(tmp_path: Path, text: str, name: str = "input.toml") -> Path:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")

@@ -9,6 +9,7 @@ import json
 
 import numpy as np
 import pytest
+from hardening_helpers import assert_bad_scene
 
 from wheelrail.cli import main
 from wheelrail.scenes import embedded_scenes, load_scene
@@ -70,18 +71,7 @@ SCENE_ERRORS = [
 
 @pytest.mark.parametrize(("old", "new", "pattern"), SCENE_ERRORS)
 def test_bad_scene_fails_before_work(tmp_path, capsys, old, new, pattern):
-    import re
-
-    text = embedded_scenes()["hunting-conical"].read_text()
-    assert old in text
-    path = tmp_path / "bad.toml"
-    path.write_text(text.replace(old, new, 1))
-    out = tmp_path / "out"
-    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("wheelrail: error: ") and "Traceback" not in err
-    assert re.search(pattern, err), err
-    assert not out.exists()
+    assert_bad_scene(tmp_path, capsys, "hunting-conical", old, new, pattern)
 
 
 def test_unreadable_profile_file_in_case(tmp_path, capsys):

@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hardening_helpers import assert_bad_scene
 
 from rigid_dynamics.wheelset import TrackDynamics, simulate
 from rigid_dynamics.wheelset.simulate import SimulationResult, build_provider
@@ -192,18 +193,7 @@ def test_peaks_after_the_settling_distance():
     ],
 )
 def test_bad_new_keys(tmp_path, capsys, old, new, pattern):
-    import re
-
-    text = embedded_scenes()["polygonal-wheel"].read_text()
-    assert old in text
-    path = tmp_path / "bad.toml"
-    path.write_text(text.replace(old, new, 1))
-    out = tmp_path / "out"
-    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("wheelrail: error: ") and "Traceback" not in err and err.count("\n") == 1
-    assert re.search(pattern, err), err
-    assert not out.exists()
+    assert_bad_scene(tmp_path, capsys, "polygonal-wheel", old, new, pattern)
 
 
 def test_python_rk4_estimates_between_output_samples():
