@@ -52,12 +52,14 @@ class StepLimit:
         frequency_hz: |Im lambda| / 2 pi of the eigenvalue that sets it, Hz.
         damping_ratio: -Re lambda / |lambda| of that eigenvalue.
         eigenvalue: that eigenvalue, 1/s.
+        where: the state linearised, in words ("at the start" unless said otherwise).
     """
 
     max_step_s: float
     frequency_hz: float
     damping_ratio: float
     eigenvalue: complex
+    where: str = "at the start"
 
     def describe(self) -> str:
         """The limit and the mode that sets it, in words."""
@@ -65,7 +67,7 @@ class StepLimit:
             mode = f"the {self.frequency_hz:.0f} Hz mode, damping ratio {self.damping_ratio:.2g}"
         else:
             mode = f"a non-oscillating mode decaying at {abs(self.eigenvalue.real):.3g} 1/s"
-        return f"RK4's stability limit {1e3 * self.max_step_s:.3g} ms (set by {mode}, linearised at the start)"
+        return f"RK4's stability limit {1e3 * self.max_step_s:.3g} ms (set by {mode}, linearised {self.where})"
 
 
 def jacobian(fun: Callable[[np.ndarray], np.ndarray], y: np.ndarray, rel_step: float = 1e-8) -> np.ndarray:
