@@ -37,16 +37,20 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from rigid_dynamics.wheelset import TrackDynamics, simulate  # noqa: E402
+from rigid_dynamics.wheelset import simulate  # noqa: E402
 from wheelrail.scenes import load_scene  # noqa: E402
 
-CASES = {
-    # scene: (reference step, steps), s
-    "polygonal-wheel": (6.25e-5, (1.25e-4, 2.5e-4, 5e-4, 1e-3, 2e-3)),
-    "wheel-flat": (2.5e-5, (5e-5, 1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3)),
-    "corrugation": (2.5e-5, (5e-5, 1e-4, 2e-4, 5e-4, 1e-3)),
-    "hunting-conical": (2.5e-4, (5e-4, 1e-3, 2e-3)),  # the Python RK4 path (conical provider), 1 s of the scene
-}
+CASES = (
+    # (scene, track model, reference step, steps), s; "lumped" is the elastic track, the scenes' own choice for
+    # wheel-flat and corrugation (RK4's stability limit on it is 0.57 ms at the start); "rigid" is issue 12's table
+    ("polygonal-wheel", "rigid", 6.25e-5, (1.25e-4, 2.5e-4, 5e-4, 1e-3, 2e-3)),
+    ("polygonal-wheel", "lumped", 6.25e-5, (1.25e-4, 2.5e-4, 5e-4, 1e-3)),
+    ("wheel-flat", "lumped", 1.25e-5, (2.5e-5, 5e-5, 1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3)),
+    ("wheel-flat", "rigid", 2.5e-5, (5e-5, 1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3)),
+    ("corrugation", "lumped", 2.5e-5, (5e-5, 1e-4, 2e-4, 5e-4, 1e-3)),
+    ("corrugation", "rigid", 2.5e-5, (5e-5, 1e-4, 2e-4, 5e-4, 1e-3)),
+    ("hunting-conical", "rigid", 2.5e-4, (5e-4, 1e-3, 2e-3)),  # the Python RK4 path (conical provider), 1 s
+)
 DURATIONS = {"hunting-conical": 1.0}
 
 
@@ -101,6 +105,7 @@ def doubling_estimate(scene, result, samples=100):
     from rigid_dynamics.wheelset import compiled
     from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.state import n_states
 
     if not result.compiled:
         return None
@@ -115,7 +120,7 @@ def doubling_estimate(scene, result, samples=100):
     h = scene.integrator.fixed_step_s
 
     def rhs(t, y):
-        out = np.zeros(14)
+        out = np.zeros(n_states(scene.track_dynamics.elastic))
         compiled.rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec)
         forces = np.zeros((2, 3))
         for c in range(len(sides)):
@@ -136,7 +141,8 @@ def doubling_estimate(scene, result, samples=100):
     index = index[:: max(1, len(index) // samples)]
     worst = 0.0
     for k in index:
-        y = np.concatenate([result.states[k], [0.0, 0.0]])
+        track = result.track_states[k] if scene.track_dynamics.elastic else []
+        y = np.concatenate([result.states[k], [0.0, 0.0], track])
         t = float(result.t[k])
         two = step(t + h, step(t, y, h), h)
         one = step(t, y, 2 * h)
@@ -150,11 +156,17 @@ def main():
         write(payload["runs"], payload["machine"])
         return
     records = []
-    for name, (ref_step, steps) in CASES.items():
+    load_before = os.getloadavg()
+    only = [a.split("=", 1)[1] for a in sys.argv[1:] if a.startswith("--only=")]
+    for name, track, ref_step, steps in CASES:
+        if only and f"{name}/{track}" not in only:
+            continue
         base = load_scene(name)
-        # the rigid track: the table of issue 12 (step_sensitivity.md) was measured on it; doubling_estimate's
-        # 14-state right-hand side has no track states
-        base = replace(base, duration_s=DURATIONS.get(name, base.duration_s), track_dynamics=TrackDynamics())
+        base = replace(
+            base,
+            duration_s=DURATIONS.get(name, base.duration_s),
+            track_dynamics=replace(base.track_dynamics, model=track),
+        )
         reference = simulate(at_step(base, ref_step))
         ref = measures(reference)
         load = base.static_wheel_load_N
@@ -169,6 +181,7 @@ def main():
                 moved = max(max(abs(a - b) for a, b in zip(got[key], ref[key], strict=True)) / load for key in got)
             rec = {
                 "scene": name,
+                "track": track,
                 "step_ms": step * 1e3,
                 "reference": step == ref_step,
                 "status": result.status,
@@ -193,19 +206,33 @@ def main():
                 rec["verdict"] = "warning-and-moved" if moved > tol else "warning-but-unmoved"
             records.append(rec)
             print(
-                f"{name} {step * 1e3:g} ms: {rec['status']} est {rec['force_error_estimate']} moved {moved} "
+                f"{name}/{track} {step * 1e3:g} ms: {rec['status']} est {rec['force_error_estimate']} moved {moved} "
                 f"doubling {rec['doubling_estimate']} {rec['verdict']}",
                 flush=True,
             )
+    load_after = os.getloadavg()
     machine = {
+        "load_average_1min_start_end": [round(load_before[0], 1), round(load_after[0], 1)],
         "platform": platform.platform(),
+        "cpu": cpu_model(),
         "cpu_count": os.cpu_count(),
         "python": platform.python_version(),
         "numpy": np.__version__,
-        "note": "one process on a 2-core machine shared with other jobs "
-        "(load average 5-7 during the run: timings scatter and run slow)",
+        "note": f"one process on a 2-core machine shared with other jobs (1-min load average {load_before[0]:.1f} "
+        f"at the start, {load_after[0]:.1f} at the end: timings scatter and run slow)",
     }
     write(records, machine)
+
+
+def cpu_model() -> str:
+    """The CPU's model name from /proc/cpuinfo (Linux), else platform.processor()."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
 
 
 def write(records, machine):
@@ -219,7 +246,8 @@ def write(records, machine):
     lines = [
         "# Step sensitivity of fixed-step RK4 and the force error estimate",
         "",
-        f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs, Python {machine['python']}, numpy "
+        f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs ({machine.get('cpu', 'unknown')}), "
+        f"Python {machine['python']}, numpy "
         f"{machine['numpy']}; {machine['note']}. Script: benchmarks/bench_dynamics_steps.py.",
         "",
         "Forces relative to the static wheel load N0. `estimate`: the run's force error estimate after the settling "
@@ -228,16 +256,17 @@ def write(records, machine):
         "creep force and peak |lateral creep force| per wheel. `passage`: steps per contact passage of the "
         "shortest irregularity. `doubling`: step-doubling (Richardson) estimate at up to 100 settled samples.",
         "",
-        "| scene | step ms | status | estimate | full run | moved | passage | doubling | peak N kN (L/R) | "
+        "| scene | track | step ms | status | estimate | full run | moved | passage | doubling | peak N kN (L/R) | "
         "mean Fx kN (L/R) | wall s | RTF | verdict |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in records:
         m = r["measures"]
         peak = "-" if m is None else "/".join(f"{v / 1e3:.0f}" for v in m["peak_normal_force_N"])
         mean = "-" if m is None else "/".join(f"{v / 1e3:.2f}" for v in m["mean_creep_force_long_N"])
         lines.append(
-            f"| {r['scene']} | {r['step_ms']:g} | {r['status']} | {fmt(r['force_error_estimate'])} | "
+            f"| {r['scene']} | {r.get('track', 'rigid')} | {r['step_ms']:g} | {r['status']} | "
+            f"{fmt(r['force_error_estimate'])} | "
             f"{fmt(r['full_run_force_error_estimate'])} | {fmt(r['moved'])} | {fmt(r['passage_steps'], '.1f')} | "
             f"{fmt(r['doubling_estimate'])} | {peak} | {mean} | {r['wall_s']:.2f} | {fmt(r['real_time_factor'])} | "
             f"{r['verdict']} |"
@@ -256,29 +285,40 @@ def write(records, machine):
 
 NOTES = """Notes.
 
+* Two tracks. `lumped` is the elastic track (a rail mass on a pad on a sleeper mass on the ballast under each
+  wheel), the default of the wheel-flat and corrugation scenes; `rigid` is issue 12's original table. No row
+  with status `ok` moves by more than force_tolerance = 0.02 of the static load: the largest among them is
+  wheel-flat on the rigid track at 0.05 ms (0.0097); on the elastic track wheel-flat at its own 0.025 ms moves by
+  0.00084 against a 0.0125 ms reference, corrugation at 0.2 ms by 0.0034, polygonal-wheel at 0.5 ms by 0.00033.
 * Which indicator catches the steps whose results move. The force error estimate (RK4 against its embedded
   third-order solution) flags every run above whose results move by more than 2 % of the static load, except
-  wheel-flat at 0.1 ms, which the half-step check of runs with a wheel lift flags (below). The contact passage
-  (steps per passage of the shortest irregularity) cannot see polygonal-wheel at 1 ms: 35 steps per polygon
-  wavelength, yet the longitudinal creep force is biased to -3.9 kN per wheel against 0.0 (the stiff creep mode
-  of the spin and fore-aft motion, lambda h ~ 1.9, well resolved in space, not in time). Step doubling
-  (Richardson, divided by 15) underestimates that case (0.009 < 0.02) and costs three extra right-hand sides per
-  check against one. So the status uses the embedded estimate, evaluated at the output samples and at least
-  every millisecond.
+  wheel-flat at 0.1 ms on the rigid track and at 0.05 ms on the elastic one, which the half-step check of runs
+  with a wheel lift flags (below). The contact passage (steps per passage of the shortest irregularity) cannot
+  see polygonal-wheel at 1 ms on the rigid track: 35 steps per polygon wavelength, yet the longitudinal creep
+  force is biased to -3.9 kN per wheel against 0.0 (the stiff creep mode of the spin and fore-aft motion,
+  lambda h ~ 1.9, well resolved in space, not in time). Step doubling (Richardson, divided by 15) underestimates
+  that case (0.009 < 0.02) and costs three extra right-hand sides per check against one. So the status uses the
+  embedded estimate, evaluated at the output samples and at least every millisecond.
 * The estimate is local. It does not see results moved by a changed sequence of contact switches: on wheel-flat
-  (rigid track) the wheel bounces after each impact and the re-impacts depend on the flight times, so at 0.1 ms
-  the first impact is within 0.4 % but later impacts move by up to 3.6 % of the static load with a largest
-  estimate of 1e-3. A fixed-step run in which a wheel lifts off after the settling distance is therefore run
-  again at half the step and the settled peaks compared (simulate._half_step_check, on by default): 2.6 % at
-  0.1 ms (warning), 1.0 % at the scene's 0.05 ms (ok). Its cost: the runs with lifts take about three times as
-  long (the wall column includes the second run). On polygonal-wheel the flips of the S1002/UIC60
-  two-point contact in the start-up (first ~10 m after the 1 mm offset) move the start-up peaks by up to 7 % at
-  0.5 ms: the scene's settling distance is 10 m, the full-run estimate (0.053 at 0.5 ms) and full-run peaks are
-  reported apart, and the message says that the start-up is not converged.
-* hunting-conical (conical provider, linear creep, Python RK4 path, 1 s): RK4 becomes unstable at 2 ms (the
-  creep-damped modes; force anomaly), the estimate stays below 1e-7 up to 1 ms.
-* wheel-flat at 2 and 5 ms ends as force-anomaly (normal force beyond 50 x the static load, 3.1-3.5 MN); with the
-  limit lifted the 5 ms run ends as "warning" (tests/test_dynamics_error_estimate.py).
+  the wheel lifts after each impact and the re-impacts depend on the flight times; on the rigid track at 0.1 ms
+  later impacts move by 3.6 % of the static load with a largest estimate of 9e-4, on the elastic track at
+  0.05 ms by 2.3 % with 9e-4. A fixed-step run in which a wheel lifts off after the settling distance is
+  therefore run again at half the step and the settled peaks compared (simulate._half_step_check, on by
+  default): rigid track 2.6 % at 0.1 ms (warning), elastic track 2.2 % at 0.05 ms (warning) and 0.08 % at the
+  scene's 0.025 ms (ok). Its cost: the runs with lifts take about three times as long (the wall column includes
+  the second run). On polygonal-wheel the flips of the S1002/UIC60 two-point contact in the start-up (first
+  ~10 m after the 1 mm offset) move the start-up peaks: the scene's settling distance is 10 m, the full-run
+  estimate (0.053 rigid, 0.15 elastic at 0.5 ms) and full-run peaks are reported apart, and the message says
+  that the start-up is not converged.
+* RK4's stability limit (stability.py). Linearised at the start: 1.15 ms for polygonal-wheel (rigid), 0.61 ms
+  on the elastic track, 0.57 ms for wheel-flat and corrugation on either track, 1.09 ms for hunting-conical.
+  Runs beyond it that fail end `step-unstable` (polygonal-wheel elastic at 1 ms, wheel-flat at 1-5 ms elastic
+  and 2-5 ms rigid, corrugation elastic at 1 ms, hunting-conical at 2 ms); those that finish end `warning`.
+  wheel-flat on the elastic track at 0.5 ms, within the start's limit, derailed after its first impact: the
+  Hertz mode stiffens with the impact force, and a failed run is now also judged at the recorded state of its
+  largest contact force (limit 0.35 ms there), so it ends `step-unstable` too instead of `derailed`.
+* hunting-conical (conical provider, linear creep, Python RK4 path, 1 s): the estimate stays below 1e-7 up to
+  1 ms.
 * The output samples carry the estimate; a check costs one right-hand side per output sample (12.5 % at the
   polygonal-wheel scene's 0.5 ms step and 1 ms output, 25 % when every step is an output sample).
 """
