@@ -311,7 +311,8 @@ NOTES = """Notes.
   estimate (0.053 rigid, 0.15 elastic at 0.5 ms) and full-run peaks are reported apart, and the message says
   that the start-up is not converged.
 * RK4's stability limit (stability.py). Linearised at the start: 1.15 ms for polygonal-wheel (rigid), 0.61 ms
-  on the elastic track, 0.57 ms for wheel-flat and corrugation on either track, 1.09 ms for hunting-conical.
+  on the elastic track, 0.57 ms for wheel-flat on either track, 0.57 ms (elastic) and 0.68 ms (rigid) for
+  corrugation, 1.09 ms for hunting-conical.
   Runs beyond it that fail end `step-unstable` (polygonal-wheel elastic at 1 ms, wheel-flat at 1-5 ms elastic
   and 2-5 ms rigid, corrugation elastic at 1 ms, hunting-conical at 2 ms); those that finish end `warning`.
   wheel-flat on the elastic track at 0.5 ms, within the start's limit, derailed after its first impact: the

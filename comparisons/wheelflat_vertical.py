@@ -22,8 +22,10 @@ constant during the impact; here C_H is that of the round wheel), roll, lateral 
 What it can add: a pad that cannot pull the rail down (``pad_separation``), the rail-pad separation the lumped
 track of the wheelset model does not have.
 
-The equations are solved with scipy's Radau (implicit, error-controlled), so this is also an independent
-integrator. Returns the contact force history; :func:`first_impact` runs a passage and returns its peak.
+The equations are solved with scipy's DOP853 (explicit Runge-Kutta 8(5,3), error-controlled at rtol 1e-8, steps of
+at most 20 us, well inside its stability region for the ~1.3 kHz contact mode; Radau gives the same peak to
+1e-6 of it: 331.78 kN at 60 km/h), so this is also an independent integrator. :func:`simulate_passage` returns
+the contact force history, :func:`first_impact` the peak of a passage.
 """
 
 from __future__ import annotations
@@ -103,7 +105,9 @@ def _static(model: VerticalModel):
     return rail + delta0, rail, sleeper, delta0
 
 
-def simulate_passage(model: VerticalModel, speed_m_per_s: float, distance_m: float, sample_s: float = 5e-6):
+def simulate_passage(
+    model: VerticalModel, speed_m_per_s: float, distance_m: float, sample_s: float = 5e-6, method: str = "DOP853"
+):
     """Contact force history of a run from static equilibrium over ``distance_m`` (the flat at flat_centre_m).
 
     Returns:
@@ -147,7 +151,7 @@ def simulate_passage(model: VerticalModel, speed_m_per_s: float, distance_m: flo
     y0 = np.array([zw0, 0.0] if m.rigid_track else [zw0, 0.0, zr0, 0.0, zs0, 0.0])
     duration = distance_m / speed_m_per_s
     t_eval = np.arange(0.0, duration, sample_s)
-    sol = solve_ivp(rhs, (0.0, duration), y0, method="Radau", t_eval=t_eval, rtol=1e-8, atol=1e-12, max_step=2e-5)
+    sol = solve_ivp(rhs, (0.0, duration), y0, method=method, t_eval=t_eval, rtol=1e-8, atol=1e-12, max_step=2e-5)
     if not sol.success:
         raise RuntimeError(f"vertical model: {sol.message}")
     force = np.array([contact(t, y) for t, y in zip(sol.t, sol.y.T, strict=True)])
@@ -155,11 +159,11 @@ def simulate_passage(model: VerticalModel, speed_m_per_s: float, distance_m: flo
     return sol.t, speed_m_per_s * sol.t, force, pad
 
 
-def first_impact(model: VerticalModel, speed_m_per_s: float, distance_m: float) -> dict:
+def first_impact(model: VerticalModel, speed_m_per_s: float, distance_m: float, method: str = "DOP853") -> dict:
     """Peak contact force of a passage over the flat, the smallest (0: the wheel lifted) after the flat's entry,
     and the smallest pad force (negative: the pad pulls the rail down), N.
     """
-    t, x, force, pad = simulate_passage(model, speed_m_per_s, distance_m)
+    t, x, force, pad = simulate_passage(model, speed_m_per_s, distance_m, method=method)
     after = x >= model.flat_centre_m - 0.5 * model.flat_length_m
     return {
         "peak_N": float(force.max()),
