@@ -13,8 +13,10 @@ with R_irr the rounded flat of rigid_dynamics.wheelset.irregular (-(d/2)(1 + cos
 s = r0 a, centred at x_c): the wheel-centre trajectory, not the profile deviation, as the input of a Hertz
 spring (Wu & Thompson 2002, J. Sound Vib. 251: "a relative displacement excitation is introduced between the
 wheel and rail that differs from the geometric form of the wheel flat due to the finite curvature of the wheel";
-Pieringer et al. 2014, Wear 314: the Hertzian spring with the wheel-centre trajectory as input gives results
-similar to a 3-D non-Hertzian contact model, with the profile deviation as input it can give large errors).
+Pieringer, Kropp et al. 2014, "The influence of contact modelling on simulated wheel/rail interaction due to
+wheel flats", abstract at research.chalmers.se/publication/197497: the Hertzian spring with the wheel-centre
+trajectory as input gives results similar to a 3-D non-Hertzian contact model, with the profile deviation as input
+it can give large errors).
 
 What it leaves out against the wheelset model (rigid_dynamics.wheelset): the 3-D contact geometry of the flat
 (the contact point's longitudinal shift and the curvature of the flattened tread, which change the Hertz
