@@ -153,7 +153,10 @@ def state_jacobian(fun: Callable) -> Callable:
 def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
     from scipy import integrate
 
-    cls = getattr(integrate, settings.method)
+    from rigid_dynamics.wheelset.compiled_adaptive import SCIPY_EQUIVALENT
+
+    # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located contact switches
+    cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
     options = {"jac": state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
     solver = cls(
         fun,
@@ -204,8 +207,13 @@ def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene
 
 
 def run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
-    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
-    from rigid_dynamics.wheelset import compiled
+    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched; the
+    embedded pairs with step-size control (``method`` "DP54" or "BS32") in compiled_adaptive.run_embedded.
+    """
+    from rigid_dynamics.wheelset import compiled, compiled_adaptive
+
+    if settings.method in compiled_adaptive.PAIRS:
+        return compiled_adaptive.run_embedded(model, packed, y0, duration, settings, recorder, report, start)
 
     par, hz, kk, sides, slots, mode, targs, sargs = packed
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))

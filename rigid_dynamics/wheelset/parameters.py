@@ -18,7 +18,7 @@ from rigid_dynamics.materials import STEEL, Material
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
 """Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
 
-INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4")
+INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4", "DP54", "BS32")
 """scipy.integrate.solve_ivp methods plus the fixed-step classical Runge-Kutta method ``RK4``."""
 
 IRREGULARITY_SIDES = ("both", "left", "right")
@@ -397,7 +397,9 @@ class IntegratorSettings:
     """Time integration, output and safety limits.
 
     Attributes:
-        method: one of RK45, DOP853, Radau, BDF, LSODA (scipy.integrate) or RK4 (fixed step).
+        method: one of RK45, DOP853, Radau, BDF, LSODA (scipy.integrate), RK4 (fixed step), or DP54 / BS32 (the
+            embedded pairs Dormand-Prince 5(4) / Bogacki-Shampine 3(2) with step-size control in the compiled loop,
+            compiled_adaptive.py; scipy's RK45 / RK23 where the scene does not run compiled).
         relative_tolerance, absolute_tolerance: error tolerances of the adaptive methods.
         fixed_step_s: step of RK4, s.
         max_step_s: largest step of the adaptive methods, s.

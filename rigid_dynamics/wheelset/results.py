@@ -25,6 +25,7 @@ STATUSES = (
     "budget-exceeded",
     "invalid-initial-state",
     "step-unstable",
+    "step-size-underflow",
     "warning",
 )
 

@@ -163,12 +163,15 @@ def simulate(
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
     model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
     from rigid_dynamics.wheelset import compiled as _compiled
+    from rigid_dynamics.wheelset import compiled_adaptive as _adaptive
 
-    can_compile = _compiled.supported(scene, provider, model_obj) and model.batch is not None
+    embedded = scene.integrator.method in _adaptive.PAIRS
+    supported = _adaptive.supported if embedded else _compiled.supported
+    can_compile = supported(scene, provider, model_obj) and model.batch is not None
     if compiled and not can_compile:
         raise ValueError(
-            "compiled = True: the compiled path needs method RK4, a TableProvider or a SearchProvider on tabulated "
-            "surfaces, and one of "
+            "compiled = True: the compiled path needs method RK4, DP54 or BS32, a TableProvider or a SearchProvider "
+            "on tabulated surfaces, and one of "
             f"the models {', '.join(_compiled.MODEL_CODES)}"
         )
     use_compiled = can_compile and compiled is not False
@@ -178,6 +181,8 @@ def simulate(
     if use_compiled:
         packed = _compiled.pack(model, provider, model.batch.tables, model.model.name, model.batch.options)
         _compiled.load(packed)  # the compiled code (from numba's cache) is loaded before the clock starts
+        if embedded:
+            _adaptive.load(packed, settings, scene)
     start = time.perf_counter()
     recorder = Recorder(model, scene)
     status, message, fail_t, fail_state = "ok", "", None, None
@@ -250,6 +255,12 @@ def simulate(
         else:
             steps = run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
         message = f"reached t = {duration:g} s"
+        stats = getattr(model, "adaptive_stats", None)
+        if use_compiled and embedded and stats:
+            message += (
+                f" ({settings.method}: {stats['accepted_steps']} steps, {stats['rejected_steps']} rejected, "
+                f"{stats['located_switches']} contact switches located)"
+            )
         del next_out
     except Stop as stop:
         status, message, fail_t, fail_state = stop.status, stop.message, stop.t, stop.state
