@@ -2,8 +2,8 @@
 compiled loop (rigid_dynamics/wheelset/compiled_adaptive.py) on the four embedded scenes.
 
 Per scene, a converged reference (RK4 at a fine step; a second reference, DP54 at rtol 1e-7 and atol 1e-10, says
-how well it is converged), then RK4 at several steps and DP54 / BS32 at several tolerances. Force error of a run, relative to the
-static wheel load N0, from the samples after the scene's settling distance (the measures of
+how well it is converged), then RK4 at several steps and DP54 / BS32 at several tolerances. Force error of a run,
+relative to the static wheel load N0, from the samples after the scene's settling distance (the measures of
 benchmarks/bench_dynamics_steps.py, which are insensitive to the timing of the S1002/UIC60 two-point-contact flips
 that make a sample-by-sample comparison meaningless on polygonal-wheel):
 
