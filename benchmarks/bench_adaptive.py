@@ -247,10 +247,11 @@ def write(payload):
         f"{machine['python']}, numpy {machine['numpy']}; {machine['note']} (load average at the end "
         f"{machine['load_average_at_end']}). Script: benchmarks/bench_adaptive.py.",
         "",
-        "Errors relative to the static wheel load against RK4 at the finest step (`reference-2`: DP54 at rtol 1e-9 "
-        "against it, the reference's own uncertainty). normal: settled peak normal force per wheel; creep: settled "
-        "mean longitudinal and peak |lateral| creep force per wheel; RTF: simulated time / in-process wall time "
-        "(best of the repeats). hunting-conical runs on its cone's tables (its conical provider is not compiled).",
+        "Errors relative to the static wheel load against RK4 at the finest step (`reference-2`: DP54 at rtol 1e-7, "
+        "atol 1e-10 against it, the reference's own uncertainty). normal: settled peak normal force per wheel; "
+        "creep: settled mean longitudinal and peak |lateral| creep force per wheel; RTF: simulated time / in-process "
+        "wall time (best of the repeats). hunting-conical runs on its cone's tables (its conical provider is not "
+        "compiled).",
         "",
     ]
     for scene in dict.fromkeys(r["scene"] for r in records):

@@ -171,7 +171,7 @@ def _contact_mask(rec, ncand, mask, gap):
 @njit(cache=True)
 def embedded_run(
     y, t0, t_end, h, a, cc, e, p, k_order, rtol, atol, weight, h_min, h_max, event_tol, max_steps,
-    par, hz, kk, sides, mode, targs, sargs, out_times, k_out, states, recs, carry, kst, mask0, gap0,
+    par, hz, kk, sides, mode, targs, sargs, out_times, k_out, states, recs, errs, carry, kst, mask0, gap0,
     ev_t, ev_mask, n_ev,
 ):  # fmt: skip
     """Advance from (t0, y) with the embedded pair (a, cc, e, p) under step-size control until t_end or
@@ -195,7 +195,8 @@ def embedded_run(
     mask1, gap1 = np.empty(ncand, np.int64), np.empty(ncand)
     mask_t, gap_t = np.empty(ncand, np.int64), np.empty(ncand)
     gap_lo, gap_hi = np.empty(ncand), np.empty(ncand)
-    f4 = np.empty((2, 3))
+    f4, f3 = np.empty((2, 3)), np.empty((2, 3))
+    force_err = np.nan
     mem, n_mem = sargs[3], sargs[4]
     mem_save, n_mem_save = mem.copy(), n_mem.copy()
     mem_end, n_mem_end = mem.copy(), n_mem.copy()
@@ -352,6 +353,28 @@ def embedded_run(
             if not np.isfinite(y_new[i]):
                 return 1, t, y, h, accepted, rejected, k_out, evals, located, 1
         t_new = t + h
+        # force error estimate of a step with output samples (as rk4_run's): the per-wheel contact forces at the
+        # propagated solution against those at the embedded lower-order one, y_new - err
+        k_first = k_out
+        if k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny:
+            _side_forces(rec_end, sides, f4)
+            for i in range(nst):
+                ys[i] = y_new[i] - err[i]
+            st = _rhs(t_new, ys, par, hz, kk, sides, mode, targs, sargs, ws, True, False, scratch)
+            evals += 1
+            force_err = np.inf
+            if st == 0:
+                _side_forces(rec, sides, f3)
+                force_err = 0.0
+                for sd in range(2):
+                    for q in range(3):
+                        d = abs(f4[sd, q] - f3[sd, q])
+                        if d != d:  # NaN: forces not computable at one of the two states
+                            force_err = np.inf
+                        elif d > force_err:
+                            force_err = d
+            mem[:, :, :] = mem_end
+            n_mem[:] = n_mem_end
         # the output samples within (t, t_new]: dense output and a right-hand side with record there
         while k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny:
             theta = (out_times[k_out] - t) / h
@@ -367,6 +390,7 @@ def embedded_run(
                 states[k_out, :] = ys
                 recs[k_out, :, :] = rec
             _side_forces(recs[k_out], sides, f4)
+            errs[k_out] = force_err if k_out == k_first else np.nan
             k_out += 1
             for sd in range(2):
                 if f4[sd, 0] > fmax:
@@ -452,7 +476,7 @@ def load(packed, settings, scene) -> None:
     embedded_run(
         y, 0.0, 0.0, 1e-3, a, c, e, p, k_order, 1e-6, atol, weight, MIN_STEP_S, 1e-3, EVENT_TIME_TOLERANCE_S, 0,
         par, hz, kk, sides, mode, targs, sargs, np.zeros(0), 0, np.zeros((0, len(y))),
-        np.zeros((0, ncand + 2, N_FIELDS)), np.array([1e-4, 1.0]), np.zeros((len(a), len(y))),
+        np.zeros((0, ncand + 2, N_FIELDS)), np.zeros(0), np.array([1e-4, 1.0]), np.zeros((len(a), len(y))),
         np.zeros(ncand, np.int64), np.zeros(ncand), np.zeros(0), np.zeros((0, ncand), np.int64),
         np.zeros(1, np.int64),
     )  # fmt: skip
@@ -523,6 +547,7 @@ def run_embedded(model, packed, y0, duration, settings, recorder, report, start)
         out_times = np.append(out_times, duration)
     states = np.zeros((len(out_times), len(y0)))
     recs = np.zeros((len(out_times), ncand + 2, compiled.N_FIELDS))
+    errs = np.full(len(out_times), np.nan)
     rec = np.zeros((ncand + 2, compiled.N_FIELDS))
 
     def rhs(t, y):
@@ -548,7 +573,7 @@ def run_embedded(model, packed, y0, duration, settings, recorder, report, start)
         status, t_end, y_end, h_next, acc, rej, k_new, evals, located, last_fail = embedded_run(
             y, t, duration, h, a, c, e, p, k_order, rtol, atol, weight, MIN_STEP_S, settings.max_step_s,
             EVENT_TIME_TOLERANCE_S, STEPS_PER_CALL, par, hz, kk, sides, mode, targs, sargs, out_times, k_out, states,
-            recs, carry, kst, mask0, gap0, ev_t, ev_mask, n_ev,
+            recs, errs, carry, kst, mask0, gap0, ev_t, ev_mask, n_ev,
         )  # fmt: skip
         model.rhs_evaluations += int(evals)
         stats["accepted_steps"] += int(acc)
@@ -567,7 +592,7 @@ def run_embedded(model, packed, y0, duration, settings, recorder, report, start)
                     states[k_out:k_new],
                     tables,
                     block[:, ncand : ncand + 2, :3].copy(),
-                    np.full(k_new - k_out, np.nan),
+                    errs[k_out:k_new],
                 )
             except Stop as stop:
                 events_to_recorder()

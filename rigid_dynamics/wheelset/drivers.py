@@ -51,12 +51,20 @@ def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, se
         return (values[k], k) if len(values) else (-np.inf, 0)
 
     tol = settings.force_tolerance
+    if settings.method == "RK4":
+        advice, failed = f"reduce fixed_step_s = {settings.fixed_step_s:g} s", "the third-order state failed"
+    else:  # the embedded pairs of compiled_adaptive.py
+        advice = (
+            f"tighten relative_tolerance = {settings.relative_tolerance:g} / absolute_tolerance = "
+            f"{settings.absolute_tolerance:g}"
+        )
+        failed = "the embedded lower-order state failed"
     value, k = worst(settled)
     if value > tol:
-        what = f"{value:.3g}" if np.isfinite(value) else "not computable (the third-order state failed)"
+        what = f"{value:.3g}" if np.isfinite(value) else f"not computable ({failed})"
         return "warning", (
             f"{message}; force error estimate {what} of the static wheel load at t = {t[k]:.6g} s exceeds "
-            f"force_tolerance = {tol:g}: reduce fixed_step_s = {settings.fixed_step_s:g} s"
+            f"force_tolerance = {tol:g}: {advice}"
         )
     value, k = worst(~settled)
     if value > tol:

@@ -410,8 +410,9 @@ class IntegratorSettings:
             anomaly (status "force-anomaly").
         max_lateral_displacement_m: |y| beyond this ends the run (status "derailed"), m.
         stop_at_wheel_lift: end the run (status "wheel-lift") when a wheel loses contact.
-        force_tolerance: RK4 only: the largest accepted force error estimate of a step (the per-wheel normal,
-            longitudinal and lateral creep force of RK4 against its embedded third-order solution, drivers.py),
+        force_tolerance: RK4 and the compiled DP54/BS32: the largest accepted force error estimate of a step (the
+            per-wheel normal, longitudinal and lateral creep force of RK4 against its embedded third-order solution,
+            drivers.py; of a pair's solution against its embedded lower-order one, compiled_adaptive.py),
             relative to the static wheel load, over the samples after the scene's settling distance (the start-up
             before it is reported apart); a run that finishes above it ends with status "warning". The default
             0.02 passes the embedded scenes at their own steps and flags the coarser steps at which their force

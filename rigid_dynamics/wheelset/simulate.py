@@ -12,7 +12,10 @@ can be watched: output samples are taken from each step's dense output at the fi
 and after every step the state is checked. The implicit Radau and BDF get the Jacobian of
 ``state_jacobian`` (exact kinematic rows, fixed finite-difference steps) instead of scipy's own.
 ``RK4`` is the classical fourth-order Runge-Kutta method with a fixed step (Butcher 1987 tableau:
-c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)).
+c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)). ``DP54`` and ``BS32`` are the embedded pairs Dormand-Prince 5(4)
+and Bogacki-Shampine 3(2) with step-size control inside the compiled loop (compiled_adaptive.py: PI controller,
+dense output at the output times, contact onset and loss located within the step and reported as the events'
+times); a scene the compiled loop cannot run takes scipy's RK45 / RK23 (the same pairs) on the Python path.
 
 Safety (a run never hangs and never writes NaN silently): the run ends with a status
 (``SimulationResult.status``) and the time and state where it happened when
@@ -23,6 +26,7 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"contact-failed"``: a contact model failed or the creepages became undefined (rolling speed 0);
 * ``"solver-failed"``: the adaptive solver could not continue (step size too small), or a numerical exception
   was raised below the driver (:data:`NUMERICAL_ERRORS`, e.g. the curvature code for a huge stiffness with RK4);
+* ``"step-size-underflow"``: DP54/BS32 in the compiled loop needed a step below compiled_adaptive.MIN_STEP_S;
 * ``"budget-exceeded"``: more than ``max_rhs_evaluations`` evaluations or ``max_wall_time_s``;
 * ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
 * ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
@@ -272,12 +276,15 @@ def simulate(
     wall = time.perf_counter() - start
     t, states, patches, forces, kin, pot, wc, we, errors, track_states = recorder.arrays()
     fixed_step = settings.method == "RK4"
-    if fixed_step:
+    checked = fixed_step or (use_compiled and embedded)  # runs with a force error estimate at their samples
+    if checked:
         errors = errors / scene.static_wheel_load_N
         if status == "ok":
             settled = states[:, 0] - states[0, 0] >= scene.settling_distance_m if len(t) else np.zeros(0, bool)
             status, message = force_error_check(errors, t, settled, settings, message)
-        if ok:  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
+        if (
+            ok and fixed_step
+        ):  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
             try:
                 limit = rk4_stable_step(lambda y: model.derivative(0.0, y), full0)
             except (ContactFailure, *NUMERICAL_ERRORS):
@@ -305,7 +312,7 @@ def simulate(
         contact_model=getattr(model_obj, "name", type(model_obj).__name__),
         method=settings.method,
         compiled=use_compiled,
-        force_error_estimate=errors if fixed_step else None,
+        force_error_estimate=errors if checked else None,
         scene=scene,
         track_states=track_states,
     )
