@@ -29,6 +29,9 @@ rejection). A rejected step is retried with h max(0.2, 0.9 norm^(-1/k)). A stage
 (status not 0, or a non-finite state) is retried at a quarter of the step. A step below ``h_min`` ends the run
 with status 5 (drivers: "step-size-underflow"), with the status of the last failure kept for the message.
 
+A step that would end a little past an output time (by less than one stage's share of it) is shortened to end
+there, so that the sample needs no right-hand side of its own.
+
 Contact onset and loss: each accepted step compares which candidates are in contact (normal force > 0, i.e.
 approach q > 0) at its two ends (the last stage is evaluated with its record). When one switches and the step is
 longer than ``event_tol`` (s), the earliest switch is located on the step's dense output (regula falsi on the
@@ -222,6 +225,12 @@ def embedded_run(
     event_t = np.nan  # the located switch that the step being retried is to end just after
     while accepted < max_steps and t < t_end - tiny:
         h = min(h, h_max)
+        if k_out < out_times.shape[0]:
+            # end the step on the next output time when that shortens it by less than one stage's worth: the
+            # sample then needs no right-hand side of its own
+            d = out_times[k_out] - t
+            if d < h and d > h * (1.0 - 1.0 / (ns - 1)):
+                h = d
         if t + 1.01 * h >= t_end:
             h = t_end - t
         if not h >= h_min:
