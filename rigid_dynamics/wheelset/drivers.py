@@ -1,7 +1,8 @@
 """The integrators over the right-hand side: scipy's adaptive ``OdeSolver`` methods stepped one step at a time
 (:func:`run_adaptive`, with the Jacobian of :func:`state_jacobian` for Radau and BDF), the fixed-step RK4 on the
-Python right-hand side (:func:`run_rk4`) and the compiled RK4 loop (:func:`run_compiled`), with the RK4 force
-error estimate and its check (:func:`force_error_check`).
+Python right-hand side (:func:`run_rk4`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
+DP54/BS32 with step-size control of compiled_adaptive.py), with the force error estimate and its check
+(:func:`force_error_check`).
 """
 
 from __future__ import annotations
