@@ -417,9 +417,10 @@ class IntegratorSettings:
             before it is reported apart); a run that finishes above it ends with status "warning". The default
             0.02 passes the embedded scenes at their own steps and flags the coarser steps at which their force
             results move (benchmarks/results/step_sensitivity.md).
-        lift_half_step_check: RK4 only: when a wheel lifts off after the settling distance, run the scene again at
-            half the step and compare the settled peaks against ``force_tolerance`` (the re-impacts after a lift
-            move with the step while the local estimate stays small; about three times the cost of the run).
+        lift_half_step_check: RK4 and the compiled DP54/BS32: when a wheel lifts off after the settling distance,
+            run the scene again at half the step (DP54/BS32: a tenth of both tolerances) and compare the settled
+            peaks against ``force_tolerance`` (the re-impacts after a lift move with the step while the local
+            estimate stays small; about three times the cost of the run).
     """
 
     method: str = "RK45"

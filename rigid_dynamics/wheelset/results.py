@@ -63,7 +63,8 @@ class SimulationResult:
             further samples in the same step); None for scipy's adaptive methods.
         half_step_peak_difference: RK4 runs in which a wheel lifted off after the settling distance: the largest
             difference of the settled peaks from a run at half the step, relative to the static wheel load
-            (:func:`_half_step_check`); None otherwise.
+            (:func:`_half_step_check`; compiled DP54/BS32 runs: from a run at a tenth of both tolerances); None
+            otherwise.
         scene: the scene that ran.
     """
 
