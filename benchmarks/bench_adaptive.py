@@ -267,7 +267,9 @@ def write(payload):
         "atol 1e-10 against it, the reference's own uncertainty). normal: settled peak normal force per wheel; "
         "creep: settled mean longitudinal and peak |lateral| creep force per wheel; RTF: simulated time / in-process "
         "wall time (best of the repeats). hunting-conical runs on its cone's tables (its conical provider is not "
-        "compiled).",
+        "compiled). The pairs sample at the scene's output step; RK4 at the larger of its step and that (a coarser "
+        "RK4 run samples its peaks more sparsely). RK4 runs without, and the pairs' runs without, the rerun of runs "
+        "with a wheel lift (lift_half_step_check). 'Fastest': among the runs that end ok within 1 %.",
         "",
     ]
     for scene in dict.fromkeys(r["scene"] for r in records):
