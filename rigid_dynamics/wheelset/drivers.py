@@ -1,7 +1,8 @@
 """The integrators over the right-hand side: scipy's adaptive ``OdeSolver`` methods stepped one step at a time
 (:func:`run_adaptive`, with the Jacobian of :func:`state_jacobian` for Radau and BDF), the fixed-step RK4 on the
-Python right-hand side (:func:`run_rk4`) and the compiled RK4 loop (:func:`run_compiled`), with the RK4 force
-error estimate and its check (:func:`force_error_check`).
+Python right-hand side (:func:`run_rk4`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
+DP54/BS32 with step-size control of compiled_adaptive.py), with the force error estimate and its check
+(:func:`force_error_check`).
 """
 
 from __future__ import annotations
@@ -51,12 +52,20 @@ def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, se
         return (values[k], k) if len(values) else (-np.inf, 0)
 
     tol = settings.force_tolerance
+    if settings.method == "RK4":
+        advice, failed = f"reduce fixed_step_s = {settings.fixed_step_s:g} s", "the third-order state failed"
+    else:  # the embedded pairs of compiled_adaptive.py
+        advice = (
+            f"tighten relative_tolerance = {settings.relative_tolerance:g} / absolute_tolerance = "
+            f"{settings.absolute_tolerance:g}"
+        )
+        failed = "the embedded lower-order state failed"
     value, k = worst(settled)
     if value > tol:
-        what = f"{value:.3g}" if np.isfinite(value) else "not computable (the third-order state failed)"
+        what = f"{value:.3g}" if np.isfinite(value) else f"not computable ({failed})"
         return "warning", (
             f"{message}; force error estimate {what} of the static wheel load at t = {t[k]:.6g} s exceeds "
-            f"force_tolerance = {tol:g}: reduce fixed_step_s = {settings.fixed_step_s:g} s"
+            f"force_tolerance = {tol:g}: {advice}"
         )
     value, k = worst(~settled)
     if value > tol:
@@ -153,7 +162,10 @@ def state_jacobian(fun: Callable) -> Callable:
 def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
     from scipy import integrate
 
-    cls = getattr(integrate, settings.method)
+    from rigid_dynamics.wheelset.compiled_adaptive import SCIPY_EQUIVALENT
+
+    # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located contact switches
+    cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
     options = {"jac": state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
     solver = cls(
         fun,
@@ -204,8 +216,13 @@ def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene
 
 
 def run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
-    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched."""
-    from rigid_dynamics.wheelset import compiled
+    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched; the
+    embedded pairs with step-size control (``method`` "DP54" or "BS32") in compiled_adaptive.run_embedded.
+    """
+    from rigid_dynamics.wheelset import compiled, compiled_adaptive
+
+    if settings.method in compiled_adaptive.PAIRS:
+        return compiled_adaptive.run_embedded(model, packed, y0, duration, settings, recorder, report, start)
 
     par, hz, kk, sides, slots, mode, targs, sargs = packed
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))

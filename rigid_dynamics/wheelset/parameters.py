@@ -18,7 +18,7 @@ from rigid_dynamics.materials import STEEL, Material
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
 """Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
 
-INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4")
+INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4", "DP54", "BS32")
 """scipy.integrate.solve_ivp methods plus the fixed-step classical Runge-Kutta method ``RK4``."""
 
 IRREGULARITY_SIDES = ("both", "left", "right")
@@ -397,7 +397,9 @@ class IntegratorSettings:
     """Time integration, output and safety limits.
 
     Attributes:
-        method: one of RK45, DOP853, Radau, BDF, LSODA (scipy.integrate) or RK4 (fixed step).
+        method: one of RK45, DOP853, Radau, BDF, LSODA (scipy.integrate), RK4 (fixed step), or DP54 / BS32 (the
+            embedded pairs Dormand-Prince 5(4) / Bogacki-Shampine 3(2) with step-size control in the compiled loop,
+            compiled_adaptive.py; scipy's RK45 / RK23 where the scene does not run compiled).
         relative_tolerance, absolute_tolerance: error tolerances of the adaptive methods.
         fixed_step_s: step of RK4, s.
         max_step_s: largest step of the adaptive methods, s.
@@ -408,15 +410,17 @@ class IntegratorSettings:
             anomaly (status "force-anomaly").
         max_lateral_displacement_m: |y| beyond this ends the run (status "derailed"), m.
         stop_at_wheel_lift: end the run (status "wheel-lift") when a wheel loses contact.
-        force_tolerance: RK4 only: the largest accepted force error estimate of a step (the per-wheel normal,
-            longitudinal and lateral creep force of RK4 against its embedded third-order solution, drivers.py),
+        force_tolerance: RK4 and the compiled DP54/BS32: the largest accepted force error estimate of a step (the
+            per-wheel normal, longitudinal and lateral creep force of RK4 against its embedded third-order solution,
+            drivers.py; of a pair's solution against its embedded lower-order one, compiled_adaptive.py),
             relative to the static wheel load, over the samples after the scene's settling distance (the start-up
             before it is reported apart); a run that finishes above it ends with status "warning". The default
             0.02 passes the embedded scenes at their own steps and flags the coarser steps at which their force
             results move (benchmarks/results/step_sensitivity.md).
-        lift_half_step_check: RK4 only: when a wheel lifts off after the settling distance, run the scene again at
-            half the step and compare the settled peaks against ``force_tolerance`` (the re-impacts after a lift
-            move with the step while the local estimate stays small; about three times the cost of the run).
+        lift_half_step_check: RK4 and the compiled DP54/BS32: when a wheel lifts off after the settling distance,
+            run the scene again at half the step (DP54/BS32: a tenth of both tolerances) and compare the settled
+            peaks against ``force_tolerance`` (the re-impacts after a lift move with the step while the local
+            estimate stays small; about three times the cost of the run).
     """
 
     method: str = "RK45"

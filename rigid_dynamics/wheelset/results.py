@@ -25,6 +25,7 @@ STATUSES = (
     "budget-exceeded",
     "invalid-initial-state",
     "step-unstable",
+    "step-size-underflow",
     "warning",
 )
 
@@ -53,14 +54,17 @@ class SimulationResult:
         rhs_evaluations, steps: counters. wall_time_s: wall time of the run (static equilibrium, integration,
             recording), s; loading the compiled code from numba's cache (once per process, ~0.1 s) is not counted.
         failure_time_s, failure_state: where the run ended abnormally (None when it did not).
-        provider, contact_model, method: what was used; compiled: whether the compiled RK4 loop ran it.
+        provider, contact_model, method: what was used; compiled: whether the compiled loop ran it (RK4, or DP54/BS32:
+            compiled_adaptive.py).
         force_error_estimate: RK4 runs: per output sample, the estimated error of one step in the per-wheel contact
             forces (normal, longitudinal and lateral creep force) divided by the static wheel load, (n,); NaN where
-            no step ends at the sample (t = 0, interpolated samples); None for the adaptive methods (their
-            error is controlled by their tolerances).
+            no step ends at the sample (t = 0, interpolated samples); compiled DP54/BS32 runs: per output sample,
+            that of the step containing it (the pair's solution against its embedded lower-order one; NaN for
+            further samples in the same step); None for scipy's adaptive methods.
         half_step_peak_difference: RK4 runs in which a wheel lifted off after the settling distance: the largest
             difference of the settled peaks from a run at half the step, relative to the static wheel load
-            (:func:`_half_step_check`); None otherwise.
+            (:func:`_half_step_check`; compiled DP54/BS32 runs: from a run at a tenth of both tolerances); None
+            otherwise.
         scene: the scene that ran.
     """
 

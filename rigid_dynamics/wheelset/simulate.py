@@ -12,7 +12,10 @@ can be watched: output samples are taken from each step's dense output at the fi
 and after every step the state is checked. The implicit Radau and BDF get the Jacobian of
 ``state_jacobian`` (exact kinematic rows, fixed finite-difference steps) instead of scipy's own.
 ``RK4`` is the classical fourth-order Runge-Kutta method with a fixed step (Butcher 1987 tableau:
-c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)).
+c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)). ``DP54`` and ``BS32`` are the embedded pairs Dormand-Prince 5(4)
+and Bogacki-Shampine 3(2) with step-size control inside the compiled loop (compiled_adaptive.py: PI controller,
+dense output at the output times, contact onset and loss located within the step and reported as the events'
+times); a scene the compiled loop cannot run takes scipy's RK45 / RK23 (the same pairs) on the Python path.
 
 Safety (a run never hangs and never writes NaN silently): the run ends with a status
 (``SimulationResult.status``) and the time and state where it happened when
@@ -23,6 +26,7 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"contact-failed"``: a contact model failed or the creepages became undefined (rolling speed 0);
 * ``"solver-failed"``: the adaptive solver could not continue (step size too small), or a numerical exception
   was raised below the driver (:data:`NUMERICAL_ERRORS`, e.g. the curvature code for a huge stiffness with RK4);
+* ``"step-size-underflow"``: DP54/BS32 in the compiled loop needed a step below compiled_adaptive.MIN_STEP_S;
 * ``"budget-exceeded"``: more than ``max_rhs_evaluations`` evaluations or ``max_wall_time_s``;
 * ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
 * ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
@@ -163,12 +167,15 @@ def simulate(
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
     model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
     from rigid_dynamics.wheelset import compiled as _compiled
+    from rigid_dynamics.wheelset import compiled_adaptive as _adaptive
 
-    can_compile = _compiled.supported(scene, provider, model_obj) and model.batch is not None
+    embedded = scene.integrator.method in _adaptive.PAIRS
+    supported = _adaptive.supported if embedded else _compiled.supported
+    can_compile = supported(scene, provider, model_obj) and model.batch is not None
     if compiled and not can_compile:
         raise ValueError(
-            "compiled = True: the compiled path needs method RK4, a TableProvider or a SearchProvider on tabulated "
-            "surfaces, and one of "
+            "compiled = True: the compiled path needs method RK4, DP54 or BS32, a TableProvider or a SearchProvider "
+            "on tabulated surfaces, and one of "
             f"the models {', '.join(_compiled.MODEL_CODES)}"
         )
     use_compiled = can_compile and compiled is not False
@@ -178,6 +185,8 @@ def simulate(
     if use_compiled:
         packed = _compiled.pack(model, provider, model.batch.tables, model.model.name, model.batch.options)
         _compiled.load(packed)  # the compiled code (from numba's cache) is loaded before the clock starts
+        if embedded:
+            _adaptive.load(packed, settings, scene)
     start = time.perf_counter()
     recorder = Recorder(model, scene)
     status, message, fail_t, fail_state = "ok", "", None, None
@@ -250,6 +259,12 @@ def simulate(
         else:
             steps = run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
         message = f"reached t = {duration:g} s"
+        stats = getattr(model, "adaptive_stats", None)
+        if use_compiled and embedded and stats:
+            message += (
+                f" ({settings.method}: {stats['accepted_steps']} steps, {stats['rejected_steps']} rejected, "
+                f"{stats['located_switches']} contact switches located)"
+            )
         del next_out
     except Stop as stop:
         status, message, fail_t, fail_state = stop.status, stop.message, stop.t, stop.state
@@ -261,12 +276,15 @@ def simulate(
     wall = time.perf_counter() - start
     t, states, patches, forces, kin, pot, wc, we, errors, track_states = recorder.arrays()
     fixed_step = settings.method == "RK4"
-    if fixed_step:
+    checked = fixed_step or (use_compiled and embedded)  # runs with a force error estimate at their samples
+    if checked:
         errors = errors / scene.static_wheel_load_N
         if status == "ok":
             settled = states[:, 0] - states[0, 0] >= scene.settling_distance_m if len(t) else np.zeros(0, bool)
             status, message = force_error_check(errors, t, settled, settings, message)
-        if ok:  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
+        if (
+            ok and fixed_step
+        ):  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
             try:
                 limit = rk4_stable_step(lambda y: model.derivative(0.0, y), full0)
             except (ContactFailure, *NUMERICAL_ERRORS):
@@ -296,11 +314,11 @@ def simulate(
         contact_model=getattr(model_obj, "name", type(model_obj).__name__),
         method=settings.method,
         compiled=use_compiled,
-        force_error_estimate=errors if fixed_step else None,
+        force_error_estimate=errors if checked else None,
         scene=scene,
         track_states=track_states,
     )
-    if fixed_step and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
+    if checked and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
         result = _half_step_check(result, provider, model_obj, compiled)
     return result
 
@@ -350,18 +368,27 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
     later impacts move (wheel-flat on the rigid track at 0.1 ms: estimate 1e-3, re-impact peaks 3.6 % of the static
     load against a 0.025 ms run; benchmarks/results/step_sensitivity.md). The difference of the two runs is an upper
     estimate of the half-step run's error and about the error of this run. "warning" when it exceeds
-    ``force_tolerance``; the wall time and RHS evaluations include the second run.
+    ``force_tolerance``; the wall time and RHS evaluations include the second run. The compiled embedded pairs
+    (DP54/BS32) get the same check with the run again at a tenth of both tolerances.
     """
     scene = result.scene
     settings = scene.integrator
-    half = simulate(
-        replace(
-            scene, integrator=replace(settings, fixed_step_s=0.5 * settings.fixed_step_s, lift_half_step_check=False)
-        ),
-        provider=provider,
-        contact_model=model_obj,
-        compiled=compiled,
-    )
+    if settings.method == "RK4":
+        finer = replace(settings, fixed_step_s=0.5 * settings.fixed_step_s, lift_half_step_check=False)
+        where, advice = "at half the step", f"reduce fixed_step_s = {settings.fixed_step_s:g} s"
+    else:  # the compiled embedded pairs: the same check at a tenth of the tolerances
+        finer = replace(
+            settings,
+            relative_tolerance=0.1 * settings.relative_tolerance,
+            absolute_tolerance=0.1 * settings.absolute_tolerance,
+            lift_half_step_check=False,
+        )
+        where = "at a tenth of the tolerances"
+        advice = (
+            f"tighten relative_tolerance = {settings.relative_tolerance:g} / absolute_tolerance = "
+            f"{settings.absolute_tolerance:g}"
+        )
+    half = simulate(replace(scene, integrator=finer), provider=provider, contact_model=model_obj, compiled=compiled)
     total = {
         "wall_time_s": result.wall_time_s + half.wall_time_s,
         "rhs_evaluations": result.rhs_evaluations + half.rhs_evaluations,
@@ -370,8 +397,7 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
         return replace(
             result,
             status="warning",
-            message=f"{result.message}; a wheel lifted off, and the check at half the step ended {half.status}: "
-            f"{half.message}",
+            message=f"{result.message}; a wheel lifted off, and the check {where} ended {half.status}: {half.message}",
             **total,
         )
     load = scene.static_wheel_load_N
@@ -383,13 +409,11 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
             if a is not None and b is not None:
                 moved = max(moved, abs(a - b) / load)
     message = (
-        f"{result.message}; a wheel lifted off: the settled peaks at half the step differ by {moved:.3g} of the "
+        f"{result.message}; a wheel lifted off: the settled peaks {where} differ by {moved:.3g} of the "
         f"static wheel load"
     )
     status = "ok"
     if moved > settings.force_tolerance:
         status = "warning"
-        message += (
-            f", above force_tolerance = {settings.force_tolerance:g}: reduce fixed_step_s = {settings.fixed_step_s:g} s"
-        )
+        message += f", above force_tolerance = {settings.force_tolerance:g}: {advice}"
     return replace(result, status=status, message=message, half_step_peak_difference=moved, **total)
