@@ -174,11 +174,15 @@ def quasi_static(scene: DynamicsScene):
             moment += np.cross(attach, f_s)
         moment[2] += -2.0 * kyaw * psi
         # gravity along the true vertical of the canted track, the carried mass's quasi-static load at the axle
-        force += m * g * np.array([0.0, s, c]) + mc * np.array([0.0, g * s - kappa * v * v * c, g * c + kappa * v * v * s])
+        force += m * g * np.array([0.0, s, c]) + mc * np.array(
+            [0.0, g * s - kappa * v * v * c, g * c + kappa * v * v * s]
+        )
         # steady state: m a = F with the centripetal acceleration; dH/dt = Omega x H = M
         accel = kappa * h * v * v * np.array([0.0, c, -s])
         precession = np.cross(omega_frame, rot @ j_body @ rot.T @ omega_a)
-        residual = np.concatenate([(force - m * accel)[1:] / 1e3, (moment - precession) / 1e3, np.array(geometry) * 1e3])
+        residual = np.concatenate(
+            [(force - m * accel)[1:] / 1e3, (moment - precession) / 1e3, np.array(geometry) * 1e3]
+        )
         return residual, rows
 
     def equations(x):
@@ -309,3 +313,67 @@ def test_python_path_matches_the_compiled_one_in_a_curve():
 def test_energy_balance_holds_in_a_curve(right_curve):
     _, result = right_curve
     assert result.summary()["energy_balance_relative"] < 1e-6
+
+
+def _settled_scene(name):
+    """An embedded scene as shipped (settled at its end: curve within 4 s of its 6 s, curve-flange within 1 s)."""
+    from wheelrail.scenes import load_scene
+
+    return load_scene(name)
+
+
+def test_curve_scenes_tread_and_flange():
+    """Regression of the embedded scenes' steady state (the numbers their files quote): curve (600 m) stays on the
+    tread near the pure-rolling line, curve-flange (100 m) runs on the outer wheel's flange root."""
+    tread = simulate(_settled_scene("curve"))
+    flange = simulate(_settled_scene("curve-flange"))
+    for result in (tread, flange):
+        assert result.status == "ok", result.message
+        assert result.summary()["energy_balance_relative"] < 1e-6
+    angle = tread.patches["contact_angle_rad"][-1, 0, 0]
+    assert tread.states[-1, 1] == pytest.approx(-3.861e-3, rel=2e-3) and angle < 0.2
+    assert abs(tread.patches["creepage_long"][-1, 0, 0]) < 1e-4
+    assert not any(kind == "flange-contact" for kind, _, _ in tread.events)
+    angle = flange.patches["contact_angle_rad"][-1, 0, 0]
+    assert flange.states[-1, 1] == pytest.approx(-5.706e-3, rel=2e-3)
+    assert angle > flange.scene.track.flange_contact_angle_rad
+    assert any(kind == "flange-contact" and side == "left" for kind, side, _ in flange.events)
+    curve = flange.summary()["curve"]
+    assert curve["cant_deficiency_m"] == pytest.approx(0.1451, abs=1e-4)
+    assert tread.summary()["curve"]["cant_deficiency_m"] == pytest.approx(0.0967, abs=1e-4)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "pattern"),
+    [
+        ("curve_radius_m = 600.0", "curve_radius_m = -600.0", r"curve_radius_m = -600\.0: expected a radius >= 50"),
+        ("curve_radius_m = 600.0", "curve_radius_m = 0.0", r"curve_radius_m = 0\.0: expected a radius >= 50"),
+        ('curve_direction = "right"', 'curve_direction = "up"', r"curve_direction = 'up': expected one of"),
+        ("cant_m = 0.1", "cant_m = 0.5", r"cant_m' = 0\.5: expected a number from 0 to 0\.2"),
+        ("cant_m = 0.1", "cant_m = -0.1", r"cant_m' = -0\.1: expected a number from 0 to 0\.2"),
+        (
+            'curve_direction = "right"\ncurve_radius_m = 600.0',
+            'curve_direction = "straight"',
+            r"cant_m = 0\.1: expected 0 on straight track",
+        ),
+        (
+            'rail_profile = "UIC60"',
+            'rail_profile = "UIC60"\nleft_rail_profile = "no_such_rail.prr"',
+            r"key 'track\.left_rail_profile' = 'no_such_rail\.prr'",
+        ),
+        (
+            'wheel_profile = "S1002"',
+            'wheel_profile = "S1002"\nright_wheel_profile = "no_such_wheel.prw"',
+            r"key 'track\.right_wheel_profile' = 'no_such_wheel\.prw'",
+        ),
+        (
+            "rail_inclination_rad = 0.025",
+            "rail_inclination_rad = 0.025\nleft_rail_inclination_rad = 0.5",
+            r"left_rail_inclination_rad' = 0\.5: expected a number from -0\.2 to 0\.2",
+        ),
+    ],
+)
+def test_bad_curve_keys_are_one_line_errors(tmp_path, capsys, old, new, pattern):
+    from hardening_helpers import assert_bad_scene
+
+    assert_bad_scene(tmp_path, capsys, "curve", old, new, pattern)

@@ -494,8 +494,11 @@ def _assemble_curve(y, par, force, moment, fe0, fe1, fe2, me0, me1, me2, om, rzx
     al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2 + (0.0 - om[0] * o2) - wd * s_
     al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2 + (om[0] * o1 - 0.0) - wd * c_
     ja0, ja1, ja2 = _j_times(rzx, jb0, jb1, jb2, al0, al1, al2)
-    p_ext += om[0] * ja0 + om[1] * ja1 + om[2] * ja2 - (
-        om[0] * (moment[0] + me0) + om[1] * (moment[1] + me1) + om[2] * (moment[2] + me2)
+    p_ext += (
+        om[0] * ja0
+        + om[1] * ja1
+        + om[2] * ja2
+        - (om[0] * (moment[0] + me0) + om[1] * (moment[1] + me1) + om[2] * (moment[2] + me2))
     )
     return acc0, acc1, acc2, al0, al1, al2, p_ext
 

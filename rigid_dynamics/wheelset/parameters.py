@@ -203,7 +203,9 @@ class TrackGeometry:
             if value is not None and not (isinstance(value, (int, float)) and abs(value) <= 0.2):
                 raise ValueError(f"{name} = {value!r}: expected |value| <= 0.2 rad (1:40 is 0.025) or no value")
         if self.curve_direction not in CURVE_DIRECTIONS:
-            raise ValueError(f"curve_direction = {self.curve_direction!r}: expected one of {', '.join(CURVE_DIRECTIONS)}")
+            raise ValueError(
+                f"curve_direction = {self.curve_direction!r}: expected one of {', '.join(CURVE_DIRECTIONS)}"
+            )
         if self.curve_direction == "straight":
             if self.curve_radius_m != 0.0:
                 raise ValueError(
