@@ -215,7 +215,8 @@ class TrackGeometry:
         elif not self.curve_radius_m >= MIN_CURVE_RADIUS_M:
             raise ValueError(
                 f"curve_radius_m = {self.curve_radius_m!r}: expected a radius >= {MIN_CURVE_RADIUS_M:g} m for the "
-                f"{self.curve_direction} curve (0 and negative radii are not curves; tighter ones are not running track)"
+                f"{self.curve_direction} curve (0 and negative radii are not curves; tighter ones are not running "
+                "track)"
             )
         if not 0.0 <= self.cant_m <= MAX_CANT_M:
             raise ValueError(
