@@ -414,3 +414,63 @@ def test_bad_curve_keys_are_one_line_errors(tmp_path, capsys, old, new, pattern)
     from hardening_helpers import assert_bad_scene
 
     assert_bad_scene(tmp_path, capsys, "curve", old, new, pattern)
+
+
+def _straight_profiles(duration_s=0.3, **track):
+    """polygonal-wheel without its polygon on a straight track, with per-side profile keys."""
+    from rigid_dynamics.wheelset.parameters import Irregularities
+    from wheelrail.scenes import load_scene
+
+    scene = load_scene("polygonal-wheel")
+    return replace(
+        scene,
+        duration_s=duration_s,
+        irregularities=Irregularities(),
+        track=replace(scene.track, **track),
+        initial=replace(scene.initial, lateral_displacement_m=0.0),
+        settling_distance_m=0.0,
+    )
+
+
+def test_per_side_keys_equal_to_the_shorthand_change_nothing():
+    """Regression: naming the two-sided profiles and inclination per side gives the same run, bit for bit."""
+    short = simulate(_straight_profiles())
+    named = simulate(
+        _straight_profiles(
+            left_wheel_profile="S1002",
+            right_wheel_profile="S1002",
+            left_rail_profile="UIC60",
+            right_rail_profile="UIC60",
+            left_rail_inclination_rad=0.025,
+            right_rail_inclination_rad=0.025,
+        )
+    )
+    assert short.status == named.status == "ok"
+    assert np.array_equal(short.states, named.states)
+
+
+def test_swapped_sides_give_mirrored_results():
+    """Unequal rails (left 1:20, right 1:40 inclination; left analytic UIC60, right the Manchester benchmark's UIC60
+    file) and unequal wheels (left analytic S1002, right the benchmark's S1002 file) against the same with the sides
+    swapped: the wheelset settles off-centre, and the swapped run is its mirror image."""
+    sides = {
+        "left_rail_inclination_rad": 0.05,
+        "right_rail_inclination_rad": 0.025,
+        "left_rail_profile": "UIC60",
+        "right_rail_profile": "MBench_UIC60_v3",
+        "left_wheel_profile": "S1002",
+        "right_wheel_profile": "MBench_S1002_v3",
+    }
+    swapped = {k.replace("left", "@").replace("right", "left").replace("@", "right"): v for k, v in sides.items()}
+    one = simulate(_straight_profiles(duration_s=1.0, **sides))
+    two = simulate(_straight_profiles(duration_s=1.0, **swapped))
+    assert one.status == "ok" and two.status == "ok", (one.message, two.message)
+    y1, y2 = one.states[-1, 1], two.states[-1, 1]
+    assert abs(y1) > 1e-5  # the asymmetric track moves the wheelset off-centre
+    assert y2 == pytest.approx(-y1, rel=1e-4)
+    assert two.states[-1, 3] == pytest.approx(-one.states[-1, 3], rel=1e-3, abs=1e-9)
+    assert two.states[-1, 4] == pytest.approx(-one.states[-1, 4], rel=1e-4)
+    n1, n2 = one.patches["normal_force_N"][-1, :, 0], two.patches["normal_force_N"][-1, :, 0]
+    assert n2 == pytest.approx(n1[::-1], rel=1e-5)
+    f1, f2 = one.contact_force_N[-1], two.contact_force_N[-1]
+    assert f2[:, 1] == pytest.approx(-f1[::-1, 1], rel=1e-3, abs=1.0)
