@@ -29,6 +29,11 @@ deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's sear
 creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
 :func:`_track_rates` (the Python path uses the same function).
 
+Curves and cant (scene ``[track] curve_direction``, ``curve_radius_m``, ``cant_m``; ``par.track_frame``): the states
+are relative to a frame following the track; :func:`_assemble_curve` adds the frame's terms to Newton and Euler and
+:func:`_forces` takes the creepages from the absolute velocities (straight track without cant: bit-identical code
+path to before).
+
 Parameters: one record with named fields (:data:`PARAMETERS`, a numpy structured dtype that numba compiles;
 ``par.mass_kg``), built by :func:`pack`. Chosen by measured overhead: a kernel reading 16 parameters, called 2e7
 times in a compiled loop, took 49.8 ns per call with the former float vector and index constants, 49.2 ns with the
