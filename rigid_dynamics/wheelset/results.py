@@ -185,8 +185,6 @@ class SimulationResult:
         """
         if self.scene is None or not self.scene.track.curved:
             return None
-        import math
-
         from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2 as g
 
         track, speed = self.scene.track, self.scene.speed_m_per_s
