@@ -18,7 +18,7 @@ from rigid_dynamics.wheelset.simulate import simulate
 from wheelrail.config import build_dataclass
 
 SCENES = Path(__file__).resolve().parents[1] / "wheelrail" / "scenes"
-NAMES = ("hunting-conical", "polygonal-wheel", "wheel-flat", "corrugation")
+NAMES = ("hunting-conical", "polygonal-wheel", "wheel-flat", "corrugation", "curve", "curve-flange")
 
 
 def load(name):
@@ -41,6 +41,12 @@ def test_scene_contents():
     assert corrugation.irregularities.corrugation_wavelength_m == 0.05
     assert corrugation.irregularities.corrugation_amplitude_m == 3e-5
     assert corrugation.speed_m_per_s == pytest.approx(80 / 3.6, rel=1e-5)
+    curve = load("curve")
+    assert (curve.track.curve_direction, curve.track.curve_radius_m, curve.track.cant_m) == ("right", 600.0, 0.1)
+    assert curve.speed_m_per_s == pytest.approx(100 / 3.6, rel=1e-5)
+    flange = load("curve-flange")
+    assert (flange.track.curve_radius_m, flange.track.cant_m) == (100.0, 0.15)
+    assert flange.speed_m_per_s == pytest.approx(50 / 3.6, rel=1e-5)
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -71,6 +71,12 @@ def cmd_critical_speed(args) -> int:
             raise ConfigError(f"--{name.replace('_', '-')} {value!r}: expected a finite number > 0")
     if args.steps < 1:
         raise ConfigError(f"--steps {args.steps!r}: expected an integer >= 1")
+    if scene.track.curved:  # the linear model and the limit cycle about the centred straight-track state
+        raise ConfigError(
+            f"key 'track.curve_direction' = {scene.track.curve_direction!r} (cant_m = {scene.track.cant_m!r}): "
+            "expected a straight track without cant for critical-speed (the analyses are about the straight track's "
+            "centred state)"
+        )
     if args.low is not None and args.high is not None and not args.low < args.high:
         raise ConfigError(f"--low {args.low!r}: expected a speed below --high {args.high!r}")
     from functools import partial

@@ -47,7 +47,10 @@ def _check_profiles(table: dict, prefix: str = "") -> None:
         dotted = f"{prefix}.{key}" if prefix else key
         if isinstance(value, dict):
             _check_profiles(value, dotted)
-        elif key.endswith("_profile") and isinstance(value, str) and value.lower() not in ANALYTIC_TRACK_NAMES:
+        elif (
+            key.endswith("_profile") and isinstance(value, str) and value and value.lower() not in ANALYTIC_TRACK_NAMES
+        ):
+            # (an empty per-side key, e.g. left_wheel_profile = "", means the two-sided profile)
             kind = "rail" if "rail" in key else "wheel"
             try:
                 load_profile(value, kind)

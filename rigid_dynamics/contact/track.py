@@ -134,7 +134,8 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
         case: provides wheel_profile, rail_profile (names or paths, Profile objects or profile curves), gauge_m,
             gauge_height_m, flange_back_distance_m, nominal_radius_m, rail_inclination_rad; optionally (getattr,
             defaults in brackets) wheel_profile_left, rail_profile_left [the right ones, mirrored],
-            rail_profile_cant_rad [the profile's own ``cant_rad``], profile_smoothing_m [2 mm],
+            rail_profile_cant_rad [the profile's own ``cant_rad``], rail_inclination_left_rad /
+            rail_inclination_right_rad [rail_inclination_rad], profile_smoothing_m [2 mm],
             wheel_profile_mirror_y/_z, rail_profile_mirror_y/_z [False].
         wheel_irregularities, rail_irregularities: optional side -> tuple of irregularities (geometry module).
 
@@ -171,9 +172,11 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
             smoothing_wavelength_m=smoothing,
         )  # fmt: skip
         cant = stated_cant if stated_cant is not None else float(getattr(rail, "cant_rad", 0.0))
+        inclination = getattr(case, f"rail_inclination_{side}_rad", None)
+        inclination = case.rail_inclination_rad if inclination is None else inclination
         track = TrackGeometry(
             rail, gauge_m=case.gauge_m, gauge_height_m=case.gauge_height_m,
-            rail_inclination_rad=case.rail_inclination_rad - cant, smoothing_wavelength_m=smoothing,
+            rail_inclination_rad=inclination - cant, smoothing_wavelength_m=smoothing,
         )  # fmt: skip
         wheels[side] = wheelset.wheel_surface(side, wheel_irregularities.get(side, ()))
         _check_flange_outside(wheelset.curve, getattr(wheel, "name", names["wheel"][side]))

@@ -29,6 +29,11 @@ deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's sear
 creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
 :func:`_track_rates` (the Python path uses the same function).
 
+Curves and cant (scene ``[track] curve_direction``, ``curve_radius_m``, ``cant_m``; ``par.track_frame``): the states
+are relative to a frame following the track; :func:`_assemble_curve` adds the frame's terms to Newton and Euler and
+:func:`_forces` takes the creepages from the absolute velocities (straight track without cant: bit-identical code
+path to before).
+
 Parameters: one record with named fields (:data:`PARAMETERS`, a numpy structured dtype that numba compiles;
 ``par.mass_kg``), built by :func:`pack`. Chosen by measured overhead: a kernel reading 16 parameters, called 2e7
 times in a compiled loop, took 49.8 ns per call with the former float vector and index constants, 49.2 ns with the
@@ -119,6 +124,11 @@ PARAMETER_FIELDS = (
     ("dip_ramp_length_m", "joint ramp length"),
     ("dip_entry_rounding_m", "joint entry rounding"),
     ("dip_rounding_m", "joint rounding"),
+    ("track_frame", "1: curve or cant: the track-following frame's terms (_assemble, _forces) are on"),
+    ("curvature_1_per_m", "signed curvature of the centreline, +1/R right curve"),
+    ("cant_sin", "sin of the signed cant angle (> 0: left rail higher)"),
+    ("cant_cos", "cos of the cant angle"),
+    ("carried_mass_kg", "axle load / g: the mass whose quasi-static gravity and centrifugal load acts at the axle"),
 )
 """The parameter record of the compiled right-hand side: (field, meaning); every field float64, SI units."""
 
@@ -416,6 +426,89 @@ def _track_rates(par, y, rail_f0, rail_f1, out, p_ext):
 
 
 @njit(cache=True, _nrt=False)
+def _j_times(rzx, jb0, jb1, jb2, v0, v1, v2):
+    """J v with J = R J_body R^T (R = R_z R_x, J_body = diag(jb0, jb1, jb2))."""
+    b0 = rzx[0, 0] * v0 + rzx[1, 0] * v1 + rzx[2, 0] * v2
+    b1 = rzx[0, 1] * v0 + rzx[1, 1] * v1 + rzx[2, 1] * v2
+    b2 = rzx[0, 2] * v0 + rzx[1, 2] * v1 + rzx[2, 2] * v2
+    return (
+        rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2,
+        rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2,
+        rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2,
+    )
+
+
+@njit(cache=True, _nrt=False)
+def _assemble_curve(y, par, force, moment, fe0, fe1, fe2, me0, me1, me2, om, rzx, p_ext):
+    """Newton and Euler in the track-following frame of a curve with cant (scene [track] curve_*, cant_m): the
+    translational and angular accelerations relative to that frame, and ``p_ext`` plus the power the frame's terms
+    add (returned: acc0, acc1, acc2, al0, al1, al2, p_ext).
+
+    The frame F(x) sits at the arc length x of the track centreline (rail level), axes t (along the track), n (in the
+    canted track plane, to the right), b (normal to it, down); the states are relative to it (x: arc length; y, z:
+    the centre's offset from the centreline point in F; yaw, roll: Euler angles relative to F). The true vertical
+    (down) in F is e_V = (0, sin c, cos c) with c the signed cant angle (> 0: left rail higher). F turns about e_V at
+    Omega = kappa x' e_V (kappa = +-1/R, > 0 for a right curve). With r_c = (0, y, z) the centre's velocity is
+    v = (x' h, y', z'), h = 1 + kappa (e_Vy z - e_Vz y) (the centre's own radius against the centreline's), and its
+    acceleration (F components) a = (x'' h + 2 kappa x' (e_Vy z' - e_Vz y'), y'' + kappa h x'^2 e_Vz,
+    z'' - kappa h x'^2 e_Vy): Newton m a = F gives the centrifugal terms. Gravity is m g e_V (the cant's lateral
+    component), and the axle load becomes the quasi-static load of the carried mass M_c = axle_load / g at the
+    frame's speed V: M_c (g e_V - kappa V^2 e_n,horizontal) = M_c (0, g sin c - kappa V^2 cos c,
+    g cos c + kappa V^2 sin c) (its centrifugal force balanced by the cant at the balancing speed, as the wheelset's
+    own). Euler with the absolute angular velocity omega_a = omega + Omega (omega relative to F, from the Euler
+    rates): J omega' = M - omega_a x J omega_a + J (omega x Omega) - J Omega', Omega' = kappa x'' e_V: the
+    gyroscopic couple of the spin with the frame's yaw rate V/R is in omega_a x J omega_a. The suspension (in
+    _assemble) acts between the wheelset and a frame that follows the track (relative positions and velocities), the
+    yaw springs about the track's tangent.
+
+    Energy: the kinetic energy and potential of the checks are those relative to F with gravity along b (T of the
+    relative velocities, -m g z); the power of everything this function changes against the straight track (the
+    frame's inertial terms, gravity's cant component, the carried mass's load) is added to ``p_ext``, so that
+    d(T + V_g)/dt = P_contact + P_exterior holds as on straight track.
+    """
+    kap, s_, c_ = par.curvature_1_per_m, par.cant_sin, par.cant_cos
+    g, m, speed = par.gravity_m_per_s2, par.mass_kg, par.speed_m_per_s
+    yc, zc = y[1], y[2]
+    vx, vy, vz = y[6], y[7], y[8]
+    h = 1.0 + kap * (s_ * zc - c_ * yc)
+    mc = par.carried_mass_kg
+    fs0 = force[0] + fe0
+    fs1 = force[1] + fe1
+    fs2 = force[2] + fe2 + m * g  # the straight track's forces (axle load along z, gravity along z)
+    f0 = fs0
+    f1 = force[1] + fe1 + mc * (g * s_ - kap * speed * speed * c_) + m * g * s_
+    f2 = force[2] + fe2 - par.axle_load_N + mc * (g * c_ + kap * speed * speed * s_) + m * g * c_
+    acc0 = (f0 / m - 2.0 * kap * vx * (s_ * vz - c_ * vy)) / h
+    acc1 = f1 / m - kap * h * vx * vx * c_
+    acc2 = f2 / m + kap * h * vx * vx * s_
+    p_ext += m * (vx * acc0 + vy * acc1 + vz * acc2) - (vx * fs0 + vy * fs1 + vz * fs2)
+    jb0, jb1, jb2 = par.inertia_transverse_kg_m2, par.inertia_axial_kg_m2, par.inertia_transverse_kg_m2
+    w = kap * vx
+    wd = kap * acc0
+    o1, o2 = w * s_, w * c_  # Omega (its x component is 0)
+    wa0, wa1, wa2 = om[0], om[1] + o1, om[2] + o2
+    jw0, jw1, jw2 = _j_times(rzx, jb0, jb1, jb2, wa0, wa1, wa2)
+    t0 = moment[0] + me0 - (wa1 * jw2 - wa2 * jw1)
+    t1 = moment[1] + me1 - (wa2 * jw0 - wa0 * jw2)
+    t2 = moment[2] + me2 - (wa0 * jw1 - wa1 * jw0)
+    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
+    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
+    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
+    # + omega x Omega - Omega'
+    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2 + (om[1] * o2 - om[2] * o1)
+    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2 + (0.0 - om[0] * o2) - wd * s_
+    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2 + (om[0] * o1 - 0.0) - wd * c_
+    ja0, ja1, ja2 = _j_times(rzx, jb0, jb1, jb2, al0, al1, al2)
+    p_ext += (
+        om[0] * ja0
+        + om[1] * ja1
+        + om[2] * ja2
+        - (om[0] * (moment[0] + me0) + om[1] * (moment[1] + me1) + om[2] * (moment[2] + me2))
+    )
+    return acc0, acc1, acc2, al0, al1, al2, p_ext
+
+
+@njit(cache=True, _nrt=False)
 def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
     """The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track: d/dt of the full
     state into ``out`` from the summed contact force and moment about the centre (main frame, N and N m), the
@@ -460,26 +553,31 @@ def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
         me1 += mt1
         me2 += mt2
         p_ext += mt0 * om[0] + mt1 * om[1] + mt2 * om[2]
-    acc0 = (force[0] + fe0) / par.mass_kg
-    acc1 = (force[1] + fe1) / par.mass_kg
-    acc2 = (force[2] + fe2) / par.mass_kg + par.gravity_m_per_s2
-    # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
     jb0, jb1, jb2 = par.inertia_transverse_kg_m2, par.inertia_axial_kg_m2, par.inertia_transverse_kg_m2
-    b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
-    b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
-    b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
-    jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
-    jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
-    jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
-    t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
-    t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
-    t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
-    c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
-    c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
-    c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
-    al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
-    al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
-    al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
+    if par.track_frame > 0:
+        acc0, acc1, acc2, al0, al1, al2, p_ext = _assemble_curve(
+            y, par, force, moment, fe0, fe1, fe2, me0, me1, me2, om, rzx, p_ext
+        )
+    else:
+        acc0 = (force[0] + fe0) / par.mass_kg
+        acc1 = (force[1] + fe1) / par.mass_kg
+        acc2 = (force[2] + fe2) / par.mass_kg + par.gravity_m_per_s2
+        # J = R J_body R^T with R = R_z R_x orthogonal: J omega and J^-1 torque = R J_body^-1 R^T torque (no solve)
+        b0 = rzx[0, 0] * om[0] + rzx[1, 0] * om[1] + rzx[2, 0] * om[2]
+        b1 = rzx[0, 1] * om[0] + rzx[1, 1] * om[1] + rzx[2, 1] * om[2]
+        b2 = rzx[0, 2] * om[0] + rzx[1, 2] * om[1] + rzx[2, 2] * om[2]
+        jw0 = rzx[0, 0] * jb0 * b0 + rzx[0, 1] * jb1 * b1 + rzx[0, 2] * jb2 * b2
+        jw1 = rzx[1, 0] * jb0 * b0 + rzx[1, 1] * jb1 * b1 + rzx[1, 2] * jb2 * b2
+        jw2 = rzx[2, 0] * jb0 * b0 + rzx[2, 1] * jb1 * b1 + rzx[2, 2] * jb2 * b2
+        t0 = moment[0] + me0 - (om[1] * jw2 - om[2] * jw1)
+        t1 = moment[1] + me1 - (om[2] * jw0 - om[0] * jw2)
+        t2 = moment[2] + me2 - (om[0] * jw1 - om[1] * jw0)
+        c0 = (rzx[0, 0] * t0 + rzx[1, 0] * t1 + rzx[2, 0] * t2) / jb0
+        c1 = (rzx[0, 1] * t0 + rzx[1, 1] * t1 + rzx[2, 1] * t2) / jb1
+        c2 = (rzx[0, 2] * t0 + rzx[1, 2] * t1 + rzx[2, 2] * t2) / jb2
+        al0 = rzx[0, 0] * c0 + rzx[0, 1] * c1 + rzx[0, 2] * c2
+        al1 = rzx[1, 0] * c0 + rzx[1, 1] * c1 + rzx[1, 2] * c2
+        al2 = rzx[2, 0] * c0 + rzx[2, 1] * c1 + rzx[2, 2] * c2
     out[0], out[1], out[2] = vx, vy, vz
     out[3], out[4], out[5] = yr, rr, sr
     out[6], out[7], out[8] = acc0, acc1, acc2
@@ -514,6 +612,21 @@ def derivative_from_contact(t, y, par, force, moment, p_con, rail_force, out):
     _assemble(t, y, par, force, moment, p_con, rail_force[0], rail_force[1], om, rzx, out)
 
 
+def frame_velocities(par, state, omega):
+    """In a curve (``par.track_frame``): the absolute angular velocity omega + Omega and the centre's absolute
+    velocity (x' h, y', z') that the creepages take (as :func:`_forces` does; _assemble_curve), from the state and
+    the angular velocity relative to the track frame; else ``omega`` and the state's velocity unchanged.
+    """
+    v = np.array(state[6:9], float)
+    if not par["track_frame"] > 0:
+        return omega, v
+    kap, s_, c_ = float(par["curvature_1_per_m"]), float(par["cant_sin"]), float(par["cant_cos"])
+    w = kap * v[0]
+    out = np.array(omega, float) + np.array([0.0, w * s_, w * c_])
+    v[0] *= 1.0 + kap * (s_ * state[2] - c_ * state[1])
+    return out, v
+
+
 @njit(cache=True)
 def track_rates(par, y, rail_force, out):
     """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``); returns the dampers' power."""
@@ -527,7 +640,8 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     when ``record``. Returns the status.
     """
     # scratch rows (no allocation in the loop): normal, lever, point velocity, e_x, e_y, force, moment,
-    # total force, total moment, side forces (2), omega, R_z R_x (3 rows)
+    # total force, total moment, side forces (2), omega, R_z R_x (3 rows); row 15: the elastic search's centre;
+    # row 16: the absolute angular velocity in a curve
     n, lever, vel, ex, ey, fc, mc = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6]
     force, moment, side_force = sc[7], sc[8], sc[9:11]
     om, rzx = sc[11], sc[12:15]
@@ -537,6 +651,17 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     yc = y[1]
     vx, vy, vz = y[6], y[7], y[8]
     _rotation(y, om, rzx)
+    # in a curve (track_frame): the creepages take the absolute angular velocity omega + Omega and the centre's
+    # absolute velocity (x' h, y', z') (_assemble_curve); the contact power stays that on the relative motion
+    curve = par.track_frame > 0
+    oma, vxa = om, vx
+    w_1, w_2 = 0.0, 0.0
+    if curve:
+        oma = sc[16]
+        w_1 = par.curvature_1_per_m * vx * par.cant_sin
+        w_2 = par.curvature_1_per_m * vx * par.cant_cos
+        oma[0], oma[1], oma[2] = om[0], om[1] + w_1, om[2] + w_2
+        vxa = vx * (1.0 + par.curvature_1_per_m * (par.cant_sin * y[2] - par.cant_cos * yc))
     p_con = 0.0
     elastic = par.elastic_track > 0
     rail_f0, rail_f1 = 0.0, 0.0
@@ -560,7 +685,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         if not q > 0.0:
             continue
         rail_vz = y[RAIL_VELOCITY + sides[c]] if elastic else 0.0  # creepages relative to the rail
-        speed, xi, eta, spin = _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey)
+        speed, xi, eta, spin = _patch_creepages(lever, n, oma, vxa, vy, vz, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
         # Hertz, approach control (tables of the axial function)
@@ -611,6 +736,11 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         moment[0] += lever[1] * fc[2] - lever[2] * fc[1] + mc[0]
         moment[1] += lever[2] * fc[0] - lever[0] * fc[2] + mc[1]
         moment[2] += lever[0] * fc[1] - lever[1] * fc[0] + mc[2]
+        if curve:  # the slip velocity less Omega x (r_c + lever): the point's velocity relative to the frame
+            p1, p2 = yc + lever[1], y[2] + lever[2]
+            vel[0] -= w_1 * p2 - w_2 * p1
+            vel[1] -= w_2 * lever[0]
+            vel[2] -= -w_1 * lever[0]
         p_con += fc[0] * vel[0] + fc[1] * vel[1] + fc[2] * vel[2] + mc[0] * om[0] + mc[1] * om[1] + mc[2] * om[2]
         if sides[c] == 0:
             rail_f0 -= fc[2]
@@ -667,7 +797,7 @@ def _workspace(par, n_rows, ncand, rec):
         bg[1, g] = math.sin(bg[0, g])
         bg[2, g] = math.cos(bg[0, g])
     return (
-        np.empty((n_rows, ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((16, 3)), bg,
+        np.empty((n_rows, ncand)), rec, np.empty(9), np.empty(8), np.zeros((1, 1)), np.zeros((17, 3)), bg,
         np.zeros((ncand, N_GEO)),
     )  # fmt: skip
 
@@ -878,6 +1008,12 @@ def model_parameters(model_wheelset):
     par["axle_load_N"], par["torque_N_m"] = m.axle_load, m.torque
     par["max_force_N"] = scene.integrator.max_force_factor * scene.static_wheel_load_N
     par["max_lateral_m"] = scene.integrator.max_lateral_displacement_m
+    geometry = scene.track
+    if geometry.curved:
+        par["track_frame"] = 1.0
+        par["curvature_1_per_m"] = geometry.curvature_1_per_m
+        par["cant_sin"], par["cant_cos"] = math.sin(geometry.cant_rad), math.cos(geometry.cant_rad)
+        par["carried_mass_kg"] = m.axle_load / m.gravity
     track = scene.track_dynamics
     if track.elastic:
         par["elastic_track"] = 1.0

@@ -50,7 +50,13 @@ import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
-from rigid_dynamics.wheelset.compiled import derivative_from_contact, model_parameters, patch_creepages, track_rates
+from rigid_dynamics.wheelset.compiled import (
+    derivative_from_contact,
+    frame_velocities,
+    model_parameters,
+    patch_creepages,
+    track_rates,
+)
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
 from rigid_dynamics.wheelset.state import (
@@ -470,11 +476,12 @@ class WheelsetModel:
         active = np.flatnonzero(patches.approach_m > 0)
         self.last_auto = None
         if len(active):
+            omega_abs, v_abs = frame_velocities(self.par, state, omega)  # in a curve: absolute, for the creepages
             frames, speed, xi, eta, spin = _creepages(
                 lever[active],
                 patches.normal[active],
-                omega,
-                v_c,
+                omega_abs,
+                v_abs,
                 None if rail_velocity is None else rail_velocity[active],
             )
             if not np.all(speed > 0) or not np.all(np.isfinite(speed)):

@@ -136,7 +136,9 @@ def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, d
     derivative = model.derivative if derivative is None else derivative
     state = state.copy()
     ic = model.scene.initial
-    solve_yaw = ic.free_rolling
+    # in a curve the yaw rate (relative to the track) is kept: a free-rolling yaw rate there would be about -V/R,
+    # the wheelset leaving the curve
+    solve_yaw = ic.free_rolling and not model.scene.track.curved
     rolling_rate = model.scene.speed_m_per_s / float(np.mean(radii))
 
     def residual(rates):

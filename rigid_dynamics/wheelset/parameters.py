@@ -143,6 +143,19 @@ class TrackGeometry:
         gauge_height_m: depth below the rail top where the gauge is measured, m.
         flange_back_distance_m: distance between the flange backs of the wheelset, m.
         flange_contact_angle_rad: patches with a contact angle above this are flange contacts, rad.
+        left_wheel_profile, right_wheel_profile, left_rail_profile, right_rail_profile: the profile of one side
+            (name or file, as ``wheel_profile`` / ``rail_profile``); "" (the default) = the two-sided key, mirrored
+            to the left. Not with the analytic conical pair.
+        left_rail_inclination_rad, right_rail_inclination_rad: the inclination of one rail towards the track
+            centre, rad; None (the default) = ``rail_inclination_rad``.
+        curve_direction: "straight" (the default), "right" or "left": the direction in which a horizontal curve of
+            constant radius turns (seen in the direction of travel; y to the right, so a right curve's centre is at
+            +y and its outer rail is the left one).
+        curve_radius_m: R of the curve at the track centreline, m (> 0 for a curve; 0 = straight).
+        cant_m: cant (superelevation): the height of the outer rail above the inner one, m (0 = none; a curve only;
+            at most ``MAX_CANT_M``).
+        cant_reference_width_m: the lateral distance over which ``cant_m`` is measured (EN 13803: 1500 mm for
+            standard gauge, the distance between the rail centres): the cant angle is asin(cant / width), m.
     """
 
     wheel_profile: str = "conical"
@@ -154,13 +167,72 @@ class TrackGeometry:
     gauge_height_m: float = 0.014
     flange_back_distance_m: float = 1.360
     flange_contact_angle_rad: float = 0.5
+    left_wheel_profile: str = ""
+    right_wheel_profile: str = ""
+    left_rail_profile: str = ""
+    right_rail_profile: str = ""
+    left_rail_inclination_rad: float | None = None
+    right_rail_inclination_rad: float | None = None
+    curve_direction: str = "straight"
+    curve_radius_m: float = 0.0
+    cant_m: float = 0.0
+    cant_reference_width_m: float = 1.5
 
     def __post_init__(self) -> None:
         _check_finite(
             self,
-            positive=["rail_head_radius_m", "gauge_m", "flange_back_distance_m", "flange_contact_angle_rad"],
+            positive=[
+                "rail_head_radius_m",
+                "gauge_m",
+                "flange_back_distance_m",
+                "flange_contact_angle_rad",
+                "cant_reference_width_m",
+            ],
             nonnegative=["gauge_height_m"],
         )
+        for name in ("left_wheel_profile", "right_wheel_profile", "left_rail_profile", "right_rail_profile"):
+            if not isinstance(getattr(self, name), str):
+                raise ValueError(f"{name} = {getattr(self, name)!r}: expected a profile name or file path, or ''")
+            if getattr(self, name) and self.is_conical:
+                raise ValueError(
+                    f"{name} = {getattr(self, name)!r}: expected '' with the analytic conical wheel on circular rails "
+                    "(separate sides need profiles: wheel_profile / rail_profile names or files)"
+                )
+        for name in ("left_rail_inclination_rad", "right_rail_inclination_rad"):
+            value = getattr(self, name)
+            if value is not None and not (isinstance(value, (int, float)) and abs(value) <= 0.2):
+                raise ValueError(f"{name} = {value!r}: expected |value| <= 0.2 rad (1:40 is 0.025) or no value")
+        if self.curve_direction not in CURVE_DIRECTIONS:
+            raise ValueError(
+                f"curve_direction = {self.curve_direction!r}: expected one of {', '.join(CURVE_DIRECTIONS)}"
+            )
+        if self.curve_direction == "straight":
+            if self.curve_radius_m != 0.0:
+                raise ValueError(
+                    f"curve_radius_m = {self.curve_radius_m!r}: expected no curve radius on straight track, or "
+                    "curve_direction = 'right' or 'left'"
+                )
+        elif not self.curve_radius_m >= MIN_CURVE_RADIUS_M:
+            raise ValueError(
+                f"curve_radius_m = {self.curve_radius_m!r}: expected a radius >= {MIN_CURVE_RADIUS_M:g} m for the "
+                f"{self.curve_direction} curve (0 and negative radii are not curves; tighter ones are not running "
+                "track)"
+            )
+        if not 0.0 <= self.cant_m <= MAX_CANT_M:
+            raise ValueError(
+                f"cant_m = {self.cant_m!r}: expected a cant from 0 to {MAX_CANT_M:g} m (the outer rail's height above "
+                "the inner one; EN 13803 allows up to 0.18 m)"
+            )
+        if self.cant_m > 0 and self.curve_direction == "straight":
+            raise ValueError(
+                f"cant_m = {self.cant_m!r}: expected 0 on straight track (cant raises the outer rail of a curve: set "
+                "curve_direction and curve_radius_m)"
+            )
+        if self.cant_m >= self.cant_reference_width_m:
+            raise ValueError(
+                f"cant_reference_width_m = {self.cant_reference_width_m!r}: expected a width above cant_m = "
+                f"{self.cant_m!r} m"
+            )
         for name in ("wheel_profile", "rail_profile"):
             if not isinstance(getattr(self, name), str) or not getattr(self, name):
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected a profile name or file path")
@@ -174,6 +246,54 @@ class TrackGeometry:
         """True for the analytic conical wheel on circular rail heads."""
         return self.wheel_profile.lower() == "conical" and self.rail_profile.lower() == "circular"
 
+    @property
+    def curvature_1_per_m(self) -> float:
+        """Signed curvature of the track centreline, 1/m: +1/R for a right curve, -1/R for a left one, 0 straight."""
+        if self.curve_direction == "straight":
+            return 0.0
+        return (1.0 if self.curve_direction == "right" else -1.0) / self.curve_radius_m
+
+    @property
+    def cant_rad(self) -> float:
+        """Signed cant angle of the track plane about the track's x axis, rad: > 0 when the left rail is the higher
+        (a right curve's cant), < 0 when the right one is; asin(cant_m / cant_reference_width_m).
+        """
+        angle = math.asin(self.cant_m / self.cant_reference_width_m)
+        return -angle if self.curve_direction == "left" else angle
+
+    def cant_deficiency_m(self, speed_m_per_s: float, gravity_m_per_s2: float) -> float:
+        """The cant deficiency at a speed: the cant that would balance V^2/R less ``cant_m``, m (EN 13803's I =
+        w V^2 / (g R) - D with w the cant reference width; 0 on straight track).
+        """
+        if self.curve_direction == "straight":
+            return 0.0
+        return self.cant_reference_width_m * speed_m_per_s**2 / (gravity_m_per_s2 * self.curve_radius_m) - self.cant_m
+
+    @property
+    def curved(self) -> bool:
+        """True for a curve or cant (the track-following frame's terms are on)."""
+        return self.curve_direction != "straight" or self.cant_m > 0
+
+    def side_profile(self, kind: str, side: str) -> str:
+        """The wheel or rail (``kind``) profile of ``side`` ("left" / "right"): the side's own key, else the
+        two-sided one.
+        """
+        own = getattr(self, f"{side}_{kind}_profile")
+        return own or getattr(self, f"{kind}_profile")
+
+    def side_inclination_rad(self, side: str) -> float:
+        """The inclination of the rail of ``side`` towards the track centre, rad."""
+        own = getattr(self, f"{side}_rail_inclination_rad")
+        return self.rail_inclination_rad if own is None else float(own)
+
+
+CURVE_DIRECTIONS = ("straight", "right", "left")
+"""Values of TrackGeometry.curve_direction."""
+MIN_CURVE_RADIUS_M = 50.0
+"""The tightest curve radius a scene accepts, m (tram and depot curves go down to about 20-50 m; main lines
+rarely below 150 m; the rigid-frame model of a single wheelset in a large curve is meant for running track)."""
+MAX_CANT_M = 0.2
+"""The largest cant (superelevation) a scene accepts, m (EN 13803: at most 0.16-0.18 m on ballasted track)."""
 
 TRACK_MODELS = ("rigid", "lumped")
 """Vertical track models under each wheel (:class:`TrackDynamics`)."""

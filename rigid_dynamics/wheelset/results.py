@@ -182,6 +182,28 @@ class SimulationResult:
                 out[name][side] = entry
         return out
 
+    def _curve_summary(self, num):
+        """The scene's curve and cant (None on straight track): direction, radius, cant, the cant angle, the cant
+        deficiency (EN 13803: w V^2/(g R) - D) and the unbalanced lateral acceleration in the track plane,
+        V^2/R cos(c) - g sin(c), m/s^2 (> 0 outwards).
+        """
+        if self.scene is None or not self.scene.track.curved:
+            return None
+        from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2 as g
+
+        track, speed = self.scene.track, self.scene.speed_m_per_s
+        cant = abs(track.cant_rad)
+        return {
+            "direction": track.curve_direction,
+            "radius_m": num(track.curve_radius_m),
+            "cant_m": num(track.cant_m),
+            "cant_rad": num(cant),
+            "cant_deficiency_m": num(track.cant_deficiency_m(speed, g)),
+            "unbalanced_lateral_acceleration_m_per_s2": num(
+                speed**2 / track.curve_radius_m * math.cos(cant) - g * math.sin(cant)
+            ),
+        }
+
     def summary(self) -> dict:
         """JSON-serialisable summary (NaN -> None); keys listed in the issue and a few diagnostics.
 
@@ -225,6 +247,7 @@ class SimulationResult:
             "method": self.method,
             "compiled": self.compiled,
             "track_model": self.scene.track_dynamics.model if self.scene is not None else None,
+            "curve": self._curve_summary(num),
             "peak_rail_deflection_m": (
                 {side: num(np.max(self.track_states[:, i])) for i, side in enumerate(SIDES)}
                 if self.track_states is not None and len(self.track_states)

@@ -26,6 +26,8 @@ MIN_LATERAL_CURVATURE_1_PER_M = 0.05
 def build_surfaces(wheelset: WheelsetParameters, track: TrackGeometry, irregularities: Irregularities | None = None):
     """Wheel and rail surfaces of both sides from the scene's profiles (contact.track.build_track).
 
+    Each side takes its own wheel and rail profile and rail inclination (TrackGeometry.side_profile,
+    side_inclination_rad; the two-sided keys by default, the left side mirrored).
     A conical track (wheel_profile "conical", rail_profile "circular") is built by :func:`conical_track`,
     placed exactly as the analytic ConicalProvider places it (contact points at +-e0, radius r0).
 
@@ -37,13 +39,17 @@ def build_surfaces(wheelset: WheelsetParameters, track: TrackGeometry, irregular
     if track.is_conical:
         return conical_track(wheelset, track, irregularities)
     case = SimpleNamespace(
-        wheel_profile=track.wheel_profile,
-        rail_profile=track.rail_profile,
+        wheel_profile=track.side_profile("wheel", "right"),
+        wheel_profile_left=track.side_profile("wheel", "left"),
+        rail_profile=track.side_profile("rail", "right"),
+        rail_profile_left=track.side_profile("rail", "left"),
         gauge_m=track.gauge_m,
         gauge_height_m=track.gauge_height_m,
         flange_back_distance_m=track.flange_back_distance_m,
         nominal_radius_m=wheelset.nominal_radius_m,
         rail_inclination_rad=track.rail_inclination_rad,
+        rail_inclination_left_rad=track.side_inclination_rad("left"),
+        rail_inclination_right_rad=track.side_inclination_rad("right"),
     )
     wheel_irr, rail_irr = {}, {}
     if irregularities is not None and irregularities.any:
