@@ -22,12 +22,9 @@ import pytest
 from hardening_helpers import assert_error, run, write
 
 from rigid_dynamics.wheelset import DynamicsScene, IntegratorSettings, Irregularities, TrackDynamics, simulate
-from rigid_dynamics.wheelset.parameters import (
-    UIC60_RAIL_SEAT,
-    SuspensionParameters,
-    lumped_track_equivalent,
-)
+from rigid_dynamics.wheelset.parameters import SuspensionParameters
 from rigid_dynamics.wheelset.state import TRACK
+from rigid_dynamics.wheelset.track import UIC60_RAIL_SEAT, lumped_track_equivalent
 from wheelrail.scenes import resolve_scene_path
 
 # Jenkins et al. (1974) equivalent track per wheel (UK concrete-sleepered CWR), as quoted with the P2 formula

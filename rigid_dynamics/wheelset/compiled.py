@@ -1,8 +1,9 @@
 """Compiled (numba) fixed-step path of the wheelset simulation for contact-geometry tables.
 
 The equations of motion (eq 59-71 with the gyroscopic term), the primary suspension and the elastic track are
-written once, here (:func:`_assemble`, :func:`_track_rates`): the compiled loop's right-hand side ends in them and
-so does the Python one (equations.WheelsetModel.derivative through :func:`derivative_from_contact`, after any
+written once (:func:`_assemble` here, the track's equations in
+:func:`rigid_dynamics.wheelset.track.track_rates`): the compiled loop's right-hand side ends in them and so does
+the Python one (equations.WheelsetModel.derivative through :func:`derivative_from_contact`, after any
 provider and contact model gave the contact forces). The same table
 look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
 creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
@@ -26,8 +27,9 @@ tests/test_dynamics_compiled.py checks that it reproduces the Python path (state
 Elastic track (scene ``track_dynamics.model = "lumped"``): the 8 track states follow the two work integrals
 (state.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
 deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the
-creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
-:func:`_track_rates` (the Python path uses the same function).
+creepages and the contact power use the velocity relative to the rail, and the track's equations, data and parameter
+fields are those of :mod:`rigid_dynamics.wheelset.track` (a track model is added there, in state.py's layout and
+in :func:`_assemble`'s call).
 
 Curves and cant (scene ``[track] curve_direction``, ``curve_radius_m``, ``cant_m``; ``par.track_frame``): the states
 are relative to a frame following the track; :func:`_assemble_curve` adds the frame's terms to Newton and Euler and
@@ -53,16 +55,16 @@ import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact.fastsim import _fastsim_one
+from rigid_dynamics.wheelset import track
 from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry, search_geometry_on_track
 from rigid_dynamics.wheelset.state import (
     RAIL,
     RAIL_VELOCITY,
-    SLEEPER,
-    SLEEPER_VELOCITY,
     WORK_CONTACT,
     WORK_EXTERIOR,
     n_states,
 )
+from rigid_dynamics.wheelset.track import track_rates as _track_rates
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
@@ -112,13 +114,7 @@ PARAMETER_FIELDS = (
     ("irregular_right", "1: right side irregular"),
     ("irregularity_reach_m", "gap beyond which a candidate is left alone"),
     ("section_half_angle_rad", "half range of the running-direction section"),
-    ("elastic_track", "1: elastic track"),
-    ("rail_mass_kg", "rail mass per wheel"),
-    ("pad_stiffness_N_per_m", "pad stiffness"),
-    ("pad_damping_N_s_per_m", "pad damping"),
-    ("sleeper_mass_kg", "sleeper mass per wheel"),
-    ("ballast_stiffness_N_per_m", "ballast stiffness"),
-    ("ballast_damping_N_s_per_m", "ballast damping"),
+    *track.PARAMETER_FIELDS,
     ("dip_angle_rad", "joint dip angle"),
     ("dip_position_m", "joint position"),
     ("dip_ramp_length_m", "joint ramp length"),
@@ -406,23 +402,6 @@ def patch_creepages(lever, normal, om, v_c, rail_vz, frames, out):
         out[0, k], out[1, k], out[2, k], out[3, k] = speed, xi, eta, spin
         for i in range(3):
             frames[k, i, 0], frames[k, i, 1], frames[k, i, 2] = ex[i], ey[i], normal[k, i]
-
-
-@njit(cache=True, _nrt=False)
-def _track_rates(par, y, rail_f0, rail_f1, out, p_ext):
-    """The elastic track (state.TRACK; a rail mass on a pad on a sleeper mass on the ballast, per wheel) under the
-    vertical contact forces on the rails (left, right), N: its rates into ``out``. Returns ``p_ext`` less the power
-    of the pad and ballast dampers.
-    """
-    for sd in range(2):
-        zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
-        pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
-        ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
-        out[RAIL + sd], out[SLEEPER + sd] = vr, vs
-        out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
-        out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
-        p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
-    return p_ext
 
 
 @njit(cache=True, _nrt=False)
@@ -1014,19 +993,7 @@ def model_parameters(model_wheelset):
         par["curvature_1_per_m"] = geometry.curvature_1_per_m
         par["cant_sin"], par["cant_cos"] = math.sin(geometry.cant_rad), math.cos(geometry.cant_rad)
         par["carried_mass_kg"] = m.axle_load / m.gravity
-    track = scene.track_dynamics
-    if track.elastic:
-        par["elastic_track"] = 1.0
-        par["rail_mass_kg"], par["pad_stiffness_N_per_m"], par["pad_damping_N_s_per_m"] = (
-            track.rail_mass_kg,
-            track.pad_stiffness_N_per_m,
-            track.pad_damping_N_s_per_m,
-        )
-        par["sleeper_mass_kg"], par["ballast_stiffness_N_per_m"] = (
-            track.sleeper_mass_kg,
-            track.ballast_stiffness_N_per_m,
-        )
-        par["ballast_damping_N_s_per_m"] = track.ballast_damping_N_s_per_m
+    track.pack_parameters(par, scene.track_dynamics)
     return par
 
 

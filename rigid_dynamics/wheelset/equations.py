@@ -50,6 +50,7 @@ import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
+from rigid_dynamics.wheelset import track as track_model
 from rigid_dynamics.wheelset.compiled import (
     derivative_from_contact,
     frame_velocities,
@@ -398,12 +399,8 @@ class WheelsetModel:
         return np.concatenate(parts)
 
     def static_track(self, rail_force_N) -> np.ndarray:
-        """Track states at rest under the vertical rail forces (left, right), N: z_s = F / k_b, z_r = z_s + F / k_p."""
-        force = np.asarray(rail_force_N, float)
-        out = np.zeros(8)
-        out[2:4] = force / self.track.ballast_stiffness_N_per_m
-        out[0:2] = out[2:4] + force / self.track.pad_stiffness_N_per_m
-        return out
+        """Track states at rest under the vertical rail forces (left, right), N (track.rest_state)."""
+        return track_model.rest_state(self.track, rail_force_N)
 
     def patches_on_track(self, centre, yaw, roll, spin, shift=None):
         """The provider's patches with the rails lowered by ``shift`` (left, right), m (None: rigid track).
@@ -589,17 +586,8 @@ class WheelsetModel:
         return float(power)
 
     def track_energy_J(self, track) -> tuple:
-        """(kinetic, potential) energy of the elastic track's states (n, 8) or (8,), J (0 for the rigid track)."""
-        if not self.elastic:
-            return 0.0, 0.0
-        tr = self.track
-        t = np.asarray(track, float)
-        z_r, z_s, v_r, v_s = t[..., 0:2], t[..., 2:4], t[..., 4:6], t[..., 6:8]
-        kinetic = 0.5 * np.sum(tr.rail_mass_kg * v_r**2 + tr.sleeper_mass_kg * v_s**2, axis=-1)
-        potential = 0.5 * np.sum(
-            tr.pad_stiffness_N_per_m * (z_r - z_s) ** 2 + tr.ballast_stiffness_N_per_m * z_s**2, axis=-1
-        )
-        return kinetic, potential
+        """(kinetic, potential) energy of the elastic track's states (n, 8) or (8,), J (track.energy_J)."""
+        return track_model.energy_J(self.track, track)
 
     # ----------------------------------------------------------------------------------------------
     def kinetic_energy_J(self, state: np.ndarray) -> float:

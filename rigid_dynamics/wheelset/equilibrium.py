@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rigid_dynamics.wheelset import track as track_model
 from rigid_dynamics.wheelset.equations import MAX_SLOTS, ContactFailure, WheelsetModel
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.state import TRACK
@@ -102,8 +103,7 @@ def _rail_forces(model: WheelsetModel, state: np.ndarray, derivative) -> np.ndar
     k_p (z_r - z_s)).
     """
     d = derivative(0.0, model.full_state(state))
-    tr, rest = model.track, model.track_rest
-    return tr.rail_mass_kg * d[TRACK][4:6] + tr.pad_stiffness_N_per_m * (rest[0:2] - rest[2:4])
+    return track_model.rail_forces_at_rest(model.track, model.track_rest, d[TRACK])
 
 
 def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, deepest=None, rolling=None):

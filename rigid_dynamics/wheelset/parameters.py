@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass, field, fields
 
 from rigid_dynamics.materials import STEEL, Material
+from rigid_dynamics.wheelset.track import TrackDynamics
 
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
 """Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
@@ -294,110 +295,6 @@ MIN_CURVE_RADIUS_M = 50.0
 rarely below 150 m; the rigid-frame model of a single wheelset in a large curve is meant for running track)."""
 MAX_CANT_M = 0.2
 """The largest cant (superelevation) a scene accepts, m (EN 13803: at most 0.16-0.18 m on ballasted track)."""
-
-TRACK_MODELS = ("rigid", "lumped")
-"""Vertical track models under each wheel (:class:`TrackDynamics`)."""
-
-
-def lumped_track_equivalent(
-    rail_mass_per_length_kg_per_m: float,
-    rail_bending_stiffness_N_m2: float,
-    sleeper_spacing_m: float,
-    pad_stiffness_N_per_m: float,
-    pad_damping_N_s_per_m: float,
-    half_sleeper_mass_kg: float,
-    ballast_stiffness_N_per_m: float,
-    ballast_damping_N_s_per_m: float,
-) -> dict:
-    """Per-wheel two-layer lumped track from per-rail-seat data (the reduction behind TrackDynamics' defaults).
-
-    The rail on its supports in series (pad and ballast per rail seat, k_s = 1/(1/k_p + 1/k_b), smeared over the
-    sleeper spacing a: foundation modulus k_f = k_s / a) is a Winkler beam with beta = (k_f / (4 EI))^(1/4), whose
-    static point stiffness is 2 k_f / beta (Timoshenko's closed form, w0 = P beta / (2 k_f)). The lumped model
-    lets n = 2 / (beta a) rail seats carry the wheel: pad, ballast, their dampers and the sleeper mass are n times
-    the per-seat values, the rail mass is the rail over n spacings. The static stiffness of the lumped model then
-    equals the beam's exactly; the masses are an approximation (a beam's participating mass depends on frequency).
-    """
-    k_series = 1.0 / (1.0 / pad_stiffness_N_per_m + 1.0 / ballast_stiffness_N_per_m)
-    k_f = k_series / sleeper_spacing_m
-    beta = (k_f / (4.0 * rail_bending_stiffness_N_m2)) ** 0.25
-    n = 2.0 / (beta * sleeper_spacing_m)
-    return {
-        "rail_mass_kg": rail_mass_per_length_kg_per_m * n * sleeper_spacing_m,
-        "pad_stiffness_N_per_m": n * pad_stiffness_N_per_m,
-        "pad_damping_N_s_per_m": n * pad_damping_N_s_per_m,
-        "sleeper_mass_kg": n * half_sleeper_mass_kg,
-        "ballast_stiffness_N_per_m": n * ballast_stiffness_N_per_m,
-        "ballast_damping_N_s_per_m": n * ballast_damping_N_s_per_m,
-    }
-
-
-UIC60_RAIL_SEAT = {
-    "rail_mass_per_length_kg_per_m": 60.21,
-    "rail_bending_stiffness_N_m2": 210.0e9 * 3038.3e-8,
-    "sleeper_spacing_m": 0.6,
-    "pad_stiffness_N_per_m": 120.0e6,
-    "pad_damping_N_s_per_m": 30.0e3,
-    "half_sleeper_mass_kg": 125.0,
-    "ballast_stiffness_N_per_m": 140.0e6,
-    "ballast_damping_N_s_per_m": 80.0e3,
-}
-"""Per-rail-seat data of a UIC60 (60E1) rail on concrete monoblock sleepers from which TrackDynamics' defaults
-are reduced (:func:`lumped_track_equivalent`): rail mass 60.21 kg/m and I_y = 3038.3 cm^4 (EN 13674-1, 60E1),
-E = 210 GPa; sleeper spacing 0.6 m; pad 120 MN/m and 30 kN s/m, half sleeper 125 kg, ballast 140 MN/m and
-80 kN s/m: values inside the ranges Knothe & Grassie (1993, Vehicle System Dynamics 22, 209-262) give for
-ballasted track with concrete sleepers and studded pads (pads ~100-500 MN/m, ballast ~50-200 MN/m per seat),
-chosen here, not one table of that paper. The result (150 MN/m static stiffness per wheel) matches the
-equivalent track stiffness 150 MN/m of Jenkins et al. (1974) for concrete-sleepered continuously welded track.
-"""
-
-
-@dataclass(frozen=True)
-class TrackDynamics:
-    """Vertical track model under each wheel (seed eq 6: the rail deflection N_d,t shifts the rail surface).
-
-    ``model`` = "rigid": the rails do not move (the default). "lumped": under each wheel a rail mass on a pad
-    (spring and damper) on a sleeper mass on the ballast (spring and damper), moving with the wheelset; the
-    rail mass's displacement (z down) lowers that rail's surface in the contact geometry, and the vertical
-    component of the wheel's contact forces acts on it. Lateral track: rigid.
-
-    The defaults are the per-wheel equivalent of a UIC60 track on concrete sleepers
-    (:data:`UIC60_RAIL_SEAT` reduced by :func:`lumped_track_equivalent`): static stiffness 150 MN/m per wheel,
-    track resonances 143 and 341 Hz without a wheel, 60 Hz (P2) with an unsprung mass of 907 kg per wheel.
-
-    Attributes:
-        model: "rigid" or "lumped".
-        rail_mass_kg, sleeper_mass_kg: m_r, m_s per wheel, kg.
-        pad_stiffness_N_per_m, pad_damping_N_s_per_m: k_p, c_p between rail and sleeper.
-        ballast_stiffness_N_per_m, ballast_damping_N_s_per_m: k_b, c_b between sleeper and ground.
-    """
-
-    model: str = "rigid"
-    rail_mass_kg: float = 84.0
-    pad_stiffness_N_per_m: float = 2.79e8
-    pad_damping_N_s_per_m: float = 6.98e4
-    sleeper_mass_kg: float = 291.0
-    ballast_stiffness_N_per_m: float = 3.26e8
-    ballast_damping_N_s_per_m: float = 1.86e5
-
-    def __post_init__(self) -> None:
-        _check_finite(
-            self,
-            positive=["rail_mass_kg", "pad_stiffness_N_per_m", "sleeper_mass_kg", "ballast_stiffness_N_per_m"],
-            nonnegative=["pad_damping_N_s_per_m", "ballast_damping_N_s_per_m"],
-        )
-        if self.model not in TRACK_MODELS:
-            raise ValueError(f"model = {self.model!r}: expected one of {', '.join(TRACK_MODELS)}")
-
-    @property
-    def elastic(self) -> bool:
-        """True for a track with states (not rigid)."""
-        return self.model != "rigid"
-
-    @property
-    def static_stiffness_N_per_m(self) -> float:
-        """Pad and ballast in series, N/m."""
-        return 1.0 / (1.0 / self.pad_stiffness_N_per_m + 1.0 / self.ballast_stiffness_N_per_m)
 
 
 @dataclass(frozen=True)
