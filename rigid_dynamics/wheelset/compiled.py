@@ -45,7 +45,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, objmode
 
 from rigid_dynamics.contact.fastsim import _fastsim_one
 from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry, search_geometry_on_track
@@ -60,8 +60,18 @@ from rigid_dynamics.wheelset.state import (
 )
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
+"""The creep laws written here (registry names -> ``model_code``)."""
+CALLBACK_CODE = 4
+"""``model_code`` of a contact model that is not compiled (bem, fea, user models): every patch through the callback."""
+AUTO_CODE = 5
+"""``model_code`` of ``auto``: the rung chosen per patch in the loop; linear, Vermeulen-Johnson and FASTSIM inline,
+BEM through the callback."""
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
-N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
+N_PATCH = 14  # equations.PATCH_FIELDS, in that order
+N_AUTO = 9  # equations.AUTO_PATCH_FIELDS, in that order, after them
+N_FIELDS = N_PATCH + N_AUTO
+AUTO_FEATURE_NAMES = ("saturation", "spin_share", "ellipticity_residual", "curvature_change", "second_patch_nearness")
+AUTO_RUNG_NAMES = ("linear", "vermeulen_johnson", "fastsim")
 
 PARAMETER_FIELDS = (
     ("mass_kg", "wheelset mass"),
@@ -119,6 +129,13 @@ PARAMETER_FIELDS = (
     ("dip_ramp_length_m", "joint ramp length"),
     ("dip_entry_rounding_m", "joint entry rounding"),
     ("dip_rounding_m", "joint rounding"),
+    ("auto_level", "auto: the tolerance level whose thresholds apply (NaN: below every level, always BEM)"),
+    ("auto_friction_bound_tolerance", "auto: FASTSIM above (1 + this) mu N is replaced by BEM (models.py)"),
+    *(
+        (f"auto_{r}_{f}", f"auto: threshold of {f} for {r} (NaN: no measured box)")
+        for r in AUTO_RUNG_NAMES
+        for f in AUTO_FEATURE_NAMES
+    ),
 )
 """The parameter record of the compiled right-hand side: (field, meaning); every field float64, SI units."""
 
@@ -521,6 +538,188 @@ def track_rates(par, y, rail_force, out):
 
 
 @njit(cache=True, _nrt=False)
+def _hertz_kalker(par, hz, kk, q, ca, cb):
+    """Hertz under approach control (tables of the axial function) and Kalker's C11, C22, C23, C33 (tables of a/b):
+    (N, a, b, C11, C22, C23, C33).
+    """
+    amin, amax = min(ca, cb), max(ca, cb)
+    i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
+    pp = hz[1, i] * (1 - w) + hz[1, i + 1] * w
+    kk_ = hz[2, i] * (1 - w) + hz[2, i + 1] * w
+    dd = hz[3, i] * (1 - w) + hz[3, i + 1] * w
+    major = math.sqrt(q * dd / (kk_ * amin))
+    normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
+    minor = major * math.sqrt(pp)
+    sa, sb = (major, minor) if ca <= cb else (minor, major)
+    i, w = _uniform(math.log(sa / sb), kk[0, 0], kk[0, 1], kk.shape[1])
+    c11 = kk[1, i] * (1 - w) + kk[1, i + 1] * w
+    c22 = kk[2, i] * (1 - w) + kk[2, i + 1] * w
+    c23 = kk[3, i] * (1 - w) + kk[3, i + 1] * w
+    c33 = kk[4, i] * (1 - w) + kk[4, i + 1] * w
+    return normal, sa, sb, c11, c22, c23, c33
+
+
+@njit(cache=True, _nrt=False)
+def _creep_law(par, code, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin):
+    """(T_x, T_y, M_z) of the compiled creep law ``code`` (MODEL_CODES) on a Hertz patch."""
+    tx, ty, mz = 0.0, 0.0, 0.0
+    if code >= 1:
+        ab = sa * sb
+        gab = par.shear_modulus_Pa * ab
+        gab15 = gab * math.sqrt(ab)
+        if code == 3:
+            l1, l2, l3 = _flexibilities(par, sa, sb, normal, xi, eta, spin, c11, c22, c23)
+            fs = _fastsim_one(
+                sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
+                int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
+            )  # fmt: skip
+            tx, ty, mz = fs[0], fs[1], fs[2]
+        else:
+            tx = -gab * c11 * xi
+            ty = -gab * c22 * eta - gab15 * c23 * spin
+            mz = gab15 * c23 * eta - gab * ab * c33 * spin
+        if code == 2:
+            tt = math.hypot(tx, ty)
+            limit = par.friction_coefficient * normal
+            if tt > 0.0:
+                wprime = tt / (3.0 * limit) if limit > 0 else np.inf
+                one = max(1.0 - wprime, 0.0)
+                scale = limit * (1.0 - one**3) / tt
+                tx *= scale
+                ty *= scale
+            mz = 0.0
+    return tx, ty, mz
+
+
+@njit(cache=True, _nrt=False)
+def _auto_threshold(par, rung, f):
+    """auto's threshold of feature f (AUTO_FEATURE_NAMES) for rung (0 linear, 1 Vermeulen-Johnson, 2 FASTSIM)."""
+    if rung == 0:
+        v = (par.auto_linear_saturation, par.auto_linear_spin_share, par.auto_linear_ellipticity_residual,
+             par.auto_linear_curvature_change, par.auto_linear_second_patch_nearness)  # fmt: skip
+    elif rung == 1:
+        v = (par.auto_vermeulen_johnson_saturation, par.auto_vermeulen_johnson_spin_share,
+             par.auto_vermeulen_johnson_ellipticity_residual, par.auto_vermeulen_johnson_curvature_change,
+             par.auto_vermeulen_johnson_second_patch_nearness)  # fmt: skip
+    else:
+        v = (par.auto_fastsim_saturation, par.auto_fastsim_spin_share, par.auto_fastsim_ellipticity_residual,
+             par.auto_fastsim_curvature_change, par.auto_fastsim_second_patch_nearness)  # fmt: skip
+    return v[f]
+
+
+@njit(cache=True, _nrt=False)
+def _auto_choice(par, feats):
+    """auto.choose_rung in the loop: (rung 0-3 as auto.AUTO_RUNGS, deciding feature index or -1, its threshold).
+    The first of linear, Vermeulen-Johnson, FASTSIM (at the run's grid) whose measured box holds every feature;
+    else BEM (3). The deciding feature: of the last rejected rung the feature furthest beyond its threshold; when the
+    cheapest rung qualified, the feature closest to its threshold.
+    """
+    if math.isnan(par.auto_level):
+        return 3, -1, np.nan
+    last_f, last_t = -1, np.nan
+    for rung in range(3):
+        if math.isnan(_auto_threshold(par, rung, 0)):
+            continue  # no measured box at this level
+        worst, worst_f = -1.0, -1
+        for f in range(5):
+            box = _auto_threshold(par, rung, f)
+            if not feats[f] <= box:
+                ratio = feats[f] / box if box > 0 else np.inf
+                if ratio > worst:
+                    worst, worst_f = ratio, f
+        if worst_f >= 0:
+            last_f, last_t = worst_f, _auto_threshold(par, rung, worst_f)
+            continue
+        if last_f < 0:
+            best, best_f = -1.0, 0
+            for f in range(5):
+                box = _auto_threshold(par, rung, f)
+                r = feats[f] / box if box > 0 else (0.0 if feats[f] <= 0 else 1.0)
+                if r > best:
+                    best, best_f = r, f
+            return rung, best_f, _auto_threshold(par, rung, best_f)
+        return rung, last_f, last_t
+    return 3, last_f, last_t
+
+
+@njit(cache=True, _nrt=False)
+def _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, row, record):
+    """The compiled contact law of one patch: (N, a, b, T_x, T_y, M_z, status); status 1: the patch is for the
+    callback (``auto`` chose BEM, or its FASTSIM broke the friction bound as auto's does in contact.models).
+
+    ``auto`` (par.model_code AUTO_CODE): the features of contact.auto.patch_features that a quadric patch has
+    (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
+    are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
+    row[N_PATCH:] as equations.AUTO_PATCH_FIELDS.
+    """
+    normal, sa, sb, c11, c22, c23, c33 = _hertz_kalker(par, hz, kk, q, ca, cb)
+    code = int(par.model_code)
+    if code != AUTO_CODE:
+        tx, ty, mz = _creep_law(par, code, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin)
+        return normal, sa, sb, tx, ty, mz, 0
+    ab = sa * sb
+    gab = par.shear_modulus_Pa * ab
+    gab15 = gab * math.sqrt(ab)
+    t_lin = math.hypot(-gab * c11 * xi, -gab * c22 * eta - gab15 * c23 * spin)
+    mu_n = par.friction_coefficient * normal
+    feats = (
+        t_lin / (3.0 * mu_n) if mu_n > 0 else np.inf,
+        gab15 * c23 * abs(spin) / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0,
+        0.0,
+        0.0,
+        0.0,
+    )
+    rung, deciding, threshold = _auto_choice(par, feats)
+    st = 0
+    tx, ty, mz = 0.0, 0.0, 0.0
+    if rung < 3:
+        tx, ty, mz = _creep_law(par, rung + 1, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin)
+        if rung == 2 and math.hypot(tx, ty) > (1.0 + par.auto_friction_bound_tolerance) * mu_n:
+            rung, st = 3, 1
+    else:
+        st = 1
+    if record:
+        row[N_PATCH], row[N_PATCH + 1], row[N_PATCH + 2], row[N_PATCH + 3] = rung, par.auto_level, deciding, threshold
+        for f in range(5):
+            row[N_PATCH + 4 + f] = feats[f]
+    return normal, sa, sb, tx, ty, mz, st
+
+
+_CALLBACK = [None]
+"""The Python object that solves the patches of the non-compiled contact models (equations.PatchCallback), set by
+:func:`use_callback` before a compiled run or right-hand side."""
+
+
+def use_callback(callback) -> None:
+    """Make ``callback`` the one the compiled code hands its patches to (see :func:`_external`)."""
+    _CALLBACK[0] = callback
+
+
+def _dispatch(c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral):
+    """The callback boundary's Python side: the patch to the callback in use (equations.PatchCallback.solve)."""
+    return _CALLBACK[0].solve(c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral)
+
+
+@njit(cache=True, _nrt=False)
+def _external(c, side, t, q, ca, cb, xi, eta, spin, speed, px, py, pz, n, ex, ey, radius, angle, lateral):
+    """The one callback boundary: a patch (candidate c of ``side`` at time t: approach, curvatures, creepages,
+    rolling speed, contact point and contact frame e_x, e_y, n in the main frame, rolling radius, contact angle,
+    wheel lateral position) handed to Python (numba objmode) and (N, T_x, T_y, M_z, a, b, status) taken back;
+    status != 0: the contact model failed (the callback keeps its message). Overhead measured with a trivial
+    Python function: 2.0-2.1 us per call (numba 0.6x, this machine), against 0.1-1 s for a BEM patch.
+    """
+    n0, n1, n2 = n[0], n[1], n[2]
+    x0, x1, x2, y0, y1, y2 = ex[0], ex[1], ex[2], ey[0], ey[1], ey[2]
+    with objmode(normal="float64", tx="float64", ty="float64", mz="float64", sa="float64", sb="float64", st="int64"):
+        normal, tx, ty, mz, sa, sb, st = _dispatch(
+            c, side, t, q, ca, cb, xi, eta, spin, speed, (px, py, pz), (n0, n1, n2), (x0, x1, x2), (y0, y1, y2),
+            radius, angle, lateral,
+        )  # fmt: skip
+    return normal, tx, ty, mz, sa, sb, st
+
+
+
+@njit(cache=True, _nrt=False)
 def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     """d/dt of the 14-state into ``out`` from the candidate geometry cg (ncand, N_GEO) (see _table_geometry;
     a candidate with q = NaN is absent: recorded as NaN); fills rec (ncand + 2, N_FIELDS) and the side forces
@@ -563,47 +762,22 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         speed, xi, eta, spin = _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
-        # Hertz, approach control (tables of the axial function)
-        amin, amax = min(ca, cb), max(ca, cb)
-        i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
-        pp = hz[1, i] * (1 - w) + hz[1, i + 1] * w
-        kk_ = hz[2, i] * (1 - w) + hz[2, i + 1] * w
-        dd = hz[3, i] * (1 - w) + hz[3, i + 1] * w
-        major = math.sqrt(q * dd / (kk_ * amin))
-        normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
-        minor = major * math.sqrt(pp)
-        sa, sb = (major, minor) if ca <= cb else (minor, major)
-        tx, ty, mz = 0.0, 0.0, 0.0
-        if par.model_code >= 1:
-            i, w = _uniform(math.log(sa / sb), kk[0, 0], kk[0, 1], kk.shape[1])
-            c11 = kk[1, i] * (1 - w) + kk[1, i + 1] * w
-            c22 = kk[2, i] * (1 - w) + kk[2, i + 1] * w
-            c23 = kk[3, i] * (1 - w) + kk[3, i + 1] * w
-            c33 = kk[4, i] * (1 - w) + kk[4, i + 1] * w
-            ab = sa * sb
-            gab = par.shear_modulus_Pa * ab
-            gab15 = gab * math.sqrt(ab)
-            if par.model_code == 3:
-                l1, l2, l3 = _flexibilities(par, sa, sb, normal, xi, eta, spin, c11, c22, c23)
-                fs = _fastsim_one(
-                    sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
-                    int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
+        if par.model_code == CALLBACK_CODE:
+            normal, tx, ty, mz, sa, sb, st = _external(
+                c, sides[c], t, q, ca, cb, xi, eta, spin, speed, y[0] + lever[0], yc + lever[1], y[2] + lever[2], n,
+                ex, ey, radius, g[11], g[10],
+            )  # fmt: skip
+            if st != 0:
+                return 5
+        else:
+            normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec[c], record)
+            if st == 1:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
+                normal, tx, ty, mz, sa, sb, st = _external(
+                    c, sides[c], t, q, ca, cb, xi, eta, spin, speed, y[0] + lever[0], yc + lever[1], y[2] + lever[2],
+                    n, ex, ey, radius, g[11], g[10],
                 )  # fmt: skip
-                tx, ty, mz = fs[0], fs[1], fs[2]
-            else:
-                tx = -gab * c11 * xi
-                ty = -gab * c22 * eta - gab15 * c23 * spin
-                mz = gab15 * c23 * eta - gab * ab * c33 * spin
-            if par.model_code == 2:
-                tt = math.hypot(tx, ty)
-                limit = par.friction_coefficient * normal
-                if tt > 0.0:
-                    wprime = tt / (3.0 * limit) if limit > 0 else np.inf
-                    one = max(1.0 - wprime, 0.0)
-                    scale = limit * (1.0 - one**3) / tt
-                    tx *= scale
-                    ty *= scale
-                mz = 0.0
+                if st != 0:
+                    return 5
         for k in range(3):
             fc[k] = ex[k] * tx + ey[k] * ty + n[k] * normal
             mc[k] = n[k] * mz
@@ -638,14 +812,16 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
 
 @njit(cache=True, _nrt=False)
 def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
-    """d/dt of the 14-state: the candidate geometry from the tables (mode 0, _table_geometry) or the 3-D search
-    (mode 1, compiled_search.search_geometry; ``full``: with the lateral scan), then _forces. Returns the status.
+    """d/dt of the 14-state: the candidate geometry from the tables (mode 0, _table_geometry), the 3-D search
+    (mode 1, compiled_search.search_geometry; ``full``: with the lateral scan) or given by the caller in ws[7]
+    (mode 2: a provider the compiled code does not evaluate, equations.WheelsetModel fills it), then _forces.
+    Returns the status.
     """
     work, rec, res, geo, dummy, sc, bg, cg = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
     if mode == 0:
         table, grid, slots = targs
         _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg)
-    else:
+    elif mode == 1:
         sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = sargs
         if par.elastic_track > 0:
             search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15])
@@ -679,6 +855,27 @@ def rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec):
     """
     ws = _workspace(par, targs[0].shape[0], sides.shape[0], rec)
     return _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
+
+
+@njit(cache=True)
+def contact_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec, cg):
+    """:func:`rhs_once` that also returns the candidate geometry into cg (ncand, N_GEO) (for inspection: the
+    contact frames and forces of equations.WheelsetModel.contact). Mode 2: cg is the given geometry.
+    """
+    if mode == 2:
+        return rhs_given(t, y, par, hz, kk, sides, cg, out, rec, True)
+    ws = _workspace(par, targs[0].shape[0], sides.shape[0], rec)
+    st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
+    cg[:, :] = ws[7]
+    return st
+
+
+@njit(cache=True)
+def rhs_given(t, y, par, hz, kk, sides, cg, out, rec, record):
+    """The right-hand side on a given candidate geometry cg (ncand, N_GEO) (mode 2: a provider the compiled code
+    does not evaluate): the compiled laws, the callback, the equations of motion, as in the loop.
+    """
+    return _forces(t, y, par, cg, sides, hz, kk, rec, record, np.zeros((1, 1)), np.zeros((16, 3)), out)
 
 
 @njit(cache=True, _nrt=False)
@@ -833,28 +1030,72 @@ def load(packed) -> None:
     rhs_once(0.0, y, par, hz, kk, sides, mode, targs, sargs, np.zeros(len(y)), rec)
 
 
-def supported(scene, provider, model) -> bool:
-    """Whether the compiled path can run this combination: RK4, one of the registry's models in MODEL_CODES, and
-    a TableProvider (with or without running-direction irregularities: polygon, rounded flat, corrugation) or a
-    SearchProvider on tabulated surfaces (ideal profiles with polygon, flats or corrugation).
+def geometry_mode(provider) -> int:
+    """How the right-hand side gets the contact geometry of ``provider``: 0 the compiled tables (a TableProvider,
+    with or without running-direction irregularities), 1 the compiled 3-D search (a SearchProvider on tabulated
+    surfaces: ideal profiles with polygon, flats or corrugation), 2 given by Python (any other provider: the conical
+    one, the search on measured grids or harmonics, user providers; equations.WheelsetModel fills the candidates).
     """
     from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
     from rigid_dynamics.wheelset.providers import SearchProvider, TableProvider
 
-    if not (
-        scene.integrator.method == "RK4"
-        and getattr(model, "name", None) in MODEL_CODES
-        and type(model).__module__ == "rigid_dynamics.contact.models"
-    ):
-        return False
     if type(provider) is TableProvider:
-        return True
+        return 0
     if type(provider) is SearchProvider:
         fast = getattr(provider.surfaces, "fast", None)
-        return fast is not None and all(
+        if fast is not None and all(
             isinstance(w, TabulatedWheel) and isinstance(r, TabulatedRail) for w, r in fast.values()
-        )
-    return False
+        ):
+            return 1
+    return 2
+
+
+def supported(scene, provider, model) -> bool:
+    """Whether the compiled RK4 loop can run this combination: method RK4 and a provider whose geometry is compiled
+    (:func:`geometry_mode` 0 or 1). Any contact model: the compiled laws inline, ``auto``'s choice inline, the
+    others (bem, fea, user models) through the callback.
+    """
+    return scene.integrator.method == "RK4" and geometry_mode(provider) < 2
+
+
+def model_code(model) -> int:
+    """``model_code`` of a contact model instance: MODEL_CODES for the registry's compiled laws, AUTO_CODE for its
+    ``auto``, CALLBACK_CODE for everything else (bem, fea, user models, subclasses)."""
+    name = getattr(model, "name", None)
+    if type(model).__module__ == "rigid_dynamics.contact.models":
+        if name in MODEL_CODES:
+            return MODEL_CODES[name]
+        if name == "auto":
+            return AUTO_CODE
+    return CALLBACK_CODE
+
+
+def auto_parameters(par, tolerance: float, fastsim_grid) -> None:
+    """auto's thresholds (contact/data/auto_thresholds.json, contact.auto) into the parameter record: the level of
+    ``tolerance`` (contact.auto.level_for; none: NaN, every patch BEM) and per rung (linear, Vermeulen-Johnson,
+    FASTSIM at the run's grid by contact.auto.fastsim_rung) the feature box (NaN: no measured box).
+    """
+    from rigid_dynamics.contact.auto import fastsim_rung, level_for, load_thresholds
+    from rigid_dynamics.contact.models import FRICTION_BOUND_TOLERANCE
+
+    data = load_thresholds()
+    key = level_for(tolerance, data)
+    par["auto_friction_bound_tolerance"] = FRICTION_BOUND_TOLERANCE
+    for rung in AUTO_RUNG_NAMES:
+        for f in AUTO_FEATURE_NAMES:
+            par[f"auto_{rung}_{f}"] = np.nan
+    if key is None:
+        par["auto_level"] = np.nan
+        return
+    par["auto_level"] = float(key)
+    level = data["levels"][key]
+    labels = ("linear", "vermeulen-johnson", fastsim_rung(int(fastsim_grid[0]), int(fastsim_grid[1]), level))
+    for rung, label in zip(AUTO_RUNG_NAMES, labels, strict=True):
+        entry = level.get(label) if label is not None else None
+        box = None if entry is None else entry["thresholds"]
+        if box is not None:
+            for f in AUTO_FEATURE_NAMES:
+                par[f"auto_{rung}_{f}"] = float(box[f])
 
 
 def model_parameters(model_wheelset):
@@ -894,26 +1135,38 @@ def model_parameters(model_wheelset):
     return par
 
 
-def pack(model_wheelset, provider, tables, model_name, options=None):
-    """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
-    Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
+def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05):
+    """Arguments of rk4_run / rhs_once from a WheelsetModel, its provider, the Hertz / Kalker tables and the contact
+    model instance: (par, hz, kk, sides, slots, mode, targs, sargs). ``options``: FASTSIM's (nx, ny, traction_bound,
+    flexibility) for ``fastsim`` and ``auto``; ``tolerance``: auto's.
     """
-    from rigid_dynamics.wheelset.providers import SearchProvider
-
-    search = type(provider) is SearchProvider
+    mode = geometry_mode(provider)
+    search = mode == 1
     m = model_wheelset
     scene = m.scene
     par = model_parameters(m)
     par["shear_modulus_Pa"] = scene.material.shear_modulus_Pa
     par["contact_modulus_Pa"] = tables.e_star
     par["friction_coefficient"] = scene.material.friction_coefficient
-    par["model_code"] = MODEL_CODES[model_name]
-    par["z_ref_m"] = 0.0 if search else provider.z_ref
+    code = model_code(model)
+    par["model_code"] = code
+    par["z_ref_m"] = provider.z_ref if mode == 0 else 0.0
     opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
-    opts.update(options or {})
+    opts.update({k: v for k, v in (options or {}).items() if k in opts})
     par["fastsim_nx"], par["fastsim_ny"] = int(opts["nx"]), int(opts["ny"])
     par["fastsim_parabolic"] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
     par["flexibility_code"] = FLEX_CODES[opts["flexibility"]]
+    if code == AUTO_CODE:
+        auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
+    hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
+    hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
+    kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
+    kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
+    if mode == 2:
+        par["nominal_radius_m"] = getattr(provider, "r0", scene.wheelset.nominal_radius_m)
+        sides = np.array([0, 0, 1, 1], np.int64)
+        slots = np.array([0, 1, 0, 1], np.int64)
+        return par, hz, kk, sides, slots, 2, (np.zeros((1, 4, 2, 2)), np.zeros(6), slots), _dummy_search()
     par["nominal_radius_m"] = provider.r0
     irr = None if search else provider.irregularities
     if irr is not None:
@@ -955,10 +1208,6 @@ def pack(model_wheelset, provider, tables, model_name, options=None):
             par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
             reach += 2.0 * dip_depth_m(irr)
         par["irregularity_reach_m"], par["section_half_angle_rad"] = reach, half
-    hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
-    hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
-    kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
-    kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
     if search:
         from rigid_dynamics.wheelset import compiled_search as cs
 

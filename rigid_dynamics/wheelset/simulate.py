@@ -49,7 +49,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_adaptive, run_compiled, run_rk4
 from rigid_dynamics.wheelset.equations import ContactFailure, WheelsetModel
-from rigid_dynamics.wheelset.equilibrium import compiled_static_functions, elastic_start, initial_state
+from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import ConicalProvider, TableProvider
 from rigid_dynamics.wheelset.recorder import NUMERICAL_ERRORS, Recorder, Stop
@@ -164,19 +164,17 @@ def simulate(
     model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
     from rigid_dynamics.wheelset import compiled as _compiled
 
-    can_compile = _compiled.supported(scene, provider, model_obj) and model.batch is not None
+    can_compile = _compiled.supported(scene, provider, model_obj)
     if compiled and not can_compile:
         raise ValueError(
-            "compiled = True: the compiled path needs method RK4, a TableProvider or a SearchProvider on tabulated "
-            "surfaces, and one of "
-            f"the models {', '.join(_compiled.MODEL_CODES)}"
+            "compiled = True: the compiled loop needs method RK4 and a TableProvider or a SearchProvider on tabulated "
+            "surfaces"
         )
     use_compiled = can_compile and compiled is not False
     settings = scene.integrator
     duration = scene.duration_s
-    packed = None
+    packed = model.packed
     if use_compiled:
-        packed = _compiled.pack(model, provider, model.batch.tables, model.model.name, model.batch.options)
         _compiled.load(packed)  # the compiled code (from numba's cache) is loaded before the clock starts
     start = time.perf_counter()
     recorder = Recorder(model, scene)
@@ -184,16 +182,11 @@ def simulate(
     steps = 0
 
     try:
-        if use_compiled:
-            derivative, deepest, rolling = compiled_static_functions(packed, model)
-            state0, ok, why = elastic_start(model, initial_state(scene), derivative, deepest, rolling)
-        else:
-            state0, ok, why = elastic_start(model, initial_state(scene))
+        state0, ok, why = elastic_start(model, initial_state(scene))
     except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
         state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
-    if packed is not None:
-        packed[0]["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
+    packed[0]["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
     model.rhs_evaluations = 0
     full0 = model.full_state(state0)
     last_fraction = [-1.0]
