@@ -685,6 +685,16 @@ def _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, row, record):
     return normal, sa, sb, tx, ty, mz, st
 
 
+@njit(cache=True)
+def patch_forces(par, hz, kk, q, ca, cb, xi, eta, spin):
+    """One patch through the compiled law of par.model_code (not the callback): (N, T_x, T_y, M_z, a, b, status),
+    for tests and inspection.
+    """
+    row = np.zeros(N_FIELDS)
+    normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, np.zeros((1, 1)), q, ca, cb, xi, eta, spin, row, False)
+    return normal, tx, ty, mz, sa, sb, st
+
+
 _CALLBACK = [None]
 """The Python object that solves the patches of the non-compiled contact models (equations.PatchCallback), set by
 :func:`use_callback` before a compiled run or right-hand side."""
@@ -1135,12 +1145,12 @@ def model_parameters(model_wheelset):
     return par
 
 
-def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05):
+def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, python_geometry=False):
     """Arguments of rk4_run / rhs_once from a WheelsetModel, its provider, the Hertz / Kalker tables and the contact
     model instance: (par, hz, kk, sides, slots, mode, targs, sargs). ``options``: FASTSIM's (nx, ny, traction_bound,
-    flexibility) for ``fastsim`` and ``auto``; ``tolerance``: auto's.
+    flexibility) for ``fastsim`` and ``auto``; ``tolerance``: auto's; ``python_geometry``: mode 2 for any provider.
     """
-    mode = geometry_mode(provider)
+    mode = 2 if python_geometry else geometry_mode(provider)
     search = mode == 1
     m = model_wheelset
     scene = m.scene

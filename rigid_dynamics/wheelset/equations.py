@@ -279,9 +279,13 @@ class WheelsetModel:
         provider: contact-geometry provider.
         contact_model: an object with the ContactModel protocol (registry.get_model).
         model_options: options handed to the model's solve().
+        python_geometry: the provider's own ``patches`` give the geometry (compiled.geometry_mode 2) even where the
+            compiled code evaluates it (the 3-D search outside the compiled loop: simulate).
     """
 
-    def __init__(self, scene: DynamicsScene, provider: ContactProvider, contact_model, model_options=None):
+    def __init__(
+        self, scene: DynamicsScene, provider: ContactProvider, contact_model, model_options=None, python_geometry=False
+    ):
         self.scene = scene
         self.provider = provider
         self.model = contact_model
@@ -318,7 +322,9 @@ class WheelsetModel:
         opts = dict(model_options or {})
         fastsim = opts if name == "fastsim" else dict((opts.get("model_options") or {}).get("fastsim") or {})
         self.tables = _tables_for(scene.material.shear_modulus_Pa, scene.material.poisson_ratio)
-        self.packed = compiled.pack(self, provider, self.tables, contact_model, fastsim, opts.get("tolerance", 0.05))
+        self.packed = compiled.pack(
+            self, provider, self.tables, contact_model, fastsim, opts.get("tolerance", 0.05), python_geometry
+        )
         self.par = self.packed[0]
         self.mode = int(self.packed[5])
         code = int(self.par["model_code"])

@@ -161,7 +161,6 @@ def simulate(
     """
     provider = provider if provider is not None else build_provider(scene)
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
-    model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
     from rigid_dynamics.wheelset import compiled as _compiled
 
     can_compile = _compiled.supported(scene, provider, model_obj)
@@ -171,6 +170,11 @@ def simulate(
             "surfaces"
         )
     use_compiled = can_compile and compiled is not False
+    options = model_options(getattr(model_obj, "name", ""), scene)
+    # the compiled 3-D search tracks its contact points between RK4 stages: outside the compiled loop (and for the
+    # finite-difference Jacobian of the stability check) the contact package's search gives the geometry
+    search_in_python = _compiled.geometry_mode(provider) == 1
+    model = WheelsetModel(scene, provider, model_obj, options, python_geometry=search_in_python and not use_compiled)
     settings = scene.integrator
     duration = scene.duration_s
     packed = model.packed
@@ -261,7 +265,11 @@ def simulate(
             status, message = force_error_check(errors, t, settled, settings, message)
         if ok:  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
             try:
-                limit = rk4_stable_step(lambda y: model.derivative(0.0, y), full0)
+                probe = model
+                if use_compiled and search_in_python:
+                    probe = WheelsetModel(scene, provider, model_obj, options, python_geometry=True)
+                    probe.frame_x0, probe.track_rest = model.frame_x0, model.track_rest
+                limit = rk4_stable_step(lambda y: probe.derivative(0.0, y), full0)
             except (ContactFailure, *NUMERICAL_ERRORS):
                 limit = None
             if limit is not None:
