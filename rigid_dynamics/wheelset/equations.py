@@ -448,12 +448,16 @@ class WheelsetModel:
             return ContactFailure(f"rolling speed not > 0 at a contact (t = {t:.6g} s): creepages undefined")
         return ContactFailure(f"compiled right-hand side: status {status}")
 
-    def contact(self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None) -> ContactState:
+    def contact(
+        self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None, keep_search_memory=False
+    ) -> ContactState:
         """Contact of every candidate (approach, geometry; forces where approach > 0) at a 12-state, for inspection
         and recording: the compiled right-hand side's candidates with their contact frames.
 
         With ``record`` the per-patch values (PATCH_FIELDS, and AUTO_PATCH_FIELDS for ``auto``) are filled, else
         ``values`` is None. ``track``: the elastic track's 8 states; None: ``track_rest`` (rigid track: ignored).
+        ``keep_search_memory``: leave the compiled search's warm starts as they were (a look that must not change the
+        run).
         """
         from rigid_dynamics.wheelset import compiled
 
@@ -461,7 +465,15 @@ class WheelsetModel:
         if self.elastic and track is not None:
             full[TRACK] = track
         out = np.empty(self.n_state)
-        status = self._compiled_rhs(0.0, full, out, True)
+        memory = None
+        if keep_search_memory and self.mode == 1:  # the compiled search's warm starts (its only state) kept
+            memory = [np.copy(a) for a in self.packed[7][3:5]]
+        try:
+            status = self._compiled_rhs(0.0, full, out, True)
+        finally:
+            if memory is not None:
+                for keep, now in zip(memory, self.packed[7][3:5], strict=True):
+                    now[...] = keep
         if status != 0:
             raise self._failure(status, 0.0)
         sides, slots = self.packed[3], self.packed[4]
@@ -547,9 +559,9 @@ class WheelsetModel:
         """Gravity potential V_g = -m g z (z down), J."""
         return -self.mass * self.gravity * float(state[2])
 
-    def contact_approaches(self, state: np.ndarray) -> list:
+    def contact_approaches(self, state: np.ndarray, keep_search_memory=False) -> list:
         """Per wheel (left, right) the approaches of its candidates at a 12-state on ``track_rest``, m."""
-        contact = self.contact(state, record=True)
+        contact = self.contact(state, record=True, keep_search_memory=keep_search_memory)
         q = contact.values["approach_m"]
         return [q[contact.side == i] for i in (0, 1)]
 
@@ -632,7 +644,7 @@ class WheelsetModel:
         work[2], work[4] = best[0]
         # accept a residual acceleration below 1e-3 m/s^2 (vertical) / 1e-2 rad/s^2 (roll)
         ok = best[1] < 1e-3
-        approach = self.contact_approaches(work)
+        approach = self.contact_approaches(work, keep_search_memory=True)
         touching = [bool(np.any(approach[i] > 0)) for i in (0, 1)]
         if ok and not all(touching):
             ok, message = False, "the equilibrium found has a wheel off its rail (no contact at rest)"
