@@ -1,33 +1,36 @@
-"""Compiled (numba) fixed-step path of the wheelset simulation for contact-geometry tables.
+"""The one right-hand side of the wheelset simulation (numba), its fixed-step RK4 loop and the callback boundary.
 
-The equations of motion (eq 59-71 with the gyroscopic term), the primary suspension and the elastic track are
-written once, here (:func:`_assemble`, :func:`_track_rates`): the compiled loop's right-hand side ends in them and
-so does the Python one (equations.WheelsetModel.derivative through :func:`derivative_from_contact`, after any
-provider and contact model gave the contact forces). The same table
-look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
-creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
-contact/linear.py), ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py) and ``fastsim``
-(the contact package's compiled strip kernel contact.fastsim._fastsim_one with the flexibilities of
-contact.fastsim.effective_flexibilities, options nx, ny, traction_bound, flexibility as in the Python path),
-integrated by the classical RK4 method with a fixed step, all inside one compiled loop.
+Every integrator ends here: the compiled RK4 loop (:func:`rk4_run`), and the scipy methods and the Python RK4
+through equations.WheelsetModel.derivative, which calls :func:`rhs_once` / :func:`rhs_given`.
 
-Running-direction irregularities of the TableProvider (polygonal wheel R_irr = A cos(n alpha + phase), rounded
-flat, rail corrugation N_irr(x); irregular.py) are evaluated in the loop exactly as
-providers.running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
-angle beta from the lowest point (81-point grid, then 3 limited Newton steps), the extra overlap projected on the
-normal, the normal tilted by N_irr', the longitudinal curvature from the polar curvature of r(beta) (floored for a
-concave flat); candidates whose gap exceeds the provider's reach are left alone.
-
-Used automatically by ``simulate`` whenever the scene runs RK4 on a TableProvider (ideal geometry or with these
-irregularities) with one of MODEL_CODES from the registry (``compiled=False`` forces the Python path); the adaptive
-scipy methods, the conical and search providers, ``auto``, ``bem`` and user models stay on the Python path.
-tests/test_dynamics_compiled.py checks that it reproduces the Python path (states to ~1e-14 relative).
+* Contact geometry (:func:`_rhs`, the ``mode`` of :func:`geometry_mode`): 0 the tables of a TableProvider
+  (:func:`_table_geometry`) with the running-direction irregularities (:func:`_irregularity`: polygonal wheel
+  R_irr = A cos(n alpha + phase), rounded flat, rail corrugation N_irr(x), dipped joint; irregular.py; a section in
+  the rolling plane maximising the extra overlap over the angle beta from the lowest point, 81-point grid then 3
+  limited Newton steps, the extra overlap projected on the normal, the normal tilted by N_irr', the longitudinal
+  curvature from the polar curvature of r(beta), floored for a concave flat; candidates whose gap exceeds the reach
+  are left alone); 1 the compiled 3-D search (compiled_search.py); 2 given by the caller (a provider the compiled
+  code does not evaluate: the conical one, the search on measured grids or harmonics, user providers, and the
+  search outside the compiled loop). TableProvider.patches and ConicalProvider's irregularities use these same
+  functions (:func:`table_candidates`, :func:`irregular_candidates`).
+* Creepages (:func:`_patch_creepages`, eq 39-49).
+* Contact laws (:func:`_law`): Hertz and Kalker's C_ij from the tables of equations.TabulatedHertzKalker, and the
+  registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52), ``vermeulen-johnson``
+  (eq 53-58 with the cube) and ``fastsim`` (the contact package's strip kernel contact.fastsim._fastsim_one with the
+  flexibilities of contact.fastsim.effective_flexibilities; options nx, ny, traction_bound, flexibility), and
+  ``auto``'s choice per patch (:func:`_auto_choice`, the measured thresholds of contact/data/auto_thresholds.json
+  in the parameter record).
+* The callback boundary (:func:`_external`): contact models that are not compiled (bem, fea, user models; BEM when
+  ``auto`` chooses it) get the patch geometry and creepages handed out patch-wise to one Python dispatcher
+  (equations.PatchCallback) and give the forces back.
+* The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track (:func:`_assemble`,
+  :func:`_track_rates`).
 
 Elastic track (scene ``track_dynamics.model = "lumped"``): the 8 track states follow the two work integrals
 (state.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
 deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the
 creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
-:func:`_track_rates` (the Python path uses the same function).
+:func:`_track_rates`.
 
 Parameters: one record with named fields (:data:`PARAMETERS`, a numpy structured dtype that numba compiles;
 ``par.mass_kg``), built by :func:`pack`. Chosen by measured overhead: a kernel reading 16 parameters, called 2e7
@@ -37,7 +40,8 @@ The record keeps numba's on-disk cache working (with a jitclass or structref arg
 cache, recompiled and appended a cache entry: numba 0.68, measured here) and is a plain numpy array (set from
 Python as ``par["frame_x0_m"] = ...``). The state is indexed by the names of state.py (``y[RAIL_VELOCITY + side]``).
 
-Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined.
+Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined,
+5 the contact model behind the callback failed (its message in the callback).
 """
 
 from __future__ import annotations
@@ -149,8 +153,8 @@ def new_parameters():
     return np.zeros(1, PARAMETERS)[0]
 
 
-IRR_GRID = 81  # grid points of the running-direction section (providers.running_irregularity)
-IRR_NEWTON = 3  # Newton steps after the grid (same as providers.running_irregularity)
+IRR_GRID = 81  # grid points of the running-direction section
+IRR_NEWTON = 3  # Newton steps after the grid
 MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
 
 
@@ -205,7 +209,7 @@ def _dip(par, x):
 
 @njit(cache=True, _nrt=False)
 def _irr_parts(par, radius, x0, spin, beta, res):
-    """providers.running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
+    """The running-direction section's parts for one candidate and one beta, into res[0:9]:
     (q, q', q'', r, r', r'', x offset, N_irr', N_irr'').
     """
     rv, r1, r2 = 0.0, 0.0, 0.0
@@ -272,8 +276,8 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
 
 @njit(cache=True, _nrt=False)
 def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
-    """Running-direction irregularity of one candidate (providers.running_irregularity, same steps: a grid of
-    IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
+    """Running-direction irregularity of one candidate (a grid of IRR_GRID angles, then IRR_NEWTON limited Newton
+    steps; derivation in the module docstring; the only implementation: the conical and table providers use it too). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
     rolling radius, A) for the candidate. bg: the grid angles (as np.linspace(-half, half, IRR_GRID)), their sines
     and cosines (3, IRR_GRID).
     """
@@ -1145,6 +1149,63 @@ def model_parameters(model_wheelset):
     return par
 
 
+def irregularity_parameters(par, irr, sides_mask, r0: float) -> None:
+    """The running-direction irregularities ``irr`` (polygon, rounded flat, corrugation, dipped joint) on the sides of
+    ``sides_mask`` (left, right) into the parameter record, with the section's reach and half angle."""
+    from rigid_dynamics.wheelset.irregular import dip_depth_m, flat_depth_m
+
+    par["nominal_radius_m"] = r0
+    par["irregular"] = 1.0
+    par["irregular_left"], par["irregular_right"] = (float(v) for v in sides_mask)
+    par["polygon_order"], par["polygon_amplitude_m"], par["polygon_phase_rad"] = (
+        irr.polygon_order,
+        irr.polygon_amplitude_m,
+        irr.polygon_phase_rad,
+    )
+    reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
+    half = 0.02
+    if irr.flat_length_m > 0:
+        depth = flat_depth_m(irr, r0)
+        par["flat_length_m"], par["flat_depth_m"], par["flat_angle_rad"] = irr.flat_length_m, depth, irr.flat_angle_rad
+        reach += 2.0 * depth
+        half = max(half, 1.5 * irr.flat_length_m / r0)
+    if irr.corrugation_amplitude_m > 0:
+        par["corrugation_wavelength_m"] = irr.corrugation_wavelength_m
+        par["corrugation_amplitude_m"] = irr.corrugation_amplitude_m
+        half = max(half, 0.6 * irr.corrugation_wavelength_m / r0)
+    if irr.joint_dip_angle_rad > 0:
+        par["dip_angle_rad"], par["dip_position_m"] = irr.joint_dip_angle_rad, irr.joint_position_m
+        par["dip_ramp_length_m"] = irr.joint_ramp_length_m
+        par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
+        reach += 2.0 * dip_depth_m(irr)
+    par["irregularity_reach_m"], par["section_half_angle_rad"] = reach, half
+
+
+@njit(cache=True)
+def table_candidates(y, par, table, grid, slots, sides, cg):
+    """The tables' candidates (with the running-direction irregularities of par) at the pose in y into cg
+    (ncand, N_GEO): :func:`_table_geometry` for providers.TableProvider.patches (inspection, tests).
+    """
+    ws = _workspace(par, table.shape[0], sides.shape[0], np.zeros((sides.shape[0] + 2, N_FIELDS)))
+    _table_geometry(y, par, table, grid, slots, sides, ws[0], ws[2], ws[3], ws[6], cg)
+
+
+@njit(cache=True)
+def irregular_candidates(par, work, sides, x0, spin, cg):
+    """The running-direction irregularities (:func:`_irregularity`) added to candidates given as table rows ``work``
+    (rows 4, 5: normal y, z; 6: A; 8: rolling radius; 0: approach) at contact points x0 (ncand), the spin angle
+    ``spin``: into cg (ncand, 8) = (q, x offset, z offset, n_x, n_y, n_z, rolling radius, A); rows of candidates left
+    alone (side not irregular, gap beyond the reach) are NaN. For providers.ConicalProvider.
+    """
+    ws = _workspace(par, work.shape[0], sides.shape[0], np.zeros((sides.shape[0] + 2, N_FIELDS)))
+    res, bg = ws[2], ws[6]
+    for c in range(sides.shape[0]):
+        cg[c, :] = np.nan
+        q = work[0, c]
+        if q > -par.irregularity_reach_m and (par.irregular_right if sides[c] == 1 else par.irregular_left) > 0:
+            _irregularity(par, work, c, q, x0[c], spin, res, cg[c], bg)
+
+
 def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, python_geometry=False):
     """Arguments of rk4_run / rhs_once from a WheelsetModel, its provider, the Hertz / Kalker tables and the contact
     model instance: (par, hz, kk, sides, slots, mode, targs, sargs). ``options``: FASTSIM's (nx, ny, traction_bound,
@@ -1178,46 +1239,8 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
         slots = np.array([0, 1, 0, 1], np.int64)
         return par, hz, kk, sides, slots, 2, (np.zeros((1, 4, 2, 2)), np.zeros(6), slots), _dummy_search()
     par["nominal_radius_m"] = provider.r0
-    irr = None if search else provider.irregularities
-    if irr is not None:
-        from rigid_dynamics.wheelset.irregular import flat_depth_m
-
-        # the same selection constants as providers.running_irregularity
-        par["irregular"] = 1.0
-        par["irregular_left"], par["irregular_right"] = (float(v) for v in provider._irr_sides)
-        par["polygon_order"], par["polygon_amplitude_m"], par["polygon_phase_rad"] = (
-            irr.polygon_order,
-            irr.polygon_amplitude_m,
-            irr.polygon_phase_rad,
-        )
-        reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
-        half = 0.02
-        if irr.flat_length_m > 0:
-            depth = flat_depth_m(irr, provider.r0)
-            par["flat_length_m"], par["flat_depth_m"], par["flat_angle_rad"] = (
-                irr.flat_length_m,
-                depth,
-                irr.flat_angle_rad,
-            )
-            reach += 2.0 * depth
-            half = max(half, 1.5 * irr.flat_length_m / provider.r0)
-        if irr.corrugation_amplitude_m > 0:
-            par["corrugation_wavelength_m"], par["corrugation_amplitude_m"] = (
-                irr.corrugation_wavelength_m,
-                irr.corrugation_amplitude_m,
-            )
-            half = max(half, 0.6 * irr.corrugation_wavelength_m / provider.r0)
-        if irr.joint_dip_angle_rad > 0:
-            from rigid_dynamics.wheelset.irregular import dip_depth_m
-
-            par["dip_angle_rad"], par["dip_position_m"], par["dip_ramp_length_m"] = (
-                irr.joint_dip_angle_rad,
-                irr.joint_position_m,
-                irr.joint_ramp_length_m,
-            )
-            par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
-            reach += 2.0 * dip_depth_m(irr)
-        par["irregularity_reach_m"], par["section_half_angle_rad"] = reach, half
+    if not search and provider.irregularities is not None:
+        irregularity_parameters(par, provider.irregularities, provider._irr_sides, provider.r0)
     if search:
         from rigid_dynamics.wheelset import compiled_search as cs
 
