@@ -277,7 +277,8 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
 @njit(cache=True, _nrt=False)
 def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
     """Running-direction irregularity of one candidate (a grid of IRR_GRID angles, then IRR_NEWTON limited Newton
-    steps; derivation in the module docstring; the only implementation: the conical and table providers use it too). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
+    steps; derivation in the module docstring; the only implementation: the conical and table providers use it
+    too). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
     rolling radius, A) for the candidate. bg: the grid angles (as np.linspace(-half, half, IRR_GRID)), their sines
     and cosines (3, IRR_GRID).
     """
@@ -597,7 +598,7 @@ def _creep_law(par, code, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, sp
 
 @njit(cache=True, _nrt=False)
 def _auto_threshold(par, rung, f):
-    """auto's threshold of feature f (AUTO_FEATURE_NAMES) for rung (0 linear, 1 Vermeulen-Johnson, 2 FASTSIM)."""
+    """Auto's threshold of feature f (AUTO_FEATURE_NAMES) for rung (0 linear, 1 Vermeulen-Johnson, 2 FASTSIM)."""
     if rung == 0:
         v = (par.auto_linear_saturation, par.auto_linear_spin_share, par.auto_linear_ellipticity_residual,
              par.auto_linear_curvature_change, par.auto_linear_second_patch_nearness)  # fmt: skip
@@ -711,7 +712,9 @@ def use_callback(callback) -> None:
 
 def _dispatch(c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral):
     """The callback boundary's Python side: the patch to the callback in use (equations.PatchCallback.solve)."""
-    return _CALLBACK[0].solve(c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral)
+    return _CALLBACK[0].solve(
+        c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral
+    )
 
 
 @njit(cache=True, _nrt=False)
@@ -730,7 +733,6 @@ def _external(c, side, t, q, ca, cb, xi, eta, spin, speed, px, py, pz, n, ex, ey
             radius, angle, lateral,
         )  # fmt: skip
     return normal, tx, ty, mz, sa, sb, st
-
 
 
 @njit(cache=True, _nrt=False)
@@ -831,7 +833,14 @@ def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
     (mode 2: a provider the compiled code does not evaluate, equations.WheelsetModel fills it), then _forces.
     Returns the status.
     """
-    work, rec, res, geo, dummy, sc, bg, cg = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
+    _geometry(y, par, sides, mode, targs, sargs, ws, full)
+    return _forces(t, y, par, ws[7], sides, hz, kk, ws[1], record, ws[4], ws[5], out)
+
+
+@njit(cache=True, _nrt=False)
+def _geometry(y, par, sides, mode, targs, sargs, ws, full):
+    """The candidate geometry at the state y into ws[7] (mode 0 tables, 1 search; mode 2: given, left alone)."""
+    work, res, geo, bg, cg = ws[0], ws[2], ws[3], ws[6], ws[7]
     if mode == 0:
         table, grid, slots = targs
         _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg)
@@ -841,7 +850,14 @@ def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
             search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15])
         else:
             search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
-    return _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out)
+
+
+@njit(cache=True)
+def geometry_once(y, par, sides, mode, targs, sargs, cg):
+    """The candidate geometry alone (no contact law: the static equilibrium's approaches) into cg (mode 0 or 1)."""
+    ws = _workspace(par, targs[0].shape[0], sides.shape[0], np.zeros((sides.shape[0] + 2, N_FIELDS)))
+    _geometry(y, par, sides, mode, targs, sargs, ws, True)
+    cg[:, :] = ws[7]
 
 
 @njit(cache=True)
@@ -1074,7 +1090,8 @@ def supported(scene, provider, model) -> bool:
 
 def model_code(model) -> int:
     """``model_code`` of a contact model instance: MODEL_CODES for the registry's compiled laws, AUTO_CODE for its
-    ``auto``, CALLBACK_CODE for everything else (bem, fea, user models, subclasses)."""
+    ``auto``, CALLBACK_CODE for everything else (bem, fea, user models, subclasses).
+    """
     name = getattr(model, "name", None)
     if type(model).__module__ == "rigid_dynamics.contact.models":
         if name in MODEL_CODES:
@@ -1085,7 +1102,7 @@ def model_code(model) -> int:
 
 
 def auto_parameters(par, tolerance: float, fastsim_grid) -> None:
-    """auto's thresholds (contact/data/auto_thresholds.json, contact.auto) into the parameter record: the level of
+    """Auto's thresholds (contact/data/auto_thresholds.json, contact.auto) into the parameter record: the level of
     ``tolerance`` (contact.auto.level_for; none: NaN, every patch BEM) and per rung (linear, Vermeulen-Johnson,
     FASTSIM at the run's grid by contact.auto.fastsim_rung) the feature box (NaN: no measured box).
     """
@@ -1151,7 +1168,8 @@ def model_parameters(model_wheelset):
 
 def irregularity_parameters(par, irr, sides_mask, r0: float) -> None:
     """The running-direction irregularities ``irr`` (polygon, rounded flat, corrugation, dipped joint) on the sides of
-    ``sides_mask`` (left, right) into the parameter record, with the section's reach and half angle."""
+    ``sides_mask`` (left, right) into the parameter record, with the section's reach and half angle.
+    """
     from rigid_dynamics.wheelset.irregular import dip_depth_m, flat_depth_m
 
     par["nominal_radius_m"] = r0

@@ -54,7 +54,6 @@ from rigid_dynamics.wheelset.compiled import model_parameters, patch_creepages, 
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
 from rigid_dynamics.wheelset.state import (
-    MECHANICAL,
     TRACK,
     n_states,
 )
@@ -256,9 +255,7 @@ class PatchCallback:
         finally:
             self.seconds += time.perf_counter() - start
         if not result.success and result.status != "no-contact":
-            self.message = (
-                f"contact model {result.method!r} failed at t = {t:.6g} s: {result.status}: {result.message}"
-            )
+            self.message = f"contact model {result.method!r} failed at t = {t:.6g} s: {result.status}: {result.message}"
             return 0.0, 0.0, 0.0, 0.0, np.nan, np.nan, 1
         return (
             float(result.normal_force_N or 0.0),
@@ -520,7 +517,8 @@ class WheelsetModel:
 
     def side_forces(self) -> np.ndarray:
         """Per wheel (left, right) the contact force of the last right-hand side, main frame, (2, 3), N: only set
-        by a recording call (:meth:`contact`)."""
+        by a recording call (:meth:`contact`).
+        """
         ncand = len(self.packed[3])
         return self._rec[ncand : ncand + 2, :3].copy()
 
@@ -560,10 +558,23 @@ class WheelsetModel:
         return -self.mass * self.gravity * float(state[2])
 
     def contact_approaches(self, state: np.ndarray, keep_search_memory=False) -> list:
-        """Per wheel (left, right) the approaches of its candidates at a 12-state on ``track_rest``, m."""
-        contact = self.contact(state, record=True, keep_search_memory=keep_search_memory)
-        q = contact.values["approach_m"]
-        return [q[contact.side == i] for i in (0, 1)]
+        """Per wheel (left, right) the approaches of its candidates at a 12-state on ``track_rest``, m: the geometry
+        alone (compiled.geometry_once; mode 2 the provider), no contact model.
+        """
+        from rigid_dynamics.wheelset import compiled
+
+        full = self.full_state(state)
+        par, _, _, sides, _, mode, targs, sargs = self.packed
+        if mode == 2:
+            self._given_geometry(full)
+        else:
+            memory = [np.copy(a) for a in sargs[3:5]] if keep_search_memory and mode == 1 else None
+            compiled.geometry_once(full, par, sides, mode, targs, sargs, self._cg)
+            if memory is not None:
+                for keep, now in zip(memory, sargs[3:5], strict=True):
+                    now[...] = keep
+        q = self._cg[:, 0]
+        return [q[(sides == i) & ~np.isnan(q)] for i in (0, 1)]
 
     def deepest_approach(self, state: np.ndarray) -> list:
         """Per wheel (left, right) the deepest approach of its candidates at a 12-state on ``track_rest``, m."""
@@ -590,13 +601,16 @@ class WheelsetModel:
         work = np.array(state, float)
         derivative = self.derivative if derivative is None else derivative
 
+        failure = []
+
         def residual(v):
             trial = work.copy()
             trial[2], trial[4] = v
             full = self.full_state(trial)
             try:
                 d = derivative(0.0, full)
-            except ContactFailure:
+            except ContactFailure as exc:
+                failure[:] = [str(exc)]
                 return np.array([1e3, 1e3])
             return np.array([d[8], d[10] * 0.1])
 
@@ -644,6 +658,8 @@ class WheelsetModel:
         work[2], work[4] = best[0]
         # accept a residual acceleration below 1e-3 m/s^2 (vertical) / 1e-2 rad/s^2 (roll)
         ok = best[1] < 1e-3
+        if not ok and failure:
+            message += f"; the contact failed: {failure[0]}"
         approach = self.contact_approaches(work, keep_search_memory=True)
         touching = [bool(np.any(approach[i] > 0)) for i in (0, 1)]
         if ok and not all(touching):

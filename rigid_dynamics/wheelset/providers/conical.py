@@ -125,7 +125,9 @@ class ConicalProvider:
         work[6], work[8] = patches.curvature_long_1_per_m, patches.rolling_radius_m
         geo = np.empty((n, 8))
         sides = np.asarray(patches.side, np.int64)
-        compiled.irregular_candidates(self._par, work, sides, np.ascontiguousarray(patches.point_m[:, 0]), spin_rad, geo)
+        compiled.irregular_candidates(
+            self._par, work, sides, np.ascontiguousarray(patches.point_m[:, 0]), spin_rad, geo
+        )
         for k in np.flatnonzero(~np.isnan(geo[:, 0])):
             patches.approach_m[k] = geo[k, 0]
             patches.point_m[k, 0] += geo[k, 1]
