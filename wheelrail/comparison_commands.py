@@ -18,8 +18,8 @@ from wheelrail.config import ConfigError
 
 DEMO_TOLERANCE = 0.1
 """auto's contact_tolerance in the demo's run: at the polygonal-wheel scene's own 0.05 the measured thresholds send
-39 % of the patches (tread patches at saturation 0.08-0.16 and spin share 0.17-0.19) to BEM, and 2 s take about
-7 minutes here instead of about one (README, demo)."""
+39 % of the patches (tread patches at saturation 0.08-0.16 and spin share 0.17-0.19) to BEM, and 2 s would take
+7-12 minutes here (0.04 s took 8.9-14.5 s in-process) instead of about half a minute (README, demo)."""
 
 
 def _check_models(models, allowed) -> list[str]:
