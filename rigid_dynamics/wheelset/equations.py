@@ -127,18 +127,6 @@ def _cross_rows(vector, rows):
     return np.stack([wy * z - wz * y, wz * x - wx * z, wx * y - wy * x], axis=-1)
 
 
-def _cross_pairs(first, second):
-    """first[i] x second[i] for two (n, 3) arrays."""
-    a1, a2, a3 = first[:, 0], first[:, 1], first[:, 2]
-    b1, b2, b3 = second[:, 0], second[:, 1], second[:, 2]
-    return np.stack([a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1], axis=-1)
-
-
-def _cross3(a, b):
-    """Cross product a x b of two 3-vectors (plain arithmetic)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     """Contact frames and creepages of many points (eq 39-49) by the compiled kernel (compiled.patch_creepages, the
     one used by the compiled right-hand side).
@@ -269,7 +257,10 @@ class PatchCallback:
 
 
 class WheelsetModel:
-    """State function of a wheelset (module docstring) for one scene, provider and contact model.
+    """State function of a wheelset (module docstring) for one scene, provider and contact model: a thin wrapper of the
+    one compiled right-hand side (compiled.py) for the scipy methods, the Python RK4, the static equilibrium,
+    inspection (:meth:`contact`) and tests; the arguments of the compiled code in ``packed`` (compiled.pack), the
+    callback of a contact model that is not compiled in ``callback`` (:class:`PatchCallback`).
 
     Args:
         scene: the scene (parameters, material, speed).
