@@ -542,7 +542,7 @@ def track_rates(par, y, rail_force, out):
     return _track_rates(par, y, rail_force[0], rail_force[1], out, 0.0)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _hertz_kalker(par, hz, kk, q, ca, cb):
     """Hertz under approach control (tables of the axial function) and Kalker's C11, C22, C23, C33 (tables of a/b):
     (N, a, b, C11, C22, C23, C33).
@@ -564,7 +564,7 @@ def _hertz_kalker(par, hz, kk, q, ca, cb):
     return normal, sa, sb, c11, c22, c23, c33
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _creep_law(par, code, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin):
     """(T_x, T_y, M_z) of the compiled creep law ``code`` (MODEL_CODES) on a Hertz patch."""
     tx, ty, mz = 0.0, 0.0, 0.0
@@ -648,14 +648,14 @@ def _auto_choice(par, feats):
 
 
 @njit(cache=True, _nrt=False)
-def _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, row, record):
+def _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec, c, record):
     """The compiled contact law of one patch: (N, a, b, T_x, T_y, M_z, status); status 1: the patch is for the
     callback (``auto`` chose BEM, or its FASTSIM broke the friction bound as auto's does in contact.models).
 
     ``auto`` (par.model_code AUTO_CODE): the features of contact.auto.patch_features that a quadric patch has
     (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
     are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
-    row[N_PATCH:] as equations.AUTO_PATCH_FIELDS.
+    rec[c, N_PATCH:] as equations.AUTO_PATCH_FIELDS.
     """
     normal, sa, sb, c11, c22, c23, c33 = _hertz_kalker(par, hz, kk, q, ca, cb)
     code = int(par.model_code)
@@ -684,9 +684,10 @@ def _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, row, record):
     else:
         st = 1
     if record:
-        row[N_PATCH], row[N_PATCH + 1], row[N_PATCH + 2], row[N_PATCH + 3] = rung, par.auto_level, deciding, threshold
+        rec[c, N_PATCH], rec[c, N_PATCH + 1], rec[c, N_PATCH + 2] = rung, par.auto_level, deciding
+        rec[c, N_PATCH + 3] = threshold
         for f in range(5):
-            row[N_PATCH + 4 + f] = feats[f]
+            rec[c, N_PATCH + 4 + f] = feats[f]
     return normal, sa, sb, tx, ty, mz, st
 
 
@@ -695,8 +696,8 @@ def patch_forces(par, hz, kk, q, ca, cb, xi, eta, spin):
     """One patch through the compiled law of par.model_code (not the callback): (N, T_x, T_y, M_z, a, b, status),
     for tests and inspection.
     """
-    row = np.zeros(N_FIELDS)
-    normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, np.zeros((1, 1)), q, ca, cb, xi, eta, spin, row, False)
+    rec = np.zeros((1, N_FIELDS))
+    normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, np.zeros((1, 1)), q, ca, cb, xi, eta, spin, rec, 0, False)
     return normal, tx, ty, mz, sa, sb, st
 
 
@@ -786,7 +787,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
             if st != 0:
                 return 5
         else:
-            normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec[c], record)
+            normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
             if st == 1:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
                 normal, tx, ty, mz, sa, sb, st = _external(
                     c, sides[c], t, q, ca, cb, xi, eta, spin, speed, y[0] + lever[0], yc + lever[1], y[2] + lever[2],
