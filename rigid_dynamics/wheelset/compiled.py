@@ -723,8 +723,9 @@ def _external(c, side, t, q, ca, cb, xi, eta, spin, speed, px, py, pz, n, ex, ey
     """The one callback boundary: a patch (candidate c of ``side`` at time t: approach, curvatures, creepages,
     rolling speed, contact point and contact frame e_x, e_y, n in the main frame, rolling radius, contact angle,
     wheel lateral position) handed to Python (numba objmode) and (N, T_x, T_y, M_z, a, b, status) taken back;
-    status != 0: the contact model failed (the callback keeps its message). Overhead measured with a trivial
-    Python function: 2.0-2.1 us per call (numba 0.6x, this machine), against 0.1-1 s for a BEM patch.
+    status != 0: the contact model failed (the callback keeps its message). Overhead measured here: 2.0-2.1 us per
+    objmode call of a trivial Python function; 25 us per patch through equations.PatchCallback with a model returning
+    constant forces (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes about 20 ms.
     """
     n0, n1, n2 = n[0], n[1], n[2]
     x0, x1, x2, y0, y1, y2 = ex[0], ex[1], ex[2], ey[0], ey[1], ey[2]
