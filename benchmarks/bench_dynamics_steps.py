@@ -112,9 +112,7 @@ def doubling_estimate(scene, result, samples=100):
     provider = build_provider(scene)
     law = get_contact_model(scene.contact_model)
     model = WheelsetModel(scene, provider, law, model_options(law.name, scene))
-    par, hz, kk, sides, _, mode, targs, sargs = compiled.pack(
-        model, provider, model.batch.tables, law.name, model.batch.options
-    )
+    par, hz, kk, sides, _, mode, targs, sargs = model.packed
     par["frame_x0_m"] = result.states[0, 0]
     rec = np.zeros((len(sides) + 2, compiled.N_FIELDS))
     h = scene.integrator.fixed_step_s

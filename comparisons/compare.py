@@ -61,6 +61,23 @@ def _main_patch(patches, side):
     return max(on_side, key=lambda p: p[3].normal_force_N or 0.0)
 
 
+def _resolution(model, options, main) -> str:
+    """The grid or mesh of a rung's solution, for the report: FASTSIM's elements per strip x strips, the BEM's
+    elements and element size (from its pressure field), Hertz none (FEA: set from its result in run_compare).
+    """
+    if model == "fastsim":
+        return f"{options.get('nx', 20)} x {options.get('ny', 20)} elements (per strip x strips)"
+    if model == "bem":
+        fields = None if main is None else main[3].fields
+        if fields is not None and len(fields.x_m) > 1 and len(fields.y_m) > 1:
+            dx, dy = abs(fields.x_m[1] - fields.x_m[0]), abs(fields.y_m[1] - fields.y_m[0])
+            return f"{len(fields.x_m)} x {len(fields.y_m)} elements of {dx * 1e3:.3g} x {dy * 1e3:.3g} mm"
+        return f"{options.get('nx', 40)} x {options.get('ny', 40)} elements"
+    if model == "hertz":
+        return "closed form"
+    return ""
+
+
 def _solve_models(named, models, options):
     from comparisons.bench import case_errors, side_values, solve_contact_case, warm_up
 
@@ -82,6 +99,7 @@ def _solve_models(named, models, options):
             "patches": patches,
             "main": _main_patch(patches, named.side),
         }
+        entry["resolution"] = _resolution(model, options.get(model, {}), entry["main"])
         if success:
             entry["values"] = side_values(patches, named.side)
             entry["errors"], entry["error"] = case_errors(named, entry["values"])
@@ -398,6 +416,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
                 "contact_area_m2": fea_result.contact_area_m2,
             },
             "note": "main BEM patch only, BEM normal force",
+            "resolution": _fea_resolution(fea_result),
         }
     report = _report(named, models, solved, sources, cuts, pictures, notes)
     write_text_atomic(out_dir / "report.md", report["markdown"])
@@ -415,6 +434,15 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
     return summary
 
 
+def _fea_resolution(result) -> str:
+    """FEA's mesh for the report: element size at the patch and elements per semi-axis."""
+    size = result.extra.get("element_size_m")
+    mesh = result.extra.get("mesh") or {}
+    cells = mesh.get("cells") or mesh.get("n_cells")
+    text = f"element size {size * 1e3:.3g} mm at the patch" if size else "mesh not reported"
+    return text + (f", {cells} cells" if cells else "")
+
+
 def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
     ref = named.reference
     lines = [
@@ -423,10 +451,11 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
         f"{named.note}. Reference: {named.source} (comparisons/cases/{named.name}/SOURCE.md). Side compared: "
         f"{named.side}.",
         "",
-        "| model | status | time | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm2] | err N | err F | err p | "
-        "err area |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
-        f"| reference | {named.source} | | {_fmt(ref.get('normal_force_N'))} | {_fmt(ref.get('creep_force_long_N'))} | "
+        "| model | grid / mesh | status | time | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm2] | err N | err F | "
+        "err p | err area |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        f"| reference | | {named.source} | | {_fmt(ref.get('normal_force_N'))} | "
+        f"{_fmt(ref.get('creep_force_long_N'))} | "
         f"{_fmt(ref.get('creep_force_lat_N'))} | {_fmt(ref.get('max_pressure_Pa'), 1e-6)} | "
         f"{_fmt(ref.get('contact_area_m2'), 1e6)} | | | | |",
     ]
@@ -440,7 +469,7 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
         if e.get("note"):
             status += f" ({e['note']})"
         lines.append(
-            f"| {model} | {status} | {_fmt(t, 1, 3)} s | {_fmt(v.get('normal_force_N'))} | "
+            f"| {model} | {e.get('resolution', '')} | {status} | {_fmt(t, 1, 3)} s | {_fmt(v.get('normal_force_N'))} | "
             f"{_fmt(v.get('creep_force_long_N'))} | {_fmt(v.get('creep_force_lat_N'))} | "
             f"{_fmt(v.get('max_pressure_Pa'), 1e-6)} | {_fmt(v.get('contact_area_m2'), 1e6)} | "
             f"{_pct(err.get('err_normal_force'))} | {_pct(err.get('err_creep_force'))} | "

@@ -24,3 +24,20 @@ def test_short_demo_writes_the_report(tmp_path, monkeypatch, capsys):
     report = (out / "report.md").read_text()
     assert "## Time series" in report and "compare/pressure.png" in report
     assert (out / "report.html").exists() and (out / "compare" / "subsurface.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "text"),
+    [
+        (["--tolerance", "0"], "wheelrail: error: --tolerance 0.0: expected a finite number > 0"),
+        (["--tolerance", "nan"], "wheelrail: error: --tolerance nan: expected a finite number > 0"),
+        (["--contact-model", "magic"], "wheelrail: error: --contact-model 'magic': expected one of"),
+    ],
+)
+def test_demo_bad_options(tmp_path, capsys, args, text):
+    """Bad demo options: one error line naming the option, the value and what was expected; exit 2; no output."""
+    out = tmp_path / "demo"
+    assert main(["demo", *args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(text)
+    assert not out.exists()

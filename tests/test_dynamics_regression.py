@@ -1,6 +1,9 @@
 """Regression (self-consistency, not physics): the embedded scenes give the same states as before the
 restructuring of issue 15 (simulate.py split by job, the providers package, the state layout, the compiled
-parameter record, the equations of motion / suspension / track and the creepage kinematics written once).
+parameter record, the equations of motion / suspension / track and the creepage kinematics written once, and then
+one right-hand side for every path: the Python driver's cases below now run the compiled geometry (tables), the
+compiled laws and the callback boundary; polygonal-wheel-python takes the contact package's 3-D search as given
+geometry; hunting-conical-default the conical provider's candidates as given geometry).
 
 The references in tests/data/dynamics_regression/ were written by commit 56c49d8 (before issue 15) from exactly the
 cases below (``python tests/test_dynamics_regression.py --write`` writes them with the code in the tree). Every

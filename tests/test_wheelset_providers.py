@@ -17,7 +17,7 @@ from rigid_dynamics.contact.registry import get_model
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.kinematics import angular_velocity, wheelset_rotation
 from rigid_dynamics.materials import STEEL
-from rigid_dynamics.wheelset.equations import _creepages, batch_contact_function, rotation_and_rates
+from rigid_dynamics.wheelset.equations import _creepages, rotation_and_rates
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
 from rigid_dynamics.wheelset.providers import ConicalProvider, ProfileSectionProvider, TableProvider
 
@@ -139,27 +139,52 @@ def test_creepages_match_contact_creepage_module():
     )
 
 
+def _compiled_law(name):
+    """The parameter record and tables of the compiled right-hand side for the registry model ``name`` on STEEL."""
+    from rigid_dynamics.wheelset import compiled
+    from rigid_dynamics.wheelset.equations import _tables_for
+
+    tables = _tables_for(STEEL.shear_modulus_Pa, STEEL.poisson_ratio)
+    par = compiled.new_parameters()
+    par["shear_modulus_Pa"], par["contact_modulus_Pa"] = STEEL.shear_modulus_Pa, tables.e_star
+    par["friction_coefficient"] = STEEL.friction_coefficient
+    par["model_code"] = compiled.model_code(get_model(name))
+    par["fastsim_nx"], par["fastsim_ny"] = 20, 20
+    hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
+    hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
+    kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
+    kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
+    return par, hz, kk
+
+
 @pytest.mark.parametrize("name", ["hertz", "linear", "vermeulen-johnson", "fastsim"])
-def test_batch_contact_equals_model_solve(name):
-    """The batched path of the dynamics (tabulated Hertz/C_ij + kernels) equals one model.solve per patch."""
+def test_compiled_laws_equal_model_solve(name):
+    """The compiled laws of the dynamics (tabulated Hertz/C_ij + kernels, compiled._law) equal the registry's models
+    (contact.models: the exact Hertz solver and Kalker's coefficients) to the tables' interpolation accuracy."""
+    from rigid_dynamics.wheelset import compiled
+
     rng = np.random.default_rng(11)
     n = 6
     curv_a = rng.uniform(0.8, 1.4, n)
     curv_b = rng.uniform(0.5, 30.0, n)
     approach = rng.uniform(2e-5, 2e-4, n)
     xi, eta, spin = rng.normal(0, 2e-3, n), rng.normal(0, 2e-3, n), rng.normal(0, 0.3, n)
-    batch = batch_contact_function(name, STEEL)(curv_a, curv_b, approach, xi, eta, spin)
+    par, hz, kk = _compiled_law(name)
     model = get_model(name)
     for k in range(n):
         res = model.solve(
             ContactGeometry(curv_a[k], curv_b[k], approach[k]), Creepage(xi[k], eta[k], spin[k], 20.0), STEEL
         )
-        got = [batch[j][k] for j in range(6)]
+        got = compiled.patch_forces(par, hz, kk, approach[k], curv_a[k], curv_b[k], xi[k], eta[k], spin[k])
+        assert got[6] == 0
         want = [res.normal_force_N, res.creep_force_long_N, res.creep_force_lat_N, res.spin_moment_Nm or 0.0,
                 res.semi_axis_long_m, res.semi_axis_lat_m]  # fmt: skip
         scale = [res.normal_force_N] * 4 + [res.semi_axis_long_m, res.semi_axis_lat_m]
-        np.testing.assert_allclose(np.array(got) / scale, np.array(want) / scale, rtol=0, atol=2e-7)
+        np.testing.assert_allclose(np.array(got[:6]) / scale, np.array(want) / scale, rtol=0, atol=2e-7)
 
 
-def test_batch_contact_unknown_model_has_no_batch_path():
-    assert batch_contact_function("bem", STEEL) is None
+def test_models_without_compiled_law_go_through_the_callback():
+    from rigid_dynamics.wheelset import compiled
+
+    assert compiled.model_code(get_model("bem")) == compiled.CALLBACK_CODE
+    assert compiled.model_code(get_model("auto")) == compiled.AUTO_CODE

@@ -16,6 +16,11 @@ from pathlib import Path
 
 from wheelrail.config import ConfigError
 
+DEMO_TOLERANCE = 0.1
+"""auto's contact_tolerance in the demo's run: at the polygonal-wheel scene's own 0.05 the measured thresholds send
+39 % of the patches (tread patches at saturation 0.08-0.16 and spin share 0.17-0.19) to BEM, and 2 s would take
+7-12 minutes here (0.04 s took 8.9-14.5 s in-process) instead of about half a minute (README, demo)."""
+
 
 def _check_models(models, allowed) -> list[str]:
     models = list(models or allowed)
@@ -94,11 +99,26 @@ def cmd_demo(args) -> int:
     from wheelrail.scenes import load_scene, resolve_scene_path, write_run_outputs
 
     models = _check_models(args.models, COMPARE_MODELS)
+    from dataclasses import replace
+
+    from rigid_dynamics.contact.registry import model_names
+
+    if not (math.isfinite(args.tolerance) and args.tolerance > 0):
+        raise ConfigError(f"--tolerance {args.tolerance!r}: expected a finite number > 0")
+    if args.contact_model not in (*model_names(), "auto"):
+        raise ConfigError(f"--contact-model {args.contact_model!r}: expected one of {', '.join(model_names())}")
     source = resolve_scene_path(args.scene)
     scene = load_scene(source)
+    if args.contact_model is not None:
+        scene = replace(scene, contact_model=args.contact_model)
+    if args.tolerance is not None:
+        scene = replace(scene, contact_tolerance=args.tolerance)
     out_dir = new_output_dir(args.out, f"demo-{source.stem}")
     start = time.perf_counter()
-    print(f"demo 1/3: {source.stem}, {scene.duration_s:g} s with {scene.contact_model} (3-D contact search)")
+    law = scene.contact_model + (
+        f" (contact_tolerance {scene.contact_tolerance:g})" if scene.contact_model == "auto" else ""
+    )
+    print(f"demo 1/3: {source.stem}, {scene.duration_s:g} s with {law} (3-D contact search)")
     result = simulate(scene)
     summary = write_run_outputs(result, source, out_dir / "run")
     if not result.success:
@@ -124,6 +144,10 @@ def cmd_demo(args) -> int:
         value = models.get(model, {}).get("values", {}).get("max_pressure_Pa")
         return "-" if value is None else f"{value / 1e6:.0f}"
 
+    def grid(model):
+        text = models.get(model, {}).get("resolution", "")
+        return f" ({text})" if text and model != "hertz" else ""
+
     def creep(model):
         v = models.get(model, {}).get("values", {})
         fx, fy = v.get("creep_force_long_N"), v.get("creep_force_lat_N")
@@ -136,8 +160,9 @@ def cmd_demo(args) -> int:
         f"run: {result.simulated_time_s:g} s of {source.stem} in {summary['wall_time_s']:.1f} s wall "
         f"(real-time factor {summary['real_time_factor']:.2g}); peak wheel-rail normal force "
         f"{patch.normal_force_N / 1e3:.1f} kN at t = {patch.time_s:.3f} s ({patch.side} wheel)",
-        f"at the peak, max pressure [MPa] Hertz {p0('hertz')}, FASTSIM {p0('fastsim')}, BEM {p0('bem')}, "
-        f"FEA {p0('fea')}; creep force [kN] FASTSIM {creep('fastsim')}, BEM {creep('bem')}",
+        f"at the peak, max pressure [MPa] Hertz {p0('hertz')}, FASTSIM{grid('fastsim')} {p0('fastsim')}, "
+        f"BEM{grid('bem')} {p0('bem')}, FEA{grid('fea')} {p0('fea')}; creep force [kN] FASTSIM {creep('fastsim')}, "
+        f"BEM {creep('bem')}",
         "subsurface max von Mises: "
         + (
             f"BEM + tractions (half-space) {with_t['max_von_mises_Pa'] / 1e6:.0f} MPa at "
@@ -151,6 +176,7 @@ def cmd_demo(args) -> int:
             else ", FEA n/a"
         ),
     ]
+    auto_lines = _auto_summary(result)
     run_pngs = sorted(p.name for p in (out_dir / "run").glob("*.png"))
     compare_md = (out_dir / "compare" / "report.md").read_text()
     compare_md = compare_md.replace("](", "](compare/").replace("# peak-contact", "## Contact at the peak", 1)
@@ -162,6 +188,7 @@ def cmd_demo(args) -> int:
         f"Total wall time {time.perf_counter() - start:.0f} s. Run folder: run/ (scene.toml, summary.json, "
         "timeseries.npz); comparison folder: compare/.",
         "",
+        *auto_lines,
         "## Time series",
         "",
         *[f"![{name}](run/{name})" for name in run_pngs],
@@ -175,6 +202,40 @@ def cmd_demo(args) -> int:
     for line in headlines:
         print(line)
     return 0 if compare["success"] else 1
+
+
+def _auto_summary(result) -> list:
+    """Report lines on ``auto``'s choices in a run (none for other models): the share of each rung over the recorded
+    patches in contact and how often each feature decided, with the tolerance level used.
+    """
+    import numpy as np
+
+    from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES
+
+    if "auto_rung" not in result.patches:
+        return []
+    rung = np.asarray(result.patches["auto_rung"], float)
+    touching = np.isfinite(rung) & (np.nan_to_num(np.asarray(result.patches["normal_force_N"], float)) > 0)
+    codes = rung[touching].astype(int)
+    if not len(codes):
+        return ["## auto's choices", "", "No patch in contact was recorded.", ""]
+    level = np.asarray(result.patches["auto_level"], float)[touching]
+    deciding = np.asarray(result.patches["auto_deciding_feature"], float)[touching].astype(int)
+    shares = ", ".join(f"{name} {np.mean(codes == i):.1%}" for i, name in enumerate(AUTO_RUNGS))
+    decided = ", ".join(
+        f"{FEATURES[f]} {np.mean(deciding == f):.0%}" for f in range(len(FEATURES)) if np.any(deciding == f)
+    )
+    lvl = f"{np.nanmax(level):.0%}" if np.any(np.isfinite(level)) else "none (every patch BEM)"
+    return [
+        "## auto's choices",
+        "",
+        f"Per recorded patch in contact ({len(codes)}), the rung auto chose in the compiled loop from the measured "
+        f"thresholds (rigid_dynamics/contact/data/auto_thresholds.json) at the level {lvl} for the scene's "
+        f"contact_tolerance {result.scene.contact_tolerance:g}: {shares}. The feature that decided: {decided}. "
+        "Per patch and sample in run/timeseries.npz (patch_auto_rung, patch_auto_deciding_feature, "
+        "patch_auto_deciding_threshold, the features).",
+        "",
+    ]
 
 
 def register(sub) -> None:
@@ -199,4 +260,11 @@ def register(sub) -> None:
     demo.add_argument("scene", nargs="?", default="polygonal-wheel", help="scene with the 3-D contact search")
     demo.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
     demo.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
+    demo.add_argument(
+        "--contact-model", default="auto", help="contact model of the run (default auto, overriding the scene file's)"
+    )
+    demo.add_argument(
+        "--tolerance", type=float, default=DEMO_TOLERANCE,
+        help=f"auto's contact_tolerance for the run (default {DEMO_TOLERANCE:g}; README: why not the scene's 0.05)",
+    )  # fmt: skip
     demo.set_defaults(func=cmd_demo)

@@ -1,35 +1,38 @@
-"""Compiled (numba) fixed-step path of the wheelset simulation for contact-geometry tables.
+"""The one right-hand side of the wheelset simulation (numba), its fixed-step RK4 loop and the callback boundary.
 
-The equations of motion (eq 59-71 with the gyroscopic term), the primary suspension and the elastic track are
-written once (:func:`_assemble` here, the track's equations in
-:func:`rigid_dynamics.wheelset.track.track_rates`): the compiled loop's right-hand side ends in them and so does
-the Python one (equations.WheelsetModel.derivative through :func:`derivative_from_contact`, after any
-provider and contact model gave the contact forces). The same table
-look-up as providers.TableProvider, Hertz and Kalker's C_ij from equations.TabulatedHertzKalker, and the
-creep laws of the registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
-contact/linear.py), ``vermeulen-johnson`` (eq 53-58 with the cube, contact/vermeulen_johnson.py) and ``fastsim``
-(the contact package's compiled strip kernel contact.fastsim._fastsim_one with the flexibilities of
-contact.fastsim.effective_flexibilities, options nx, ny, traction_bound, flexibility as in the Python path),
-integrated by the classical RK4 method with a fixed step, all inside one compiled loop.
+Every integrator ends here: the compiled RK4 loop (:func:`rk4_run`), the compiled DP54/BS32 pairs
+(compiled_adaptive.py), and the scipy methods and the Python RK4 through equations.WheelsetModel.derivative, which
+calls :func:`rhs_once` / :func:`rhs_given`.
 
-Running-direction irregularities of the TableProvider (polygonal wheel R_irr = A cos(n alpha + phase), rounded
-flat, rail corrugation N_irr(x); irregular.py) are evaluated in the loop exactly as
-providers.running_irregularity does it: a section in the rolling plane maximising the extra overlap over the
-angle beta from the lowest point (81-point grid, then 3 limited Newton steps), the extra overlap projected on the
-normal, the normal tilted by N_irr', the longitudinal curvature from the polar curvature of r(beta) (floored for a
-concave flat); candidates whose gap exceeds the provider's reach are left alone.
-
-Used automatically by ``simulate`` whenever the scene runs RK4 on a TableProvider (ideal geometry or with these
-irregularities) with one of MODEL_CODES from the registry (``compiled=False`` forces the Python path); the adaptive
-scipy methods, the conical and search providers, ``auto``, ``bem`` and user models stay on the Python path.
-tests/test_dynamics_compiled.py checks that it reproduces the Python path (states to ~1e-14 relative).
+* Contact geometry (:func:`_rhs`, the ``mode`` of :func:`geometry_mode`): 0 the tables of a TableProvider
+  (:func:`_table_geometry`) with the running-direction irregularities (:func:`_irregularity`: polygonal wheel
+  R_irr = A cos(n alpha + phase), rounded flat, rail corrugation N_irr(x), dipped joint; irregular.py; a section in
+  the rolling plane maximising the extra overlap over the angle beta from the lowest point, 81-point grid then 3
+  limited Newton steps, the extra overlap projected on the normal, the normal tilted by N_irr', the longitudinal
+  curvature from the polar curvature of r(beta), floored for a concave flat; candidates whose gap exceeds the reach
+  are left alone); 1 the compiled 3-D search (compiled_search.py); 2 given by the caller (a provider the compiled
+  code does not evaluate: the conical one, the search on measured grids or harmonics, user providers, and the
+  search outside the compiled loop). TableProvider.patches and ConicalProvider's irregularities use these same
+  functions (:func:`table_candidates`, :func:`irregular_candidates`).
+* Creepages (:func:`_patch_creepages`, eq 39-49).
+* Contact laws (:func:`_law`): Hertz and Kalker's C_ij from the tables of equations.TabulatedHertzKalker, and the
+  registry's ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52), ``vermeulen-johnson``
+  (eq 53-58 with the cube) and ``fastsim`` (the contact package's strip kernel contact.fastsim._fastsim_one with the
+  flexibilities of contact.fastsim.effective_flexibilities; options nx, ny, traction_bound, flexibility), and
+  ``auto``'s choice per patch (:func:`_auto_choice`, the measured thresholds of contact/data/auto_thresholds.json
+  in the parameter record).
+* The callback boundary (:func:`_external`): contact models that are not compiled (bem, fea, user models; BEM when
+  ``auto`` chooses it) get the patch geometry and creepages handed out patch-wise to one Python dispatcher
+  (equations.PatchCallback) and give the forces back.
+* The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track (:func:`_assemble`;
+  the track's equations, data and parameter fields are those of :mod:`rigid_dynamics.wheelset.track`: a track model
+  is added there, in state.py's layout and in :func:`_assemble`'s call).
 
 Elastic track (scene ``track_dynamics.model = "lumped"``): the 8 track states follow the two work integrals
 (state.TRACK); the candidate geometry is evaluated with the wheelset centre raised by that side's rail
 deflection (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the
-creepages and the contact power use the velocity relative to the rail, and the track's equations, data and parameter
-fields are those of :mod:`rigid_dynamics.wheelset.track` (a track model is added there, in state.py's layout and
-in :func:`_assemble`'s call).
+creepages and the contact power use the velocity relative to the rail, and the track's equations are those of
+:func:`rigid_dynamics.wheelset.track.track_rates`.
 
 Curves and cant (scene ``[track] curve_direction``, ``curve_radius_m``, ``cant_m``; ``par.track_frame``): the states
 are relative to a frame following the track; :func:`_assemble_curve` adds the frame's terms to Newton and Euler and
@@ -44,7 +47,8 @@ The record keeps numba's on-disk cache working (with a jitclass or structref arg
 cache, recompiled and appended a cache entry: numba 0.68, measured here) and is a plain numpy array (set from
 Python as ``par["frame_x0_m"] = ...``). The state is indexed by the names of state.py (``y[RAIL_VELOCITY + side]``).
 
-Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined.
+Status codes of the loop: 0 ok, 1 non-finite state (blow-up), 2 force anomaly, 3 derailed, 4 creepages undefined,
+5 the contact model behind the callback failed (its message in the callback).
 """
 
 from __future__ import annotations
@@ -52,7 +56,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, objmode
 
 from rigid_dynamics.contact.fastsim import _fastsim_one
 from rigid_dynamics.wheelset import track
@@ -67,8 +71,18 @@ from rigid_dynamics.wheelset.state import (
 from rigid_dynamics.wheelset.track import track_rates as _track_rates
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
+"""The creep laws written here (registry names -> ``model_code``)."""
+CALLBACK_CODE = 4
+"""``model_code`` of a contact model that is not compiled (bem, fea, user models): every patch through the callback."""
+AUTO_CODE = 5
+"""``model_code`` of ``auto``: the rung chosen per patch in the loop; linear, Vermeulen-Johnson and FASTSIM inline,
+BEM through the callback."""
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
-N_FIELDS = 14  # equations.PATCH_FIELDS, in that order
+N_PATCH = 14  # equations.PATCH_FIELDS, in that order
+N_AUTO = 9  # equations.AUTO_PATCH_FIELDS, in that order, after them
+N_FIELDS = N_PATCH + N_AUTO
+AUTO_FEATURE_NAMES = ("saturation", "spin_share", "ellipticity_residual", "curvature_change", "second_patch_nearness")
+AUTO_RUNG_NAMES = ("linear", "vermeulen_johnson", "fastsim")
 
 PARAMETER_FIELDS = (
     ("mass_kg", "wheelset mass"),
@@ -125,6 +139,13 @@ PARAMETER_FIELDS = (
     ("cant_sin", "sin of the signed cant angle (> 0: left rail higher)"),
     ("cant_cos", "cos of the cant angle"),
     ("carried_mass_kg", "axle load / g: the mass whose quasi-static gravity and centrifugal load acts at the axle"),
+    ("auto_level", "auto: the tolerance level whose thresholds apply (NaN: below every level, always BEM)"),
+    ("auto_friction_bound_tolerance", "auto: FASTSIM above (1 + this) mu N is replaced by BEM (models.py)"),
+    *(
+        (f"auto_{r}_{f}", f"auto: threshold of {f} for {r} (NaN: no measured box)")
+        for r in AUTO_RUNG_NAMES
+        for f in AUTO_FEATURE_NAMES
+    ),
 )
 """The parameter record of the compiled right-hand side: (field, meaning); every field float64, SI units."""
 
@@ -138,8 +159,8 @@ def new_parameters():
     return np.zeros(1, PARAMETERS)[0]
 
 
-IRR_GRID = 81  # grid points of the running-direction section (providers.running_irregularity)
-IRR_NEWTON = 3  # Newton steps after the grid (same as providers.running_irregularity)
+IRR_GRID = 81  # grid points of the running-direction section
+IRR_NEWTON = 3  # Newton steps after the grid
 MIN_LONG_CURV_FRACTION = 0.1  # providers.MIN_LONGITUDINAL_CURVATURE_FRACTION
 
 
@@ -194,7 +215,7 @@ def _dip(par, x):
 
 @njit(cache=True, _nrt=False)
 def _irr_parts(par, radius, x0, spin, beta, res):
-    """providers.running_irregularity's ``parts`` for one candidate and one beta, into res[0:9]:
+    """The running-direction section's parts for one candidate and one beta, into res[0:9]:
     (q, q', q'', r, r', r'', x offset, N_irr', N_irr'').
     """
     rv, r1, r2 = 0.0, 0.0, 0.0
@@ -261,8 +282,9 @@ def _irr_q(par, radius, x0, spin, beta, sin_beta, cos_beta):
 
 @njit(cache=True, _nrt=False)
 def _irregularity(par, work, c, q, x0, spin, res, geo, bg):
-    """Running-direction irregularity of one candidate (providers.running_irregularity, same steps: a grid of
-    IRR_GRID angles, then IRR_NEWTON limited Newton steps). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
+    """Running-direction irregularity of one candidate (a grid of IRR_GRID angles, then IRR_NEWTON limited Newton
+    steps; derivation in the module docstring; the only implementation: the conical and table providers use it
+    too). Fills geo = (q, x offset, z offset, n_x, n_y, n_z,
     rolling radius, A) for the candidate. bg: the grid angles (as np.linspace(-half, half, IRR_GRID)), their sines
     and cosines (3, IRR_GRID).
     """
@@ -492,9 +514,9 @@ def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
     """The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track: d/dt of the full
     state into ``out`` from the summed contact force and moment about the centre (main frame, N and N m), the
     contact power ``p_con`` (W), the vertical contact forces on the rails (left, right; elastic track) and the
-    angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: the compiled
-    right-hand side (:func:`_forces`) and the Python one (equations.WheelsetModel.derivative through
-    :func:`derivative_from_contact`) both end here.
+    angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: every
+    right-hand side (the RK4 loop, the DP54/BS32 pairs, and equations.WheelsetModel.derivative for scipy's
+    methods) ends here through :func:`_forces`.
     """
     xc, yc, zc = y[0], y[1], y[2]
     yaw, roll = y[3], y[4]
@@ -581,35 +603,204 @@ def _rotation(y, om, rzx):
 
 
 @njit(cache=True)
-def derivative_from_contact(t, y, par, force, moment, p_con, rail_force, out):
-    """:func:`_assemble` for the Python right-hand side (equations.WheelsetModel.derivative): the contact sums
-    come from any contact model (the callback boundary: patches and creepages out, forces back, in Python).
-    """
-    om = np.empty(3)
-    rzx = np.empty((3, 3))
-    _rotation(y, om, rzx)
-    _assemble(t, y, par, force, moment, p_con, rail_force[0], rail_force[1], om, rzx, out)
-
-
-def frame_velocities(par, state, omega):
-    """In a curve (``par.track_frame``): the absolute angular velocity omega + Omega and the centre's absolute
-    velocity (x' h, y', z') that the creepages take (as :func:`_forces` does; _assemble_curve), from the state and
-    the angular velocity relative to the track frame; else ``omega`` and the state's velocity unchanged.
-    """
-    v = np.array(state[6:9], float)
-    if not par["track_frame"] > 0:
-        return omega, v
-    kap, s_, c_ = float(par["curvature_1_per_m"]), float(par["cant_sin"]), float(par["cant_cos"])
-    w = kap * v[0]
-    out = np.array(omega, float) + np.array([0.0, w * s_, w * c_])
-    v[0] *= 1.0 + kap * (s_ * state[2] - c_ * state[1])
-    return out, v
-
-
-@njit(cache=True)
 def track_rates(par, y, rail_force, out):
     """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``); returns the dampers' power."""
     return _track_rates(par, y, rail_force[0], rail_force[1], out, 0.0)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _hertz_kalker(par, hz, kk, q, ca, cb):
+    """Hertz under approach control (tables of the axial function) and Kalker's C11, C22, C23, C33 (tables of a/b):
+    (N, a, b, C11, C22, C23, C33).
+    """
+    amin, amax = min(ca, cb), max(ca, cb)
+    i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
+    pp = hz[1, i] * (1 - w) + hz[1, i + 1] * w
+    kk_ = hz[2, i] * (1 - w) + hz[2, i + 1] * w
+    dd = hz[3, i] * (1 - w) + hz[3, i + 1] * w
+    major = math.sqrt(q * dd / (kk_ * amin))
+    normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
+    minor = major * math.sqrt(pp)
+    sa, sb = (major, minor) if ca <= cb else (minor, major)
+    i, w = _uniform(math.log(sa / sb), kk[0, 0], kk[0, 1], kk.shape[1])
+    c11 = kk[1, i] * (1 - w) + kk[1, i + 1] * w
+    c22 = kk[2, i] * (1 - w) + kk[2, i + 1] * w
+    c23 = kk[3, i] * (1 - w) + kk[3, i + 1] * w
+    c33 = kk[4, i] * (1 - w) + kk[4, i + 1] * w
+    return normal, sa, sb, c11, c22, c23, c33
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _creep_law(par, code, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin):
+    """(T_x, T_y, M_z) of the compiled creep law ``code`` (MODEL_CODES) on a Hertz patch."""
+    tx, ty, mz = 0.0, 0.0, 0.0
+    if code >= 1:
+        ab = sa * sb
+        gab = par.shear_modulus_Pa * ab
+        gab15 = gab * math.sqrt(ab)
+        if code == 3:
+            l1, l2, l3 = _flexibilities(par, sa, sb, normal, xi, eta, spin, c11, c22, c23)
+            fs = _fastsim_one(
+                sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
+                int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
+            )  # fmt: skip
+            tx, ty, mz = fs[0], fs[1], fs[2]
+        else:
+            tx = -gab * c11 * xi
+            ty = -gab * c22 * eta - gab15 * c23 * spin
+            mz = gab15 * c23 * eta - gab * ab * c33 * spin
+        if code == 2:
+            tt = math.hypot(tx, ty)
+            limit = par.friction_coefficient * normal
+            if tt > 0.0:
+                wprime = tt / (3.0 * limit) if limit > 0 else np.inf
+                one = max(1.0 - wprime, 0.0)
+                scale = limit * (1.0 - one**3) / tt
+                tx *= scale
+                ty *= scale
+            mz = 0.0
+    return tx, ty, mz
+
+
+@njit(cache=True, _nrt=False)
+def _auto_threshold(par, rung, f):
+    """Auto's threshold of feature f (AUTO_FEATURE_NAMES) for rung (0 linear, 1 Vermeulen-Johnson, 2 FASTSIM)."""
+    if rung == 0:
+        v = (par.auto_linear_saturation, par.auto_linear_spin_share, par.auto_linear_ellipticity_residual,
+             par.auto_linear_curvature_change, par.auto_linear_second_patch_nearness)  # fmt: skip
+    elif rung == 1:
+        v = (par.auto_vermeulen_johnson_saturation, par.auto_vermeulen_johnson_spin_share,
+             par.auto_vermeulen_johnson_ellipticity_residual, par.auto_vermeulen_johnson_curvature_change,
+             par.auto_vermeulen_johnson_second_patch_nearness)  # fmt: skip
+    else:
+        v = (par.auto_fastsim_saturation, par.auto_fastsim_spin_share, par.auto_fastsim_ellipticity_residual,
+             par.auto_fastsim_curvature_change, par.auto_fastsim_second_patch_nearness)  # fmt: skip
+    return v[f]
+
+
+@njit(cache=True, _nrt=False)
+def _auto_choice(par, feats):
+    """auto.choose_rung in the loop: (rung 0-3 as auto.AUTO_RUNGS, deciding feature index or -1, its threshold).
+    The first of linear, Vermeulen-Johnson, FASTSIM (at the run's grid) whose measured box holds every feature;
+    else BEM (3). The deciding feature: of the last rejected rung the feature furthest beyond its threshold; when the
+    cheapest rung qualified, the feature closest to its threshold.
+    """
+    if math.isnan(par.auto_level):
+        return 3, -1, np.nan
+    last_f, last_t = -1, np.nan
+    for rung in range(3):
+        if math.isnan(_auto_threshold(par, rung, 0)):
+            continue  # no measured box at this level
+        worst, worst_f = -1.0, -1
+        for f in range(5):
+            box = _auto_threshold(par, rung, f)
+            if not feats[f] <= box:
+                ratio = feats[f] / box if box > 0 else np.inf
+                if ratio > worst:
+                    worst, worst_f = ratio, f
+        if worst_f >= 0:
+            last_f, last_t = worst_f, _auto_threshold(par, rung, worst_f)
+            continue
+        if last_f < 0:
+            best, best_f = -1.0, 0
+            for f in range(5):
+                box = _auto_threshold(par, rung, f)
+                r = feats[f] / box if box > 0 else (0.0 if feats[f] <= 0 else 1.0)
+                if r > best:
+                    best, best_f = r, f
+            return rung, best_f, _auto_threshold(par, rung, best_f)
+        return rung, last_f, last_t
+    return 3, last_f, last_t
+
+
+@njit(cache=True, _nrt=False)
+def _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec, c, record):
+    """The compiled contact law of one patch: (N, a, b, T_x, T_y, M_z, status); status 1: the patch is for the
+    callback (``auto`` chose BEM, or its FASTSIM broke the friction bound as auto's does in contact.models).
+
+    ``auto`` (par.model_code AUTO_CODE): the features of contact.auto.patch_features that a quadric patch has
+    (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
+    are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
+    rec[c, N_PATCH:] as equations.AUTO_PATCH_FIELDS.
+    """
+    normal, sa, sb, c11, c22, c23, c33 = _hertz_kalker(par, hz, kk, q, ca, cb)
+    code = int(par.model_code)
+    if code != AUTO_CODE:
+        tx, ty, mz = _creep_law(par, code, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin)
+        return normal, sa, sb, tx, ty, mz, 0
+    ab = sa * sb
+    gab = par.shear_modulus_Pa * ab
+    gab15 = gab * math.sqrt(ab)
+    t_lin = math.hypot(-gab * c11 * xi, -gab * c22 * eta - gab15 * c23 * spin)
+    mu_n = par.friction_coefficient * normal
+    feats = (
+        t_lin / (3.0 * mu_n) if mu_n > 0 else np.inf,
+        gab15 * c23 * abs(spin) / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0,
+        0.0,
+        0.0,
+        0.0,
+    )
+    rung, deciding, threshold = _auto_choice(par, feats)
+    st = 0
+    tx, ty, mz = 0.0, 0.0, 0.0
+    if rung < 3:
+        tx, ty, mz = _creep_law(par, rung + 1, dummy, normal, sa, sb, c11, c22, c23, c33, xi, eta, spin)
+        if rung == 2 and math.hypot(tx, ty) > (1.0 + par.auto_friction_bound_tolerance) * mu_n:
+            rung, st = 3, 1
+    else:
+        st = 1
+    if record:
+        rec[c, N_PATCH], rec[c, N_PATCH + 1], rec[c, N_PATCH + 2] = rung, par.auto_level, deciding
+        rec[c, N_PATCH + 3] = threshold
+        for f in range(5):
+            rec[c, N_PATCH + 4 + f] = feats[f]
+    return normal, sa, sb, tx, ty, mz, st
+
+
+@njit(cache=True)
+def patch_forces(par, hz, kk, q, ca, cb, xi, eta, spin):
+    """One patch through the compiled law of par.model_code (not the callback): (N, T_x, T_y, M_z, a, b, status),
+    for tests and inspection.
+    """
+    rec = np.zeros((1, N_FIELDS))
+    normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, np.zeros((1, 1)), q, ca, cb, xi, eta, spin, rec, 0, False)
+    return normal, tx, ty, mz, sa, sb, st
+
+
+_CALLBACK = [None]
+"""The Python object that solves the patches of the non-compiled contact models (equations.PatchCallback), set by
+:func:`use_callback` before a compiled run or right-hand side."""
+
+
+def use_callback(callback) -> None:
+    """Make ``callback`` the one the compiled code hands its patches to (see :func:`_external`)."""
+    _CALLBACK[0] = callback
+
+
+def _dispatch(c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral):
+    """The callback boundary's Python side: the patch to the callback in use (equations.PatchCallback.solve)."""
+    return _CALLBACK[0].solve(
+        c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral
+    )
+
+
+@njit(cache=True, _nrt=False)
+def _external(c, side, t, q, ca, cb, xi, eta, spin, speed, px, py, pz, n, ex, ey, radius, angle, lateral):
+    """The one callback boundary: a patch (candidate c of ``side`` at time t: approach, curvatures, creepages,
+    rolling speed, contact point and contact frame e_x, e_y, n in the main frame, rolling radius, contact angle,
+    wheel lateral position) handed to Python (numba objmode) and (N, T_x, T_y, M_z, a, b, status) taken back;
+    status != 0: the contact model failed (the callback keeps its message). Overhead measured here: 2.0-2.1 us per
+    objmode call of a trivial Python function; 25 us per patch through equations.PatchCallback with a model returning
+    constant forces (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes about 20 ms.
+    """
+    n0, n1, n2 = n[0], n[1], n[2]
+    x0, x1, x2, y0, y1, y2 = ex[0], ex[1], ex[2], ey[0], ey[1], ey[2]
+    with objmode(normal="float64", tx="float64", ty="float64", mz="float64", sa="float64", sb="float64", st="int64"):
+        normal, tx, ty, mz, sa, sb, st = _dispatch(
+            c, side, t, q, ca, cb, xi, eta, spin, speed, (px, py, pz), (n0, n1, n2), (x0, x1, x2), (y0, y1, y2),
+            radius, angle, lateral,
+        )  # fmt: skip
+    return normal, tx, ty, mz, sa, sb, st
 
 
 @njit(cache=True, _nrt=False)
@@ -667,47 +858,22 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         speed, xi, eta, spin = _patch_creepages(lever, n, oma, vxa, vy, vz, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
-        # Hertz, approach control (tables of the axial function)
-        amin, amax = min(ca, cb), max(ca, cb)
-        i, w = _uniform(math.log(amax / amin), hz[0, 0], hz[0, 1], hz.shape[1])
-        pp = hz[1, i] * (1 - w) + hz[1, i + 1] * w
-        kk_ = hz[2, i] * (1 - w) + hz[2, i + 1] * w
-        dd = hz[3, i] * (1 - w) + hz[3, i + 1] * w
-        major = math.sqrt(q * dd / (kk_ * amin))
-        normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
-        minor = major * math.sqrt(pp)
-        sa, sb = (major, minor) if ca <= cb else (minor, major)
-        tx, ty, mz = 0.0, 0.0, 0.0
-        if par.model_code >= 1:
-            i, w = _uniform(math.log(sa / sb), kk[0, 0], kk[0, 1], kk.shape[1])
-            c11 = kk[1, i] * (1 - w) + kk[1, i + 1] * w
-            c22 = kk[2, i] * (1 - w) + kk[2, i + 1] * w
-            c23 = kk[3, i] * (1 - w) + kk[3, i + 1] * w
-            c33 = kk[4, i] * (1 - w) + kk[4, i + 1] * w
-            ab = sa * sb
-            gab = par.shear_modulus_Pa * ab
-            gab15 = gab * math.sqrt(ab)
-            if par.model_code == 3:
-                l1, l2, l3 = _flexibilities(par, sa, sb, normal, xi, eta, spin, c11, c22, c23)
-                fs = _fastsim_one(
-                    sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
-                    int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
+        if par.model_code == CALLBACK_CODE:
+            normal, tx, ty, mz, sa, sb, st = _external(
+                c, sides[c], t, q, ca, cb, xi, eta, spin, speed, y[0] + lever[0], yc + lever[1], y[2] + lever[2], n,
+                ex, ey, radius, g[11], g[10],
+            )  # fmt: skip
+            if st != 0:
+                return 5
+        else:
+            normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
+            if st == 1:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
+                normal, tx, ty, mz, sa, sb, st = _external(
+                    c, sides[c], t, q, ca, cb, xi, eta, spin, speed, y[0] + lever[0], yc + lever[1], y[2] + lever[2],
+                    n, ex, ey, radius, g[11], g[10],
                 )  # fmt: skip
-                tx, ty, mz = fs[0], fs[1], fs[2]
-            else:
-                tx = -gab * c11 * xi
-                ty = -gab * c22 * eta - gab15 * c23 * spin
-                mz = gab15 * c23 * eta - gab * ab * c33 * spin
-            if par.model_code == 2:
-                tt = math.hypot(tx, ty)
-                limit = par.friction_coefficient * normal
-                if tt > 0.0:
-                    wprime = tt / (3.0 * limit) if limit > 0 else np.inf
-                    one = max(1.0 - wprime, 0.0)
-                    scale = limit * (1.0 - one**3) / tt
-                    tx *= scale
-                    ty *= scale
-                mz = 0.0
+                if st != 0:
+                    return 5
         for k in range(3):
             fc[k] = ex[k] * tx + ey[k] * ty + n[k] * normal
             mc[k] = n[k] * mz
@@ -747,20 +913,36 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
 
 @njit(cache=True, _nrt=False)
 def _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, record, full, out):
-    """d/dt of the 14-state: the candidate geometry from the tables (mode 0, _table_geometry) or the 3-D search
-    (mode 1, compiled_search.search_geometry; ``full``: with the lateral scan), then _forces. Returns the status.
+    """d/dt of the 14-state: the candidate geometry from the tables (mode 0, _table_geometry), the 3-D search
+    (mode 1, compiled_search.search_geometry; ``full``: with the lateral scan) or given by the caller in ws[7]
+    (mode 2: a provider the compiled code does not evaluate, equations.WheelsetModel fills it), then _forces.
+    Returns the status.
     """
-    work, rec, res, geo, dummy, sc, bg, cg = ws[0], ws[1], ws[2], ws[3], ws[4], ws[5], ws[6], ws[7]
+    _geometry(y, par, sides, mode, targs, sargs, ws, full)
+    return _forces(t, y, par, ws[7], sides, hz, kk, ws[1], record, ws[4], ws[5], out)
+
+
+@njit(cache=True, _nrt=False)
+def _geometry(y, par, sides, mode, targs, sargs, ws, full):
+    """The candidate geometry at the state y into ws[7] (mode 0 tables, 1 search; mode 2: given, left alone)."""
+    work, res, geo, bg, cg = ws[0], ws[2], ws[3], ws[6], ws[7]
     if mode == 0:
         table, grid, slots = targs
         _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg)
-    else:
+    elif mode == 1:
         sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = sargs
         if par.elastic_track > 0:
             search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15])
         else:
             search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
-    return _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out)
+
+
+@njit(cache=True)
+def geometry_once(y, par, sides, mode, targs, sargs, cg):
+    """The candidate geometry alone (no contact law: the static equilibrium's approaches) into cg (mode 0 or 1)."""
+    ws = _workspace(par, targs[0].shape[0], sides.shape[0], np.zeros((sides.shape[0] + 2, N_FIELDS)))
+    _geometry(y, par, sides, mode, targs, sargs, ws, True)
+    cg[:, :] = ws[7]
 
 
 @njit(cache=True)
@@ -788,6 +970,27 @@ def rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec):
     """
     ws = _workspace(par, targs[0].shape[0], sides.shape[0], rec)
     return _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
+
+
+@njit(cache=True)
+def contact_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec, cg):
+    """:func:`rhs_once` that also returns the candidate geometry into cg (ncand, N_GEO) (for inspection: the
+    contact frames and forces of equations.WheelsetModel.contact). Mode 2: cg is the given geometry.
+    """
+    if mode == 2:
+        return rhs_given(t, y, par, hz, kk, sides, cg, out, rec, True)
+    ws = _workspace(par, targs[0].shape[0], sides.shape[0], rec)
+    st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, out)
+    cg[:, :] = ws[7]
+    return st
+
+
+@njit(cache=True)
+def rhs_given(t, y, par, hz, kk, sides, cg, out, rec, record):
+    """The right-hand side on a given candidate geometry cg (ncand, N_GEO) (mode 2: a provider the compiled code
+    does not evaluate): the compiled laws, the callback, the equations of motion, as in the loop.
+    """
+    return _forces(t, y, par, cg, sides, hz, kk, rec, record, np.zeros((1, 1)), np.zeros((16, 3)), out)
 
 
 @njit(cache=True, _nrt=False)
@@ -942,28 +1145,73 @@ def load(packed) -> None:
     rhs_once(0.0, y, par, hz, kk, sides, mode, targs, sargs, np.zeros(len(y)), rec)
 
 
-def supported(scene, provider, model) -> bool:
-    """Whether the compiled path can run this combination: RK4, one of the registry's models in MODEL_CODES, and
-    a TableProvider (with or without running-direction irregularities: polygon, rounded flat, corrugation) or a
-    SearchProvider on tabulated surfaces (ideal profiles with polygon, flats or corrugation).
+def geometry_mode(provider) -> int:
+    """How the right-hand side gets the contact geometry of ``provider``: 0 the compiled tables (a TableProvider,
+    with or without running-direction irregularities), 1 the compiled 3-D search (a SearchProvider on tabulated
+    surfaces: ideal profiles with polygon, flats or corrugation), 2 given by Python (any other provider: the conical
+    one, the search on measured grids or harmonics, user providers; equations.WheelsetModel fills the candidates).
     """
     from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
     from rigid_dynamics.wheelset.providers import SearchProvider, TableProvider
 
-    if not (
-        scene.integrator.method == "RK4"
-        and getattr(model, "name", None) in MODEL_CODES
-        and type(model).__module__ == "rigid_dynamics.contact.models"
-    ):
-        return False
     if type(provider) is TableProvider:
-        return True
+        return 0
     if type(provider) is SearchProvider:
         fast = getattr(provider.surfaces, "fast", None)
-        return fast is not None and all(
+        if fast is not None and all(
             isinstance(w, TabulatedWheel) and isinstance(r, TabulatedRail) for w, r in fast.values()
-        )
-    return False
+        ):
+            return 1
+    return 2
+
+
+def supported(scene, provider, model) -> bool:
+    """Whether the compiled RK4 loop can run this combination: method RK4 and a provider whose geometry is compiled
+    (:func:`geometry_mode` 0 or 1). Any contact model: the compiled laws inline, ``auto``'s choice inline, the
+    others (bem, fea, user models) through the callback.
+    """
+    return scene.integrator.method == "RK4" and geometry_mode(provider) < 2
+
+
+def model_code(model) -> int:
+    """``model_code`` of a contact model instance: MODEL_CODES for the registry's compiled laws, AUTO_CODE for its
+    ``auto``, CALLBACK_CODE for everything else (bem, fea, user models, subclasses).
+    """
+    name = getattr(model, "name", None)
+    if type(model).__module__ == "rigid_dynamics.contact.models":
+        if name in MODEL_CODES:
+            return MODEL_CODES[name]
+        if name == "auto":
+            return AUTO_CODE
+    return CALLBACK_CODE
+
+
+def auto_parameters(par, tolerance: float, fastsim_grid) -> None:
+    """Auto's thresholds (contact/data/auto_thresholds.json, contact.auto) into the parameter record: the level of
+    ``tolerance`` (contact.auto.level_for; none: NaN, every patch BEM) and per rung (linear, Vermeulen-Johnson,
+    FASTSIM at the run's grid by contact.auto.fastsim_rung) the feature box (NaN: no measured box).
+    """
+    from rigid_dynamics.contact.auto import fastsim_rung, level_for, load_thresholds
+    from rigid_dynamics.contact.models import FRICTION_BOUND_TOLERANCE
+
+    data = load_thresholds()
+    key = level_for(tolerance, data)
+    par["auto_friction_bound_tolerance"] = FRICTION_BOUND_TOLERANCE
+    for rung in AUTO_RUNG_NAMES:
+        for f in AUTO_FEATURE_NAMES:
+            par[f"auto_{rung}_{f}"] = np.nan
+    if key is None:
+        par["auto_level"] = np.nan
+        return
+    par["auto_level"] = float(key)
+    level = data["levels"][key]
+    labels = ("linear", "vermeulen-johnson", fastsim_rung(int(fastsim_grid[0]), int(fastsim_grid[1]), level))
+    for rung, label in zip(AUTO_RUNG_NAMES, labels, strict=True):
+        entry = level.get(label) if label is not None else None
+        box = None if entry is None else entry["thresholds"]
+        if box is not None:
+            for f in AUTO_FEATURE_NAMES:
+                par[f"auto_{rung}_{f}"] = float(box[f])
 
 
 def model_parameters(model_wheelset):
@@ -997,71 +1245,99 @@ def model_parameters(model_wheelset):
     return par
 
 
-def pack(model_wheelset, provider, tables, model_name, options=None):
-    """Arguments of rk4_run from a WheelsetModel, its provider (TableProvider or SearchProvider) and the Hertz /
-    Kalker tables: (par, hz, kk, sides, slots, mode, targs, sargs).
+def irregularity_parameters(par, irr, sides_mask, r0: float) -> None:
+    """The running-direction irregularities ``irr`` (polygon, rounded flat, corrugation, dipped joint) on the sides of
+    ``sides_mask`` (left, right) into the parameter record, with the section's reach and half angle.
     """
-    from rigid_dynamics.wheelset.providers import SearchProvider
+    from rigid_dynamics.wheelset.irregular import dip_depth_m, flat_depth_m
 
-    search = type(provider) is SearchProvider
+    par["nominal_radius_m"] = r0
+    par["irregular"] = 1.0
+    par["irregular_left"], par["irregular_right"] = (float(v) for v in sides_mask)
+    par["polygon_order"], par["polygon_amplitude_m"], par["polygon_phase_rad"] = (
+        irr.polygon_order,
+        irr.polygon_amplitude_m,
+        irr.polygon_phase_rad,
+    )
+    reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
+    half = 0.02
+    if irr.flat_length_m > 0:
+        depth = flat_depth_m(irr, r0)
+        par["flat_length_m"], par["flat_depth_m"], par["flat_angle_rad"] = irr.flat_length_m, depth, irr.flat_angle_rad
+        reach += 2.0 * depth
+        half = max(half, 1.5 * irr.flat_length_m / r0)
+    if irr.corrugation_amplitude_m > 0:
+        par["corrugation_wavelength_m"] = irr.corrugation_wavelength_m
+        par["corrugation_amplitude_m"] = irr.corrugation_amplitude_m
+        half = max(half, 0.6 * irr.corrugation_wavelength_m / r0)
+    if irr.joint_dip_angle_rad > 0:
+        par["dip_angle_rad"], par["dip_position_m"] = irr.joint_dip_angle_rad, irr.joint_position_m
+        par["dip_ramp_length_m"] = irr.joint_ramp_length_m
+        par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
+        reach += 2.0 * dip_depth_m(irr)
+    par["irregularity_reach_m"], par["section_half_angle_rad"] = reach, half
+
+
+@njit(cache=True)
+def table_candidates(y, par, table, grid, slots, sides, cg):
+    """The tables' candidates (with the running-direction irregularities of par) at the pose in y into cg
+    (ncand, N_GEO): :func:`_table_geometry` for providers.TableProvider.patches (inspection, tests).
+    """
+    ws = _workspace(par, table.shape[0], sides.shape[0], np.zeros((sides.shape[0] + 2, N_FIELDS)))
+    _table_geometry(y, par, table, grid, slots, sides, ws[0], ws[2], ws[3], ws[6], cg)
+
+
+@njit(cache=True)
+def irregular_candidates(par, work, sides, x0, spin, cg):
+    """The running-direction irregularities (:func:`_irregularity`) added to candidates given as table rows ``work``
+    (rows 4, 5: normal y, z; 6: A; 8: rolling radius; 0: approach) at contact points x0 (ncand), the spin angle
+    ``spin``: into cg (ncand, 8) = (q, x offset, z offset, n_x, n_y, n_z, rolling radius, A); rows of candidates left
+    alone (side not irregular, gap beyond the reach) are NaN. For providers.ConicalProvider.
+    """
+    ws = _workspace(par, work.shape[0], sides.shape[0], np.zeros((sides.shape[0] + 2, N_FIELDS)))
+    res, bg = ws[2], ws[6]
+    for c in range(sides.shape[0]):
+        cg[c, :] = np.nan
+        q = work[0, c]
+        if q > -par.irregularity_reach_m and (par.irregular_right if sides[c] == 1 else par.irregular_left) > 0:
+            _irregularity(par, work, c, q, x0[c], spin, res, cg[c], bg)
+
+
+def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, python_geometry=False):
+    """Arguments of rk4_run / rhs_once from a WheelsetModel, its provider, the Hertz / Kalker tables and the contact
+    model instance: (par, hz, kk, sides, slots, mode, targs, sargs). ``options``: FASTSIM's (nx, ny, traction_bound,
+    flexibility) for ``fastsim`` and ``auto``; ``tolerance``: auto's; ``python_geometry``: mode 2 for any provider.
+    """
+    mode = 2 if python_geometry else geometry_mode(provider)
+    search = mode == 1
     m = model_wheelset
     scene = m.scene
     par = model_parameters(m)
     par["shear_modulus_Pa"] = scene.material.shear_modulus_Pa
     par["contact_modulus_Pa"] = tables.e_star
     par["friction_coefficient"] = scene.material.friction_coefficient
-    par["model_code"] = MODEL_CODES[model_name]
-    par["z_ref_m"] = 0.0 if search else provider.z_ref
+    code = model_code(model)
+    par["model_code"] = code
+    par["z_ref_m"] = provider.z_ref if mode == 0 else 0.0
     opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
-    opts.update(options or {})
+    opts.update({k: v for k, v in (options or {}).items() if k in opts})
     par["fastsim_nx"], par["fastsim_ny"] = int(opts["nx"]), int(opts["ny"])
     par["fastsim_parabolic"] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
     par["flexibility_code"] = FLEX_CODES[opts["flexibility"]]
-    par["nominal_radius_m"] = provider.r0
-    irr = None if search else provider.irregularities
-    if irr is not None:
-        from rigid_dynamics.wheelset.irregular import flat_depth_m
-
-        # the same selection constants as providers.running_irregularity
-        par["irregular"] = 1.0
-        par["irregular_left"], par["irregular_right"] = (float(v) for v in provider._irr_sides)
-        par["polygon_order"], par["polygon_amplitude_m"], par["polygon_phase_rad"] = (
-            irr.polygon_order,
-            irr.polygon_amplitude_m,
-            irr.polygon_phase_rad,
-        )
-        reach = 2.0 * (irr.polygon_amplitude_m + irr.corrugation_amplitude_m) + 1e-4
-        half = 0.02
-        if irr.flat_length_m > 0:
-            depth = flat_depth_m(irr, provider.r0)
-            par["flat_length_m"], par["flat_depth_m"], par["flat_angle_rad"] = (
-                irr.flat_length_m,
-                depth,
-                irr.flat_angle_rad,
-            )
-            reach += 2.0 * depth
-            half = max(half, 1.5 * irr.flat_length_m / provider.r0)
-        if irr.corrugation_amplitude_m > 0:
-            par["corrugation_wavelength_m"], par["corrugation_amplitude_m"] = (
-                irr.corrugation_wavelength_m,
-                irr.corrugation_amplitude_m,
-            )
-            half = max(half, 0.6 * irr.corrugation_wavelength_m / provider.r0)
-        if irr.joint_dip_angle_rad > 0:
-            from rigid_dynamics.wheelset.irregular import dip_depth_m
-
-            par["dip_angle_rad"], par["dip_position_m"], par["dip_ramp_length_m"] = (
-                irr.joint_dip_angle_rad,
-                irr.joint_position_m,
-                irr.joint_ramp_length_m,
-            )
-            par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
-            reach += 2.0 * dip_depth_m(irr)
-        par["irregularity_reach_m"], par["section_half_angle_rad"] = reach, half
+    if code == AUTO_CODE:
+        auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
     hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
     hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
     kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
     kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
+    if mode == 2:
+        par["nominal_radius_m"] = getattr(provider, "r0", scene.wheelset.nominal_radius_m)
+        sides = np.array([0, 0, 1, 1], np.int64)
+        slots = np.array([0, 1, 0, 1], np.int64)
+        return par, hz, kk, sides, slots, 2, (np.zeros((1, 4, 2, 2)), np.zeros(6), slots), _dummy_search()
+    par["nominal_radius_m"] = provider.r0
+    if not search and provider.irregularities is not None:
+        irregularity_parameters(par, provider.irregularities, provider._irr_sides, provider.r0)
     if search:
         from rigid_dynamics.wheelset import compiled_search as cs
 

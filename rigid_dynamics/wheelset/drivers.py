@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import MAX_SLOTS, PATCH_FIELDS, ContactFailure
+from rigid_dynamics.wheelset.equations import AUTO_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS, ContactFailure
 from rigid_dynamics.wheelset.equilibrium import COMPILED_STATUS, contact_force_sums
 from rigid_dynamics.wheelset.recorder import Stop
 from rigid_dynamics.wheelset.state import (
@@ -225,6 +225,7 @@ def run_compiled(model, packed, y0, duration, settings, recorder, report, start)
         return compiled_adaptive.run_embedded(model, packed, y0, duration, settings, recorder, report, start)
 
     par, hz, kk, sides, slots, mode, targs, sargs = packed
+    compiled.use_callback(model.callback)
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
     out_every = max(1, int(round(settings.output_step_s / h)))
@@ -236,7 +237,7 @@ def run_compiled(model, packed, y0, duration, settings, recorder, report, start)
     errs = np.full(n_out, np.nan)
     y, t, done, k_out = y0.copy(), 0.0, 0, 0
     chunk = max(out_every, (2000 // out_every) * out_every)
-    fields_ = PATCH_FIELDS
+    fields_ = PATCH_FIELDS + (AUTO_PATCH_FIELDS if model.auto else ())
     while done < n_steps:
         todo = min(chunk, n_steps - done)
         status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
@@ -256,9 +257,10 @@ def run_compiled(model, packed, y0, duration, settings, recorder, report, start)
             )
         k_out = k_new
         if status != 0:
+            why = f": {model.callback.message}" if status == 5 and model.callback is not None else ""
             stop = Stop(
                 COMPILED_STATUS[int(status)],
-                f"compiled RK4 stopped ({COMPILED_STATUS[int(status)]}) at t = {t_end:.6g} s",
+                f"compiled RK4 stopped ({COMPILED_STATUS[int(status)]}) at t = {t_end:.6g} s{why}",
                 float(t_end),
                 np.array(y_end[:12]),
             )

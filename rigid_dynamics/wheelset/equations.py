@@ -51,17 +51,10 @@ import numpy as np
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
 from rigid_dynamics.wheelset import track as track_model
-from rigid_dynamics.wheelset.compiled import (
-    derivative_from_contact,
-    frame_velocities,
-    model_parameters,
-    patch_creepages,
-    track_rates,
-)
+from rigid_dynamics.wheelset.compiled import model_parameters, patch_creepages, track_rates
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
 from rigid_dynamics.wheelset.state import (
-    MECHANICAL,
     TRACK,
     n_states,
 )
@@ -135,18 +128,6 @@ def _cross_rows(vector, rows):
     return np.stack([wy * z - wz * y, wz * x - wx * z, wx * y - wy * x], axis=-1)
 
 
-def _cross_pairs(first, second):
-    """first[i] x second[i] for two (n, 3) arrays."""
-    a1, a2, a3 = first[:, 0], first[:, 1], first[:, 2]
-    b1, b2, b3 = second[:, 0], second[:, 1], second[:, 2]
-    return np.stack([a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1], axis=-1)
-
-
-def _cross3(a, b):
-    """Cross product a x b of two 3-vectors (plain arithmetic)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     """Contact frames and creepages of many points (eq 39-49) by the compiled kernel (compiled.patch_creepages, the
     one used by the compiled right-hand side).
@@ -164,19 +145,6 @@ def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     return frames, out[0], out[1], out[2], out[3]
 
 
-BATCH_MODELS = ("hertz", "linear", "vermeulen-johnson", "fastsim")
-"""Registered models evaluated for all patches at once through their vectorised kernels."""
-
-
-def _uniform_interp(x, grid, rows):
-    """Linear interpolation of several tables sampled on the same uniform grid (x inside the grid)."""
-    step = grid[1] - grid[0]
-    f = (x - grid[0]) / step
-    i = np.minimum(f.astype(np.intp), len(grid) - 2)
-    w = f - i
-    return [row[i] * (1.0 - w) + row[i + 1] * w for row in rows]
-
-
 class TabulatedHertzKalker:
     """Hertz (approach control) and Kalker's C_ij for many patches by look-up tables, for speed.
 
@@ -189,9 +157,10 @@ class TabulatedHertzKalker:
     * C11, C22, C23, C33 (contact.kalker.kalker_coefficients at the material's nu) on ``KALKER_POINTS``
       points of ln(a/b) in [-ln 50, ln 50].
 
-    Then (hertz.py, approach control): a_major = sqrt(q D / (K min(A, B))), N = 2 pi a_major E* q / (3 K),
-    b_minor = a_major sqrt(p), E* = G/(1 - nu). Relative interpolation error < 1e-7 (the test compares
-    with hertz_solve_batch and kalker_coefficients). Ratios outside the grids fall back to the solvers.
+    The compiled right-hand side (compiled._hertz_kalker) interpolates them: a_major = sqrt(q D / (K min(A, B))),
+    N = 2 pi a_major E* q / (3 K), b_minor = a_major sqrt(p), E* = G/(1 - nu). Relative interpolation error < 1e-7
+    (tests/test_wheelset_providers.py compares with hertz_solve_batch and kalker_coefficients); ratios outside the
+    grids are clamped to their ends.
     """
 
     HERTZ_POINTS = 20001
@@ -212,33 +181,6 @@ class TabulatedHertzKalker:
         coef = kalker_coefficients(np.exp(self.log_ab), self.nu)
         self.c = np.stack([coef.c11, coef.c22, coef.c23, coef.c33])
 
-    def hertz(self, curv_a, curv_b, approach):
-        """(a, b, N) for approach control (arrays); exact solver outside the table."""
-        from rigid_dynamics.contact.hertz import hertz_solve_batch
-
-        a_min = np.minimum(curv_a, curv_b)
-        log_r = np.log(np.maximum(curv_a, curv_b) / a_min)
-        if np.any(log_r > self.log_r[-1]) or not np.all(a_min > 0):
-            sol = hertz_solve_batch(
-                curv_a, curv_b, approach_m=approach, shear_modulus_Pa=self.shear, poisson_ratio=self.nu
-            )
-            return sol.semi_axis_long_m, sol.semi_axis_lat_m, sol.normal_force_N
-        p, k, d = _uniform_interp(log_r, self.log_r, (self.p, self.k, self.d))
-        major = np.sqrt(approach * d / (k * a_min))
-        force = 2.0 * math.pi * major * self.e_star * approach / (3.0 * k)
-        minor = major * np.sqrt(p)
-        along_x = curv_a <= curv_b
-        return np.where(along_x, major, minor), np.where(along_x, minor, major), force
-
-    def coefficients(self, semi_a, semi_b):
-        """CreepCoefficients for a/b (table, exact outside)."""
-        from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
-
-        log_ab = np.log(semi_a / semi_b)
-        if np.any(np.abs(log_ab) > self.log_ab[-1]):
-            return kalker_coefficients(semi_a / semi_b, self.nu)
-        return CreepCoefficients(*_uniform_interp(log_ab, self.log_ab, self.c))
-
 
 @functools.lru_cache(maxsize=8)
 def _tables_for(shear_modulus_Pa: float, poisson_ratio: float) -> TabulatedHertzKalker:
@@ -246,86 +188,6 @@ def _tables_for(shear_modulus_Pa: float, poisson_ratio: float) -> TabulatedHertz
     from rigid_dynamics.materials import Material
 
     return TabulatedHertzKalker(Material(shear_modulus_Pa, poisson_ratio, 0.0))
-
-
-def batch_contact_function(name: str, material, options=None):
-    """A function (A, B, q, xi, eta, phi) -> (N, T_x, T_y, M_z, a, b) for all patches at once, or None.
-
-    Uses the vectorised kernels behind the registry's models (contact.linear.linear_creep_forces,
-    contact.vermeulen_johnson.vermeulen_johnson_saturation, contact.fastsim.fastsim_batch) with the same
-    defaults as the model classes (contact.models), Hertz and C_ij from :class:`TabulatedHertzKalker`, so
-    the result equals one ``solve`` per patch to interpolation accuracy (tests/test_dynamics_contact.py).
-    Approach control. Returns None for models without a batch path (then every patch is solved by
-    ``model.solve``).
-    """
-    if name not in BATCH_MODELS:
-        return None
-    from rigid_dynamics.contact.linear import linear_creep_forces
-
-    shear, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
-    opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
-    opts.update({k: v for k, v in (options or {}).items() if k in opts})
-    tables = _tables_for(material.shear_modulus_Pa, material.poisson_ratio)
-
-    def solve(curv_a, curv_b, approach, xi, eta, spin):
-        semi_a, semi_b, normal = tables.hertz(curv_a, curv_b, approach)
-        zero = np.zeros_like(normal)
-        if name == "hertz":
-            return normal, zero, zero, zero, semi_a, semi_b
-        coef = tables.coefficients(semi_a, semi_b)
-        if name == "fastsim":
-            from rigid_dynamics.contact.fastsim import fastsim_batch
-
-            res = fastsim_batch(
-                semi_a, semi_b, normal, xi, eta, spin, shear_modulus_Pa=shear, poisson_ratio=nu,
-                friction_coefficient=mu, coefficients=coef, **opts,
-            )  # fmt: skip
-            return normal, res.creep_force_long_N, res.creep_force_lat_N, res.spin_moment_Nm, semi_a, semi_b
-        t_x, t_y, m_z = linear_creep_forces(
-            semi_a, semi_b, xi, eta, spin, shear_modulus_Pa=shear, poisson_ratio=nu, coefficients=coef
-        )
-        if name == "vermeulen-johnson":
-            from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
-
-            t_x, t_y = vermeulen_johnson_saturation(t_x, t_y, normal, mu)
-            m_z = zero
-        return normal, np.asarray(t_x, float), np.asarray(t_y, float), np.asarray(m_z, float), semi_a, semi_b
-
-    solve.tables = tables
-    solve.options = dict(opts)
-    return solve
-
-
-def _auto_record(extra: dict) -> np.ndarray:
-    """AUTO_PATCH_FIELDS values of one ``auto`` result's ``extra``."""
-    from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES
-
-    model = extra.get("selected_model", "")
-    feats = extra.get("auto_features") or {}
-    deciding = extra.get("auto_deciding_feature")
-    return np.array(
-        [
-            AUTO_RUNGS.index(model) if model in AUTO_RUNGS else np.nan,
-            np.nan if extra.get("auto_level") is None else extra["auto_level"],
-            FEATURES.index(deciding) if deciding in FEATURES else -1,
-            np.nan if extra.get("auto_deciding_threshold") is None else extra["auto_deciding_threshold"],
-            *(feats.get(f, np.nan) for f in FEATURES),
-        ],
-        float,
-    )
-
-
-def _patch_values(patches) -> dict:
-    """PATCH_FIELDS arrays of a PatchSet: geometry filled in, forces 0 / creepages NaN until solved."""
-    n = len(patches)
-    values = {name: np.full(n, np.nan) for name in PATCH_FIELDS}
-    values["normal_force_N"] = np.zeros(n)
-    values["approach_m"] = np.asarray(patches.approach_m, float).copy()
-    values["contact_point_y_m"] = patches.point_m[:, 1].copy()
-    values["wheel_lateral_m"] = np.asarray(patches.wheel_lateral_m, float).copy()
-    values["rolling_radius_m"] = np.asarray(patches.rolling_radius_m, float).copy()
-    values["contact_angle_rad"] = np.asarray(patches.contact_angle_rad, float).copy()
-    return values
 
 
 @dataclass(eq=False)
@@ -341,28 +203,82 @@ class ContactState:
     values: dict | None  # PATCH_FIELDS -> (n,) when recorded
 
 
+class PatchCallback:
+    """The Python side of the compiled code's one callback boundary (compiled._external): a contact model that is not
+    compiled (bem, fea, user models; BEM for ``auto``) solves one patch from its geometry and creepages.
+
+    The geometry is the quadric of the compiled candidate (curvatures, approach, contact point and frame, rolling
+    radius, contact angle) unless the provider gave a sampled one (``geometries``, candidate index -> ContactGeometry;
+    set per right-hand side by WheelsetModel for providers evaluated in Python). ``calls`` and ``seconds`` count the
+    solves; ``message`` holds the last failure.
+    """
+
+    def __init__(self, model, options, material):
+        self.model = model
+        self.options = options
+        self.material = material
+        self.geometries: dict = {}
+        self.calls = 0
+        self.seconds = 0.0
+        self.message = ""
+
+    def solve(self, c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral):
+        import time
+
+        start = time.perf_counter()
+        self.calls += 1
+        try:
+            geometry = self.geometries.get(c)
+            if geometry is None:
+                frame = np.array([ex, ey, normal], float).T
+                geometry = ContactGeometry(
+                    curvature_long_1_per_m=float(ca), curvature_lat_1_per_m=float(cb), approach_m=float(q),
+                    side=SIDES[int(side)], point_m=np.array(point, float), frame=frame,
+                    contact_angle_rad=float(angle), rolling_radius_m=float(radius),
+                )  # fmt: skip
+            creepage = Creepage(float(xi), float(eta), float(spin), float(speed))
+            result = self.model.solve(geometry, creepage, self.material, options=self.options)
+        except Exception as exc:  # noqa: BLE001 (any failure of a user model is reported as the run's status)
+            self.message = f"contact model {getattr(self.model, 'name', self.model)!r} raised at t = {t:.6g} s: {exc}"
+            return 0.0, 0.0, 0.0, 0.0, np.nan, np.nan, 1
+        finally:
+            self.seconds += time.perf_counter() - start
+        if not result.success and result.status != "no-contact":
+            self.message = f"contact model {result.method!r} failed at t = {t:.6g} s: {result.status}: {result.message}"
+            return 0.0, 0.0, 0.0, 0.0, np.nan, np.nan, 1
+        return (
+            float(result.normal_force_N or 0.0),
+            float(result.creep_force_long_N or 0.0),
+            float(result.creep_force_lat_N or 0.0),
+            float(result.spin_moment_Nm or 0.0),
+            float(result.semi_axis_long_m or np.nan),
+            float(result.semi_axis_lat_m or np.nan),
+            0,
+        )
+
+
 class WheelsetModel:
-    """State function of a wheelset (module docstring) for one scene, provider and contact model.
+    """State function of a wheelset (module docstring) for one scene, provider and contact model: a thin wrapper of the
+    one compiled right-hand side (compiled.py) for the scipy methods, the Python RK4, the static equilibrium,
+    inspection (:meth:`contact`) and tests; the arguments of the compiled code in ``packed`` (compiled.pack), the
+    callback of a contact model that is not compiled in ``callback`` (:class:`PatchCallback`).
 
     Args:
         scene: the scene (parameters, material, speed).
         provider: contact-geometry provider.
         contact_model: an object with the ContactModel protocol (registry.get_model).
         model_options: options handed to the model's solve().
+        python_geometry: the provider's own ``patches`` give the geometry (compiled.geometry_mode 2) even where the
+            compiled code evaluates it (the 3-D search outside the compiled loop: simulate).
     """
 
-    def __init__(self, scene: DynamicsScene, provider: ContactProvider, contact_model, model_options=None):
+    def __init__(
+        self, scene: DynamicsScene, provider: ContactProvider, contact_model, model_options=None, python_geometry=False
+    ):
         self.scene = scene
         self.provider = provider
         self.model = contact_model
         self.model_options = model_options
-        name = getattr(contact_model, "name", "")
-        model_cls = type(contact_model).__module__
-        self.batch = (
-            batch_contact_function(name, scene.material, model_options)
-            if model_cls == "rigid_dynamics.contact.models"
-            else None
-        )
         ws = scene.wheelset
         self.mass = ws.mass_kg
         self.j_body = np.diag([ws.transverse_inertia_kg_m2, ws.axle_inertia_kg_m2, ws.transverse_inertia_kg_m2])
@@ -388,8 +304,31 @@ class WheelsetModel:
         self.n_state = n_states(self.elastic)
         self.track_rest = np.zeros(8)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
-        self.last_auto = None  # AUTO_PATCH_FIELDS of the last contact() that ran "auto", (n_active, fields)
-        self.par = model_parameters(self)  # the compiled equations' parameter record (compiled.PARAMETERS)
+        self.par = model_parameters(self)  # replaced by the packed record below (same fields, contact fields set)
+        from rigid_dynamics.wheelset import compiled
+
+        name = getattr(contact_model, "name", "")
+        opts = dict(model_options or {})
+        fastsim = opts if name == "fastsim" else dict((opts.get("model_options") or {}).get("fastsim") or {})
+        self.tables = _tables_for(scene.material.shear_modulus_Pa, scene.material.poisson_ratio)
+        self.packed = compiled.pack(
+            self, provider, self.tables, contact_model, fastsim, opts.get("tolerance", 0.05), python_geometry
+        )
+        self.par = self.packed[0]
+        self.mode = int(self.packed[5])
+        code = int(self.par["model_code"])
+        self.callback = None
+        if code == compiled.CALLBACK_CODE:
+            self.callback = PatchCallback(contact_model, model_options, scene.material)
+        elif code == compiled.AUTO_CODE:
+            from rigid_dynamics.contact.registry import get_model
+
+            bem_options = (opts.get("model_options") or {}).get("bem")
+            self.callback = PatchCallback(get_model("bem"), bem_options, scene.material)
+        self.auto = code == compiled.AUTO_CODE
+        ncand = len(self.packed[3])
+        self._rec = np.zeros((ncand + 2, compiled.N_FIELDS))
+        self._cg = np.full((ncand, compiled.N_GEO), np.nan)
 
     def full_state(self, state: np.ndarray) -> np.ndarray:
         """The full state of a 12-state: work integrals 0 and, with the elastic track, ``track_rest``."""
@@ -444,135 +383,132 @@ class WheelsetModel:
         return PatchSet(geometries=geometries, **fields)
 
     # ----------------------------------------------------------------------------------------------
-    def contact(self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None) -> ContactState:
-        """Contact forces of every candidate in contact (approach > 0) for a 12-state.
-
-        With ``record`` the per-patch values (PATCH_FIELDS) are filled, else ``values`` is None. ``track``: the
-        elastic track's 8 states (TRACK_STATE_NAMES); None: ``track_rest`` (rigid track: ignored).
+    def _compiled_rhs(self, t: float, full: np.ndarray, out: np.ndarray, record: bool) -> int:
+        """The compiled right-hand side (compiled.rhs_once / rhs_given) at the full state into ``out``; the
+        candidates into self._rec (and self._cg with ``record``). Returns its status.
         """
-        x, y, z, yaw, roll, spin = state[:6]
-        centre = state[0:3]
-        v_c = state[6:9]
-        c_d, _, omega = rotation_and_rates(yaw, roll, spin, state[9], state[10], state[11])
-        rail_velocity = None
-        if self.elastic:
-            track = self.track_rest if track is None else track
-            patches = self.patches_on_track(centre, yaw, roll, spin, track[0:2])
-        else:
-            patches = self.provider.patches(centre, yaw, roll, spin)
-        n = len(patches)
-        values = None
-        force = np.zeros((n, 3))
-        moment = np.zeros((n, 3))
-        lever = patches.point_m - centre
-        velocity = v_c + _cross_rows(omega, lever)
-        if self.elastic:
-            rail_velocity = np.zeros((n, 3))
-            rail_velocity[:, 2] = track[4:6][patches.side]
-            velocity = velocity - rail_velocity  # relative to the rail (power on wheel and rail together)
-        active = np.flatnonzero(patches.approach_m > 0)
-        self.last_auto = None
-        if len(active):
-            omega_abs, v_abs = frame_velocities(self.par, state, omega)  # in a curve: absolute, for the creepages
-            frames, speed, xi, eta, spin = _creepages(
-                lever[active],
-                patches.normal[active],
-                omega_abs,
-                v_abs,
-                None if rail_velocity is None else rail_velocity[active],
-            )
-            if not np.all(speed > 0) or not np.all(np.isfinite(speed)):
-                raise ContactFailure(f"rolling speed {speed.min()!r} m/s at a contact: creepages undefined")
-            elliptic = patches.geometries is None or all(patches.geometries[k].is_elliptic for k in active)
-            if self.batch is not None and elliptic:
-                normal, t_x, t_y, m_z, semi_a, semi_b = self.batch(
-                    patches.curvature_long_1_per_m[active],
-                    patches.curvature_lat_1_per_m[active],
-                    patches.approach_m[active],
-                    xi,
-                    eta,
-                    spin,
-                )
-            else:
-                normal, t_x, t_y, m_z, semi_a, semi_b = self._solve_each(patches, active, frames, speed, xi, eta, spin)
-            force[active] = (
-                frames[:, :, 0] * t_x[:, None] + frames[:, :, 1] * t_y[:, None] + frames[:, :, 2] * normal[:, None]
-            )
-            moment[active] = frames[:, :, 2] * m_z[:, None]
-            if record:
-                values = _patch_values(patches)
-                for key, val in (
-                    ("normal_force_N", normal), ("creep_force_long_N", t_x), ("creep_force_lat_N", t_y),
-                    ("spin_moment_Nm", m_z), ("creepage_long", xi), ("creepage_lat", eta),
-                    ("spin_creepage_1_per_m", spin), ("semi_axis_long_m", semi_a), ("semi_axis_lat_m", semi_b),
-                ):  # fmt: skip
-                    values[key][active] = val
-                if self.last_auto is not None:
-                    for j, key in enumerate(AUTO_PATCH_FIELDS):
-                        values[key] = np.full(n, np.nan)
-                        values[key][active] = self.last_auto[:, j]
-        elif record:
-            values = _patch_values(patches)
-        return ContactState(patches.side, patches.slot, force, moment, lever, velocity, values)
+        from rigid_dynamics.wheelset import compiled
 
-    def _solve_each(self, patches, active, frames, speed, xi, eta, spin):
-        """One ``model.solve`` per active patch (any registered model, sampled geometries)."""
-        n = len(active)
-        out = [np.zeros(n) for _ in range(6)]
-        material = self.scene.material
-        for i, k in enumerate(active):
+        par, hz, kk, sides, _, mode, targs, sargs = self.packed
+        par["frame_x0_m"] = self.frame_x0
+        compiled.use_callback(self.callback)
+        if mode == 2:
+            self._given_geometry(full)
+            return int(compiled.rhs_given(float(t), full, par, hz, kk, sides, self._cg, out, self._rec, record))
+        if record:
+            return int(
+                compiled.contact_once(float(t), full, par, hz, kk, sides, mode, targs, sargs, out, self._rec, self._cg)
+            )
+        return int(compiled.rhs_once(float(t), full, par, hz, kk, sides, mode, targs, sargs, out, self._rec))
+
+    def _given_geometry(self, full: np.ndarray) -> None:
+        """Mode 2 (compiled.geometry_mode): the provider's candidates into self._cg (side s, slot k at row 2 s + k;
+        rows without a candidate NaN) and their sampled geometries (if any) to the callback.
+        """
+        track = full[TRACK][0:2] if self.elastic else None
+        patches = self.patches_on_track(full[0:3], full[3], full[4], full[5], track)
+        cg = self._cg
+        cg[:, :] = np.nan
+        geometries = {}
+        for k in range(len(patches)):
+            side, slot = int(patches.side[k]), int(patches.slot[k])
+            if slot >= MAX_SLOTS:
+                raise ContactFailure(f"provider {self.provider.name!r}: more than {MAX_SLOTS} candidates on a side")
+            c = 2 * side + slot
+            cg[c, 0] = patches.approach_m[k]
+            cg[c, 1:4] = patches.point_m[k] - full[0:3]
+            cg[c, 4:7] = patches.normal[k]
+            cg[c, 7], cg[c, 8] = patches.curvature_long_1_per_m[k], patches.curvature_lat_1_per_m[k]
+            cg[c, 9], cg[c, 10] = patches.rolling_radius_m[k], patches.wheel_lateral_m[k]
+            cg[c, 11] = patches.contact_angle_rad[k]
             if patches.geometries is not None:
-                geometry = patches.geometries[k]
-            else:
-                geometry = ContactGeometry(
-                    curvature_long_1_per_m=float(patches.curvature_long_1_per_m[k]),
-                    curvature_lat_1_per_m=float(patches.curvature_lat_1_per_m[k]),
-                    approach_m=float(patches.approach_m[k]),
-                    side=SIDES[patches.side[k]],
-                    point_m=patches.point_m[k],
-                    frame=frames[i],
-                    contact_angle_rad=float(patches.contact_angle_rad[k]),
-                    rolling_radius_m=float(patches.rolling_radius_m[k]),
-                )
-            creepage = Creepage(float(xi[i]), float(eta[i]), float(spin[i]), float(speed[i]))
-            result = self.model.solve(geometry, creepage, material, options=self.model_options)
-            if not result.success and result.status != "no-contact":
-                raise ContactFailure(f"contact model {result.method!r} failed: {result.status}: {result.message}")
-            out[0][i] = result.normal_force_N or 0.0
-            out[1][i] = result.creep_force_long_N or 0.0
-            out[2][i] = result.creep_force_lat_N or 0.0
-            out[3][i] = result.spin_moment_Nm or 0.0
-            out[4][i] = result.semi_axis_long_m or np.nan
-            out[5][i] = result.semi_axis_lat_m or np.nan
-            if "auto_rung" in result.extra:
-                if self.last_auto is None:
-                    self.last_auto = np.full((n, len(AUTO_PATCH_FIELDS)), np.nan)
-                self.last_auto[i] = _auto_record(result.extra)
-        return out
+                geometries[c] = patches.geometries[k]
+        if self.callback is not None:
+            self.callback.geometries = geometries
 
-    def derivative(self, t: float, state: np.ndarray, contact: ContactState | None = None) -> np.ndarray:
-        """d/dt of the full state (12 mechanical + 2 work integrals [+ 8 track states, TRACK]).
+    def _failure(self, status: int, t: float) -> ContactFailure:
+        if status == 5 and self.callback is not None:
+            return ContactFailure(self.callback.message)
+        if status == 4:
+            return ContactFailure(f"rolling speed not > 0 at a contact (t = {t:.6g} s): creepages undefined")
+        return ContactFailure(f"compiled right-hand side: status {status}")
 
-        The contact forces come from :meth:`contact` (any provider and contact model); the equations of motion,
-        the suspension and the track are the compiled ones (compiled.derivative_from_contact, the same code as the
-        compiled loop's right-hand side).
+    def contact(
+        self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None, keep_search_memory=False
+    ) -> ContactState:
+        """Contact of every candidate (approach, geometry; forces where approach > 0) at a 12-state, for inspection
+        and recording: the compiled right-hand side's candidates with their contact frames.
+
+        With ``record`` the per-patch values (PATCH_FIELDS, and AUTO_PATCH_FIELDS for ``auto``) are filled, else
+        ``values`` is None. ``track``: the elastic track's 8 states; None: ``track_rest`` (rigid track: ignored).
+        ``keep_search_memory``: leave the compiled search's warm starts as they were (a look that must not change the
+        run).
+        """
+        from rigid_dynamics.wheelset import compiled
+
+        full = self.full_state(state)
+        if self.elastic and track is not None:
+            full[TRACK] = track
+        out = np.empty(self.n_state)
+        memory = None
+        if keep_search_memory and self.mode == 1:  # the compiled search's warm starts (its only state) kept
+            memory = [np.copy(a) for a in self.packed[7][3:5]]
+        try:
+            status = self._compiled_rhs(0.0, full, out, True)
+        finally:
+            if memory is not None:
+                for keep, now in zip(memory, self.packed[7][3:5], strict=True):
+                    now[...] = keep
+        if status != 0:
+            raise self._failure(status, 0.0)
+        sides, slots = self.packed[3], self.packed[4]
+        present = np.flatnonzero(~np.isnan(self._cg[:, 0]))
+        rec, cg = self._rec[present], self._cg[present]
+        centre, v_c = full[0:3], full[6:9]
+        _, _, omega = rotation_and_rates(*full[3:6], *full[9:12])
+        lever, normal = cg[:, 1:4], cg[:, 4:7]
+        velocity = v_c + _cross_rows(omega, lever)
+        rail_velocity = np.zeros((len(present), 3))
+        if self.elastic:
+            rail_velocity[:, 2] = full[TRACK][4:6][sides[present]]
+        velocity = velocity - rail_velocity
+        frames, _, _, _, _ = _creepages(lever, normal, omega, v_c, rail_velocity)
+        active = np.nan_to_num(rec[:, 0], nan=0.0) > 0
+        t_x, t_y, n_f, m_z = (np.where(active, np.nan_to_num(rec[:, k]), 0.0) for k in (1, 2, 0, 3))
+        force = frames[:, :, 0] * t_x[:, None] + frames[:, :, 1] * t_y[:, None] + frames[:, :, 2] * n_f[:, None]
+        moment = frames[:, :, 2] * m_z[:, None]
+        force[~active] = 0.0
+        moment[~active] = 0.0
+        values = None
+        if record:
+            names = PATCH_FIELDS + (AUTO_PATCH_FIELDS if self.auto else ())
+            values = {name: rec[:, f].copy() for f, name in enumerate(names)}
+            values["contact_point_y_m"] = centre[1] + lever[:, 1]
+        del compiled
+        return ContactState(sides[present], slots[present], force, moment, lever.copy(), velocity, values)
+
+    def derivative(self, t: float, state: np.ndarray) -> np.ndarray:
+        """d/dt of the full state (12 mechanical + 2 work integrals [+ 8 track states, TRACK]) by the compiled
+        right-hand side (compiled._rhs's geometry, compiled laws and callback, compiled._assemble): the one
+        implementation, also for the scipy methods and the Python RK4.
+
+        Raises:
+            ContactFailure: creepages undefined or the contact model failed.
         """
         self.rhs_evaluations += 1
-        state = np.asarray(state, float)
-        track = state[TRACK] if self.elastic else None
-        if contact is None:
-            contact = self.contact(state[MECHANICAL], track=track)
-        _, _, omega = rotation_and_rates(*state[3:6], *state[9:12])
-        f_con = contact.force_N.sum(axis=0)
-        m_con = _cross_pairs(contact.lever_m, contact.force_N).sum(axis=0) + contact.moment_Nm.sum(axis=0)
-        p_con = float(np.sum(contact.force_N * contact.point_velocity_m_per_s) + contact.moment_Nm.sum(axis=0) @ omega)
-        rail_force = np.zeros(2)
-        if self.elastic:
-            np.add.at(rail_force, contact.side, -contact.force_N[:, 2])
+        full = np.array(state, float)
         out = np.empty(self.n_state)
-        self.par["frame_x0_m"] = self.frame_x0
-        derivative_from_contact(float(t), state, self.par, f_con, m_con, p_con, rail_force, out)
+        status = self._compiled_rhs(t, full, out, False)
+        if status != 0:
+            raise self._failure(status, t)
         return out
+
+    def side_forces(self) -> np.ndarray:
+        """Per wheel (left, right) the contact force of the last right-hand side, main frame, (2, 3), N: only set
+        by a recording call (:meth:`contact`).
+        """
+        ncand = len(self.packed[3])
+        return self._rec[ncand : ncand + 2, :3].copy()
 
     def _track_derivative(self, track, rail_force, out) -> float:
         """d/dt of the 8 track states into ``out`` under the rail forces (left, right) (compiled.track_rates);
@@ -600,6 +536,29 @@ class WheelsetModel:
         """Gravity potential V_g = -m g z (z down), J."""
         return -self.mass * self.gravity * float(state[2])
 
+    def contact_approaches(self, state: np.ndarray, keep_search_memory=False) -> list:
+        """Per wheel (left, right) the approaches of its candidates at a 12-state on ``track_rest``, m: the geometry
+        alone (compiled.geometry_once; mode 2 the provider), no contact model.
+        """
+        from rigid_dynamics.wheelset import compiled
+
+        full = self.full_state(state)
+        par, _, _, sides, _, mode, targs, sargs = self.packed
+        if mode == 2:
+            self._given_geometry(full)
+        else:
+            memory = [np.copy(a) for a in sargs[3:5]] if keep_search_memory and mode == 1 else None
+            compiled.geometry_once(full, par, sides, mode, targs, sargs, self._cg)
+            if memory is not None:
+                for keep, now in zip(memory, sargs[3:5], strict=True):
+                    now[...] = keep
+        q = self._cg[:, 0]
+        return [q[(sides == i) & ~np.isnan(q)] for i in (0, 1)]
+
+    def deepest_approach(self, state: np.ndarray) -> list:
+        """Per wheel (left, right) the deepest approach of its candidates at a 12-state on ``track_rest``, m."""
+        return [float(np.max(q)) if len(q) else 0.0 for q in self.contact_approaches(state)]
+
     def _rest_shift(self):
         """The rails' deflection in ``track_rest`` (None for the rigid track)."""
         return self.track_rest[0:2] if self.elastic else None
@@ -621,13 +580,16 @@ class WheelsetModel:
         work = np.array(state, float)
         derivative = self.derivative if derivative is None else derivative
 
+        failure = []
+
         def residual(v):
             trial = work.copy()
             trial[2], trial[4] = v
             full = self.full_state(trial)
             try:
                 d = derivative(0.0, full)
-            except ContactFailure:
+            except ContactFailure as exc:
+                failure[:] = [str(exc)]
                 return np.array([1e3, 1e3])
             return np.array([d[8], d[10] * 0.1])
 
@@ -635,13 +597,7 @@ class WheelsetModel:
         # (a roll theta lowers the right wheel by about e0 theta and lifts the left one: level them first)
         e0 = self.scene.wheelset.contact_half_distance_m
         for _ in range(6):
-            if deepest_approach is not None:
-                deepest = deepest_approach(work)
-            else:
-                patches = self.patches_on_track(work[0:3], work[3], work[4], work[5], self._rest_shift())
-                deepest = [
-                    np.max(patches.approach_m[patches.side == i]) if np.any(patches.side == i) else 0.0 for i in (0, 1)
-                ]
+            deepest = (deepest_approach or self.deepest_approach)(work)
             work[4] += (deepest[0] - deepest[1]) / (2.0 * e0)
             shift = 1e-4 - 0.5 * (deepest[0] + deepest[1])
             work[2] += shift
@@ -681,8 +637,10 @@ class WheelsetModel:
         work[2], work[4] = best[0]
         # accept a residual acceleration below 1e-3 m/s^2 (vertical) / 1e-2 rad/s^2 (roll)
         ok = best[1] < 1e-3
-        patches = self.patches_on_track(work[0:3], work[3], work[4], work[5], self._rest_shift())
-        touching = [bool(np.any((patches.side == i) & (patches.approach_m > 0))) for i in (0, 1)]
+        if not ok and failure:
+            message += f"; the contact failed: {failure[0]}"
+        approach = self.contact_approaches(work, keep_search_memory=True)
+        touching = [bool(np.any(approach[i] > 0)) for i in (0, 1)]
         if ok and not all(touching):
             ok, message = False, "the equilibrium found has a wheel off its rail (no contact at rest)"
         return work, ok, message

@@ -12,7 +12,7 @@ from rigid_dynamics.wheelset.equations import MAX_SLOTS, ContactFailure, Wheelse
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.state import TRACK
 
-COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed"}
+COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed", 5: "contact-failed"}
 """Status codes of the compiled loop (compiled.rk4_run) -> run statuses."""
 
 
@@ -120,8 +120,7 @@ def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, d
        psi' = -V (r_right - r_left)/(2 e0 r_roll) to first order, at the extreme of the offset.
     3. The static equilibrium again at that spin rate.
 
-    ``derivative``, ``deepest``, ``rolling``: the compiled right-hand side's versions (compiled_static_functions);
-    None: the Python path's.
+    ``derivative``, ``deepest``, ``rolling``: replacements; None: the model's own (the compiled right-hand side).
     """
     state, ok, why = model.static_state(state, derivative, deepest)
     if not ok:
@@ -179,34 +178,3 @@ def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, d
     state[11] = (1.0 - ic.longitudinal_creepage) * rates[0]
     state[9] = rates[1]
     return model.static_state(state, derivative, deepest)
-
-
-def compiled_static_functions(packed, model):
-    """(derivative, deepest approach per wheel, rolling radius per wheel) by the compiled right-hand side, for
-    :func:`consistent_start`.
-    """
-    from rigid_dynamics.wheelset import compiled
-
-    par, hz, kk, sides, _, mode, targs, sargs = packed
-    ncand = len(sides)
-    rec = np.zeros((ncand + 2, compiled.N_FIELDS))
-
-    def derivative(t, full_state):
-        out = np.zeros(len(full_state))
-        status = compiled.rhs_once(
-            float(t), np.asarray(full_state, float), par, hz, kk, sides, mode, targs, sargs, out, rec
-        )
-        if status != 0:
-            raise ContactFailure(f"compiled right-hand side: {COMPILED_STATUS[int(status)]}")
-        return out
-
-    def deepest(state):
-        derivative(0.0, model.full_state(state))
-        approach = np.nan_to_num(rec[:ncand, 7], nan=-np.inf)
-        return [float(np.max(approach[sides == i])) if np.any(sides == i) else 0.0 for i in (0, 1)]
-
-    def rolling(state):
-        derivative(0.0, model.full_state(state))
-        return rolling_radii(sides, rec[:ncand, 0], rec[:ncand, 10])
-
-    return derivative, deepest, rolling

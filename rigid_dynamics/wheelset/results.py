@@ -254,6 +254,35 @@ class SimulationResult:
                 else None
             ),
             **self._error_summary(num),
+            **self._auto_summary(),
+        }
+
+    def _auto_summary(self) -> dict:
+        """``auto``'s choices over the run (empty for other models): per rung (contact.auto.AUTO_RUNGS) the share of
+        the recorded patches in contact, per feature (contact.auto.FEATURES) the share it decided, the tolerance
+        level used and the thresholds' identity; per patch and sample in timeseries.npz (``patch_auto_*``).
+        """
+        if "auto_rung" not in self.patches:
+            return {}
+        from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES, load_thresholds
+        from rigid_dynamics.contact.models import thresholds_identity
+
+        rung = np.asarray(self.patches["auto_rung"], float)
+        touching = np.isfinite(rung) & (np.nan_to_num(np.asarray(self.patches["normal_force_N"], float)) > 0)
+        codes = rung[touching].astype(int)
+        deciding = np.asarray(self.patches["auto_deciding_feature"], float)[touching].astype(int)
+        level = np.asarray(self.patches["auto_level"], float)[touching]
+        n = max(len(codes), 1)
+        return {
+            "auto": {
+                "patches": len(codes),
+                "level": float(np.nanmax(level)) if np.any(np.isfinite(level)) else None,
+                "rung_share": {r: float(np.count_nonzero(codes == i) / n) for i, r in enumerate(AUTO_RUNGS)},
+                "deciding_feature_share": {
+                    f: float(np.count_nonzero(deciding == i) / n) for i, f in enumerate(FEATURES)
+                },
+                "thresholds": thresholds_identity(load_thresholds()),
+            }
         }
 
     def _error_summary(self, num) -> dict:

@@ -53,7 +53,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_adaptive, run_compiled, run_rk4
 from rigid_dynamics.wheelset.equations import ContactFailure, WheelsetModel
-from rigid_dynamics.wheelset.equilibrium import compiled_static_functions, elastic_start, initial_state
+from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import ConicalProvider, TableProvider
 from rigid_dynamics.wheelset.recorder import NUMERICAL_ERRORS, Recorder, Stop
@@ -165,25 +165,27 @@ def simulate(
     """
     provider = provider if provider is not None else build_provider(scene)
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
-    model = WheelsetModel(scene, provider, model_obj, model_options(getattr(model_obj, "name", ""), scene))
     from rigid_dynamics.wheelset import compiled as _compiled
     from rigid_dynamics.wheelset import compiled_adaptive as _adaptive
 
     embedded = scene.integrator.method in _adaptive.PAIRS
     supported = _adaptive.supported if embedded else _compiled.supported
-    can_compile = supported(scene, provider, model_obj) and model.batch is not None
+    can_compile = supported(scene, provider, model_obj)
     if compiled and not can_compile:
         raise ValueError(
-            "compiled = True: the compiled path needs method RK4, DP54 or BS32, a TableProvider or a SearchProvider "
-            "on tabulated surfaces, and one of "
-            f"the models {', '.join(_compiled.MODEL_CODES)}"
+            "compiled = True: the compiled loop needs method RK4, DP54 or BS32 and a TableProvider or a "
+            "SearchProvider on tabulated surfaces"
         )
     use_compiled = can_compile and compiled is not False
+    options = model_options(getattr(model_obj, "name", ""), scene)
+    # the compiled 3-D search tracks its contact points between RK4 stages: outside the compiled loop (and for the
+    # finite-difference Jacobian of the stability check) the contact package's search gives the geometry
+    search_in_python = _compiled.geometry_mode(provider) == 1
+    model = WheelsetModel(scene, provider, model_obj, options, python_geometry=search_in_python and not use_compiled)
     settings = scene.integrator
     duration = scene.duration_s
-    packed = None
+    packed = model.packed
     if use_compiled:
-        packed = _compiled.pack(model, provider, model.batch.tables, model.model.name, model.batch.options)
         _compiled.load(packed)  # the compiled code (from numba's cache) is loaded before the clock starts
         if embedded:
             _adaptive.load(packed, settings, scene)
@@ -193,16 +195,11 @@ def simulate(
     steps = 0
 
     try:
-        if use_compiled:
-            derivative, deepest, rolling = compiled_static_functions(packed, model)
-            state0, ok, why = elastic_start(model, initial_state(scene), derivative, deepest, rolling)
-        else:
-            state0, ok, why = elastic_start(model, initial_state(scene))
+        state0, ok, why = elastic_start(model, initial_state(scene))
     except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
         state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
-    if packed is not None:
-        packed[0]["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
+    packed[0]["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
     model.rhs_evaluations = 0
     full0 = model.full_state(state0)
     last_fraction = [-1.0]
@@ -286,11 +283,15 @@ def simulate(
             ok and fixed_step
         ):  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
             try:
-                limit = rk4_stable_step(lambda y: model.derivative(0.0, y), full0)
+                probe = model
+                if use_compiled and search_in_python:
+                    probe = WheelsetModel(scene, provider, model_obj, options, python_geometry=True)
+                    probe.frame_x0, probe.track_rest = model.frame_x0, model.track_rest
+                limit = rk4_stable_step(lambda y: probe.derivative(0.0, y), full0)
             except (ContactFailure, *NUMERICAL_ERRORS):
                 limit = None
             if limit is not None and status in NUMERICAL_LOOKING and not settings.fixed_step_s > limit.max_step_s:
-                limit = _limit_at_largest_force(model, t, states, patches, wc, we, track_states, limit)
+                limit = _limit_at_largest_force(probe, t, states, patches, wc, we, track_states, limit)
             if limit is not None:
                 status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit)
     result = SimulationResult(

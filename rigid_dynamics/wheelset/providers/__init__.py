@@ -17,9 +17,9 @@ wheel lift can be detected). Providers here:
   irregularities) when it is available.
 * :class:`ProfileSectionProvider` — a 2-D profile section of real profiles, the section sampled by the tables.
 
-Files: patches.py (PatchSet, the protocol, SIDES), conical.py, tables.py, running_irregularity.py (the
-running-direction section of the conical and table providers), surfaces.py (wheel and rail surfaces from the
-scene), profile_section.py, search.py.
+Files: patches.py (PatchSet, the protocol, SIDES), conical.py, tables.py (both add the running-direction
+irregularities by the compiled section of the dynamics, compiled._irregularity), surfaces.py (wheel and rail
+surfaces from the scene), profile_section.py, search.py.
 """
 
 from rigid_dynamics.wheelset.providers.conical import ConicalProvider
@@ -32,7 +32,6 @@ from rigid_dynamics.wheelset.providers.patches import (
     running_direction_only,
 )
 from rigid_dynamics.wheelset.providers.profile_section import ProfileSectionProvider
-from rigid_dynamics.wheelset.providers.running_irregularity import running_irregularity
 from rigid_dynamics.wheelset.providers.search import SearchProvider
 from rigid_dynamics.wheelset.providers.surfaces import (
     ABSENT_GAP_M,
@@ -59,5 +58,4 @@ __all__ = [
     "conical_track",
     "geometry_irregularities",
     "running_direction_only",
-    "running_irregularity",
 ]

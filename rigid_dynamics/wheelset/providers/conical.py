@@ -32,7 +32,6 @@ import numpy as np
 from rigid_dynamics.wheelset.irregular import applies_to
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
 from rigid_dynamics.wheelset.providers.patches import SIDE_SIGNS, SIDES, PatchSet, running_direction_only
-from rigid_dynamics.wheelset.providers.running_irregularity import running_irregularity
 
 
 class ConicalProvider:
@@ -106,5 +105,32 @@ class ConicalProvider:
             wheel_lateral_m=np.array([rows[0][5], rows[1][5]]),
         )
         if self.irregularities is not None:
-            running_irregularity(patches, self._irr_sides, centre_m, spin_rad, self.irregularities, r0)
+            self._add_irregularities(patches, spin_rad)
         return patches
+
+    def _add_irregularities(self, patches: PatchSet, spin_rad: float) -> None:
+        """The running-direction irregularities by the compiled section of the dynamics (compiled._irregularity:
+        the wheel point at beta from the lowest point, the extra overlap maximised over beta, projected on the normal;
+        the normal tilted by N_irr'; A from the polar curvature of r(beta), floored for a concave flat).
+        """
+        from rigid_dynamics.wheelset import compiled
+
+        if getattr(self, "_par", None) is None:
+            self._par = compiled.new_parameters()
+            compiled.irregularity_parameters(self._par, self.irregularities, self._irr_sides, self.r0)
+        n = len(patches)
+        work = np.zeros((9, n))
+        work[0] = patches.approach_m
+        work[4], work[5] = patches.normal[:, 1], patches.normal[:, 2]
+        work[6], work[8] = patches.curvature_long_1_per_m, patches.rolling_radius_m
+        geo = np.empty((n, 8))
+        sides = np.asarray(patches.side, np.int64)
+        compiled.irregular_candidates(
+            self._par, work, sides, np.ascontiguousarray(patches.point_m[:, 0]), spin_rad, geo
+        )
+        for k in np.flatnonzero(~np.isnan(geo[:, 0])):
+            patches.approach_m[k] = geo[k, 0]
+            patches.point_m[k, 0] += geo[k, 1]
+            patches.point_m[k, 2] += geo[k, 2]
+            patches.normal[k] = geo[k, 3:6]
+            patches.rolling_radius_m[k], patches.curvature_long_1_per_m[k] = geo[k, 6], geo[k, 7]

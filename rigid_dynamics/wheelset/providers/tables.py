@@ -1,5 +1,6 @@
 """Contact-geometry tables over lateral shift and roll for ideal geometry (:class:`TableProvider`), with the
-running-direction irregularities added per pose (running_irregularity.py).
+running-direction irregularities added per pose; evaluated by the compiled look-up of the dynamics
+(compiled._table_geometry), also for inspection.
 """
 
 from __future__ import annotations
@@ -11,7 +12,6 @@ import numpy as np
 from rigid_dynamics.wheelset.irregular import applies_to
 from rigid_dynamics.wheelset.parameters import Irregularities
 from rigid_dynamics.wheelset.providers.patches import SIDES, ContactProvider, PatchSet, running_direction_only
-from rigid_dynamics.wheelset.providers.running_irregularity import running_irregularity
 
 
 class TableProvider:
@@ -92,39 +92,43 @@ class TableProvider:
         if self.irregularities is not None:
             self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
 
+    def _compiled(self):
+        """(par, grid) of the compiled look-up (compiled.table_candidates), built once."""
+        if getattr(self, "_packed", None) is None:
+            from rigid_dynamics.wheelset import compiled
+
+            par = compiled.new_parameters()
+            par["z_ref_m"], par["nominal_radius_m"] = self.z_ref, self.r0
+            if self.irregularities is not None:
+                compiled.irregularity_parameters(par, self.irregularities, self._irr_sides, self.r0)
+            yg, rg = self.y_grid, self.roll_grid
+            grid = np.array([yg[0], yg[1] - yg[0], len(yg), rg[0], rg[1] - rg[0], len(rg)], float)
+            self._packed = (par, grid, np.ascontiguousarray(self.table), np.asarray(self.slot, np.int64))
+        return self._packed
+
     def patches(self, centre_m, yaw_rad, roll_rad, spin_rad=0.0) -> PatchSet:
-        x_c, y_c, z_c = float(centre_m[0]), float(centre_m[1]), float(centre_m[2])
-        yg, rg = self.y_grid, self.roll_grid
-        fy = (min(max(y_c, yg[0]), yg[-1]) - yg[0]) / (yg[1] - yg[0])
-        j = min(int(fy), len(yg) - 2)
-        wy = fy - j
-        fr = (min(max(roll_rad, rg[0]), rg[-1]) - rg[0]) / (rg[1] - rg[0])
-        i = min(int(fr), len(rg) - 2)
-        wr = fr - i
-        t = self.table
-        v = (1 - wr) * ((1 - wy) * t[:, :, i, j] + wy * t[:, :, i, j + 1]) + wr * (
-            (1 - wy) * t[:, :, i + 1, j] + wy * t[:, :, i + 1, j + 1]
-        )
-        approach = v[0] + (z_c - self.z_ref) * v[1]
-        merged = v[11] + (z_c - self.z_ref) * v[1] > 0
-        approach = np.where(merged & (self.slot > 0), -0.01, approach)
-        n_y, n_z = v[4], v[5]
-        norm = np.sqrt(n_y * n_y + n_z * n_z)
-        normal = np.stack([np.zeros_like(n_y), n_y / norm, n_z / norm], axis=-1)
-        x_off = -math.sin(yaw_rad) * v[10]
-        point = np.stack([x_c + x_off, y_c + v[2], z_c + v[3]], axis=-1)
-        patches = PatchSet(
+        """The candidates at a pose by the compiled look-up of the dynamics (compiled._table_geometry: bilinear in
+        (theta, y), q = q_ref + (z - z_ref) dq/dz, a merged second candidate dropped, the running-direction
+        irregularities added by compiled._irregularity).
+        """
+        from rigid_dynamics.wheelset import compiled
+
+        par, grid, table, slots = self._compiled()
+        sides = np.asarray(self.side, np.int64)
+        y = np.zeros(14)
+        y[0:3] = np.asarray(centre_m, float)[:3]
+        y[3], y[4], y[5] = yaw_rad, roll_rad, spin_rad
+        cg = np.empty((len(sides), compiled.N_GEO))
+        compiled.table_candidates(y, par, table, grid, slots, sides, cg)
+        return PatchSet(
             side=self.side,
             slot=self.slot,
-            point_m=point,
-            normal=normal,
-            curvature_long_1_per_m=v[6].copy(),
-            curvature_lat_1_per_m=v[7].copy(),
-            approach_m=approach,
-            rolling_radius_m=v[8].copy(),
-            contact_angle_rad=v[9].copy(),
-            wheel_lateral_m=v[10].copy(),
+            point_m=y[0:3] + cg[:, 1:4],
+            normal=cg[:, 4:7].copy(),
+            curvature_long_1_per_m=cg[:, 7].copy(),
+            curvature_lat_1_per_m=cg[:, 8].copy(),
+            approach_m=cg[:, 0].copy(),
+            rolling_radius_m=cg[:, 9].copy(),
+            contact_angle_rad=cg[:, 11].copy(),
+            wheel_lateral_m=cg[:, 10].copy(),
         )
-        if self.irregularities is not None:
-            running_irregularity(patches, self._irr_sides, centre_m, spin_rad, self.irregularities, self.r0)
-        return patches
