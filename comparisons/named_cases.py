@@ -3,8 +3,9 @@
 Each folder holds
 
 * ``case.toml``: a contact-case file (the format of ``wheelrail contact``; :mod:`wheelrail.cases`);
-* ``reference.toml``: ``source`` (``closed-form``, ``contact-published`` or ``bem-richardson``), ``side`` (the
-  patch side compared: ``"single"`` for a quadric, ``"right"`` for a wheelset case), ``note``, and a table
+* ``reference.toml``: ``source`` (``closed-form``, ``contact-published``, ``contact-converged`` or
+  ``bem-richardson``), ``side`` (the patch side compared: ``"single"`` for a quadric, ``"right"`` for a wheelset
+  case), ``note``, and a table
   ``[reference]`` of numbers on the wheel in the contact frame (SI: ``normal_force_N``,
   ``creep_force_long_N``, ``creep_force_lat_N``, ``max_pressure_Pa``, ``contact_area_m2``; a closed-form
   Hertz case also ``semi_axis_long_m``, ``semi_axis_lat_m``), and ``[uncertainty]`` (the reference's own
