@@ -3,14 +3,21 @@
 Each folder holds
 
 * ``case.toml``: a contact-case file (the format of ``wheelrail contact``; :mod:`wheelrail.cases`);
-* ``reference.toml``: ``source`` (``closed-form``, ``contact-published`` or ``bem-richardson``), ``side`` (the
-  patch side compared: ``"single"`` for a quadric, ``"right"`` for a wheelset case), ``note``, and a table
+* ``reference.toml``: ``source`` (``closed-form``, ``contact-published``, ``contact-converged`` or
+  ``bem-richardson``), ``side`` (the patch side compared: ``"single"`` for a quadric, ``"right"`` for a wheelset
+  case), ``note``, and a table
   ``[reference]`` of numbers on the wheel in the contact frame (SI: ``normal_force_N``,
   ``creep_force_long_N``, ``creep_force_lat_N``, ``max_pressure_Pa``, ``contact_area_m2``; a closed-form
   Hertz case also ``semi_axis_long_m``, ``semi_axis_lat_m``), and ``[uncertainty]`` (the reference's own
   relative error estimate per quantity, where known);
-* ``contact_reference.csv`` (``contact-published`` cases): the row(s) of CONTACT's published solution,
-  copied unchanged; the numbers of ``[reference]`` are derived from it here (:func:`contact_row_reference`);
+* ``contact_reference.csv`` (``contact-published`` and ``contact-converged`` cases): the row(s) of CONTACT's
+  published solution, copied unchanged; for ``contact-published`` the numbers of ``[reference]`` are derived
+  from it here (:func:`contact_row_reference`);
+* ``contact_grid.csv`` (``contact-converged`` cases): CONTACT's solution of the same deck run here at element
+  sizes DX = DS halved down from the deck's 0.2 mm (benchmarks/contact_grid_study.py); the reference is the
+  finest row and its own error estimate per quantity the change over the last halving
+  (:func:`contact_grid_reference`): CONTACT's max pressure and area (NCON dx ds) depend on the element size, so
+  the published 0.2 mm numbers are no grid-converged reference (on the flange, 3-4 elements across the patch);
 * ``reference_field.npz`` (``bem-richardson`` cases): the pressure field of the finest BEM run
   (``x_m``, ``y_m``, ``pressure_Pa``), for the field norm;
 * ``SOURCE.md``: where the numbers come from.
@@ -23,6 +30,7 @@ max pressure and the summed area.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,7 +38,9 @@ import numpy as np
 
 CASES_ROOT = Path(__file__).parent / "cases"
 QUANTITIES = ("normal_force_N", "creep_force_long_N", "creep_force_lat_N", "max_pressure_Pa", "contact_area_m2")
-SOURCES = ("closed-form", "contact-published", "bem-richardson")
+SOURCES = ("closed-form", "contact-published", "contact-converged", "bem-richardson")
+CONTACT_PRINT_RESOLUTION = 5e-4
+"""CONTACT prints FN, FX, FS and PMAX with 4 significant digits: half a unit of the last one, relative (at most)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,6 +133,40 @@ def contact_row_reference(row: dict) -> dict:
         "max_pressure_Pa": float(row["pmax_N_per_mm2"]) * 1e6,
         "contact_area_m2": float(row["contact_area_mm2"]) * 1e-6,
     }
+
+
+def contact_grid_reference(rows: list[dict]) -> tuple[dict, dict]:
+    """Reference and its own relative error estimate from CONTACT rows at several element sizes (one patch sum).
+
+    ``rows``: dicts with ``dx_mm``, ``ds_mm`` and the columns of :func:`contact_row_reference`. The reference is
+    the row of the smallest element; the uncertainty of each quantity is the relative change from the row with
+    twice its DX and DS (for the first-order convergence of the area and the max pressure, the remaining error of
+    the finest grid is about that change), at least CONTACT's print resolution
+    (:data:`CONTACT_PRINT_RESOLUTION`); for the creep forces the change of the vector (Fx, Fy) over |F|.
+    """
+    by_size = sorted(rows, key=lambda r: float(r["dx_mm"]) * float(r["ds_mm"]))
+    finest = by_size[0]
+    coarser = [
+        r
+        for r in by_size[1:]
+        if math.isclose(float(r["dx_mm"]), 2 * float(finest["dx_mm"]))
+        and math.isclose(float(r["ds_mm"]), 2 * float(finest["ds_mm"]))
+    ]
+    if not coarser:
+        raise ValueError(f"CONTACT grid rows {[(r['dx_mm'], r['ds_mm']) for r in rows]}: expected the finest "
+                         "element and one of twice its size")  # fmt: skip
+    fine, coarse = contact_row_reference(finest), contact_row_reference(coarser[0])
+    uncertainty = {}
+    for key in ("normal_force_N", "max_pressure_Pa", "contact_area_m2"):
+        uncertainty[key] = max(abs(coarse[key] / fine[key] - 1.0), CONTACT_PRINT_RESOLUTION)
+    force = math.hypot(fine["creep_force_long_N"], fine["creep_force_lat_N"])
+    change = math.hypot(
+        coarse["creep_force_long_N"] - fine["creep_force_long_N"],
+        coarse["creep_force_lat_N"] - fine["creep_force_lat_N"],
+    )
+    for key in ("creep_force_long_N", "creep_force_lat_N"):
+        uncertainty[key] = max(change / force, CONTACT_PRINT_RESOLUTION)
+    return fine, uncertainty
 
 
 def named_case_names() -> list[str]:

@@ -4,7 +4,7 @@ Independent checks of the stored references: the Hertz ellipses against the proj
 checked against a quadrature of Hertz's integrals, tests/test_hertz.py) -- the references were written from
 scipy's elliptic integrals by a separate route (benchmarks/make_case_references.py); the small-creepage BEM
 reference against Kalker's published linear coefficient; the saturated one against full slip (F = mu N); the
-A-2.2 rows against CONTACT's printed numbers.
+A-2.2 references against CONTACT's printed numbers (its runs at the deck's element against the published rows).
 """
 
 import math
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from hardening_helpers import quadric_case
 
-from comparisons.named_cases import SOURCES, named_case_names
+from comparisons.named_cases import QUANTITIES, SOURCES, named_case_names
 from rigid_dynamics.contact.hertz import hertz_solve_batch
 from rigid_dynamics.contact.kalker import kalker_coefficients
 from wheelrail.cases import parse_case
@@ -84,14 +84,60 @@ def test_saturated_reference_is_full_slip():
     assert named.reference["creep_force_long_N"] == pytest.approx(-mu_n, rel=1e-3)
 
 
-def test_a22_references_are_contacts_printed_numbers_on_the_wheel():
-    tread = load_named_case("a22-tread").reference
-    assert tread["normal_force_N"] == 9787.0
-    assert tread["creep_force_long_N"] == 456.2  # Fx on the wheel = -FX of CONTACT (on the rail)
-    assert tread["creep_force_lat_N"] == -2900.0
-    assert tread["max_pressure_Pa"] == pytest.approx(730.4e6)
-    assert tread["contact_area_m2"] == pytest.approx(20.4e-6)
-    assert load_named_case("a22-flange").reference["normal_force_N"] == 12720.0
+A22 = ("a22-tread", "a22-flange-root", "a22-flange")
+
+
+def _contact_rows(path):
+    import csv
+
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(line for line in handle if not line.startswith("#")))
+
+
+@pytest.mark.parametrize("name", A22)
+def test_a22_contact_runs_at_the_decks_element_reproduce_the_published_solution(name):
+    """CONTACT as run here (contact_grid.csv) at the deck's 0.2 mm equals its published row (contact_reference.csv):
+    the refined runs are of the same program and deck."""
+    folder = load_named_case(name).folder
+    published = _contact_rows(folder / "contact_reference.csv")[0]
+    row = next(r for r in _contact_rows(folder / "contact_grid.csv") if float(r["dx_mm"]) == 0.2)
+    assert float(row["ds_mm"]) == 0.2
+    for key in ("fn_N", "fx_N", "fs_N", "pmax_N_per_mm2", "ncon", "contact_area_mm2"):
+        assert float(row[key]) == pytest.approx(float(published[key]), rel=1e-9), key
+
+
+def test_a22_references_are_contacts_finest_element_on_the_wheel():
+    """The reference is CONTACT's finest run (forces on the wheel: Fx = -FX, Fy = +FS), with the change over the
+    last halving of the element as its own error (CONTACT's printed numbers, benchmarks/results/contact_grid.md)."""
+    flange = load_named_case("a22-flange")
+    assert flange.source == "contact-converged"
+    ref, unc = flange.reference, flange.uncertainty
+    assert ref["normal_force_N"] == 12730.0
+    assert ref["creep_force_long_N"] == 2073.0
+    assert ref["creep_force_lat_N"] == -3194.0
+    assert ref["max_pressure_Pa"] == pytest.approx(2597e6)
+    assert ref["contact_area_m2"] == pytest.approx(11885 * 0.025**2 * 1e-6, rel=1e-5)  # NCON dx ds
+    assert unc["contact_area_m2"] == pytest.approx(7.5075 / 7.428125 - 1.0, rel=1e-4)  # 0.05 mm -> 0.025 mm
+    assert unc["max_pressure_Pa"] == 5e-4  # 2596 -> 2597 MPa: below CONTACT's print resolution
+    assert unc["normal_force_N"] == 5e-4  # unchanged
+    for name in A22:
+        named = load_named_case(name)
+        assert set(named.uncertainty) == set(QUANTITIES)
+        # the published 0.2 mm area lies above the finest by more than the finest's own error (first order)
+        published = float(_contact_rows(named.folder / "contact_reference.csv")[0]["contact_area_mm2"]) * 1e-6
+        assert published > named.reference["contact_area_m2"] * (1 + named.uncertainty["contact_area_m2"])
+
+
+def test_contact_converged_case_needs_two_grids(tmp_path):
+    import shutil
+
+    folder = tmp_path / "one-grid"
+    shutil.copytree(load_named_case("a22-flange").folder, folder)
+    rows = (folder / "contact_grid.csv").read_text().splitlines()
+    lines = [r for r in rows if not r.startswith("#")]
+    (folder / "contact_grid.csv").write_text("\n".join([lines[0], lines[-1]]) + "\n")  # the finest row alone
+    with pytest.raises(ConfigError, match="contact_grid.csv: .*expected the finest element and one of twice"):
+        load_named_case(folder)
 
 
 def test_flat_and_corrugation_give_a_sampled_gap_with_local_curvature():
@@ -131,3 +177,23 @@ def test_bad_irregularity_keys_name_the_key(extra, match):
 def test_unknown_named_case_lists_the_choices():
     with pytest.raises(ConfigError, match="expected one of .*hertz-ab-1"):
         load_named_case("no-such-case")
+
+
+def test_bem_equals_contact_at_the_same_fine_element_on_the_flange():
+    """Our BEM on CONTACT's deck (step 17) with CONTACT's 0.05 mm elements against CONTACT's own 0.05 mm run
+    (contact_grid.csv): the grid dependence of the published numbers is CONTACT's and ours alike. Recorded: max
+    pressure -0.15 %, area +0.03 %, FN -0.03 % (benchmarks/results/contact_grid.md)."""
+    from comparisons.manchester import MATERIAL, a22_case
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    row = next(
+        r for r in _contact_rows(load_named_case("a22-flange").folder / "contact_grid.csv") if r["dx_mm"] == "0.05"
+    )
+    options = {"model": {"element_size_m": 0.05e-3}, "sides": ("right",)}
+    sol = solve_wheelset_case(a22_case(16, "deck"), MATERIAL, "bem", options)
+    (patch,) = [p.result for p in sol.patches if p.side == "right"]
+    assert patch.normal_force_N == pytest.approx(float(row["fn_N"]), rel=2e-3)
+    assert patch.max_pressure_Pa == pytest.approx(float(row["pmax_N_per_mm2"]) * 1e6, rel=5e-3)
+    assert patch.contact_area_m2 == pytest.approx(float(row["contact_area_mm2"]) * 1e-6, rel=5e-3)
+    # and both lie 3.5 % below the published 0.2 mm area
+    assert patch.contact_area_m2 < 0.97 * 7.96e-6

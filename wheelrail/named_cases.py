@@ -10,7 +10,7 @@ import math
 import tomllib
 from pathlib import Path
 
-from comparisons.named_cases import CASES_ROOT, SOURCES, NamedCase, contact_row_reference
+from comparisons.named_cases import CASES_ROOT, SOURCES, NamedCase, contact_grid_reference, contact_row_reference
 from wheelrail.config import ConfigError
 
 
@@ -19,12 +19,26 @@ def named_case_names() -> list[str]:
     return sorted(p.parent.name for p in CASES_ROOT.glob("*/reference.toml"))
 
 
-def _contact_reference(folder: Path) -> dict:
-    """Sum of the published CONTACT rows of ``contact_reference.csv`` (N, Fx, Fy summed; max p; summed area)."""
-    with open(folder / "contact_reference.csv", newline="") as handle:
+def _csv_rows(path: Path) -> list[dict]:
+    with open(path, newline="") as handle:
         rows = list(csv.DictReader(line for line in handle if not line.startswith("#")))
     if not rows:
-        raise ConfigError(f"{folder / 'contact_reference.csv'}: no data row")
+        raise ConfigError(f"{path}: no data row")
+    return rows
+
+
+def _contact_grid_reference(folder: Path) -> tuple[dict, dict]:
+    """Reference and uncertainty from CONTACT's runs at refined elements (``contact_grid.csv``)."""
+    path = folder / "contact_grid.csv"
+    try:
+        return contact_grid_reference(_csv_rows(path))
+    except (KeyError, ValueError) as exc:
+        raise ConfigError(f"{path}: {exc}") from None
+
+
+def _contact_reference(folder: Path) -> dict:
+    """Sum of the published CONTACT rows of ``contact_reference.csv`` (N, Fx, Fy summed; max p; summed area)."""
+    rows = _csv_rows(folder / "contact_reference.csv")
     parts = [contact_row_reference(r) for r in rows]
     out = {k: sum(p[k] for p in parts) for k in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")}
     out["max_pressure_Pa"] = max(p["max_pressure_Pa"] for p in parts)
@@ -55,15 +69,19 @@ def load_named_case(name_or_folder: str | Path) -> NamedCase:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ConfigError(f"key 'reference.{key}' = {value!r} in {path}: expected a finite number")
         reference[key] = float(value)
+    uncertainty = {k: float(v) for k, v in doc.get("uncertainty", {}).items()}
     if source == "contact-published":
         reference = {**_contact_reference(folder), **reference}
+    elif source == "contact-converged":
+        grid, grid_uncertainty = _contact_grid_reference(folder)
+        reference, uncertainty = {**grid, **reference}, {**grid_uncertainty, **uncertainty}
     return NamedCase(
         name=folder.name,
         folder=folder,
         source=source,
         side=str(doc.get("side", "single")),
         reference=reference,
-        uncertainty={k: float(v) for k, v in doc.get("uncertainty", {}).items()},
+        uncertainty=uncertainty,
         note=str(doc.get("note", "")),
         tags=tuple(doc.get("tags", ())),
         case=load_case(folder / "case.toml"),
