@@ -170,7 +170,7 @@ def _wheel_forces(result):
     [("wheel-flat", 0.2, 1.25e-5), ("polygonal-wheel", 0.6, 6.25e-5)],
 )
 def test_forces_against_fine_rk4(name, duration_s, ref_step_s):
-    """The compiled 3-D search (the scenes' provider): DP54 at rtol 1e-4, atol 1e-7 against RK4 at a fine step.
+    """The compiled 3-D search (the scenes' provider): DP54 at rtol 3e-5, atol 1e-7 against RK4 at a fine step.
     wheel-flat (elastic track, the first flat impact and the wheel lift after it): the impact peak, and every sample
     of the normal and creep forces against the reference within +-25 us, within 1 % of the static load, at under a
     third of the reference's right-hand sides. polygonal-wheel: the settled (after 10 m) peak
@@ -179,7 +179,10 @@ def test_forces_against_fine_rk4(name, duration_s, ref_step_s):
     scene = replace(load_scene(name), duration_s=duration_s)
     provider = build_provider(scene)
     reference = simulate(_rk4(scene, ref_step_s), provider=provider)
-    result = simulate(_adaptive(scene), provider=provider)
+    # rtol 3e-5: at 1e-4 the flat's impact peak (a cusp between samples) lands within 0.7-1.5 % of the static load
+    # depending on the accepted step sequence, which round-off in the right-hand side changes (measured after the
+    # callback merge: 1.47 %; 5e-5: 0.23 %, 3e-5: 0.075 % for 3 % more right-hand sides)
+    result = simulate(_adaptive(scene, rtol=3e-5), provider=provider)
     assert reference.status == "ok" and result.status == "ok", (reference.message, result.message)
     assert result.compiled and result.provider == reference.provider
     load = scene.static_wheel_load_N
