@@ -219,7 +219,7 @@ def test_wheel_lift_is_located_within_the_step():
     scene = replace(load_scene("wheel-flat"), duration_s=0.06)
     provider = build_provider(scene)
     reference = simulate(_rk4(scene, 5e-6, output_step_s=5e-6), provider=provider)
-    result = simulate(_adaptive(scene), provider=provider)
+    result = simulate(_adaptive(scene, rtol=3e-5), provider=provider)  # ok at 3e-5 (test_loose_tolerance_is_flagged)
     # the reference checks its force error at every step, and the step onto the flat's first edge (a new patch from
     # the search's scan: a jump) exceeds the tolerance: "warning"; its lift times are those of its samples
     assert reference.status in ("ok", "warning") and result.status == "ok", (reference.message, result.message)
@@ -246,25 +246,26 @@ def test_wheel_lift_is_located_within_the_step():
     assert scene.duration_s / result.steps > 100 * 2e-6
 
 
-def test_loose_tolerance_is_flagged_by_the_force_error_estimate():
-    """Like RK4's, a compiled pair's run carries a force error estimate per sample (the pair's solution against its
-    embedded lower-order one at the end of the step containing the sample, relative to the static load): at rtol
-    1e-2, atol 1e-6 (the settled impact peak 4.7 % off, benchmarks/results/adaptive.md) wheel-flat ends "warning"
-    with the advice to tighten the tolerances; at rtol 1e-4, atol 1e-7 it ends "ok" with an estimate below 0.01, and
-    passes the check of runs with a wheel lift."""
+def test_loose_tolerance_is_flagged():
+    """A compiled pair's run carries a force error estimate per sample (the pair's solution against its embedded
+    lower-order one at the end of the step containing the sample, relative to the static load) and, with a wheel
+    lift, the check at a tenth of both tolerances. wheel-flat at rtol 1e-2, atol 1e-6: the settled impact peak is
+    2.26 % of the static load off a fine RK4 run (measured), the local estimate says 1.2 % and the check's
+    difference 1.76 %: judged against half the force tolerance (simulate._half_step_check), the run ends "warning"
+    with the advice to tighten the tolerances. At rtol 3e-5, atol 1e-7 (peak 0.075 % off) it ends "ok"."""
     scene = replace(load_scene("wheel-flat"), duration_s=0.2)
     provider = build_provider(scene)
     loose = simulate(_adaptive(scene, rtol=1e-2, atol=1e-6), provider=provider)
     assert loose.status == "warning", loose.message
-    assert "force error estimate" in loose.message and "tighten relative_tolerance = 0.01" in loose.message
-    assert loose.summary()["force_error_estimate"] > scene.integrator.force_tolerance
-    tight = simulate(_adaptive(scene), provider=provider)
+    assert "at a tenth of the tolerances" in loose.message and "tighten relative_tolerance = 0.01" in loose.message
+    assert loose.half_step_peak_difference > 0.5 * scene.integrator.force_tolerance
+    tight = simulate(_adaptive(scene, rtol=3e-5), provider=provider)
     assert tight.status == "ok" and tight.summary()["force_error_estimate"] < 0.01, tight.message
     # the wheel lifts after the flat's impact: as for RK4 (its half-step check), the run is repeated at a tenth of
     # both tolerances and the settled peaks compared (the re-impacts move with the flight, which the local estimate
     # does not see)
     assert "the settled peaks at a tenth of the tolerances differ by" in tight.message
-    assert tight.half_step_peak_difference < scene.integrator.force_tolerance
+    assert tight.half_step_peak_difference < 0.5 * scene.integrator.force_tolerance
     # one estimate per step with samples (steps of ~0.36 ms, samples every 0.1 ms)
     assert np.isfinite(tight.force_error_estimate).sum() > 0.2 * len(tight.t)
 

@@ -105,15 +105,17 @@ def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_i
 
 
 def test_failure_within_the_start_limit_is_judged_at_the_impact():
-    """wheel-flat on the elastic track at 0.5 ms: within RK4's limit at the start (0.568 ms), the run derailed after
-    the first impact (step_sensitivity.md, before the fix), a numerical failure reported as physics. The Hertz
-    mode stiffens with the impact force, so the limit at the recorded state of the largest contact force is
-    smaller than the step: step-unstable, naming that state."""
+    """wheel-flat on the elastic track at 0.5 ms: within RK4's limit at the start (0.568 ms), the run derailed (or
+    hit the force limit) after the first impact (step_sensitivity.md, before the fix), a numerical failure reported
+    as physics. The Hertz mode stiffens with the impact force, so the limit at the recorded state of the largest
+    contact force is smaller than the step: step-unstable, naming that state."""
     shipped = load_scene("wheel-flat")
     result = simulate(replace(shipped, integrator=replace(shipped.integrator, fixed_step_s=5e-4, output_step_s=5e-4)))
     print(result.status, result.message)
     assert result.status == "step-unstable", result.message
-    assert result.message.startswith("derailed") and "the largest contact force" in result.message
+    # the numerical blow-up ends as derailed or force-anomaly depending on round-off (both seen); either way the
+    # message names the state of the largest contact force
+    assert result.message.startswith(("derailed", "force-anomaly")) and "the largest contact force" in result.message
     assert "0.5 ms" in result.message
 
 

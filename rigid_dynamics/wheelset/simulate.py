@@ -370,14 +370,21 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
     load against a 0.025 ms run; benchmarks/results/step_sensitivity.md). The difference of the two runs is an upper
     estimate of the half-step run's error and about the error of this run. "warning" when it exceeds
     ``force_tolerance``; the wall time and RHS evaluations include the second run. The compiled embedded pairs
-    (DP54/BS32) get the same check with the run again at a tenth of both tolerances.
+    (DP54/BS32) get the same check with the run again at a tenth of both tolerances, judged against half of
+    ``force_tolerance``: a tenth of the tolerances does not make the second run's error negligible (the sampled
+    impact peak of wheel-flat falls only 2.6-fold from rtol 1e-2 to 1e-3: 2.26 % and 0.87 % of the static load,
+    so the difference, 1.76 %, understates the first run's error). Half the tolerance keeps the first run's error
+    within the tolerance wherever the error falls at least 2-fold per tenfold tolerance.
     """
     scene = result.scene
     settings = scene.integrator
+    limit, limit_words = settings.force_tolerance, f"force_tolerance = {settings.force_tolerance:g}"
     if settings.method == "RK4":
         finer = replace(settings, fixed_step_s=0.5 * settings.fixed_step_s, lift_half_step_check=False)
         where, advice = "at half the step", f"reduce fixed_step_s = {settings.fixed_step_s:g} s"
-    else:  # the compiled embedded pairs: the same check at a tenth of the tolerances
+    else:
+        limit = 0.5 * settings.force_tolerance
+        limit_words = f"half of force_tolerance = {settings.force_tolerance:g}"  # the pairs: a tenth of the tolerances
         finer = replace(
             settings,
             relative_tolerance=0.1 * settings.relative_tolerance,
@@ -414,7 +421,7 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
         f"static wheel load"
     )
     status = "ok"
-    if moved > settings.force_tolerance:
+    if moved > limit:
         status = "warning"
-        message += f", above force_tolerance = {settings.force_tolerance:g}: {advice}"
+        message += f", above {limit_words}: {advice}"
     return replace(result, status=status, message=message, half_step_peak_difference=moved, **total)
