@@ -48,6 +48,9 @@ sys.path.insert(0, str(ROOT))
 from rigid_dynamics.wheelset import build_provider, simulate  # noqa: E402
 from wheelrail.scenes import load_scene  # noqa: E402
 
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from bench_dynamics_steps import measures  # noqa: E402  (settled peaks per wheel, the step table's measures)
+
 TOLERANCE = 0.01  # the target: force error within 1 % of the static wheel load
 CASES = {
     # scene: (provider override, reference step, RK4 steps), s
@@ -61,26 +64,6 @@ PAIR_TOLERANCES = {  # (relative_tolerance, absolute_tolerance)
     "BS32": ((1e-2, 1e-6), (1e-3, 1e-6), (1e-3, 1e-7), (1e-4, 1e-7), (1e-4, 1e-8), (1e-5, 1e-8), (1e-6, 1e-9)),
 }
 REFERENCE_2 = ("DP54", 1e-7, 1e-10)
-
-
-def wheel_series(result, name):
-    touching = np.nan_to_num(result.patches["normal_force_N"], nan=0.0) > 0
-    return np.where(touching, np.nan_to_num(result.patches[name], nan=0.0), 0.0).sum(axis=2)
-
-
-def measures(result):
-    """Settled measures per wheel, N: peak normal force, mean longitudinal creep force, peak |lateral creep force|."""
-    mask = result.settled
-    if not np.any(mask):
-        return None
-    normal = wheel_series(result, "normal_force_N")[mask]
-    longitudinal = wheel_series(result, "creep_force_long_N")[mask]
-    lateral = wheel_series(result, "creep_force_lat_N")[mask]
-    return {
-        "peak_normal_force_N": normal.max(axis=0).tolist(),
-        "mean_creep_force_long_N": longitudinal.mean(axis=0).tolist(),
-        "peak_abs_creep_force_lat_N": np.abs(lateral).max(axis=0).tolist(),
-    }
 
 
 def errors(got, ref, load):

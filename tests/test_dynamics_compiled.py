@@ -209,3 +209,28 @@ def test_compiled_stops_and_refuses():
     assert result.failure_state is not None and np.all(np.isfinite(result.states))
     with pytest.raises(ValueError, match="compiled = True: the compiled loop needs method RK4"):
         simulate(replace(scene, integrator=IntegratorSettings(method="RK45")), compiled=True)
+
+
+def test_embedded_pair_names_a_callback_failure_and_records_auto(monkeypatch):
+    """The compiled DP54 loop: a model behind the callback that fails mid-run ends the run "contact-failed" with the
+    model's message (a model's failure is not retried at smaller steps down to "step-size-underflow"); with ``auto``
+    the per-patch choice is recorded as in the RK4 loop (both loops through drivers.patch_tables)."""
+    import importlib
+
+    dp54 = replace(SCENE, integrator=replace(SCENE.integrator, method="DP54"), duration_s=0.01)
+    simulate_module = importlib.import_module("rigid_dynamics.wheelset.simulate")
+    run = simulate_module.run_compiled
+
+    def armed(*args, **kwargs):
+        FailingLater.armed = True
+        return run(*args, **kwargs)
+
+    FailingLater.armed = False
+    monkeypatch.setattr(simulate_module, "run_compiled", armed)
+    result = simulate(dp54, contact_model=FailingLater(), compiled=True)
+    assert result.status == "contact-failed" and not result.success, result.message
+    assert "'failing-later' raised" in result.message and "no answer" in result.message
+    monkeypatch.setattr(simulate_module, "run_compiled", run)
+    auto = simulate(replace(dp54, contact_model="auto", contact_tolerance=0.1), compiled=True)
+    assert auto.success and auto.compiled and auto.method == "DP54", auto.message
+    assert np.any(np.isfinite(auto.patches["auto_rung"]))

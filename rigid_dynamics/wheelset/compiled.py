@@ -77,6 +77,8 @@ CALLBACK_CODE = 4
 AUTO_CODE = 5
 """``model_code`` of ``auto``: the rung chosen per patch in the loop; linear, Vermeulen-Johnson and FASTSIM inline,
 BEM through the callback."""
+CALLBACK_FAILED = 5
+"""Status of the right-hand side when the contact model behind the callback failed (its message: the callback's)."""
 FLEX_CODES = {"three": 0, "single": 1, "three-unblended": 2}
 N_PATCH = 14  # equations.PATCH_FIELDS, in that order
 N_AUTO = 9  # equations.AUTO_PATCH_FIELDS, in that order, after them
@@ -864,7 +866,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
                 ex, ey, radius, g[11], g[10],
             )  # fmt: skip
             if st != 0:
-                return 5
+                return CALLBACK_FAILED
         else:
             normal, sa, sb, tx, ty, mz, st = _law(par, hz, kk, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
             if st == 1:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
@@ -873,7 +875,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
                     n, ex, ey, radius, g[11], g[10],
                 )  # fmt: skip
                 if st != 0:
-                    return 5
+                    return CALLBACK_FAILED
         for k in range(3):
             fc[k] = ex[k] * tx + ey[k] * ty + n[k] * normal
             mc[k] = n[k] * mz

@@ -26,8 +26,10 @@ wheel-flat impact that way); the rates get atol + rtol |y|. A step with size <= 
 accepted; the next step is h (0.9 norm^(-0.7/k) norm_prev^(0.4/k)), a PI controller (Gustafsson 1991; Hairer &
 Wanner II, IV.2), k = the order of the error estimate + 1, the factor within [0.2, 10] (not above 1 right after a
 rejection). A rejected step is retried with h max(0.2, 0.9 norm^(-1/k)). A stage whose right-hand side fails
-(status not 0, or a non-finite state) is retried at a quarter of the step. A step below ``h_min`` ends the run
-with status 5 (drivers: "step-size-underflow"), with the status of the last failure kept for the message.
+(status not 0, or a non-finite state) is retried at a quarter of the step, except a contact model that failed
+behind the callback (status 5, compiled._external: not a matter of the step), which ends the run. A step below
+``h_min`` ends the run with status 6 (UNDERFLOW, drivers: "step-size-underflow"), with the status of the last
+failure kept for the message.
 
 A step that would end a little past an output time (by less than one stage's share of it) is shortened to end
 there, so that the sample needs no right-hand side of its own.
@@ -57,7 +59,7 @@ from fractions import Fraction as F
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.wheelset.compiled import N_FIELDS, _rhs, _side_forces, _workspace
+from rigid_dynamics.wheelset.compiled import CALLBACK_FAILED, N_FIELDS, _rhs, _side_forces, _workspace
 
 MIN_STEP_S = 1e-10
 """Smallest step of an error-controlled run, s: below it the run ends with status "step-size-underflow" (a contact
@@ -73,7 +75,7 @@ MAX_EVENTS = 100_000
 STEPS_PER_CALL = 2000
 """Accepted steps per call of the compiled loop (between calls the driver checks wall time and budget)."""
 
-UNDERFLOW = 5
+UNDERFLOW = 6
 
 
 def _tableau(a_rows, b_hat, p_rows=None):
@@ -249,6 +251,8 @@ def embedded_run(
             last = s == ns - 1
             st = _rhs(t + cc[s] * h, ys, par, hz, kk, sides, mode, targs, sargs, ws, last, last, kst[s])
             evals += 1
+            if st == CALLBACK_FAILED:  # the contact model behind the callback failed: not a matter of the step
+                return st, t, y, h, accepted, rejected, k_out, evals, located, st
             if st != 0:
                 failed = st
                 break
@@ -444,6 +448,7 @@ ADAPTIVE_STATUS = {
     2: "force-anomaly",
     3: "derailed",
     4: "contact-failed",
+    CALLBACK_FAILED: "contact-failed",
     UNDERFLOW: "step-size-underflow",
 }
 """Status codes of :func:`embedded_run` -> run statuses."""
@@ -542,11 +547,12 @@ def run_embedded(model, packed, y0, duration, settings, recorder, report, start)
     import time
 
     from rigid_dynamics.wheelset import compiled
-    from rigid_dynamics.wheelset.equations import MAX_SLOTS, PATCH_FIELDS
+    from rigid_dynamics.wheelset.drivers import patch_tables
     from rigid_dynamics.wheelset.recorder import Stop
 
     scene = model.scene
     par, hz, kk, sides, slots, mode, targs, sargs = packed
+    compiled.use_callback(model.callback)
     a, c, e, p, k_order, atol, weight = _arguments(packed, settings, scene)
     rtol = settings.relative_tolerance
     ncand = len(sides)
@@ -590,11 +596,7 @@ def run_embedded(model, packed, y0, duration, settings, recorder, report, start)
         stats["located_switches"] += int(located)
         if k_new > k_out:
             block = recs[k_out:k_new]
-            tables = {name: np.full((k_new - k_out, 2, MAX_SLOTS), np.nan) for name in PATCH_FIELDS}
-            for cand in range(ncand):
-                if slots[cand] < MAX_SLOTS:
-                    for f, name in enumerate(PATCH_FIELDS):
-                        tables[name][:, sides[cand], slots[cand]] = block[:, cand, f]
+            tables = patch_tables(model, block, sides, slots)
             try:
                 recorder.append_many(
                     out_times[k_out:k_new],
@@ -612,6 +614,8 @@ def run_embedded(model, packed, y0, duration, settings, recorder, report, start)
             events_to_recorder()
             name = ADAPTIVE_STATUS[int(status)]
             why = ""
+            if status == CALLBACK_FAILED and model.callback is not None:
+                why = f": {model.callback.message}"
             if status == UNDERFLOW:
                 why = (
                     f": the step fell below {MIN_STEP_S:g} s"

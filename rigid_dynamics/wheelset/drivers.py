@@ -215,6 +215,20 @@ def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene
     return steps
 
 
+def patch_tables(model, block, sides, slots) -> dict:
+    """The compiled loops' records of a block of output samples (n, candidates + 2, compiled.N_FIELDS) as the
+    recorder's per-patch tables: field -> (n, 2 sides, MAX_SLOTS), NaN where no candidate sits (PATCH_FIELDS, and
+    AUTO_PATCH_FIELDS for ``auto``).
+    """
+    fields_ = PATCH_FIELDS + (AUTO_PATCH_FIELDS if model.auto else ())
+    tables = {name: np.full((len(block), 2, MAX_SLOTS), np.nan) for name in fields_}
+    for c in range(len(sides)):
+        if slots[c] < MAX_SLOTS:
+            for f, name in enumerate(fields_):
+                tables[name][:, sides[c], slots[c]] = block[:, c, f]
+    return tables
+
+
 def run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
     """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched; the
     embedded pairs with step-size control (``method`` "DP54" or "BS32") in compiled_adaptive.run_embedded.
@@ -237,7 +251,6 @@ def run_compiled(model, packed, y0, duration, settings, recorder, report, start)
     errs = np.full(n_out, np.nan)
     y, t, done, k_out = y0.copy(), 0.0, 0, 0
     chunk = max(out_every, (2000 // out_every) * out_every)
-    fields_ = PATCH_FIELDS + (AUTO_PATCH_FIELDS if model.auto else ())
     while done < n_steps:
         todo = min(chunk, n_steps - done)
         status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
@@ -246,18 +259,18 @@ def run_compiled(model, packed, y0, duration, settings, recorder, report, start)
         model.rhs_evaluations += int(evals)
         if k_new > k_out:
             block = recs[k_out:k_new]
-            tables = {name: np.full((k_new - k_out, 2, MAX_SLOTS), np.nan) for name in fields_}
-            for c in range(ncand):
-                if slots[c] < MAX_SLOTS:
-                    for f, name in enumerate(fields_):
-                        tables[name][:, sides[c], slots[c]] = block[:, c, f]
+            tables = patch_tables(model, block, sides, slots)
             times = (done // out_every + np.arange(1, k_new - k_out + 1)) * out_every * h
             recorder.append_many(
                 times, states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy(), errs[k_out:k_new]
             )
         k_out = k_new
         if status != 0:
-            why = f": {model.callback.message}" if status == 5 and model.callback is not None else ""
+            why = (
+                f": {model.callback.message}"
+                if status == compiled.CALLBACK_FAILED and model.callback is not None
+                else ""
+            )
             stop = Stop(
                 COMPILED_STATUS[int(status)],
                 f"compiled RK4 stopped ({COMPILED_STATUS[int(status)]}) at t = {t_end:.6g} s{why}",
