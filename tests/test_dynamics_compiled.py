@@ -136,12 +136,9 @@ class FailingLater(LinearModel):
         return super().solve(geometry, creepage, material, **kwargs)
 
 
-def test_callback_failure_is_a_status(monkeypatch):
-    """A user model that raises: at the start the run has no equilibrium and says why; in the loop the run stops
-    with "contact-failed" and the model's message."""
-    result = simulate(replace(SCENE, duration_s=0.01), contact_model=Failing(), compiled=True)
-    assert result.status == "invalid-initial-state" and not result.success
-    assert "'failing' raised" in result.message and "no answer" in result.message
+def _arm_failing_later_in_the_loop(monkeypatch):
+    """FailingLater answers until the compiled loop starts (the equilibrium before it succeeds), then raises.
+    Returns the unpatched run_compiled."""
     import importlib
 
     simulate_module = importlib.import_module("rigid_dynamics.wheelset.simulate")
@@ -153,6 +150,16 @@ def test_callback_failure_is_a_status(monkeypatch):
 
     FailingLater.armed = False
     monkeypatch.setattr(simulate_module, "run_compiled", armed)
+    return run
+
+
+def test_callback_failure_is_a_status(monkeypatch):
+    """A user model that raises: at the start the run has no equilibrium and says why; in the loop the run stops
+    with "contact-failed" and the model's message."""
+    result = simulate(replace(SCENE, duration_s=0.01), contact_model=Failing(), compiled=True)
+    assert result.status == "invalid-initial-state" and not result.success
+    assert "'failing' raised" in result.message and "no answer" in result.message
+    _arm_failing_later_in_the_loop(monkeypatch)
     result = simulate(replace(SCENE, duration_s=0.01), contact_model=FailingLater(), compiled=True)
     assert result.status == "contact-failed" and not result.success
     assert "'failing-later' raised" in result.message and "no answer" in result.message
@@ -215,22 +222,12 @@ def test_embedded_pair_names_a_callback_failure_and_records_auto(monkeypatch):
     """The compiled DP54 loop: a model behind the callback that fails mid-run ends the run "contact-failed" with the
     model's message (a model's failure is not retried at smaller steps down to "step-size-underflow"); with ``auto``
     the per-patch choice is recorded as in the RK4 loop (both loops through drivers.patch_tables)."""
-    import importlib
-
     dp54 = replace(SCENE, integrator=replace(SCENE.integrator, method="DP54"), duration_s=0.01)
-    simulate_module = importlib.import_module("rigid_dynamics.wheelset.simulate")
-    run = simulate_module.run_compiled
-
-    def armed(*args, **kwargs):
-        FailingLater.armed = True
-        return run(*args, **kwargs)
-
-    FailingLater.armed = False
-    monkeypatch.setattr(simulate_module, "run_compiled", armed)
+    _arm_failing_later_in_the_loop(monkeypatch)
     result = simulate(dp54, contact_model=FailingLater(), compiled=True)
     assert result.status == "contact-failed" and not result.success, result.message
     assert "'failing-later' raised" in result.message and "no answer" in result.message
-    monkeypatch.setattr(simulate_module, "run_compiled", run)
+    monkeypatch.undo()  # run_compiled unpatched again
     auto = simulate(replace(dp54, contact_model="auto", contact_tolerance=0.1), compiled=True)
     assert auto.success and auto.compiled and auto.method == "DP54", auto.message
     assert np.any(np.isfinite(auto.patches["auto_rung"]))
