@@ -45,6 +45,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from rigid_dynamics.files import write_text  # noqa: E402  (atomic)
 from rigid_dynamics.wheelset import build_provider, simulate  # noqa: E402
 from wheelrail.scenes import load_scene  # noqa: E402
 
@@ -293,9 +294,7 @@ def write(payload):
         ("adaptive.json", json.dumps(payload, indent=2) + "\n"),
         ("adaptive.md", "\n".join(lines) + "\n"),
     ):
-        tmp = out / f".{fname}.tmp"
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, out / fname)
+        write_text(out / fname, text)
     print("\n".join(lines))
 
 

@@ -48,6 +48,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from rigid_dynamics.files import write_text  # noqa: E402  (atomic)
 from rigid_dynamics.wheelset import DynamicsScene, Irregularities, simulate  # noqa: E402
 from rigid_dynamics.wheelset.providers import SearchProvider  # noqa: E402
 from rigid_dynamics.wheelset.simulate import build_provider  # noqa: E402
@@ -247,9 +248,7 @@ def main(argv=None):
         NOTES.format(vs=vs, reused=next((r["searches_reused"] for r in records if "searches_reused" in r), 0)),
     ]
     for name, text in (("dynamics.json", json.dumps(payload, indent=2) + "\n"), ("dynamics.md", "\n".join(lines))):
-        tmp = args.out / f".{name}.tmp"
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, args.out / name)
+        write_text(args.out / name, text)
     print("\n".join(lines))
 
 

@@ -56,6 +56,7 @@ sys.path.insert(0, str(ROOT))
 from rigid_dynamics.contact import fastsim  # noqa: E402
 from rigid_dynamics.contact.fastsim import effective_flexibilities  # noqa: E402
 from rigid_dynamics.contact.kalker import kalker_coefficients  # noqa: E402
+from rigid_dynamics.files import write_text  # noqa: E402  (atomic)
 
 G, NU, MU = 82.0e9, 0.28, 0.3
 A, B, FN = 6.0e-3, 4.0e-3, 80.0e3
@@ -545,9 +546,7 @@ def main():
         ("fastsim_grid.json", json.dumps(payload, indent=2) + "\n"),
         ("fastsim_grid.md", "\n".join(lines)),
     ):
-        tmp = args.out / f".{name}.tmp"
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, args.out / name)
+        write_text(args.out / name, text)
     print("\n".join(lines))
 
 

@@ -58,6 +58,7 @@ from rigid_dynamics.contact.search import SIDES  # noqa: E402
 from rigid_dynamics.contact.track import build_track  # noqa: E402
 from rigid_dynamics.contact.wheelset_case import solve_wheelset_case  # noqa: E402
 from rigid_dynamics.contact.wheelset_patches import wheel_patches  # noqa: E402
+from rigid_dynamics.files import write_text  # noqa: E402  (atomic)
 
 METHODS = ("hertz", "fastsim", "bem")
 
@@ -305,9 +306,7 @@ def main():
     out = ROOT / "benchmarks" / "results"
     out.mkdir(parents=True, exist_ok=True)
     for name, text in (("wheelset_case.json", json.dumps(result, indent=2)), ("wheelset_case.md", markdown(result))):
-        tmp = out / (name + ".tmp")
-        tmp.write_text(text)
-        os.replace(tmp, out / name)
+        write_text(out / name, text)
     print(markdown(result))
 
 
