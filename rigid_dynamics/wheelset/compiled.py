@@ -1007,6 +1007,23 @@ def _side_forces(rec, sides, out):
                 out[sides[c], k] += rec[c, k]
 
 
+@njit(cache=True, _nrt=False)
+def _force_difference(f4, f3):
+    """The largest |f4 - f3| over both sides' normal, longitudinal and lateral contact forces (two _side_forces
+    results, (2, 3)), N; inf when one is NaN (forces not computable at one of the two states). The force error
+    estimate of RK4 (against its embedded third-order solution) and of the DP54/BS32 pairs.
+    """
+    worst = 0.0
+    for sd in range(2):
+        for k in range(3):
+            d = abs(f4[sd, k] - f3[sd, k])
+            if d != d:
+                return np.inf
+            if d > worst:
+                worst = d
+    return worst
+
+
 @njit(cache=True)
 def rk4_run(
     y, t0, h, n_steps, out_every, check_every, par, hz, kk, sides, mode, targs, sargs, states, recs, errs, out_start
@@ -1092,14 +1109,7 @@ def rk4_run(
             worst = np.inf
             if st == 0:
                 _side_forces(rec, sides, f3)
-                worst = 0.0
-                for sd in range(2):
-                    for k in range(3):
-                        d = abs(f4[sd, k] - f3[sd, k])
-                        if d != d:  # NaN: forces not computable at one of the two states
-                            worst = np.inf
-                        elif d > worst:
-                            worst = d
+                worst = _force_difference(f4, f3)
             if not pending >= worst:  # also when pending is NaN
                 pending = worst
             for i in range(nst):

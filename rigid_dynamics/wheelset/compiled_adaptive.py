@@ -59,7 +59,14 @@ from fractions import Fraction as F
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.wheelset.compiled import CALLBACK_FAILED, N_FIELDS, _rhs, _side_forces, _workspace
+from rigid_dynamics.wheelset.compiled import (
+    CALLBACK_FAILED,
+    N_FIELDS,
+    _force_difference,
+    _rhs,
+    _side_forces,
+    _workspace,
+)
 
 MIN_STEP_S = 1e-10
 """Smallest step of an error-controlled run, s: below it the run ends with status "step-size-underflow" (a contact
@@ -378,14 +385,7 @@ def embedded_run(
             force_err = np.inf
             if st == 0:
                 _side_forces(rec, sides, f3)
-                force_err = 0.0
-                for sd in range(2):
-                    for q in range(3):
-                        d = abs(f4[sd, q] - f3[sd, q])
-                        if d != d:  # NaN: forces not computable at one of the two states
-                            force_err = np.inf
-                        elif d > force_err:
-                            force_err = d
+                force_err = _force_difference(f4, f3)
             mem[:, :, :] = mem_end
             n_mem[:] = n_mem_end
         # the output samples within (t, t_new]: dense output and a right-hand side with record there
