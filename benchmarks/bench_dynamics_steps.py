@@ -106,7 +106,6 @@ def doubling_estimate(scene, result, samples=100):
     from rigid_dynamics.wheelset import compiled
     from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
-    from rigid_dynamics.wheelset.state import n_states
 
     if not result.compiled:
         return None
@@ -119,7 +118,7 @@ def doubling_estimate(scene, result, samples=100):
     h = scene.integrator.fixed_step_s
 
     def rhs(t, y):
-        out = np.zeros(n_states(scene.track_dynamics.elastic))
+        out = np.zeros(len(y))
         compiled.rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec)
         forces = np.zeros((2, 3))
         for c in range(len(sides)):

@@ -206,13 +206,17 @@ def test_dipped_joint_p2_against_jenkins(speed):
 
 
 def test_track_model_is_validated(capsys, tmp_path):
-    text = resolve_scene_path("hunting-conical").read_text(encoding="utf-8") + '\n[track_dynamics]\nmodel = "beam"\n'
+    text = resolve_scene_path("hunting-conical").read_text(encoding="utf-8") + '\n[track_dynamics]\nmodel = "slab"\n'
     code, _, err = run(capsys, "run", write(tmp_path, text, "scene.toml"), "--out", tmp_path / "o", "--quiet")
-    assert_error(code, err, "track_dynamics", "'beam'", "rigid")
+    assert_error(code, err, "track_dynamics", "'slab'", "rigid, lumped, beam")
     text = resolve_scene_path("hunting-conical").read_text(encoding="utf-8")
     text += '\n[track_dynamics]\nmodel = "lumped"\nrail_mass_kg = -1.0\n'
     code, _, err = run(capsys, "run", write(tmp_path, text, "scene2.toml"), "--out", tmp_path / "o2", "--quiet")
     assert_error(code, err, "rail_mass_kg", "-1.0")
+    text = resolve_scene_path("hunting-conical").read_text(encoding="utf-8")
+    text += '\n[track_dynamics]\nmodel = "beam"\nrail_theory = "bernoulli"\n'
+    code, _, err = run(capsys, "run", write(tmp_path, text, "scene3.toml"), "--out", tmp_path / "o3", "--quiet")
+    assert_error(code, err, "rail_theory", "'bernoulli'", "timoshenko, euler-bernoulli")
     text = resolve_scene_path("hunting-conical").read_text(encoding="utf-8")
     text += '\n[track_dynamics]\nmodel = "lumped"\npad_stiffness_N_per_m = 1e20\n'
     code, _, err = run(capsys, "run", write(tmp_path, text, "scene3.toml"), "--out", tmp_path / "o3", "--quiet")
@@ -225,7 +229,11 @@ def test_dipped_joint_refused_on_the_search():
 
 
 def test_track_states_sit_in_their_slice():
-    assert TRACK == slice(14, 22)
+    from rigid_dynamics.wheelset.state import RAIL, RAIL_VELOCITY, n_states, track_positions, track_velocities
+
+    assert TRACK == slice(14, None) and n_states(4) == 22 and n_states(0) == 14
+    assert track_positions(22) == slice(14, 18) and track_velocities(22) == slice(18, 22)
+    assert (RAIL, RAIL_VELOCITY) == (14, 18)
 
 
 def test_compiled_search_equals_the_python_search_on_the_elastic_track():

@@ -62,12 +62,11 @@ from rigid_dynamics.contact.fastsim import _fastsim_one
 from rigid_dynamics.wheelset import track
 from rigid_dynamics.wheelset.compiled_search import N_GEO, search_geometry, search_geometry_on_track
 from rigid_dynamics.wheelset.state import (
-    RAIL,
-    RAIL_VELOCITY,
     WORK_CONTACT,
     WORK_EXTERIOR,
     n_states,
 )
+from rigid_dynamics.wheelset.track import rail_under_wheel
 from rigid_dynamics.wheelset.track import track_rates as _track_rates
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
@@ -356,9 +355,10 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
     sps = math.sin(y[3])
     _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, y[4], work)
     zref = par.z_ref_m
-    elastic = par.elastic_track > 0
+    rail0, _ = rail_under_wheel(par, y, 0)
+    rail1, _ = rail_under_wheel(par, y, 1)
     for c in range(table.shape[1]):
-        zs = zc - y[RAIL + sides[c]] if elastic else zc  # the rail lowered by z_r: the centre raised for this side
+        zs = zc - (rail0 if sides[c] == 0 else rail1)  # the rail lowered by w: the centre raised for this side
         q = work[0, c] + (zs - zref) * work[1, c]
         if slots[c] > 0 and work[11, c] + (zs - zref) * work[1, c] > 0:
             q = -0.01
@@ -835,7 +835,8 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         oma[0], oma[1], oma[2] = om[0], om[1] + w_1, om[2] + w_2
         vxa = vx * (1.0 + par.curvature_1_per_m * (par.cant_sin * y[2] - par.cant_cos * yc))
     p_con = 0.0
-    elastic = par.elastic_track > 0
+    _, rail_v0 = rail_under_wheel(par, y, 0)
+    _, rail_v1 = rail_under_wheel(par, y, 1)
     rail_f0, rail_f1 = 0.0, 0.0
     ncand = cg.shape[0]
     for c in range(ncand):
@@ -856,7 +857,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
                 rec[c, 11] = g[11]
         if not q > 0.0:
             continue
-        rail_vz = y[RAIL_VELOCITY + sides[c]] if elastic else 0.0  # creepages relative to the rail
+        rail_vz = rail_v0 if sides[c] == 0 else rail_v1  # creepages relative to the rail (0: rigid track)
         speed, xi, eta, spin = _patch_creepages(lever, n, oma, vxa, vy, vz, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
@@ -934,7 +935,11 @@ def _geometry(y, par, sides, mode, targs, sargs, ws, full):
     elif mode == 1:
         sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = sargs
         if par.elastic_track > 0:
-            search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15])
+            rail0, _ = rail_under_wheel(par, y, 0)
+            rail1, _ = rail_under_wheel(par, y, 1)
+            search_geometry_on_track(
+                y, rail0, rail1, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15]
+            )
         else:
             search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
 
@@ -1133,7 +1138,7 @@ def load(packed) -> None:
     search memory, whose warm starts are its only state).
     """
     par, hz, kk, sides, _, mode, targs, sargs = packed
-    y = np.zeros(n_states(par["elastic_track"] > 0))
+    y = np.zeros(n_states(int(par["track_positions"])))
     rec = np.zeros((len(sides) + 2, N_FIELDS))
     rk4_run(
         y,
@@ -1253,7 +1258,7 @@ def model_parameters(model_wheelset):
         par["curvature_1_per_m"] = geometry.curvature_1_per_m
         par["cant_sin"], par["cant_cos"] = math.sin(geometry.cant_rad), math.cos(geometry.cant_rad)
         par["carried_mass_kg"] = m.axle_load / m.gravity
-    track.pack_parameters(par, scene.track_dynamics)
+    track.pack_parameters(par, scene.track_dynamics, track.travel_m(scene))
     return par
 
 

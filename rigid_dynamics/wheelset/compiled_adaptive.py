@@ -468,13 +468,13 @@ def supported(scene, provider, model) -> bool:
 def _arguments(packed, settings, scene):
     """(tableau and control arguments) of embedded_run for a run: (a, c, e, p, k, atol, weight)."""
     from rigid_dynamics.wheelset.drivers import tolerances
-    from rigid_dynamics.wheelset.state import POSITIONS, TRACK_POSITIONS, WORK
+    from rigid_dynamics.wheelset.state import POSITIONS, WORK, track_positions
 
     (a, c, e, p), k_order, _ = PAIRS[settings.method]
     atol = tolerances(settings, scene)
     weight = np.full(len(atol), 2.0)  # 2: atol + rtol |y|
     weight[POSITIONS] = 1.0  # 1: atol alone (offsets: x and the spin angle grow along the track, z is ~ r0)
-    weight[TRACK_POSITIONS] = 1.0  # (absent on the rigid track)
+    weight[track_positions(len(atol))] = 1.0  # (absent on the rigid track)
     weight[WORK] = 0.0  # diagnostics, not in the right-hand side
     return a, c, e, p, k_order, atol, weight
 

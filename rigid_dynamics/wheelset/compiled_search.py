@@ -42,7 +42,6 @@ from rigid_dynamics.contact._search_kernels import (
     refine_point,
     wheel_irregularity,
 )
-from rigid_dynamics.wheelset.state import RAIL
 
 N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
 MAX_START = 8  # starts refined per side and evaluation
@@ -443,15 +442,17 @@ def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, c
 
 
 @njit(cache=True, _nrt=False)
-def search_geometry_on_track(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, centre):
-    """search_geometry with the rails lowered by the elastic track's rail deflections y[RAIL + side] (state.py):
+def search_geometry_on_track(
+    y, rail_left_m, rail_right_m, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, centre
+):
+    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels (left, right):
     each side is searched at the wheelset centre raised by its rail's deflection (centre: a scratch 3-vector), and
     the levers (contact point - centre) are those of the raised pose (a rigid vertical shift of the rail).
     """
     rotation(y[3], y[4], y[5], rot)
     failed = 0
     for s in range(2):
-        centre[0], centre[1], centre[2] = y[0], y[1], y[2] - y[RAIL + s]
+        centre[0], centre[1], centre[2] = y[0], y[1], y[2] - (rail_left_m if s == 0 else rail_right_m)
         failed += search_side(s, centre, rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
     return failed
 

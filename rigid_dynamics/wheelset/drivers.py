@@ -22,12 +22,12 @@ from rigid_dynamics.wheelset.state import (
     POSITIONS,
     SPIN,
     SPIN_RATE,
-    TRACK_POSITIONS,
-    TRACK_VELOCITIES,
     VELOCITIES,
     WORK,
     n_states,
     state_names,
+    track_positions,
+    track_velocities,
 )
 
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
@@ -84,12 +84,15 @@ def tolerances(settings, scene):
     tolerance 1e4-fold or tightening it to atol (m g + axle load) changes the steps of RK45, BDF, Radau and
     LSODA on hunting-conical by under 2 %: the mechanical states set the steps).
     """
-    atol = np.full(n_states(scene.track_dynamics.elastic), settings.absolute_tolerance)
+    from rigid_dynamics.wheelset.track import n_positions, travel_m
+
+    n = n_states(n_positions(scene.track_dynamics, travel_m(scene)))
+    atol = np.full(n, settings.absolute_tolerance)
     atol[VELOCITIES] = settings.absolute_tolerance * 100.0
     atol[SPIN] = settings.absolute_tolerance * 100.0
     atol[SPIN_RATE] = settings.absolute_tolerance * 1e3
     atol[WORK] = 1e-3
-    atol[TRACK_VELOCITIES] = settings.absolute_tolerance * 100.0  # the track's rates (absent for the rigid track)
+    atol[track_velocities(n)] = settings.absolute_tolerance * 100.0  # the track's rates (absent for the rigid track)
     return atol
 
 
@@ -135,7 +138,7 @@ def state_jacobian(fun: Callable) -> Callable:
         jac_matrix = np.zeros((n, n))
         jac_matrix[POSITIONS, VELOCITIES] = np.eye(6)
         if n > N_RIGID:
-            jac_matrix[TRACK_POSITIONS, TRACK_VELOCITIES] = np.eye(4)
+            jac_matrix[track_positions(n), track_velocities(n)] = np.eye((n - N_RIGID) // 2)
         for j in [*range(N_MECHANICAL), *range(N_RIGID, n)]:  # not the work integrals
             for sign in (1.0, -1.0):
                 trial = y.copy()
@@ -148,7 +151,7 @@ def state_jacobian(fun: Callable) -> Callable:
                 raise Stop(
                     "solver-failed",
                     f"no Jacobian: the state function is not finite next to the state at t = {t:.6g} s "
-                    f"(column {j}, {state_names(True)[j]})",
+                    f"(column {j}, {state_names(n)[j]})",
                     t,
                     y,
                 )

@@ -23,9 +23,11 @@ normal and curvatures; creepages by eq 39-49, rigid_dynamics.contact.creepage):
   couples yaw and roll.
 * alpha -> (psi'', theta'', phi'') by eq 68-70 (kinematics.euler_accelerations).
 
-Elastic track (scene ``track_dynamics.model = "lumped"``, seed eq 6's rail deflection N_d,t): 8 more states
-after the two work integrals, :data:`TRACK` = [z_r, z_s per side (left, right), then their rates], z down, from
-the unloaded track. Per wheel m_r z_r'' = F_r - k_p (z_r - z_s) - c_p (z_r' - z_s') and
+Elastic track (scene ``track_dynamics``, seed eq 6's rail deflection N_d,t): its states follow the two work
+integrals (:data:`TRACK`), positions then rates, z down from the unloaded track; their physics is in
+:mod:`rigid_dynamics.wheelset.track` (the lumped track below; the discretely supported beam there, whose rail
+deflection and velocity under the wheel, track.rail_under_wheel, take the place of z_r and z_r'). Lumped: per
+wheel m_r z_r'' = F_r - k_p (z_r - z_s) - c_p (z_r' - z_s') and
 m_s z_s'' = k_p (z_r - z_s) + c_p (z_r' - z_s') - k_b z_s - c_b z_s', with F_r = -sum F_con,z over that wheel's
 patches (the vertical component of the contact forces, on the rail). The rail mass's displacement z_r lowers that
 rail's surface: the contact geometry is evaluated with the wheelset centre raised by z_r for that side (a rigid
@@ -301,8 +303,9 @@ class WheelsetModel:
         self.torque = scene.loads.traction_torque_N_m
         self.track = scene.track_dynamics
         self.elastic = self.track.elastic
-        self.n_state = n_states(self.elastic)
-        self.track_rest = np.zeros(8)  # the track's states used with a 12-state (static equilibrium)
+        self.track_system = track_model.TrackSystem(self.track, track_model.travel_m(scene)) if self.elastic else None
+        self.n_state = n_states(self.track_system.n_positions if self.elastic else 0)
+        self.track_rest = np.zeros(self.n_state - 14)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
         self.par = model_parameters(self)  # replaced by the packed record below (same fields, contact fields set)
         from rigid_dynamics.wheelset import compiled
@@ -338,8 +341,21 @@ class WheelsetModel:
         return np.concatenate(parts)
 
     def static_track(self, rail_force_N) -> np.ndarray:
-        """Track states at rest under the vertical rail forces (left, right), N (track.rest_state)."""
-        return track_model.rest_state(self.track, rail_force_N)
+        """Track states at rest under the vertical rail forces (left, right), N, with the wheelset at its start
+        (track.TrackSystem.rest_state).
+        """
+        return self.track_system.rest_state(rail_force_N)
+
+    def rail_under_wheels(self, full: np.ndarray) -> np.ndarray:
+        """The rails' deflection (left, right) and velocity (left, right) under the wheels at a full state, (4,), m
+        and m/s, z down (track.rail_under_wheel; zeros on the rigid track).
+        """
+        out = np.zeros(4)
+        if self.elastic:
+            self.par["frame_x0_m"] = self.frame_x0
+            for side in (0, 1):
+                out[side], out[2 + side] = track_model.rail_under_wheel(self.par, full, side)
+        return out
 
     def patches_on_track(self, centre, yaw, roll, spin, shift=None):
         """The provider's patches with the rails lowered by ``shift`` (left, right), m (None: rigid track).
@@ -405,7 +421,7 @@ class WheelsetModel:
         """Mode 2 (compiled.geometry_mode): the provider's candidates into self._cg (side s, slot k at row 2 s + k;
         rows without a candidate NaN) and their sampled geometries (if any) to the callback.
         """
-        track = full[TRACK][0:2] if self.elastic else None
+        track = self.rail_under_wheels(full)[0:2] if self.elastic else None
         patches = self.patches_on_track(full[0:3], full[3], full[4], full[5], track)
         cg = self._cg
         cg[:, :] = np.nan
@@ -440,7 +456,7 @@ class WheelsetModel:
         and recording: the compiled right-hand side's candidates with their contact frames.
 
         With ``record`` the per-patch values (PATCH_FIELDS, and AUTO_PATCH_FIELDS for ``auto``) are filled, else
-        ``values`` is None. ``track``: the elastic track's 8 states; None: ``track_rest`` (rigid track: ignored).
+        ``values`` is None. ``track``: the elastic track's states; None: ``track_rest`` (rigid track: ignored).
         ``keep_search_memory``: leave the compiled search's warm starts as they were (a look that must not change the
         run).
         """
@@ -470,7 +486,7 @@ class WheelsetModel:
         velocity = v_c + _cross_rows(omega, lever)
         rail_velocity = np.zeros((len(present), 3))
         if self.elastic:
-            rail_velocity[:, 2] = full[TRACK][4:6][sides[present]]
+            rail_velocity[:, 2] = self.rail_under_wheels(full)[2:4][sides[present]]
         velocity = velocity - rail_velocity
         frames, _, _, _, _ = _creepages(lever, normal, omega, v_c, rail_velocity)
         active = np.nan_to_num(rec[:, 0], nan=0.0) > 0
@@ -488,7 +504,7 @@ class WheelsetModel:
         return ContactState(sides[present], slots[present], force, moment, lever.copy(), velocity, values)
 
     def derivative(self, t: float, state: np.ndarray) -> np.ndarray:
-        """d/dt of the full state (12 mechanical + 2 work integrals [+ 8 track states, TRACK]) by the compiled
+        """d/dt of the full state (12 mechanical + 2 work integrals [+ the track's states, TRACK]) by the compiled
         right-hand side (compiled._rhs's geometry, compiled laws and callback, compiled._assemble): the one
         implementation, also for the scipy methods and the Python RK4.
 
@@ -510,11 +526,12 @@ class WheelsetModel:
         ncand = len(self.packed[3])
         return self._rec[ncand : ncand + 2, :3].copy()
 
-    def _track_derivative(self, track, rail_force, out) -> float:
-        """d/dt of the 8 track states into ``out`` under the rail forces (left, right) (compiled.track_rates);
-        returns the dampers' power.
+    def _track_derivative(self, track, rail_force, out, x_m: float = 0.0) -> float:
+        """d/dt of the track's states into ``out`` under the rail forces (left, right) (compiled.track_rates) with
+        the wheelset at x (the beam: xi = x - x0 + margin); returns the dampers' power.
         """
         full = np.zeros(self.n_state)
+        full[0] = x_m
         full[TRACK] = track
         rates = np.zeros(self.n_state)
         power = track_rates(self.par, full, np.asarray(rail_force, float), rates)
@@ -522,8 +539,12 @@ class WheelsetModel:
         return float(power)
 
     def track_energy_J(self, track) -> tuple:
-        """(kinetic, potential) energy of the elastic track's states (n, 8) or (8,), J (track.energy_J)."""
-        return track_model.energy_J(self.track, track)
+        """(kinetic, potential) energy of the elastic track's states (n, k) or (k,), J (track.TrackSystem.energy_J;
+        0, 0 on the rigid track).
+        """
+        if not self.elastic:
+            return 0.0, 0.0
+        return self.track_system.energy_J(track)
 
     # ----------------------------------------------------------------------------------------------
     def kinetic_energy_J(self, state: np.ndarray) -> float:
@@ -558,10 +579,6 @@ class WheelsetModel:
     def deepest_approach(self, state: np.ndarray) -> list:
         """Per wheel (left, right) the deepest approach of its candidates at a 12-state on ``track_rest``, m."""
         return [float(np.max(q)) if len(q) else 0.0 for q in self.contact_approaches(state)]
-
-    def _rest_shift(self):
-        """The rails' deflection in ``track_rest`` (None for the rigid track)."""
-        return self.track_rest[0:2] if self.elastic else None
 
     def static_state(self, state: np.ndarray, derivative=None, deepest_approach=None) -> tuple[np.ndarray, bool, str]:
         """Adjust z and theta of ``state`` so that vertical force and roll moment balance (t = 0).

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigid_dynamics.wheelset import track as track_model
 from rigid_dynamics.wheelset.equations import MAX_SLOTS, ContactFailure, WheelsetModel
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.state import TRACK
@@ -84,26 +83,26 @@ def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deep
     model.track_rest = model.static_track([load, load])
     derivative_ = model.derivative if derivative is None else derivative
     out = (state, False, "no rounds")
+    before = np.array([load, load], float)
     for _ in range(8):
         out = consistent_start(model, state, derivative, deepest, rolling)
         if not out[1]:
             return out
         force = _rail_forces(model, out[0], derivative_)
-        before = model.track_rest.copy()
         model.track_rest = model.static_track(force)
         state = out[0]
-        if np.max(np.abs(model.track_rest[0:2] - before[0:2])) * model.track.static_stiffness_N_per_m < 1e-6 * load:
+        if np.max(np.abs(force - before)) < 1e-6 * load:
             break
+        before = force
     return consistent_start(model, state, derivative, deepest, rolling)
 
 
 def _rail_forces(model: WheelsetModel, state: np.ndarray, derivative) -> np.ndarray:
     """Vertical contact force on each rail (left, right) at a 12-state on ``track_rest``, N, from the track
-    acceleration the right-hand side gives (m_r z_r'' = F_r - pad force; the pad is at rest: F_r = m_r z_r'' +
-    k_p (z_r - z_s)).
+    acceleration the right-hand side gives (at rest b F = M q'' + K q: track.TrackSystem.rail_forces_at_rest).
     """
     d = derivative(0.0, model.full_state(state))
-    return track_model.rail_forces_at_rest(model.track, model.track_rest, d[TRACK])
+    return model.track_system.rail_forces_at_rest(model.track_rest, d[TRACK])
 
 
 def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, deepest=None, rolling=None):

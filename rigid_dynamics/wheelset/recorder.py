@@ -45,6 +45,7 @@ class Recorder:
         self.work_exterior: list[np.ndarray] = []
         self.errors: list[np.ndarray] = []
         self.track: list[np.ndarray] = []
+        self.track_summary: list[np.ndarray] = []
         self.events: list[tuple] = []
         self.in_contact = None
         self.flange = None
@@ -120,6 +121,7 @@ class Recorder:
         self.potential.append(np.array([self.model.potential_energy_J(state) + track_potential], float))
         if self.model.elastic:
             self.track.append(np.asarray(full_state[TRACK], float)[None].copy())
+            self.track_summary.append(self._summary(full_state[None]))
         self.work_contact.append(np.array([full_state[12]], float))
         self.work_exterior.append(np.array([full_state[13]], float))
         self.errors.append(np.array([error], float))
@@ -201,6 +203,7 @@ class Recorder:
         self.potential.append(-self.model.mass * self.model.gravity * states[:, 2] + track_potential)
         if self.model.elastic:
             self.track.append(np.asarray(full_states[:, TRACK], float).copy())
+            self.track_summary.append(self._summary(full_states))
         self.work_contact.append(full_states[:, 12].copy())
         self.work_exterior.append(full_states[:, 13].copy())
         self.errors.append(np.asarray(errors, float).copy())
@@ -220,5 +223,19 @@ class Recorder:
             joined(self.work_contact, (0,)),
             joined(self.work_exterior, (0,)),
             joined(self.errors, (0,)),
-            joined(self.track, (0, 8)) if self.model.elastic else None,
+            joined(self.track, (0, self.model.n_state - 14)) if self.model.elastic else None,
         )
+
+    def _summary(self, full_states: np.ndarray) -> np.ndarray:
+        """What the run records of the track at full states (n, n_state): track.TrackSystem.summary."""
+        system = self.model.track_system
+        xi = full_states[:, 0] - self.model.frame_x0 + system.start_position_m()
+        return system.summary(full_states[:, TRACK], xi)
+
+    def summary_arrays(self):
+        """(names, (n, k) array) of the recorded track summary (None, None on the rigid track)."""
+        if not self.model.elastic:
+            return None, None
+        system = self.model.track_system
+        blocks = self.track_summary
+        return system.summary_names, np.concatenate(blocks) if blocks else np.zeros((0, len(system.summary_names)))

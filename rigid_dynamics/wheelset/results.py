@@ -12,7 +12,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES
-from rigid_dynamics.wheelset.state import STATE_NAMES, TRACK_STATE_NAMES
+from rigid_dynamics.wheelset.state import STATE_NAMES
 
 STATUSES = (
     "ok",
@@ -48,8 +48,12 @@ class SimulationResult:
         work_contact_J, work_exterior_J: work done on the wheelset since t = 0 by contact forces and
             by exterior forces (suspension, axle load, torque), (n,); with the elastic track the contact work is
             that on wheel and rail together and the exterior work includes the track dampers'.
-        track_states: the elastic track's states (TRACK_STATE_NAMES, z down) at the output times, (n, 8); None
-            for the rigid track.
+        track_states: what the run records of the elastic track at the output times, named by
+            ``track_state_names`` (z down): the lumped track's 8 states (state.TRACK_STATE_NAMES), or the beam's
+            rail deflection and velocity under each wheel (track.BEAM_SUMMARY_NAMES); None for the rigid track.
+        track_state_names: the names of ``track_states``' columns.
+        track_full_states: every state of the elastic track at the output times (n, k) (the beam's modes and rail
+            seats: track.BeamLayout); None for the rigid track.
         events: tuples (kind, side, time_s): "wheel-lift", "contact-restored", "flange-contact".
         rhs_evaluations, steps: counters. wall_time_s: wall time of the run (static equilibrium, integration,
             recording), s; loading the compiled code from numba's cache (once per process, ~0.1 s) is not counted.
@@ -92,6 +96,8 @@ class SimulationResult:
     half_step_peak_difference: float | None = None
     scene: DynamicsScene | None = field(default=None, repr=False)
     track_states: np.ndarray | None = None
+    track_state_names: tuple = ()
+    track_full_states: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def success(self) -> bool:
@@ -349,8 +355,8 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
     PATCH_FIELDS entry (sides left/right, slots tread/flange) and, for contact_model "auto", every
     AUTO_PATCH_FIELDS entry (the choice per patch) with ``auto_rung_names`` and ``auto_feature_names`` (what
     the codes of ``patch_auto_rung`` and ``patch_auto_deciding_feature`` index), ``contact_force_N`` (n, 2, 3),
-    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult), ``track_states`` (n, 8) with
-    ``track_state_names`` for the elastic track,
+    ``force_error_estimate`` (n,) for RK4 runs (SimulationResult), ``track_states`` (n, k) with
+    ``track_state_names`` for the elastic track (SimulationResult.track_states),
     ``kinetic_energy_J``, ``potential_energy_J``, ``work_contact_J``, ``work_exterior_J``, and
     ``status``/``message``/``sides`` as strings. NaN marks candidates without contact, never a failed number:
     a failed run stops at its last good sample and says so in ``status``.
@@ -372,7 +378,7 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
         arrays["force_error_estimate"] = result.force_error_estimate
     if result.track_states is not None:
         arrays["track_states"] = result.track_states
-        arrays["track_state_names"] = np.array(TRACK_STATE_NAMES)
+        arrays["track_state_names"] = np.array(result.track_state_names)
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
     if "auto_rung" in result.patches:

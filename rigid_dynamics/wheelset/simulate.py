@@ -271,7 +271,8 @@ def simulate(
     except NUMERICAL_ERRORS as exc:  # raised below the driver (e.g. the curvature code for a huge stiffness with RK4)
         status, message = "solver-failed", f"numerical failure: {type(exc).__name__}: {exc}"
     wall = time.perf_counter() - start
-    t, states, patches, forces, kin, pot, wc, we, errors, track_states = recorder.arrays()
+    t, states, patches, forces, kin, pot, wc, we, errors, track_full = recorder.arrays()
+    track_names, track_states = recorder.summary_arrays()
     fixed_step = settings.method == "RK4"
     checked = fixed_step or (use_compiled and embedded)  # runs with a force error estimate at their samples
     if checked:
@@ -291,7 +292,7 @@ def simulate(
             except (ContactFailure, *NUMERICAL_ERRORS):
                 limit = None
             if limit is not None and status in NUMERICAL_LOOKING and not settings.fixed_step_s > limit.max_step_s:
-                limit = _limit_at_largest_force(probe, t, states, patches, wc, we, track_states, limit)
+                limit = _limit_at_largest_force(probe, t, states, patches, wc, we, track_full, limit)
             if limit is not None:
                 status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit)
     result = SimulationResult(
@@ -318,6 +319,8 @@ def simulate(
         force_error_estimate=errors if checked else None,
         scene=scene,
         track_states=track_states,
+        track_state_names=tuple(track_names or ()),
+        track_full_states=track_full,
     )
     if checked and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
         result = _half_step_check(result, provider, model_obj, compiled)

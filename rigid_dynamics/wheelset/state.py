@@ -6,9 +6,10 @@ The full state is, in order,
   their rates (:data:`VELOCITIES`), main frame, SI units (:data:`STATE_NAMES`);
 * two work integrals (:data:`WORK`): the work of the contact forces (:data:`WORK_CONTACT`) and of the exterior
   forces (:data:`WORK_EXTERIOR`), J, diagnostics for the energy balance that do not enter the right-hand side;
-* with the elastic track (scene ``track_dynamics.model = "lumped"``) its 8 states (:data:`TRACK`): rail and
-  sleeper deflection per side (left, right), z down from the unloaded track, then their rates
-  (:data:`TRACK_STATE_NAMES`).
+* with an elastic track its states (:data:`TRACK`: everything after the work integrals), positions then their
+  rates, z down from the unloaded track: for ``track_dynamics.model = "lumped"`` 8 states, rail and sleeper
+  deflection per side (left, right) and their rates (:data:`TRACK_STATE_NAMES`); for "beam" the modes and rail
+  seats of both rails (track.BeamLayout), as many as the run's beam needs.
 
 Module-level integers are compile-time constants in numba, so the compiled right-hand side indexes with these
 names at no cost (``y[RAIL_VELOCITY + side]``). A new state is added here (its slice and names), in the
@@ -59,21 +60,38 @@ WORK = slice(12, 14)
 N_RIGID = 14
 """Length of the full state on the rigid track."""
 
-# elastic track: first index of each pair (left, right)
+TRACK = slice(N_RIGID, None)
+"""Where an elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
+# the lumped track: first index of each pair (left, right)
 RAIL, SLEEPER, RAIL_VELOCITY, SLEEPER_VELOCITY = 14, 16, 18, 20
-TRACK = slice(14, 22)
-"""Where the elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
-TRACK_POSITIONS = slice(14, 18)
-TRACK_VELOCITIES = slice(18, 22)
-N_ELASTIC = 22
-"""Length of the full state with the elastic track."""
+N_LUMPED = 22
+"""Length of the full state with the lumped track."""
 
 
-def n_states(elastic: bool) -> int:
-    """Length of the full state: 14 on the rigid track, 22 with the elastic track."""
-    return N_ELASTIC if elastic else N_RIGID
+def n_states(track_positions: int) -> int:
+    """Length of the full state with ``track_positions`` track positions (as many rates follow): 14 on the rigid
+    track, 22 with the lumped track.
+    """
+    return N_RIGID + 2 * int(track_positions)
 
 
-def state_names(elastic: bool) -> tuple[str, ...]:
-    """Names of every entry of the full state (work integrals ``work_contact_J``, ``work_exterior_J``)."""
-    return STATE_NAMES + ("work_contact_J", "work_exterior_J") + (TRACK_STATE_NAMES if elastic else ())
+def track_positions(n_state: int) -> slice:
+    """The track's positions in a full state of length ``n_state`` (empty on the rigid track)."""
+    n = (n_state - N_RIGID) // 2
+    return slice(N_RIGID, N_RIGID + n)
+
+
+def track_velocities(n_state: int) -> slice:
+    """The track's rates in a full state of length ``n_state`` (empty on the rigid track)."""
+    n = (n_state - N_RIGID) // 2
+    return slice(N_RIGID + n, N_RIGID + 2 * n)
+
+
+def state_names(n_state: int) -> tuple[str, ...]:
+    """Names of every entry of a full state of length ``n_state`` (work integrals ``work_contact_J``,
+    ``work_exterior_J``; the lumped track's TRACK_STATE_NAMES; a beam's states ``track_<i>``).
+    """
+    names = STATE_NAMES + ("work_contact_J", "work_exterior_J")
+    if n_state == N_LUMPED:
+        return names + TRACK_STATE_NAMES
+    return names + tuple(f"track_{i}" for i in range(n_state - N_RIGID))

@@ -78,10 +78,8 @@ def result_columns(result) -> dict[str, np.ndarray]:
     }
     columns = timeseries_columns(result.t, result.states, result.patches, result.contact_force_N, energies)
     track = getattr(result, "track_states", None)
-    if track is not None:  # the elastic track's states (state.TRACK_STATE_NAMES), after the others
-        from rigid_dynamics.wheelset.state import TRACK_STATE_NAMES
-
-        for k, name in enumerate(TRACK_STATE_NAMES):
+    if track is not None:  # what the run recorded of the elastic track (its track_state_names), after the others
+        for k, name in enumerate(result.track_state_names):
             columns[name] = np.asarray(track, float)[:, k]
     return columns
 

@@ -1,4 +1,4 @@
-"""The vertical track under each wheel: its models, data, states' physics and parameters, in one module.
+"""The vertical track under the wheels: its models, data, states' physics and parameters, in one module.
 
 Everything the elastic track adds to a wheelset run lives here, apart from the state layout
 (:mod:`rigid_dynamics.wheelset.state`: where its states sit, :data:`state.TRACK`, and their names) and the one
@@ -9,26 +9,41 @@ its deflection in the contact geometry):
   :func:`lumped_track_equivalent`);
 * the fields the track adds to the compiled parameter record (:data:`PARAMETER_FIELDS`) and how a scene fills them
   (:func:`pack_parameters`);
-* the track's equations of motion (:func:`track_rates`, compiled), its energy (:func:`energy_J`), its state at
-  rest under given rail forces (:func:`rest_state`) and the rail forces that hold a resting track
-  (:func:`rail_forces_at_rest`).
+* the track's equations of motion (:func:`track_rates`, compiled) and the rail under each wheel
+  (:func:`rail_under_wheel`, compiled);
+* the same equations as matrices, M a + C v + K q = b(x) F per rail (:class:`TrackSystem`): the state at rest
+  under given rail forces, the rail forces that hold a resting track, the energy, the receptance and the
+  eigenfrequencies. The compiled rates equal M^-1 (b F - C v - K q) (a regression test); the physics tests check
+  the matrices against closed forms.
 
-The lumped model: under each wheel a rail mass on a pad (spring and damper) on a sleeper mass on the ballast
-(spring and damper), moving with the wheelset (the seed's rail deflection N_d,t of eq 6). States, z down from the
-unloaded track: rail and sleeper deflection per side (left, right), then their rates (state.TRACK_STATE_NAMES).
+Two elastic models (``model``):
+
+* "lumped": under each wheel a rail mass on a pad (spring and damper) on a sleeper mass on the ballast (spring
+  and damper), moving with the wheelset (the seed's rail deflection N_d,t of eq 6). States, z down from the
+  unloaded track: rail and sleeper deflection per side (left, right), then their rates (state.TRACK_STATE_NAMES).
+* "beam": each rail a beam (Timoshenko, or Euler-Bernoulli) on discrete rail seats (pad, half sleeper mass,
+  ballast) at the sleeper spacing, fixed in space, the wheel rolling along it: sleeper-passing and the
+  pinned-pinned resonance are in it. The beam is simply supported over a length that holds the run with a margin
+  at each end and is written as a sum of its sine modes up to a cut-off frequency (modal superposition; the
+  sleepers are discrete masses). States per rail: the modes' amplitudes W_n (and, Timoshenko, the section
+  rotations Psi_n), the sleepers' deflections; then their rates (:class:`BeamLayout`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.wheelset.state import RAIL, RAIL_VELOCITY, SLEEPER, SLEEPER_VELOCITY
+from rigid_dynamics.wheelset.state import N_RIGID, RAIL, RAIL_VELOCITY, SLEEPER, SLEEPER_VELOCITY, TRACK_STATE_NAMES
 
-TRACK_MODELS = ("rigid", "lumped")
-"""Vertical track models under each wheel (:class:`TrackDynamics`)."""
+TRACK_MODELS = ("rigid", "lumped", "beam")
+"""Vertical track models (:class:`TrackDynamics`)."""
+
+RAIL_THEORIES = ("timoshenko", "euler-bernoulli")
+"""Beam theories of the rail in the discretely supported model."""
 
 
 def lumped_track_equivalent(
@@ -84,24 +99,52 @@ equivalent track stiffness 150 MN/m of Jenkins et al. (1974) for concrete-sleepe
 """
 
 
+UIC60_BEAM = {
+    "rail_shear_stiffness_N": 0.4 * 80.77e9 * 76.70e-4,
+    "rail_rotary_inertia_kg_m": 7850.0 * 3038.3e-8,
+}
+"""The Timoshenko terms of the UIC60 (60E1) rail in vertical bending: kappa G A with the shear coefficient
+kappa = 0.4 (the value used for a 60 kg rail in vertical bending in the railway-noise literature, e.g.
+D.J. Thompson, Railway Noise and Vibration, Elsevier 2009, ch. 3), G = E / (2 (1 + 0.3)) = 80.77 GPa and
+A = 76.70 cm^2 (EN 13674-1, 60E1); the rotary inertia rho I with rho = 7850 kg/m^3 and I_y = 3038.3 cm^4.
+"""
+
+
 @dataclass(frozen=True)
 class TrackDynamics:
-    """Vertical track model under each wheel (seed eq 6: the rail deflection N_d,t shifts the rail surface).
+    """Vertical track model under the wheels (seed eq 6: the rail deflection N_d,t shifts the rail surface).
 
     ``model`` = "rigid": the rails do not move (the default). "lumped": under each wheel a rail mass on a pad
     (spring and damper) on a sleeper mass on the ballast (spring and damper), moving with the wheelset; the
     rail mass's displacement (z down) lowers that rail's surface in the contact geometry, and the vertical
-    component of the wheel's contact forces acts on it. Lateral track: rigid.
+    component of the wheel's contact forces acts on it. "beam": each rail a Timoshenko (``rail_theory``, or
+    Euler-Bernoulli) beam on discrete rail seats (pad, half sleeper, ballast) every ``sleeper_spacing_m``, fixed
+    in space; the rail's deflection under the wheel lowers its surface and the vertical contact force acts on the
+    beam where the wheel is. Lateral track: rigid in both.
 
-    The defaults are the per-wheel equivalent of a UIC60 track on concrete sleepers
+    The lumped defaults are the per-wheel equivalent of a UIC60 track on concrete sleepers
     (:data:`UIC60_RAIL_SEAT` reduced by :func:`lumped_track_equivalent`): static stiffness 150 MN/m per wheel,
-    track resonances 143 and 341 Hz without a wheel, 60 Hz (P2) with an unsprung mass of 907 kg per wheel.
+    track resonances 143 and 341 Hz without a wheel, 60 Hz (P2) with an unsprung mass of 907 kg per wheel. The
+    beam's defaults are that UIC60 track itself (:data:`UIC60_RAIL_SEAT`, :data:`UIC60_BEAM`).
 
     Attributes:
-        model: "rigid" or "lumped".
-        rail_mass_kg, sleeper_mass_kg: m_r, m_s per wheel, kg.
-        pad_stiffness_N_per_m, pad_damping_N_s_per_m: k_p, c_p between rail and sleeper.
-        ballast_stiffness_N_per_m, ballast_damping_N_s_per_m: k_b, c_b between sleeper and ground.
+        model: "rigid", "lumped" or "beam".
+        rail_mass_kg, sleeper_mass_kg: m_r, m_s per wheel, kg (lumped).
+        pad_stiffness_N_per_m, pad_damping_N_s_per_m: k_p, c_p between rail and sleeper (lumped, per wheel).
+        ballast_stiffness_N_per_m, ballast_damping_N_s_per_m: k_b, c_b between sleeper and ground (lumped).
+        rail_theory: "timoshenko" or "euler-bernoulli" (beam).
+        rail_mass_per_length_kg_per_m, rail_bending_stiffness_N_m2: rho A and E I of the rail (beam).
+        rail_shear_stiffness_N, rail_rotary_inertia_kg_m: kappa G A and rho I (beam, Timoshenko).
+        sleeper_spacing_m: distance between rail seats (beam).
+        seat_pad_stiffness_N_per_m, seat_pad_damping_N_s_per_m: one rail seat's pad (beam).
+        seat_sleeper_mass_kg: the sleeper mass under one rail (half a sleeper) (beam).
+        seat_ballast_stiffness_N_per_m, seat_ballast_damping_N_s_per_m: the ballast under one rail seat (beam).
+        rail_loss_factor: the rail's own damping, eta (beam): each mode's amplitude W_n has the viscous damping
+            eta omega_n (rho A L / 2), omega_n its flexural frequency (the loss factor at that frequency). 0.02 is
+            the order used for a rail's own vertical damping in the railway-noise literature (Thompson 2009,
+            ch. 3); without it the pinned-pinned mode, which the pads do not touch, would ring undamped.
+        cutoff_frequency_Hz: the beam's modes up to this frequency are kept (the flexural branch; beam).
+        end_margin_m: the beam reaches this far beyond the run at each end (beam).
     """
 
     model: str = "rigid"
@@ -111,17 +154,41 @@ class TrackDynamics:
     sleeper_mass_kg: float = 291.0
     ballast_stiffness_N_per_m: float = 3.26e8
     ballast_damping_N_s_per_m: float = 1.86e5
+    rail_theory: str = "timoshenko"
+    rail_mass_per_length_kg_per_m: float = UIC60_RAIL_SEAT["rail_mass_per_length_kg_per_m"]
+    rail_bending_stiffness_N_m2: float = UIC60_RAIL_SEAT["rail_bending_stiffness_N_m2"]
+    rail_shear_stiffness_N: float = UIC60_BEAM["rail_shear_stiffness_N"]
+    rail_rotary_inertia_kg_m: float = UIC60_BEAM["rail_rotary_inertia_kg_m"]
+    sleeper_spacing_m: float = UIC60_RAIL_SEAT["sleeper_spacing_m"]
+    seat_pad_stiffness_N_per_m: float = UIC60_RAIL_SEAT["pad_stiffness_N_per_m"]
+    seat_pad_damping_N_s_per_m: float = UIC60_RAIL_SEAT["pad_damping_N_s_per_m"]
+    seat_sleeper_mass_kg: float = UIC60_RAIL_SEAT["half_sleeper_mass_kg"]
+    seat_ballast_stiffness_N_per_m: float = UIC60_RAIL_SEAT["ballast_stiffness_N_per_m"]
+    seat_ballast_damping_N_s_per_m: float = UIC60_RAIL_SEAT["ballast_damping_N_s_per_m"]
+    rail_loss_factor: float = 0.02
+    cutoff_frequency_Hz: float = 5000.0
+    end_margin_m: float = 6.0
 
     def __post_init__(self) -> None:
         from rigid_dynamics.wheelset.parameters import _check_finite  # parameters imports this module
 
         _check_finite(
             self,
-            positive=["rail_mass_kg", "pad_stiffness_N_per_m", "sleeper_mass_kg", "ballast_stiffness_N_per_m"],
-            nonnegative=["pad_damping_N_s_per_m", "ballast_damping_N_s_per_m"],
-        )
+            positive=[
+                "rail_mass_kg", "pad_stiffness_N_per_m", "sleeper_mass_kg", "ballast_stiffness_N_per_m",
+                "rail_mass_per_length_kg_per_m", "rail_bending_stiffness_N_m2", "rail_shear_stiffness_N",
+                "rail_rotary_inertia_kg_m", "sleeper_spacing_m", "seat_pad_stiffness_N_per_m", "seat_sleeper_mass_kg",
+                "seat_ballast_stiffness_N_per_m", "cutoff_frequency_Hz", "end_margin_m",
+            ],
+            nonnegative=[
+                "pad_damping_N_s_per_m", "ballast_damping_N_s_per_m", "seat_pad_damping_N_s_per_m",
+                "seat_ballast_damping_N_s_per_m", "rail_loss_factor",
+            ],
+        )  # fmt: skip
         if self.model not in TRACK_MODELS:
             raise ValueError(f"model = {self.model!r}: expected one of {', '.join(TRACK_MODELS)}")
+        if self.rail_theory not in RAIL_THEORIES:
+            raise ValueError(f"rail_theory = {self.rail_theory!r}: expected one of {', '.join(RAIL_THEORIES)}")
 
     @property
     def elastic(self) -> bool:
@@ -130,77 +197,461 @@ class TrackDynamics:
 
     @property
     def static_stiffness_N_per_m(self) -> float:
-        """Pad and ballast in series, N/m."""
+        """The lumped model's pad and ballast in series, N/m."""
         return 1.0 / (1.0 / self.pad_stiffness_N_per_m + 1.0 / self.ballast_stiffness_N_per_m)
+
+    @property
+    def seat_stiffness_N_per_m(self) -> float:
+        """One rail seat's pad and ballast in series, N/m (beam)."""
+        return 1.0 / (1.0 / self.seat_pad_stiffness_N_per_m + 1.0 / self.seat_ballast_stiffness_N_per_m)
+
+    @property
+    def timoshenko(self) -> bool:
+        return self.rail_theory == "timoshenko"
+
+
+def flexural_frequency_rad_per_s(track: TrackDynamics, wavenumber_1_per_m):
+    """Free rail's lower (flexural) natural frequency at the wavenumber k, rad/s: Euler-Bernoulli
+    k^2 sqrt(EI / rho A); Timoshenko the lower root of
+    (kGA k^2 - rho A w^2)(EI k^2 + kGA - rho I w^2) = (kGA k)^2.
+    """
+    k = np.asarray(wavenumber_1_per_m, float)
+    ei, ra = track.rail_bending_stiffness_N_m2, track.rail_mass_per_length_kg_per_m
+    if not track.timoshenko:
+        return k * k * np.sqrt(ei / ra)
+    ga, ri = track.rail_shear_stiffness_N, track.rail_rotary_inertia_kg_m
+    a = ra * ri
+    b = ga * k * k * ri + ra * (ei * k * k + ga)
+    c = ga * k * k * (ei * k * k + ga) - (ga * k) ** 2
+    return np.sqrt((b - np.sqrt(b * b - 4.0 * a * c)) / (2.0 * a))
+
+
+@dataclass(frozen=True)
+class BeamLayout:
+    """Size of the discretely supported beam of a run and where its states sit.
+
+    The beam of length L = (n_sleepers + 1) a (a the sleeper spacing) is simply supported at its ends; rail seat j
+    is at (j + 1) a from its start (j = 0 .. n_sleepers - 1), so that the pinned-pinned mode sin(pi x / a), with
+    its nodes at the seats, is one of the beam's modes. The wheelset is at xi = x - x0 + margin along it (x0 its
+    x at t = 0). Per rail the positions are [W_1..W_N, (Psi_1..Psi_N for Timoshenko), z_1..z_S],
+    w(x) = sum W_n sin(n pi x / L) (z down), the section rotation psi(x) = sum Psi_n cos(n pi x / L); left rail
+    first, then the right rail, then every rate in the same order.
+    """
+
+    n_modes: int
+    n_sleepers: int
+    length_m: float
+    margin_m: float
+    timoshenko: bool
+
+    @property
+    def per_rail(self) -> int:
+        return self.n_modes * (2 if self.timoshenko else 1) + self.n_sleepers
+
+    @property
+    def n_positions(self) -> int:
+        return 2 * self.per_rail
+
+
+def beam_layout(track: TrackDynamics, travel_m: float) -> BeamLayout:
+    """The beam for a run of ``travel_m``: it holds the travel (with 10 % and one sleeper spacing to spare) and
+    ``end_margin_m`` at each end, in whole sleeper spacings; its modes are those whose flexural frequency
+    (:func:`flexural_frequency_rad_per_s`) is at most ``cutoff_frequency_Hz``.
+    """
+    a = track.sleeper_spacing_m
+    n_sleepers = int(math.ceil((1.1 * max(travel_m, 0.0) + a + 2.0 * track.end_margin_m) / a)) - 1
+    length = (n_sleepers + 1) * a
+    cutoff = 2.0 * math.pi * track.cutoff_frequency_Hz
+    n = 0
+    while float(flexural_frequency_rad_per_s(track, (n + 1) * math.pi / length)) <= cutoff:
+        n += 1
+    return BeamLayout(max(n, 1), n_sleepers, length, track.end_margin_m, track.timoshenko)
 
 
 PARAMETER_FIELDS = (
-    ("elastic_track", "1: elastic track"),
+    ("elastic_track", "1: lumped track, 2: discretely supported beam, 0: rigid"),
+    ("track_positions", "number of the track's position states (0, 4 lumped, BeamLayout.n_positions)"),
     ("rail_mass_kg", "rail mass per wheel"),
     ("pad_stiffness_N_per_m", "pad stiffness"),
     ("pad_damping_N_s_per_m", "pad damping"),
     ("sleeper_mass_kg", "sleeper mass per wheel"),
     ("ballast_stiffness_N_per_m", "ballast stiffness"),
     ("ballast_damping_N_s_per_m", "ballast damping"),
+    ("beam_modes", "beam: modes per rail"),
+    ("beam_sleepers", "beam: rail seats per rail"),
+    ("beam_timoshenko", "beam: 1 Timoshenko, 0 Euler-Bernoulli"),
+    ("beam_length_m", "beam: length"),
+    ("beam_margin_m", "beam: where the wheelset starts along it"),
+    ("rail_mass_per_length_kg_per_m", "beam: rho A"),
+    ("rail_bending_stiffness_N_m2", "beam: E I"),
+    ("rail_shear_stiffness_N", "beam: kappa G A"),
+    ("rail_rotary_inertia_kg_m", "beam: rho I"),
+    ("sleeper_spacing_m", "beam: rail seat spacing"),
+    ("seat_pad_stiffness_N_per_m", "beam: pad per seat"),
+    ("seat_pad_damping_N_s_per_m", "beam: pad damping per seat"),
+    ("seat_sleeper_mass_kg", "beam: sleeper mass per seat"),
+    ("seat_ballast_stiffness_N_per_m", "beam: ballast per seat"),
+    ("seat_ballast_damping_N_s_per_m", "beam: ballast damping per seat"),
+    ("rail_loss_factor", "beam: the rail's loss factor"),
 )
 """The track's fields of the compiled parameter record (compiled.PARAMETER_FIELDS): (field, meaning), SI units."""
 
+_LUMPED_FIELDS = (
+    "rail_mass_kg", "pad_stiffness_N_per_m", "pad_damping_N_s_per_m", "sleeper_mass_kg",
+    "ballast_stiffness_N_per_m", "ballast_damping_N_s_per_m",
+)  # fmt: skip
+_BEAM_FIELDS = (
+    "rail_mass_per_length_kg_per_m", "rail_bending_stiffness_N_m2", "rail_shear_stiffness_N",
+    "rail_rotary_inertia_kg_m", "sleeper_spacing_m", "seat_pad_stiffness_N_per_m", "seat_pad_damping_N_s_per_m",
+    "seat_sleeper_mass_kg", "seat_ballast_stiffness_N_per_m", "seat_ballast_damping_N_s_per_m", "rail_loss_factor",
+)  # fmt: skip
 
-def pack_parameters(par, track: TrackDynamics) -> None:
-    """Fill the track's fields of the parameter record ``par`` (compiled.PARAMETERS) from the scene's table."""
-    if not track.elastic:
-        par["elastic_track"] = 0.0
-        return
-    par["elastic_track"] = 1.0
-    for name, _ in PARAMETER_FIELDS[1:]:
-        par[name] = getattr(track, name)
+
+def travel_m(scene) -> float:
+    """How far a scene's wheelset runs: speed x duration, m (the beam is sized for it)."""
+    return float(scene.speed_m_per_s * scene.duration_s)
+
+
+def n_positions(track: TrackDynamics, travel: float) -> int:
+    """Number of the track's position states (as many rates follow): 0 rigid, 4 lumped, the beam's layout."""
+    if track.model == "rigid":
+        return 0
+    if track.model == "lumped":
+        return 4
+    return beam_layout(track, travel).n_positions
+
+
+def pack_parameters(par, track: TrackDynamics, travel: float) -> None:
+    """Fill the track's fields of the parameter record ``par`` (compiled.PARAMETERS) from the scene's table and the
+    run's travel (m, :func:`travel_m`; it sizes the beam).
+    """
+    par["elastic_track"] = {"rigid": 0.0, "lumped": 1.0, "beam": 2.0}[track.model]
+    par["track_positions"] = float(n_positions(track, travel))
+    if track.model == "lumped":
+        for name in _LUMPED_FIELDS:
+            par[name] = getattr(track, name)
+    elif track.model == "beam":
+        layout = beam_layout(track, travel)
+        for name in _BEAM_FIELDS:
+            par[name] = getattr(track, name)
+        par["beam_modes"], par["beam_sleepers"] = float(layout.n_modes), float(layout.n_sleepers)
+        par["beam_timoshenko"] = 1.0 if layout.timoshenko else 0.0
+        par["beam_length_m"], par["beam_margin_m"] = layout.length_m, layout.margin_m
+
+
+@njit(cache=True, _nrt=False)
+def beam_position_m(par, y):
+    """Where the wheelset is along the beam, m: xi = x - x0 + margin (BeamLayout)."""
+    return y[0] - par.frame_x0_m + par.beam_margin_m
+
+
+@njit(cache=True, _nrt=False)
+def rail_under_wheel(par, y, side):
+    """(deflection m, vertical velocity m/s) of the rail of ``side`` (0 left, 1 right) under the wheel, z down, at
+    the full state ``y``: the lumped rail mass, or the beam's modal sum at the wheelset's position (the material
+    velocity of the rail there). (0, 0) on the rigid track.
+    """
+    if par.elastic_track < 0.5:
+        return 0.0, 0.0
+    if par.elastic_track < 1.5:
+        return y[RAIL + side], y[RAIL_VELOCITY + side]
+    n_modes = int(par.beam_modes)
+    per_rail = n_modes * (2 if par.beam_timoshenko > 0 else 1) + int(par.beam_sleepers)
+    base = N_RIGID + side * per_rail
+    rates = base + int(par.track_positions)
+    theta = math.pi * beam_position_m(par, y) / par.beam_length_m
+    s_prev, s, c2 = 0.0, math.sin(theta), 2.0 * math.cos(theta)
+    w, v = 0.0, 0.0
+    for n in range(n_modes):  # sin((n+1) theta) by the recurrence s_{n+1} = 2 cos(theta) s_n - s_{n-1}
+        w += y[base + n] * s
+        v += y[rates + n] * s
+        s_prev, s = s, c2 * s - s_prev
+    return w, v
 
 
 @njit(cache=True, _nrt=False)
 def track_rates(par, y, rail_f0, rail_f1, out, p_ext):
-    """The lumped track's equations of motion under the vertical contact forces on the rails (left, right), N
-    (z down, acting on the rail): its rates into ``out`` (state.TRACK). Returns ``p_ext`` less the power of the
-    pad and ballast dampers.
+    """The elastic track's equations of motion under the vertical contact forces on the rails (left, right), N (z
+    down, acting on the rail under the wheel): its rates into ``out`` (the full state's track part). Returns
+    ``p_ext`` less the power of the pad and ballast dampers.
     """
+    if par.elastic_track < 1.5:
+        for sd in range(2):
+            zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
+            pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
+            ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
+            out[RAIL + sd], out[SLEEPER + sd] = vr, vs
+            out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
+            out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
+            p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
+        return p_ext
+    return _beam_rates(par, y, rail_f0, rail_f1, out, p_ext)
+
+
+@njit(cache=True, _nrt=False)
+def _beam_rates(par, y, rail_f0, rail_f1, out, p_ext):
+    """track_rates of the discretely supported beam (BeamLayout), per rail:
+    (rho A L/2) W_n'' = F sin(k_n xi) - sum_s P_s sin(k_n x_s) - (L/2) [E I k_n^4 W_n] (Euler-Bernoulli) or
+    - (L/2) kGA (k_n^2 W_n - k_n Psi_n) (Timoshenko, with (rho I L/2) Psi_n'' = -(L/2) [E I k_n^2 Psi_n +
+    kGA (Psi_n - k_n W_n)]); m_s z_s'' = P_s - k_b z_s - c_b z_s', the pad force P_s = k_p (w(x_s) - z_s) +
+    c_p (w'(x_s) - z_s'), k_n = n pi / L.
+    """
+    n_modes, n_seats = int(par.beam_modes), int(par.beam_sleepers)
+    timo = par.beam_timoshenko > 0
+    n_w = n_modes * (2 if timo else 1)
+    per_rail = n_w + n_seats
+    n_pos = int(par.track_positions)
+    length, spacing = par.beam_length_m, par.sleeper_spacing_m
+    kp, cp = par.seat_pad_stiffness_N_per_m, par.seat_pad_damping_N_s_per_m
+    kb, cb, ms = par.seat_ballast_stiffness_N_per_m, par.seat_ballast_damping_N_s_per_m, par.seat_sleeper_mass_kg
+    ei, ga = par.rail_bending_stiffness_N_m2, par.rail_shear_stiffness_N
+    modal_mass, rotary = 0.5 * par.rail_mass_per_length_kg_per_m * length, par.rail_rotary_inertia_kg_m
+    theta_w = math.pi * beam_position_m(par, y) / length
+    ra = par.rail_mass_per_length_kg_per_m
     for sd in range(2):
-        zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
-        pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
-        ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
-        out[RAIL + sd], out[SLEEPER + sd] = vr, vs
-        out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
-        out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
-        p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
+        base = N_RIGID + sd * per_rail
+        rates = base + n_pos
+        force = rail_f0 if sd == 0 else rail_f1
+        s_prev, s, c2 = 0.0, math.sin(theta_w), 2.0 * math.cos(theta_w)
+        for n in range(n_modes):  # the generalised forces collect in the modes' acceleration slots
+            out[rates + n] = force * s
+            s_prev, s = s, c2 * s - s_prev
+        for j in range(n_seats):
+            theta = math.pi * (j + 1) * spacing / length
+            c2 = 2.0 * math.cos(theta)
+            s_prev, s = 0.0, math.sin(theta)
+            w, v = 0.0, 0.0
+            for n in range(n_modes):
+                w += y[base + n] * s
+                v += y[rates + n] * s
+                s_prev, s = s, c2 * s - s_prev
+            z, vz = y[base + n_w + j], y[rates + n_w + j]
+            pad = kp * (w - z) + cp * (v - vz)
+            out[base + n_w + j] = vz
+            out[rates + n_w + j] = (pad - kb * z - cb * vz) / ms
+            p_ext -= cp * (v - vz) ** 2 + cb * vz * vz
+            s_prev, s = 0.0, math.sin(theta)
+            for n in range(n_modes):
+                out[rates + n] -= pad * s
+                s_prev, s = s, c2 * s - s_prev
+        for n in range(n_modes):
+            k = (n + 1) * math.pi / length
+            w_n = y[base + n]
+            out[base + n] = y[rates + n]
+            damping = par.rail_loss_factor * _flexural_omega(k, ei, ra, ga, rotary, timo) * modal_mass
+            out[rates + n] -= damping * y[rates + n]
+            p_ext -= damping * y[rates + n] ** 2
+            if timo:
+                psi = y[base + n_modes + n]
+                out[base + n_modes + n] = y[rates + n_modes + n]
+                out[rates + n] = (out[rates + n] - 0.5 * length * ga * (k * k * w_n - k * psi)) / modal_mass
+                out[rates + n_modes + n] = -(ei * k * k * psi + ga * (psi - k * w_n)) / rotary
+            else:
+                out[rates + n] = (out[rates + n] - 0.5 * length * ei * k**4 * w_n) / modal_mass
     return p_ext
 
 
-def energy_J(track: TrackDynamics, states) -> tuple:
-    """(kinetic, potential) energy of the track's states (n, 8) or (8,) (state.TRACK order), J: the masses' kinetic
-    energy and the pad's and ballast's strain energy (0, 0 for the rigid track).
+@njit(cache=True, _nrt=False)
+def _flexural_omega(k, ei, ra, ga, ri, timo):
+    """flexural_frequency_rad_per_s at one wavenumber (compiled)."""
+    if not timo:
+        return k * k * math.sqrt(ei / ra)
+    a = ra * ri
+    b = ga * k * k * ri + ra * (ei * k * k + ga)
+    c = ga * k * k * (ei * k * k + ga) - (ga * k) ** 2
+    return math.sqrt((b - math.sqrt(b * b - 4.0 * a * c)) / (2.0 * a))
+
+
+BEAM_SUMMARY_NAMES = (
+    "rail_left_m",
+    "rail_right_m",
+    "rail_left_velocity_m_per_s",
+    "rail_right_velocity_m_per_s",
+)
+"""What a run records of the beam: the rail's deflection (z down) and velocity under each wheel."""
+
+
+class TrackSystem:
+    """The elastic track of a run as matrices: per rail M q'' + C q' + K q = b(xi) F, F the vertical contact force
+    on that rail (z down) and xi where the wheelset is; both rails alike and uncoupled.
+
+    The same equations as :func:`track_rates` (a regression test compares them), in the form the rest state, the
+    energy, the receptance and the eigenfrequencies need. ``rows(side)``: the rail's positions within the track's
+    positions (lumped: [rail, sleeper] of that side; beam: the rail's block of BeamLayout).
     """
-    if not track.elastic:
-        return 0.0, 0.0
-    t = np.asarray(states, float)
-    z_r, z_s, v_r, v_s = t[..., 0:2], t[..., 2:4], t[..., 4:6], t[..., 6:8]
-    kinetic = 0.5 * np.sum(track.rail_mass_kg * v_r**2 + track.sleeper_mass_kg * v_s**2, axis=-1)
-    potential = 0.5 * np.sum(
-        track.pad_stiffness_N_per_m * (z_r - z_s) ** 2 + track.ballast_stiffness_N_per_m * z_s**2, axis=-1
-    )
-    return kinetic, potential
 
+    def __init__(self, track: TrackDynamics, travel: float):
+        if not track.elastic:
+            raise ValueError("TrackSystem: the rigid track has no states")
+        self.track = track
+        self.model = track.model
+        self.layout = None
+        if track.model == "lumped":
+            kp, kb, cp, cb = (track.pad_stiffness_N_per_m, track.ballast_stiffness_N_per_m,
+                              track.pad_damping_N_s_per_m, track.ballast_damping_N_s_per_m)  # fmt: skip
+            self.mass = np.array([track.rail_mass_kg, track.sleeper_mass_kg])
+            self.stiffness = np.array([[kp, -kp], [-kp, kp + kb]])
+            self.damping = np.array([[cp, -cp], [-cp, cp + cb]])
+            self.n_positions = 4
+            self.summary_names = TRACK_STATE_NAMES
+            return
+        layout = self.layout = beam_layout(track, travel)
+        nm, ns, length = layout.n_modes, layout.n_sleepers, layout.length_m
+        self.n_positions = layout.n_positions
+        self.summary_names = BEAM_SUMMARY_NAMES
+        k = np.arange(1, nm + 1) * math.pi / length
+        self.wavenumber_1_per_m = k
+        self.seat_m = (np.arange(ns) + 1.0) * track.sleeper_spacing_m
+        phi = np.sin(np.outer(self.seat_m, k))  # (seats, modes)
+        n_w = nm * (2 if layout.timoshenko else 1)
+        n = layout.per_rail
+        ei, ga, half = track.rail_bending_stiffness_N_m2, track.rail_shear_stiffness_N, 0.5 * length
+        mass = np.empty(n)
+        mass[:nm] = half * track.rail_mass_per_length_kg_per_m
+        stiff = np.zeros((n, n))
+        w_rows = np.arange(nm)
+        if layout.timoshenko:
+            p_rows = nm + w_rows
+            mass[nm:n_w] = half * track.rail_rotary_inertia_kg_m
+            stiff[w_rows, w_rows] = half * ga * k * k
+            stiff[w_rows, p_rows] = stiff[p_rows, w_rows] = -half * ga * k
+            stiff[p_rows, p_rows] = half * (ei * k * k + ga)
+        else:
+            stiff[w_rows, w_rows] = half * ei * k**4
+        mass[n_w:] = track.seat_sleeper_mass_kg
+        damp = np.zeros((n, n))
+        damp[w_rows, w_rows] = track.rail_loss_factor * flexural_frequency_rad_per_s(track, k) * mass[:nm]
+        z_rows = n_w + np.arange(ns)
+        for matrix, pad, ballast in (
+            (stiff, track.seat_pad_stiffness_N_per_m, track.seat_ballast_stiffness_N_per_m),
+            (damp, track.seat_pad_damping_N_s_per_m, track.seat_ballast_damping_N_s_per_m),
+        ):
+            matrix[:nm, :nm] += pad * phi.T @ phi
+            matrix[np.ix_(w_rows, z_rows)] -= pad * phi.T
+            matrix[np.ix_(z_rows, w_rows)] -= pad * phi
+            matrix[z_rows, z_rows] += pad + ballast
+        self.mass, self.stiffness, self.damping = mass, stiff, damp
 
-def rest_state(track: TrackDynamics, rail_force_N) -> np.ndarray:
-    """The track's states at rest under the vertical rail forces (left, right), N: z_s = F / k_b,
-    z_r = z_s + F / k_p, rates 0 (state.TRACK order).
-    """
-    force = np.asarray(rail_force_N, float)
-    out = np.zeros(8)
-    out[2:4] = force / track.ballast_stiffness_N_per_m
-    out[0:2] = out[2:4] + force / track.pad_stiffness_N_per_m
-    return out
+    def rows(self, side: int) -> np.ndarray:
+        """The rail's positions within the track's positions (its rates: + n_positions)."""
+        if self.layout is None:
+            return np.array([side, 2 + side])
+        return side * self.layout.per_rail + np.arange(self.layout.per_rail)
 
+    def load_vector(self, xi_m: float) -> np.ndarray:
+        """b(xi): the generalised forces of a unit force on the rail at xi (lumped: on the rail mass)."""
+        if self.layout is None:
+            return np.array([1.0, 0.0])
+        b = np.zeros(self.layout.per_rail)
+        b[: self.layout.n_modes] = np.sin(self.wavenumber_1_per_m * xi_m)
+        return b
 
-def rail_forces_at_rest(track: TrackDynamics, rest, rates) -> np.ndarray:
-    """The vertical contact force on each rail (left, right), N, of a track at rest in ``rest`` (state.TRACK order)
-    whose rates the right-hand side gives as ``rates`` (state.TRACK order): m_r z_r'' = F_r - k_p (z_r - z_s).
-    """
-    return track.rail_mass_kg * np.asarray(rates)[4:6] + track.pad_stiffness_N_per_m * (rest[0:2] - rest[2:4])
+    def start_position_m(self) -> float:
+        """Where the wheelset is along the beam at t = 0 (xi = margin; 0 for the lumped track)."""
+        return 0.0 if self.layout is None else self.layout.margin_m
+
+    def rest_state(self, rail_force_N, xi_m: float | None = None) -> np.ndarray:
+        """The track's states (positions, then zero rates) at rest under the vertical rail forces (left, right), N,
+        applied at xi (default: the start): K q = b F per rail.
+        """
+        xi = self.start_position_m() if xi_m is None else xi_m
+        out = np.zeros(2 * self.n_positions)
+        b = self.load_vector(xi)
+        for side in (0, 1):
+            out[self.rows(side)] = np.linalg.solve(self.stiffness, b * float(rail_force_N[side]))
+        return out
+
+    def rail_forces_at_rest(self, rest, rates, xi_m: float | None = None) -> np.ndarray:
+        """The vertical contact force on each rail (left, right), N, of a track at rest in ``rest`` whose rates the
+        right-hand side gives as ``rates`` (track part of the full state): b F = M q'' + K q (least squares in F).
+        """
+        xi = self.start_position_m() if xi_m is None else xi_m
+        b = self.load_vector(xi)
+        rest, rates = np.asarray(rest, float), np.asarray(rates, float)
+        force = np.zeros(2)
+        for side in (0, 1):
+            r = self.rows(side)
+            lhs = self.mass * rates[self.n_positions + r] + self.stiffness @ rest[r]
+            force[side] = float(b @ lhs / (b @ b))
+        return force
+
+    def rates(self, track_state, rail_force_N, xi_m: float) -> np.ndarray:
+        """The track's rates M^-1 (b F - C v - K q) (the matrices' version of :func:`track_rates`)."""
+        y = np.asarray(track_state, float)
+        out = np.zeros_like(y)
+        b = self.load_vector(xi_m)
+        for side in (0, 1):
+            r = self.rows(side)
+            q, v = y[r], y[self.n_positions + r]
+            out[r] = v
+            out[self.n_positions + r] = (
+                b * float(rail_force_N[side]) - self.damping @ v - self.stiffness @ q
+            ) / self.mass
+        return out
+
+    def energy_J(self, states) -> tuple:
+        """(kinetic, potential) energy of the track's states (n, 2 n_positions) or (2 n_positions,), J:
+        v^T M v / 2 and q^T K q / 2 summed over both rails.
+        """
+        t = np.asarray(states, float)
+        kinetic = np.zeros(t.shape[:-1])
+        potential = np.zeros(t.shape[:-1])
+        for side in (0, 1):
+            r = self.rows(side)
+            q, v = t[..., r], t[..., self.n_positions + r]
+            kinetic = kinetic + 0.5 * np.sum(self.mass * v * v, axis=-1)
+            potential = potential + 0.5 * np.sum(q * (q @ self.stiffness), axis=-1)
+        return kinetic, potential
+
+    def under_wheel(self, states, xi_m) -> np.ndarray:
+        """Rail deflection (left, right) and velocity (left, right) under the wheels, (n, 4), from the track's
+        states (n, 2 n_positions) with the wheelset at xi (n,).
+        """
+        t = np.atleast_2d(np.asarray(states, float))
+        xi = np.broadcast_to(np.asarray(xi_m, float), (len(t),))
+        out = np.zeros((len(t), 4))
+        for side in (0, 1):
+            r = self.rows(side)
+            if self.layout is None:
+                out[:, side], out[:, 2 + side] = t[:, r[0]], t[:, self.n_positions + r[0]]
+                continue
+            shape = np.sin(np.outer(xi, self.wavenumber_1_per_m))
+            nm = self.layout.n_modes
+            out[:, side] = np.sum(shape * t[:, r[:nm]], axis=1)
+            out[:, 2 + side] = np.sum(shape * t[:, self.n_positions + r[:nm]], axis=1)
+        return out
+
+    def summary(self, states, xi_m) -> np.ndarray:
+        """What a run records of the track (``summary_names``): the lumped track's 8 states, or the beam's rail
+        deflection and velocity under each wheel (BEAM_SUMMARY_NAMES).
+        """
+        t = np.atleast_2d(np.asarray(states, float))
+        return t.copy() if self.layout is None else self.under_wheel(t, xi_m)
+
+    def deflection_m(self, track_state, x_m) -> np.ndarray:
+        """The beam's deflection of each rail (2, len(x)) at positions x along it, m (lumped: the rail mass)."""
+        y = np.asarray(track_state, float)
+        x = np.atleast_1d(np.asarray(x_m, float))
+        if self.layout is None:
+            return np.repeat(y[[0, 1]][:, None], len(x), axis=1)
+        shape = np.sin(np.outer(x, self.wavenumber_1_per_m))
+        nm = self.layout.n_modes
+        return np.stack([shape @ y[self.rows(side)[:nm]] for side in (0, 1)])
+
+    def receptance_m_per_N(self, frequency_Hz, x_force_m: float, x_response_m: float | None = None) -> np.ndarray:
+        """One rail's receptance (complex, m/N) at the frequencies: (K + i w C - w^2 M) u = b(x_force), the
+        response at x_response (default: at the force).
+        """
+        xr = x_force_m if x_response_m is None else x_response_m
+        b, r = self.load_vector(x_force_m), self.load_vector(xr)
+        out = np.empty(len(np.atleast_1d(frequency_Hz)), complex)
+        for i, f in enumerate(np.atleast_1d(frequency_Hz)):
+            w = 2.0 * math.pi * f
+            u = np.linalg.solve(self.stiffness + 1j * w * self.damping - w * w * np.diag(self.mass), b)
+            out[i] = r @ u
+        return out
+
+    def eigenfrequencies_Hz(self) -> np.ndarray:
+        """One rail's undamped natural frequencies, Hz, ascending."""
+        values = np.linalg.eigvalsh(self.stiffness / np.sqrt(np.outer(self.mass, self.mass)))
+        return np.sqrt(np.clip(values, 0.0, None)) / (2.0 * math.pi)
