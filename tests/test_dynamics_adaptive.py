@@ -22,6 +22,13 @@ from rigid_dynamics.wheelset.parameters import IntegratorSettings
 from wheelrail.scenes import load_scene
 
 
+def _wheel_flat_lumped():
+    """The wheel-flat scene on the lumped track: the numbers of these tests were measured there (the scene runs on
+    the discretely supported beam by default since; tests/test_dynamics_beam.py and bench_beam_track.py)."""
+    scene = load_scene("wheel-flat")
+    return replace(scene, track_dynamics=replace(scene.track_dynamics, model="lumped"))
+
+
 def _order_conditions(rows, weights, order):
     """Butcher's order conditions up to ``order`` (exact, in Fractions): the failing ones by name."""
     s = len(rows)
@@ -176,7 +183,7 @@ def test_forces_against_fine_rk4(name, duration_s, ref_step_s):
     third of the reference's right-hand sides. polygonal-wheel: the settled (after 10 m) peak
     normal force, mean longitudinal and peak lateral creep force per wheel within 1 % (sample by sample the
     S1002/UIC60 two-point-contact flips of its start-up shift in time with any change of the integrator)."""
-    scene = replace(load_scene(name), duration_s=duration_s)
+    scene = replace(_wheel_flat_lumped() if name == "wheel-flat" else load_scene(name), duration_s=duration_s)
     provider = build_provider(scene)
     reference = simulate(_rk4(scene, ref_step_s), provider=provider)
     # rtol 3e-5: at 1e-4 the flat's impact peak (a cusp between samples) lands within 0.7-1.5 % of the static load
@@ -216,7 +223,7 @@ def test_wheel_lift_is_located_within_the_step():
     the adaptive run to within 2 us of the lift in RK4 at 5 us steps with a sample at every step (the sign change of
     the normal force between two samples; measured: 0.14 us inside that 5 us bracket), while its own steps are 300 us
     on average; likewise the restored contact; the located switches are reported."""
-    scene = replace(load_scene("wheel-flat"), duration_s=0.06)
+    scene = replace(_wheel_flat_lumped(), duration_s=0.06)
     provider = build_provider(scene)
     reference = simulate(_rk4(scene, 5e-6, output_step_s=5e-6), provider=provider)
     result = simulate(_adaptive(scene, rtol=3e-5), provider=provider)  # ok at 3e-5 (test_loose_tolerance_is_flagged)
@@ -253,7 +260,7 @@ def test_loose_tolerance_is_flagged():
     2.26 % of the static load off a fine RK4 run (measured), the local estimate says 1.2 % and the check's
     difference 1.76 %: judged against half the force tolerance (simulate._half_step_check), the run ends "warning"
     with the advice to tighten the tolerances. At rtol 3e-5, atol 1e-7 (peak 0.075 % off) it ends "ok"."""
-    scene = replace(load_scene("wheel-flat"), duration_s=0.2)
+    scene = replace(_wheel_flat_lumped(), duration_s=0.2)
     provider = build_provider(scene)
     loose = simulate(_adaptive(scene, rtol=1e-2, atol=1e-6), provider=provider)
     assert loose.status == "warning", loose.message
@@ -274,7 +281,7 @@ def test_step_size_underflow_is_a_named_status(monkeypatch):
     """A step below compiled_adaptive.MIN_STEP_S ends the run as "step-size-underflow" with the time and the
     tolerances in the message (here the floor raised to 1 ms, above the steps the wheel-flat impact needs)."""
     monkeypatch.setattr(compiled_adaptive, "MIN_STEP_S", 1e-3)
-    scene = replace(load_scene("wheel-flat"), duration_s=0.05)
+    scene = replace(_wheel_flat_lumped(), duration_s=0.05)
     result = simulate(_adaptive(scene))
     assert result.status == "step-size-underflow", result.message
     assert "fell below 0.001 s" in result.message and "relative_tolerance" in result.message

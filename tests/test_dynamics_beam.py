@@ -216,3 +216,120 @@ def test_wheelset_on_the_beam_starts_at_rest_on_its_static_deflection():
     scale = max(float(np.max(np.abs(beam.kinetic_energy_J))), 1.0)
     print(f"energy residual {np.max(np.abs(beam.energy_residual_J)):.3g} J of {scale:.3g} J")
     assert np.max(np.abs(beam.energy_residual_J)) < 1e-6 * scale
+
+
+def test_structured_jacobian_equals_the_difference_quotients():
+    """Regression (two ways to the same matrix): WheelsetModel.state_jacobian (differences in the mechanical states,
+    the beam's columns from its linear equations and the rail under the wheels) against central differences in
+    every state, at the rest state of a short run on the beam; and the RK4 step limit from both."""
+    from rigid_dynamics.wheelset.equations import WheelsetModel
+    from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
+    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.stability import jacobian, rk4_stable_step
+
+    scene = _scene(duration_s=0.001, track_dynamics=_beam(cutoff_frequency_Hz=2000.0, end_margin_m=1.2))
+    law = get_contact_model(scene.contact_model)
+    model = WheelsetModel(scene, build_provider(scene), law, model_options(law.name, scene))
+    state, ok, _ = elastic_start(model, initial_state(scene))
+    assert ok
+    y = model.full_state(state)
+
+    def fun(v):
+        return model.derivative(0.0, v)
+
+    fast = model.state_jacobian(fun, y)
+    slow = jacobian(fun, y)
+    rows = slice(0, None)
+    scale = np.max(np.abs(slow[rows]), axis=1, keepdims=True) + 1e-30
+    rel = np.abs(fast - slow) / scale
+    rel[12:14] = 0.0  # the work integrals' rows (diagnostics: the dampers' power is quadratic in the rates)
+    print(f"{len(y)} states, largest difference {np.max(rel):.2e} of each row's largest entry")
+    assert np.max(rel) < 1e-4
+    a = rk4_stable_step(fun, y, jac=model.state_jacobian)
+    b = rk4_stable_step(fun, y)
+    assert a.max_step_s == pytest.approx(b.max_step_s, rel=1e-4)
+
+
+def test_largest_eigenvalues_give_the_step_limit_of_the_full_spectrum():
+    """Regression (two ways to the same limit): above 200 states the step limit comes from ARPACK's largest
+    eigenvalues (stability._largest_eigenvalues); on the wheel-flat scene's beam (Timoshenko, 5 kHz) it equals the
+    limit from every eigenvalue (numpy) to 1e-6."""
+    from rigid_dynamics.wheelset import stability
+    from rigid_dynamics.wheelset.equations import WheelsetModel
+    from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
+    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+
+    scene = _scene(duration_s=0.05)
+    law = get_contact_model(scene.contact_model)
+    model = WheelsetModel(scene, build_provider(scene), law, model_options(law.name, scene))
+    state, ok, _ = elastic_start(model, initial_state(scene))
+    y = model.full_state(state)
+    assert ok and len(y) > 200
+
+    def fun(v):
+        return model.derivative(0.0, v)
+
+    matrix = model.state_jacobian(fun, y)
+    fast = stability.rk4_stable_step(fun, y, jac=lambda f, v: matrix)
+    original = stability._largest_eigenvalues
+    try:
+        stability._largest_eigenvalues = np.linalg.eigvals
+        full = stability.rk4_stable_step(fun, y, jac=lambda f, v: matrix)
+    finally:
+        stability._largest_eigenvalues = original
+    print(f"{len(y)} states: limit {fast.max_step_s * 1e6:.2f} us ({fast.describe()}); all eigenvalues "
+          f"{full.max_step_s * 1e6:.2f} us")  # fmt: skip
+    assert fast.max_step_s == pytest.approx(full.max_step_s, rel=1e-6)
+
+
+def test_fe_rail_static_deflection_equals_the_modal_beam():
+    """The finite-element rail of comparisons/wheelflat_fe_beam.py (Hermite elements, 6 per span) against the modal
+    beam with modes to 40 kHz (Euler-Bernoulli): the static deflection under 100 kN at a seat and at mid-span within
+    0.1 % (two discretisations of the same beam)."""
+    from scipy.sparse.linalg import spsolve
+
+    from comparisons.wheelflat_fe_beam import FeBeam, fe_track_from_scene
+
+    track = _beam(rail_theory="euler-bernoulli", cutoff_frequency_Hz=40000.0)
+    system = TrackSystem(track, 4.0)
+    fe = FeBeam(fe_track_from_scene(track, system.layout.n_sleepers, 6))
+    for offset in (0.0, 0.3):
+        xi = system.start_position_m() + 1.2 + offset
+        modal = system.deflection_m(system.rest_state([1e5, 1e5], xi), [xi])[0, 0]
+        shape = fe.shape_vector(xi)
+        finite = float(shape @ spsolve(fe.K, shape * 1e5))
+        print(f"{offset} m from a seat: modal {modal * 1e3:.5f} mm, FE {finite * 1e3:.5f} mm")
+        assert modal == pytest.approx(finite, rel=1e-3)
+
+
+def test_wheel_flat_on_the_beam_against_the_fe_rail():
+    """The wheel-flat scene (100 mm flat, 60 km/h) on the Euler-Bernoulli modal beam without rail damping against the
+    vertical half-wheelset on the finite-element rail (comparisons/wheelflat_fe_beam.py: FE rail, Newmark, a point
+    Hertz spring fed with the wheel-centre trajectory): the peak within 5 % (measured 0.985; the two contact models
+    differ as on the lumped and rigid tracks, ratios 0.88-1.07 in wheelflat_study.md)."""
+    from comparisons.wheelflat_fe_beam import fe_track_from_scene, simulate_passage_fe
+    from comparisons.wheelflat_vertical import from_scene
+    from wheelrail.scenes import load_scene
+
+    speed, distance = 60.0 / 3.6, 0.5
+    scene = load_scene("wheel-flat")
+    assert scene.track_dynamics.model == "beam"  # the scene's default
+    scene = replace(
+        scene,
+        speed_m_per_s=speed,
+        duration_s=distance / speed,
+        irregularities=replace(scene.irregularities, flat_length_m=0.10),
+        track_dynamics=replace(scene.track_dynamics, rail_theory="euler-bernoulli", rail_loss_factor=0.0),
+        integrator=replace(scene.integrator, output_step_s=2.5e-5, lift_half_step_check=False),
+    )
+    result = simulate(scene)
+    assert result.status in ("ok", "warning"), result.message
+    peak = float(np.max(-result.contact_force_N[:, :, 2]))
+    hertz = result.patches["normal_force_N"][0, 0, 0] / result.patches["approach_m"][0, 0, 0] ** 1.5
+    centre = scene.wheelset.nominal_radius_m * (0.5 * math.pi - scene.irregularities.flat_angle_rad)
+    wheel = from_scene(replace(scene, track_dynamics=replace(scene.track_dynamics, model="lumped")), hertz, centre)
+    layout = beam_layout(scene.track_dynamics, distance)
+    track = fe_track_from_scene(scene.track_dynamics, layout.n_sleepers)
+    _, _, force = simulate_passage_fe(wheel, track, speed, layout.margin_m, distance)
+    print(f"peak: wheelset on the modal beam {peak / 1e3:.1f} kN, vertical on the FE rail {force.max() / 1e3:.1f} kN")
+    assert peak / force.max() == pytest.approx(1.0, abs=0.05)

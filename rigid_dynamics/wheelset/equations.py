@@ -56,10 +56,7 @@ from rigid_dynamics.wheelset import track as track_model
 from rigid_dynamics.wheelset.compiled import model_parameters, patch_creepages, track_rates
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
-from rigid_dynamics.wheelset.state import (
-    TRACK,
-    n_states,
-)
+from rigid_dynamics.wheelset.state import N_RIGID, TRACK, n_states
 
 PATCH_FIELDS = (
     "normal_force_N",
@@ -537,6 +534,50 @@ class WheelsetModel:
         power = track_rates(self.par, full, np.asarray(rail_force, float), rates)
         out[:] = rates[TRACK]
         return float(power)
+
+    def state_jacobian(self, fun, y: np.ndarray, rel_step: float = 1e-8) -> np.ndarray:
+        """Jacobian of ``fun`` (this model's full-state rates) at ``y``, by central differences
+        (stability.jacobian) in the mechanical states and the work integrals; on the beam the track's columns from
+        the structure of the equations: the track's own rates are linear in its states (TrackSystem), and the
+        contact sees the track only through the rail's deflection and velocity under each wheel
+        (track.rail_under_wheel, linear in the modes: b(xi)). So column j of the track is
+        A e_j + sum_k G_k dq_k/dy_j, q = (w left, w right, v left, v right) under the wheels, with G_k the
+        difference quotient along a track direction d_k that moves q_k alone (by one), less A d_k; 8 more
+        evaluations instead of two per track state. Other tracks: all columns by differences.
+        """
+        from rigid_dynamics.wheelset.stability import jacobian
+
+        y = np.asarray(y, float)
+        n = len(y)
+        if not self.elastic or self.track_system.layout is None:
+            return jacobian(fun, y, rel_step)
+        jac = jacobian(fun, y, rel_step, columns=range(N_RIGID))
+        system = self.track_system
+        npos = system.n_positions
+        xi = float(y[0]) - self.frame_x0 + system.start_position_m()
+        b = system.load_vector(xi)  # the rail's deflection under the wheel is b . q of its rows
+        linear = np.zeros((2 * npos, 2 * npos))
+        probes = []
+        for side in (0, 1):
+            r = system.rows(side)
+            linear[np.ix_(r, npos + r)] = np.eye(len(r))
+            linear[np.ix_(npos + r, r)] = -system.stiffness / system.mass[:, None]
+            linear[np.ix_(npos + r, npos + r)] = -system.damping / system.mass[:, None]
+            for offset in (0, npos):  # deflection, then velocity
+                d = np.zeros(2 * npos)
+                d[offset + r] = b / (b @ b)
+                coupling = np.zeros(2 * npos)
+                coupling[offset + r] = b
+                probes.append((d, coupling))
+        jac[N_RIGID:, N_RIGID:] = linear
+        for d, coupling in probes:
+            full_d = np.zeros(n)
+            full_d[N_RIGID:] = d
+            h = rel_step  # q_k moves by rel_step (m or m/s)
+            g = (np.asarray(fun(y + h * full_d)) - np.asarray(fun(y - h * full_d))) / (2.0 * h)
+            g[N_RIGID:] -= linear @ d
+            jac[:, N_RIGID:] += np.outer(g, coupling)
+        return jac
 
     def track_energy_J(self, track) -> tuple:
         """(kinetic, potential) energy of the elastic track's states (n, k) or (k,), J (track.TrackSystem.energy_J;

@@ -288,7 +288,7 @@ def simulate(
                 if use_compiled and search_in_python:
                     probe = WheelsetModel(scene, provider, model_obj, options, python_geometry=True)
                     probe.frame_x0, probe.track_rest = model.frame_x0, model.track_rest
-                limit = rk4_stable_step(lambda y: probe.derivative(0.0, y), full0)
+                limit = rk4_stable_step(lambda y: probe.derivative(0.0, y), full0, jac=probe.state_jacobian)
             except (ContactFailure, *NUMERICAL_ERRORS):
                 limit = None
             if limit is not None and status in NUMERICAL_LOOKING and not settings.fixed_step_s > limit.max_step_s:
@@ -347,7 +347,7 @@ def _limit_at_largest_force(model, t, states, patches, work_contact, work_exteri
         parts.append(track_states[k])
     y = np.concatenate(parts)
     try:
-        limit = rk4_stable_step(lambda yy: model.derivative(float(t[k]), yy), y)
+        limit = rk4_stable_step(lambda yy: model.derivative(float(t[k]), yy), y, jac=model.state_jacobian)
     except (ContactFailure, *NUMERICAL_ERRORS):
         return start_limit
     if not limit.max_step_s < start_limit.max_step_s:
