@@ -403,6 +403,8 @@ class WheelsetModel:
         from rigid_dynamics.wheelset import compiled
 
         par, hz, kk, sides, _, mode, targs, sargs = self.packed
+        if len(full) != self.n_state or len(out) != self.n_state:  # the compiled code does not check bounds
+            raise ValueError(f"full state of length {len(full)}: this run's state has {self.n_state} entries")
         par["frame_x0_m"] = self.frame_x0
         compiled.use_callback(self.callback)
         if mode == 2:
