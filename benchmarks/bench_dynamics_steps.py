@@ -255,7 +255,9 @@ def write(records, machine):
         "",
         f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs ({machine.get('cpu', 'unknown')}), "
         f"Python {machine['python']}, numpy "
-        f"{machine['numpy']}; {machine['note']}. Script: benchmarks/bench_dynamics_steps.py.",
+        f"{machine['numpy']}; {machine['note']}"
+        + (f"; later, {machine['rerun_note']}" if machine.get("rerun_note") else "")
+        + ". Script: benchmarks/bench_dynamics_steps.py.",
         "",
         "Forces relative to the static wheel load N0. `estimate`: the run's force error estimate after the settling "
         "distance (the status judges it against force_tolerance = 0.02), `full run`: including the start-up. "
@@ -290,8 +292,11 @@ def write(records, machine):
 
 NOTES = """Notes.
 
-* Two tracks. `lumped` is the elastic track (a rail mass on a pad on a sleeper mass on the ballast under each
-  wheel), the default of the wheel-flat and corrugation scenes; `rigid` is issue 12's original table. No row
+* Three tracks. `beam` is the discretely supported rail (track.py), the wheel-flat scene's default: at its own
+  0.025 ms it moves by 0.0015 against a 0.0125 ms reference; 0.05 ms and above lie beyond RK4's stability limit
+  of the beam's stiffest rail modes (0.0305 ms at the start, Timoshenko's shear branch at 14.7 kHz) and end
+  `step-unstable`. `lumped` (a rail mass on a pad on a sleeper mass on the ballast under each wheel) is the
+  corrugation scene's default and was wheel-flat's; `rigid` is issue 12's original table. No row
   with status `ok` moves by more than force_tolerance = 0.02 of the static load: the largest among them is
   wheel-flat on the rigid track at 0.05 ms (0.0097); on the elastic track wheel-flat at its own 0.025 ms moves by
   0.00084 against a 0.0125 ms reference, corrugation at 0.2 ms by 0.0034, polygonal-wheel at 0.5 ms by 0.00033.

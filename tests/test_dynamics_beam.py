@@ -333,3 +333,24 @@ def test_wheel_flat_on_the_beam_against_the_fe_rail():
     _, _, force = simulate_passage_fe(wheel, track, speed, layout.margin_m, distance)
     print(f"peak: wheelset on the modal beam {peak / 1e3:.1f} kN, vertical on the FE rail {force.max() / 1e3:.1f} kN")
     assert peak / force.max() == pytest.approx(1.0, abs=0.05)
+
+
+def test_beam_input_is_checked(capsys, tmp_path):
+    """Bad beam keys get one line naming the key, the value and the range; a run too long for a beam is refused
+    with its size."""
+    from hardening_helpers import assert_error, run, write
+
+    from wheelrail.scenes import resolve_scene_path
+
+    base = resolve_scene_path("wheel-flat").read_text(encoding="utf-8")
+    for key, value, fragment in (
+        ("sleeper_spacing_m", "0.001", "0.3 to 1.5"),
+        ("cutoff_frequency_Hz", "1e9", "500 to 50000"),
+        ("rail_loss_factor", "-0.1", "0 to 1"),
+    ):
+        text = base.replace('model = "beam"', f'model = "beam"\n{key} = {value}')
+        code, _, err = run(capsys, "run", write(tmp_path, text, f"{key}.toml"), "--out", tmp_path / key, "--quiet")
+        assert_error(code, err, key, fragment)
+    text = base.replace("duration_s = 0.4", "duration_s = 60.0")
+    code, _, err = run(capsys, "run", write(tmp_path, text, "long.toml"), "--out", tmp_path / "long", "--quiet")
+    assert_error(code, err, "track_dynamics.model = 'beam'", "1000 m", "at most 8000")

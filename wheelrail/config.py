@@ -74,6 +74,19 @@ PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
     "ballast_stiffness_N_per_m": (1.0e5, 1.0e12, "N/m per wheel: the default is 3.26e8"),
     "pad_damping_N_s_per_m": (0.0, 1.0e9, "N s/m per wheel: the default is 6.98e4"),
     "ballast_damping_N_s_per_m": (0.0, 1.0e9, "N s/m per wheel: the default is 1.86e5"),
+    "rail_mass_per_length_kg_per_m": (10.0, 200.0, "kg/m: UIC60 is 60.21"),
+    "rail_bending_stiffness_N_m2": (1.0e5, 1.0e8, "N m^2: UIC60 is 6.38e6"),
+    "rail_shear_stiffness_N": (1.0e6, 1.0e10, "kappa G A in N: UIC60 is 2.48e8"),
+    "rail_rotary_inertia_kg_m": (1.0e-3, 10.0, "rho I in kg m: UIC60 is 0.2385"),
+    "sleeper_spacing_m": (0.3, 1.5, "m: 0.6 for concrete sleepers"),
+    "seat_pad_stiffness_N_per_m": (1.0e5, 1.0e11, "N/m per rail seat: the default is 1.2e8"),
+    "seat_pad_damping_N_s_per_m": (0.0, 1.0e8, "N s/m per rail seat: the default is 3e4"),
+    "seat_sleeper_mass_kg": (1.0, 1.0e4, "kg per rail seat (half a sleeper): the default is 125 kg"),
+    "seat_ballast_stiffness_N_per_m": (1.0e5, 1.0e11, "N/m per rail seat: the default is 1.4e8"),
+    "seat_ballast_damping_N_s_per_m": (0.0, 1.0e8, "N s/m per rail seat: the default is 8e4"),
+    "rail_loss_factor": (0.0, 1.0, "the rail's loss factor: the default is 0.02"),
+    "cutoff_frequency_Hz": (500.0, 5.0e4, "Hz: the beam's modes up to it; 5 kHz resolves a wheel-flat impact"),
+    "end_margin_m": (1.0, 100.0, "m of beam beyond the run at each end: the default is 6 m"),
 }
 """Key name -> (lowest, highest, why): numbers outside are bad input however well typed (the range and
 the reason are in the message). Applied to every key of that name in scene and case files."""

@@ -584,6 +584,17 @@ class DynamicsScene:
                 "corrugation_file: expected contact_provider 'search' or 'auto' (only the 3-D search evaluates them)"
             )
 
+        if self.track_dynamics.model == "beam":
+            from rigid_dynamics.wheelset.track import MAX_BEAM_STATES, beam_layout
+
+            layout = beam_layout(self.track_dynamics, self.speed_m_per_s * self.duration_s)
+            if 2 * layout.n_positions > MAX_BEAM_STATES:
+                raise ValueError(
+                    f"track_dynamics.model = 'beam' over {self.speed_m_per_s * self.duration_s:.4g} m "
+                    f"(speed_m_per_s x duration_s): a beam of {layout.n_modes} modes and {layout.n_sleepers} seats "
+                    f"per rail, {2 * layout.n_positions} states: expected at most {MAX_BEAM_STATES} (its cost grows "
+                    "with the square of the length: shorten the run, lower cutoff_frequency_Hz, or use model 'lumped')"
+                )
         if self.irregularities.joint_dip_angle_rad > 0 and (
             self.contact_provider == "search" or self.irregularities.needs_search
         ):

@@ -42,6 +42,10 @@ from rigid_dynamics.wheelset.state import N_RIGID, RAIL, RAIL_VELOCITY, SLEEPER,
 TRACK_MODELS = ("rigid", "lumped", "beam")
 """Vertical track models (:class:`TrackDynamics`)."""
 
+MAX_BEAM_STATES = 8000
+"""The largest beam a scene may ask for (states of both rails, positions and rates): about 80 m of track with
+modes to 5 kHz; each right-hand side costs ~ modes x seats per rail."""
+
 RAIL_THEORIES = ("timoshenko", "euler-bernoulli")
 """Beam theories of the rail in the discretely supported model."""
 
