@@ -115,9 +115,11 @@ def test_failure_within_the_start_limit_is_judged_at_the_impact():
     result = simulate(replace(shipped, integrator=replace(shipped.integrator, fixed_step_s=5e-4, output_step_s=5e-4)))
     print(result.status, result.message)
     assert result.status == "step-unstable", result.message
-    # the numerical blow-up ends as derailed or force-anomaly depending on round-off (both seen); either way the
-    # message names the state of the largest contact force
-    assert result.message.startswith(("derailed", "force-anomaly")) and "the largest contact force" in result.message
+    # the numerical blow-up ends as derailed, force-anomaly or blow-up (the rail's deflection beyond
+    # recorder.MAX_RAIL_DEFLECTION_M) depending on round-off and which bound it crosses first (all seen); either way
+    # the message names the state of the largest contact force
+    assert result.message.startswith(("derailed", "force-anomaly", "blow-up"))
+    assert "the largest contact force" in result.message
     assert "0.5 ms" in result.message
 
 

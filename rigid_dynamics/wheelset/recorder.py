@@ -19,6 +19,11 @@ NUMERICAL_ERRORS = (ValueError, ArithmeticError, np.linalg.LinAlgError)
 into a status (``invalid-initial-state``, ``solver-failed``) at the driver, never a traceback."""
 
 
+MAX_RAIL_DEFLECTION_M = 0.05
+"""A rail deflected this far under a wheel (a hundred times a static deflection) ends the run as "blow-up": the track's
+states diverged (an RK4 step beyond the stability limit of the beam's rail modes can leave every other state finite)."""
+
+
 class Stop(Exception):
     def __init__(self, status: str, message: str, t: float | None = None, state=None):
         super().__init__(message)
@@ -95,6 +100,16 @@ class Recorder:
             raise Stop(
                 "derailed", f"|y| = {abs(state[1]):.4g} m exceeds {self.limit_y:.4g} m at t = {t:.6g} s", t, state
             )
+        if self.model.elastic:
+            rail = float(np.max(np.abs(self._summary(np.asarray(full_state, float)[None])[0, :2])))
+            if rail > MAX_RAIL_DEFLECTION_M:
+                raise Stop(
+                    "blow-up",
+                    f"rail deflection {rail:.4g} m under a wheel exceeds {MAX_RAIL_DEFLECTION_M:g} m (the track's "
+                    f"states diverged) at t = {t:.6g} s",
+                    t,
+                    state,
+                )
         touching = normal > 0
         flange = np.array(
             [
@@ -143,6 +158,8 @@ class Recorder:
         bad |= ~np.all(np.isfinite(normal), axis=1)
         bad |= np.max(normal, axis=1) > self.limit_force
         bad |= np.abs(full_states[:, 1]) > self.limit_y
+        if self.model.elastic:
+            bad |= np.max(np.abs(self._summary(full_states)[:, :2]), axis=1) > MAX_RAIL_DEFLECTION_M
         touching = normal > 0
         if self.scene.integrator.stop_at_wheel_lift:
             bad |= ~np.all(touching, axis=1)
