@@ -42,6 +42,7 @@ from rigid_dynamics.contact._search_kernels import (
     refine_point,
     wheel_irregularity,
 )
+from rigid_dynamics.wheelset.providers.surfaces import MIN_LATERAL_CURVATURE_1_PER_M
 from rigid_dynamics.wheelset.state import RAIL
 
 N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
@@ -190,7 +191,9 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
     g[0] = -h
     g[1], g[2], g[3] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1], 0.5 * (p[2] + qz) - centre[2]
     g[4], g[5], g[6] = n[0], n[1], n[2]
-    g[7], g[8] = max(big_a, 1e-6), max(big_b, 1e-6)
+    # B floored as the profile section floors it (SearchProvider too): on the conformal arcs of a flange root and a
+    # gauge corner of equal radius (S1002 / UIC60: 13 mm) the surface curvatures cancel and B is round-off
+    g[7], g[8] = max(big_a, 1e-6), max(big_b, MIN_LATERAL_CURVATURE_1_PER_M)
     g[9] = r
     g[10] = y_d
     tilt = -n[1] if right else n[1]

@@ -21,7 +21,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
 from rigid_dynamics.wheelset.providers.patches import SIDE_SIGNS, SIDES, PatchSet
-from rigid_dynamics.wheelset.providers.surfaces import ABSENT_GAP_M, build_surfaces
+from rigid_dynamics.wheelset.providers.surfaces import ABSENT_GAP_M, MIN_LATERAL_CURVATURE_1_PER_M, build_surfaces
 
 
 class SearchProvider:
@@ -147,7 +147,11 @@ class SearchProvider:
             point_m=np.array([g.point_m for g in geometries], float),
             normal=np.array([g.frame[:, 2] for g in geometries], float),
             curvature_long_1_per_m=np.array([g.curvature_long_1_per_m for g in geometries]),
-            curvature_lat_1_per_m=np.array([g.curvature_lat_1_per_m for g in geometries]),
+            # floored as the profile section's B (MIN_LATERAL_CURVATURE_1_PER_M): conformal contacts (equal radii of
+            # flange root and gauge corner) have B ~ 0, whose Hertz stiffness is unbounded
+            curvature_lat_1_per_m=np.maximum(
+                [g.curvature_lat_1_per_m for g in geometries], MIN_LATERAL_CURVATURE_1_PER_M
+            ),
             approach_m=np.array([g.approach_m for g in geometries]),
             rolling_radius_m=np.array([g.rolling_radius_m for g in geometries]),
             contact_angle_rad=np.array([g.contact_angle_rad for g in geometries]),
