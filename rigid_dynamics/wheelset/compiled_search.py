@@ -260,6 +260,7 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
     iters, radius = int(sp[s, S_NEWTON]), sp[s, S_RADIUS]
     alpha_mid = 0.5 * math.pi - spin
     n_start = 0
+    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
     if full:
         step = sp[s, S_SCAN]
         # y_d whose lowest point can lie over the rail: p_y = rot[1, 1] y_d + rot[1, 0] x + rot[1, 2] z + c_y with
@@ -282,6 +283,27 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
             # the previous sample is a minimum: below its left neighbour, not above its right one
             if k >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < limit:
                 n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, y0 + (k - 1) * step, g_prev)
+            g_prev2, g_prev = g_prev, gk
+        # the same samples' distance h along the wheel normal: on conformal arcs (S1002's flange root and UIC60's
+        # gauge corner are both R13) h is nearly flat and can be deepest inside the arc while the vertical gap's
+        # minimum sits at one end of it; a minimum of h more than a step from every vertical-gap minimum is a start
+        n_vertical = n_y
+        g_prev2, g_prev, h_start = math.inf, math.inf, 0.0
+        for k in range(n_scan + 1):
+            if k < n_scan:
+                gk = distance(alpha_mid, y0 + k * step, *args, h_start)
+                if math.isfinite(gk):
+                    h_start = gk
+            else:
+                gk = math.inf
+            if k >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < sp[s, S_GAP]:
+                y_prev = y0 + (k - 1) * step
+                new = True
+                for j in range(MAX_START, MAX_START + n_vertical):
+                    if abs(cand[j, 1] - y_prev) <= 1.5 * step:
+                        new = False
+                if new:
+                    n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, y_prev, g_prev)
             g_prev2, g_prev = g_prev, gk
         # at each lateral minimum, the minima over the angle (search_side's alpha grid: e.g. both edges of a flat)
         n_a, half = int(sp[s, S_APTS]), sp[s, S_AHALF]
@@ -315,7 +337,6 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
             cand[n_start, 3] = m
             n_start += 1
     failed = 0
-    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
     for j in range(n_start):
         m = int(cand[j, 3])
         cand[j, 7] = 0.0
