@@ -12,9 +12,11 @@ h < 0 an interpenetration (the rail's material is at z > N, the main z axis poin
 
 Every local minimum of h(alpha, y_d) on the grid below ``candidate_gap_m`` is refined by a damped Newton
 iteration on (alpha, y_d) (gradient and Hessian of h by central differences of the vectorised distance
-function, all candidates at once). Minima that end in the same interpenetration region (h < 0 along the
-segment joining them) are merged, so tread and flange contact give two patches and one patch is never counted
-twice. At each patch:
+function, all candidates at once); where h is not convex (e.g. along the conformal arcs of S1002's flange root
+and UIC60's gauge corner, both R13, where h is nearly flat) the step goes down the gradient with a line search
+(first trial 5e-5 m, doubled while h decreases up to 3e-3 m, else halved to an Armijo decrease). Minima that
+end in the same interpenetration region (h < 0 along the segment joining them) are merged, so tread and flange
+contact give two patches and one patch is never counted twice. At each patch:
 
 * normal n = -n_w (from the rail into the wheel), contact frame e_x = rolling direction (main x projected on the
   contact plane, eq 39-43), e_y = n x e_x, e_z = n;

@@ -12,12 +12,16 @@ right-hand side:
   vertical gap is the normal gap divided by the cosine of the contact angle to first order, and its minima
   sit where the profile slopes are equal, the 2-D condition of a minimum of h); at each such y_d the gap is scanned
   over search_side's angles (``alpha_points`` over +-``alpha_half_range_rad``), and every minimum over the angle
-  (e.g. both edges of a wheel flat) is a start. The start is the nearest
+  (e.g. both edges of a wheel flat) is a start. The same samples' normal distance h is scanned too: a minimum of
+  h below ``candidate_gap_m`` more than 1.5 steps from every vertical-gap minimum is a further start (on conformal
+  arcs, S1002's R13 flange root on UIC60's R13 gauge corner, h is nearly flat and deepest inside the arc while
+  the vertical gap's minimum sits at its end). The start is the nearest
   candidate of the previous evaluation within ``memory_radius_m`` when there is one (warm start), else the scan
   point. The other RK4 stages start from the previous evaluation's candidates alone (the pose moves by
   O(h v) within a step; a new minimum appears at the next step's scan at the latest).
 * Patch geometry. Point, normal and curvatures (eq 12-33: curvature tensors of both surfaces in the rolling-
-  direction basis, D = (K_w - K_r)/2, principal A nearest the rolling direction) are evaluated on the same
+  direction basis, D = (K_w - K_r)/2, principal A nearest the rolling direction; B floored at the profile
+  section's MIN_LATERAL_CURVATURE_1_PER_M, as SearchProvider) are evaluated on the same
   tabulated surfaces (the second derivative of each profile interpolated linearly between nodes 2e-5 m apart)
   instead of search_side's exact surfaces.
 

@@ -1,6 +1,9 @@
 """SearchProvider: the 3-D contact search (rigid_dynamics.contact.search, eq 5-11) per side and pose, with
 irregularities; patches ordered by contact angle (slot 0 the tread side), at most two per side; a side with
-no patch gets a gap candidate (approach = -smallest gap) so that wheel lift is seen.
+no patch gets a gap candidate (approach = -smallest gap) so that wheel lift is seen. The lateral relative
+curvature B is floored at MIN_LATERAL_CURVATURE_1_PER_M as the profile section's (conformal contacts, e.g. the
+R13 flange root of S1002 on the R13 gauge corner of UIC60, have B ~ 0: Hertz's force would be unbounded; the
+patch's ContactGeometry keeps the search's own value).
 
 Reuse of the last search (SearchProvider ``reuse_m``): a pose identical to the last one searched (the RK4 output
 sample and the next step's first stage) returns the last patches unchanged (exact). With ``reuse_m`` > 0 a pose
