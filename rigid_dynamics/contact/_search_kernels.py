@@ -388,11 +388,12 @@ def refine_point(
             s_a = -(h_yy * g_a - h_ay * g_y) / det
             s_y = -(h_aa * g_y - h_ay * g_a) / det
             ok = True
-        else:
-            # not convex here (e.g. along the conformal arcs of a flange root and a gauge corner of equal radius,
-            # where h is nearly flat and its difference curvature has either sign): a descent step whose length
-            # the line search finds (a fixed fraction of the gradient crawls, ~2e-5 m per iteration, and stops
-            # short of the minimum)
+        elif h_aa > 0:
+            # convex along the rolling direction but not across it (e.g. the conformal arcs of a flange root and a
+            # gauge corner of equal radius, R13 on S1002 and UIC60, where h is nearly flat across the profile and
+            # its curvature has either sign): a descent step whose length the line search finds (the fixed
+            # fraction of the gradient below crawls, ~2e-5 m per iteration, and stopped 0.3 mm short of the
+            # minimum: tests/test_search_flange.py)
             length = _descent_length(a, y, g_a, g_y, h0, args, hs, radius, y_range)
             g_norm = math.sqrt(g_a * g_a + g_y * g_y)
             if length > 0.0:
@@ -400,6 +401,12 @@ def refine_point(
             else:
                 s_a, s_y = 0.0, 0.0
             ok = False
+        else:
+            # concave along the rolling direction: between the two edges of a wheel flat, which the angle grid
+            # (search_side) or the angle scan (compiled_search) seeds each; a short gradient step (1e-3 times the
+            # gradient, m) keeps this start near its seed (a descent to one edge changes which edges the compiled
+            # search's tracked stages hold, and the wheel-flat impact with them)
+            s_a, s_y, ok = -g_a * 1e-3, -g_y * 1e-3, False
         norm = math.sqrt(s_a * s_a + s_y * s_y)
         if norm > 3.0e-3:
             s_a *= 3.0e-3 / norm

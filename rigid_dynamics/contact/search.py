@@ -12,9 +12,11 @@ h < 0 an interpenetration (the rail's material is at z > N, the main z axis poin
 
 Every local minimum of h(alpha, y_d) on the grid below ``candidate_gap_m`` is refined by a damped Newton
 iteration on (alpha, y_d) (gradient and Hessian of h by central differences of the vectorised distance
-function, all candidates at once); where h is not convex (e.g. along the conformal arcs of S1002's flange root
-and UIC60's gauge corner, both R13, where h is nearly flat) the step goes down the gradient with a line search
-(first trial 5e-5 m, doubled while h decreases up to 3e-3 m, else halved to an Armijo decrease). Minima that
+function, all candidates at once); where h is convex along the rolling direction but not across it (e.g. along
+the conformal arcs of S1002's flange root and UIC60's gauge corner, both R13, where h is nearly flat) the step goes
+down the gradient with a line search (first trial 5e-5 m, doubled while h decreases up to 3e-3 m, else halved to an
+Armijo decrease); where it is concave along the rolling direction (between a wheel flat's edges) the step is 1e-3
+times the gradient. Minima that
 end in the same interpenetration region (h < 0 along the segment joining them) are merged, so tread and flange
 contact give two patches and one patch is never counted twice. At each patch:
 
@@ -434,12 +436,13 @@ def _refine(geo: _SideGeometry, alpha, y, opts, radius_guess):
         det = haa * hyy - hay**2
         ok = (haa > 0) & (det > 0) & np.all(np.isfinite(h), axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
-            s_a = np.where(ok, -(hyy * g[:, 0] - hay * g[:, 1]) / det, 0.0)
-            s_y = np.where(ok, -(haa * g[:, 1] - hay * g[:, 0]) / det, 0.0)
+            s_a = np.where(ok, -(hyy * g[:, 0] - hay * g[:, 1]) / det, -g[:, 0] * 1e-3)
+            s_y = np.where(ok, -(haa * g[:, 1] - hay * g[:, 0]) / det, -g[:, 1] * 1e-3)
         s_a, s_y = np.nan_to_num(s_a), np.nan_to_num(s_y)
-        # not convex (e.g. the conformal arcs of a flange root and a gauge corner of equal radius): a descent step
-        # with a line search (_search_kernels._descent_length, the same rule)
-        for k in np.flatnonzero(~ok & ~converged):
+        # convex along the rolling direction, not across it (e.g. the conformal R13 arcs of a flange root and a
+        # gauge corner): a descent step with a line search (_search_kernels.refine_point, the same rule); concave
+        # along the rolling direction (between a wheel flat's edges, each seeded by the angle grid): the short step
+        for k in np.flatnonzero(~ok & ~converged & (haa > 0)):
             s_a[k], s_y[k] = _descent_step(geo, alpha[k], y[k], g[k], h[k, 0], opts, radius_guess)
         norm = np.hypot(s_a, s_y)
         limit = 3.0e-3
