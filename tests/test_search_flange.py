@@ -4,7 +4,7 @@ embedded scene ``curve-flange`` (R = 100 m, cant 150 mm, 50 km/h).
 The S1002 flange root (EN 13715, section D: R13, standard_profiles) and the UIC60 gauge corner (EN 13674-1: R13)
 are arcs of one radius: in flange-root contact the two profiles are conformal over a 0.45 rad arc, the distance h
 along the wheel normal is nearly flat along it and the relative lateral curvature of the surfaces,
-B = (K_w - K_r)/2, is zero to round-off (either sign). Two defects followed from that, both in the search
+B = (K_w - K_r)/2, is zero to round-off (either sign). Three defects followed from that, all in the search
 (contact._search_kernels.refine_point / search._refine, wheelset.compiled_search, providers.SearchProvider):
 
 * where h was not convex the refinement stepped by 1e-3 times the gradient (~2e-5 m per iteration): on the
@@ -12,9 +12,14 @@ B = (K_w - K_r)/2, is zero to round-off (either sign). Two defects followed from
 * B was floored at 1e-6 1/m only, and Hertz's force at q = 0.13 mm is then 3.6e7 N (at B = 0.05: 0.4 MN):
   curve-flange on the search ended ``force-anomaly`` at t = 0.092 s (the Python search at the same time), and with
   the refinement fixed the compiled search still kicked the wheelset off the track at t = 0.135 s from a
-  stage whose tracked contact point lay inside the arc (B = -0.18 1/m).
+  stage whose tracked contact point lay inside the arc (B = -0.18 1/m);
+* the compiled search's starts (minima of the vertical gap along the axle) missed the deepest point of h inside
+  the arc, where the vertical gap has no minimum: it reported the arc's end (q 7 um shallower, contact angle
+  1.20 rad against 0.78) where the Python search (minima of h on an (alpha, y_d) grid) found the deepest point.
 
-Now a non-convex h takes a descent step with a line search, and the dynamics' search providers floor B at the
+Now h convex along the rolling direction but not across it takes a descent step with a line search (concave along
+it, between a wheel flat's edges, keeps the short step: the angle scan seeds both edges), the compiled scan also
+starts from the minima of h where the vertical gap is negative, and the dynamics' search providers floor B at the
 profile section's MIN_LATERAL_CURVATURE_1_PER_M (0.05 1/m: a conformal contact is not Hertzian; the floor keeps
 the ellipse finite, as the tables do).
 
@@ -142,7 +147,9 @@ def test_refinement_reaches_the_minimum_on_the_flat_flange_arc(flange_search):
 def test_contact_inside_the_conformal_arc_gets_the_section_floor(flange_search):
     """At this pose (POSE moved 0.2 mm out and 0.2 mrad in roll) the minimum of h lies inside the arc (y_d -0.7147,
     contact angle 0.78 rad): the surfaces' B is <= 0 there; the providers give the profile section's floor, and
-    Hertz's force stays below the run's force limit (at the old floor 1e-6 1/m it exceeds it 40 times)."""
+    Hertz's force stays below the run's force limit (at the old floor 1e-6 1/m it exceeds it 40 times). The
+    compiled search finds the same point (its vertical-gap scan alone gave the arc's flank end: y_d -0.7117,
+    q 7 um shallower, B 6.3)."""
     pose = np.array(POSE)
     pose[1] -= 2e-4
     pose[4] -= 2e-4
@@ -153,6 +160,7 @@ def test_contact_inside_the_conformal_arc_gets_the_section_floor(flange_search):
     cg, _ = _compiled_patches(flange_search, pose)
     assert cg[0, 8] == MIN_LATERAL_CURVATURE_1_PER_M
     assert cg[0, 0] == pytest.approx(patches.approach_m[0], abs=1e-11)
+    assert cg[0, 10] == pytest.approx(patches.wheel_lateral_m[0], abs=1e-7)
     scene = _scene("curve-flange", "search")
     limit = scene.integrator.max_force_factor * scene.static_wheel_load_N
     material = {"shear_modulus_Pa": scene.material.shear_modulus_Pa, "poisson_ratio": scene.material.poisson_ratio}
@@ -205,7 +213,8 @@ def test_curve_flange_on_the_search_agrees_with_the_section_and_the_tables():
 def test_curve_on_the_search_agrees_with_the_tables():
     """curve (600 m, tread contact, 6 s): the search and the tables settle 0.065 mm apart (y -3.926 / -3.861 mm),
     normal forces 28 N, lateral creep forces 92 N, longitudinal 11 N apart; the tables' approach of the outer wheel is
-    1.6 um above the search's and the section's (which agree to 0.04 um) at the same pose."""
+    1.6 um above the search's and the section's (which agree to 0.04 um) at the same pose, and the profile section
+    without tables (Python loop, 3 s) settles between the two (-3.884 mm at 2.5-3 s). Bounds ~1.5 times those."""
     search = simulate(_scene("curve", "search"))
     tables = simulate(_scene("curve", "tables"))
     assert search.status == tables.status == "ok", (search.message, tables.message)
