@@ -316,6 +316,44 @@ def _finite_distance(a, y, args, h_start):
     return v if math.isfinite(v) else 1.0
 
 
+_DESCENT_FIRST_M = 5.0e-5  # first trial length of a descent step (five difference steps)
+_DESCENT_MAX_M = 3.0e-3  # longest step (the Newton step's limit)
+_DESCENT_MIN_M = 1.0e-9  # shortest trial before giving up (below the refinement tolerances' scale)
+
+
+@njit(cache=True, _nrt=False)
+def _along(a, y, u_a, u_y, length, args, hs, y_range):
+    """The distance h at ``length`` along the unit direction (u_a per m of arc length, u_y) from (a, y)."""
+    return _finite_distance(a + u_a * length, min(max(y + u_y * length, y_range[0]), y_range[1]), args, hs)
+
+
+@njit(cache=True, _nrt=False)
+def _descent_length(a, y, g_a, g_y, h0, args, hs, radius, y_range):
+    """Length (m of arc length) of a step from (a, y) along -grad h where h is not convex: the first trial
+    (_DESCENT_FIRST_M) is doubled while h keeps decreasing (up to _DESCENT_MAX_M: the step stops near the first
+    minimum along the line, not beyond a rise into another region), or halved until h decreases by the Armijo
+    fraction 1e-4 of the slope. 0 when no trial decreases h (a stationary point to the differences' resolution).
+    """
+    g_norm = math.sqrt(g_a * g_a + g_y * g_y)
+    if not (g_norm > 0.0 and math.isfinite(g_norm)):
+        return 0.0
+    u_a, u_y = -g_a / g_norm / radius, -g_y / g_norm
+    length = _DESCENT_FIRST_M
+    h_l = _along(a, y, u_a, u_y, length, args, hs, y_range)
+    if h_l < h0 - 1.0e-4 * g_norm * length:
+        while 2.0 * length <= _DESCENT_MAX_M:
+            h_2 = _along(a, y, u_a, u_y, 2.0 * length, args, hs, y_range)
+            if not h_2 < h_l:
+                break
+            length, h_l = 2.0 * length, h_2
+        return length
+    while length > _DESCENT_MIN_M:
+        length *= 0.5
+        if _along(a, y, u_a, u_y, length, args, hs, y_range) < h0 - 1.0e-4 * g_norm * length:
+            return length
+    return 0.0
+
+
 @njit(cache=True, _nrt=False)
 def refine_point(
     a, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
@@ -350,7 +388,24 @@ def refine_point(
             s_a = -(h_yy * g_a - h_ay * g_y) / det
             s_y = -(h_aa * g_y - h_ay * g_a) / det
             ok = True
+        elif h_aa > 0:
+            # convex along the rolling direction but not across it (e.g. the conformal arcs of a flange root and a
+            # gauge corner of equal radius, R13 on S1002 and UIC60, where h is nearly flat across the profile and
+            # its curvature has either sign): a descent step whose length the line search finds (the fixed
+            # fraction of the gradient below crawls, ~2e-5 m per iteration, and stopped 0.3 mm short of the
+            # minimum: tests/test_search_flange.py)
+            length = _descent_length(a, y, g_a, g_y, h0, args, hs, radius, y_range)
+            g_norm = math.sqrt(g_a * g_a + g_y * g_y)
+            if length > 0.0:
+                s_a, s_y = -g_a / g_norm * length, -g_y / g_norm * length
+            else:
+                s_a, s_y = 0.0, 0.0
+            ok = False
         else:
+            # concave along the rolling direction: between the two edges of a wheel flat, which the angle grid
+            # (search_side) or the angle scan (compiled_search) seeds each; a short gradient step (1e-3 times the
+            # gradient, m) keeps this start near its seed (a descent to one edge changes which edges the compiled
+            # search's tracked stages hold, and the wheel-flat impact with them)
             s_a, s_y, ok = -g_a * 1e-3, -g_y * 1e-3, False
         norm = math.sqrt(s_a * s_a + s_y * s_y)
         if norm > 3.0e-3:

@@ -12,9 +12,13 @@ h < 0 an interpenetration (the rail's material is at z > N, the main z axis poin
 
 Every local minimum of h(alpha, y_d) on the grid below ``candidate_gap_m`` is refined by a damped Newton
 iteration on (alpha, y_d) (gradient and Hessian of h by central differences of the vectorised distance
-function, all candidates at once). Minima that end in the same interpenetration region (h < 0 along the
-segment joining them) are merged, so tread and flange contact give two patches and one patch is never counted
-twice. At each patch:
+function, all candidates at once); where h is convex along the rolling direction but not across it (e.g. along
+the conformal arcs of S1002's flange root and UIC60's gauge corner, both R13, where h is nearly flat) the step goes
+down the gradient with a line search (first trial 5e-5 m, doubled while h decreases up to 3e-3 m, else halved to an
+Armijo decrease); where it is concave along the rolling direction (between a wheel flat's edges) the step is 1e-3
+times the gradient. Minima that
+end in the same interpenetration region (h < 0 along the segment joining them) are merged, so tread and flange
+contact give two patches and one patch is never counted twice. At each patch:
 
 * normal n = -n_w (from the rail into the wheel), contact frame e_x = rolling direction (main x projected on the
   contact plane, eq 39-43), e_y = n x e_x, e_z = n;
@@ -435,6 +439,11 @@ def _refine(geo: _SideGeometry, alpha, y, opts, radius_guess):
             s_a = np.where(ok, -(hyy * g[:, 0] - hay * g[:, 1]) / det, -g[:, 0] * 1e-3)
             s_y = np.where(ok, -(haa * g[:, 1] - hay * g[:, 0]) / det, -g[:, 1] * 1e-3)
         s_a, s_y = np.nan_to_num(s_a), np.nan_to_num(s_y)
+        # convex along the rolling direction, not across it (e.g. the conformal R13 arcs of a flange root and a
+        # gauge corner): a descent step with a line search (_search_kernels.refine_point, the same rule); concave
+        # along the rolling direction (between a wheel flat's edges, each seeded by the angle grid): the short step
+        for k in np.flatnonzero(~ok & ~converged & (haa > 0)):
+            s_a[k], s_y[k] = _descent_step(geo, alpha[k], y[k], g[k], h[k, 0], opts, radius_guess)
         norm = np.hypot(s_a, s_y)
         limit = 3.0e-3
         scale = np.where(norm > limit, limit / np.maximum(norm, 1e-300), 1.0)
@@ -445,6 +454,41 @@ def _refine(geo: _SideGeometry, alpha, y, opts, radius_guess):
         if np.all(converged):
             break
     return alpha, y, converged
+
+
+def _descent_step(geo: _SideGeometry, alpha, y, grad, h0, opts, radius_guess):
+    """Step (arc length, y) along -grad h of _refine where h is not convex, its length by the line search of
+    _search_kernels._descent_length (first trial 5e-5 m doubled while h decreases, up to 3e-3 m, else halved to
+    the Armijo decrease; no step when nothing decreases h).
+    """
+    g_norm = math.hypot(grad[0], grad[1])
+    if not (g_norm > 0 and math.isfinite(g_norm)):
+        return 0.0, 0.0
+    u_a, u_y = -grad[0] / g_norm, -grad[1] / g_norm
+
+    def along(length):
+        yt = min(max(y + u_y * length, geo.y_range[0]), geo.y_range[1])
+        v = float(
+            geo.distance(np.array([alpha + u_a * length / radius_guess]), np.array([yt]), opts["newton_iterations"])[0][
+                0
+            ]
+        )
+        return v if math.isfinite(v) else 1.0
+
+    length = 5.0e-5
+    h_l = along(length)
+    if h_l < h0 - 1e-4 * g_norm * length:
+        while 2 * length <= 3.0e-3:
+            h_2 = along(2 * length)
+            if not h_2 < h_l:
+                break
+            length, h_l = 2 * length, h_2
+        return u_a * length, u_y * length
+    while length > 1.0e-9:
+        length *= 0.5
+        if along(length) < h0 - 1e-4 * g_norm * length:
+            return u_a * length, u_y * length
+    return 0.0, 0.0
 
 
 def ellipticity_error(undeformed: UndeformedDistance, a_1_per_m, b_1_per_m, angle_rad, approach_m) -> float:

@@ -12,12 +12,16 @@ right-hand side:
   vertical gap is the normal gap divided by the cosine of the contact angle to first order, and its minima
   sit where the profile slopes are equal, the 2-D condition of a minimum of h); at each such y_d the gap is scanned
   over search_side's angles (``alpha_points`` over +-``alpha_half_range_rad``), and every minimum over the angle
-  (e.g. both edges of a wheel flat) is a start. The start is the nearest
+  (e.g. both edges of a wheel flat) is a start. Where the vertical gap is negative the samples' normal distance h
+  is evaluated too: a minimum of h more than 1.5 steps from every vertical-gap minimum is a further start (on
+  conformal arcs, S1002's R13 flange root on UIC60's R13 gauge corner, h is nearly flat and deepest inside the
+  arc while the vertical gap's minimum sits at its end). The start is the nearest
   candidate of the previous evaluation within ``memory_radius_m`` when there is one (warm start), else the scan
   point. The other RK4 stages start from the previous evaluation's candidates alone (the pose moves by
   O(h v) within a step; a new minimum appears at the next step's scan at the latest).
 * Patch geometry. Point, normal and curvatures (eq 12-33: curvature tensors of both surfaces in the rolling-
-  direction basis, D = (K_w - K_r)/2, principal A nearest the rolling direction) are evaluated on the same
+  direction basis, D = (K_w - K_r)/2, principal A nearest the rolling direction; B floored at the profile
+  section's MIN_LATERAL_CURVATURE_1_PER_M, as SearchProvider) are evaluated on the same
   tabulated surfaces (the second derivative of each profile interpolated linearly between nodes 2e-5 m apart)
   instead of search_side's exact surfaces.
 
@@ -42,6 +46,7 @@ from rigid_dynamics.contact._search_kernels import (
     refine_point,
     wheel_irregularity,
 )
+from rigid_dynamics.wheelset.providers.surfaces import MIN_LATERAL_CURVATURE_1_PER_M
 
 N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
 MAX_START = 8  # starts refined per side and evaluation
@@ -189,7 +194,9 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
     g[0] = -h
     g[1], g[2], g[3] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1], 0.5 * (p[2] + qz) - centre[2]
     g[4], g[5], g[6] = n[0], n[1], n[2]
-    g[7], g[8] = max(big_a, 1e-6), max(big_b, 1e-6)
+    # B floored as the profile section floors it (SearchProvider too): on the conformal arcs of a flange root and a
+    # gauge corner of equal radius (S1002 / UIC60: 13 mm) the surface curvatures cancel and B is round-off
+    g[7], g[8] = max(big_a, 1e-6), max(big_b, MIN_LATERAL_CURVATURE_1_PER_M)
     g[9] = r
     g[10] = y_d
     tilt = -n[1] if right else n[1]
@@ -256,6 +263,7 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
     iters, radius = int(sp[s, S_NEWTON]), sp[s, S_RADIUS]
     alpha_mid = 0.5 * math.pi - spin
     n_start = 0
+    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
     if full:
         step = sp[s, S_SCAN]
         # y_d whose lowest point can lie over the rail: p_y = rot[1, 1] y_d + rot[1, 0] x + rot[1, 2] z + c_y with
@@ -267,18 +275,41 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
         n_scan = int((min(y_range[1], max(lo, hi) + step) - y0) / step) + 1
         limit = sp[s, S_GAP] / COS_STEEPEST
         cos_a, sin_a, r_irr = math.cos(alpha_mid), math.sin(alpha_mid), wheel_irregularity(alpha_mid, wheel_irr)[0]
+        # Along the same samples, where the vertical gap is negative (interpenetration), the distance h along the
+        # wheel normal: on conformal arcs (S1002's flange root and UIC60's gauge corner are both R13) h is nearly flat
+        # and can be deepest inside the arc while the vertical gap's minimum sits at one end of it. A minimum of h
+        # more than 1.5 steps from every vertical-gap minimum is a start too (kept in cand[:MAX_START] until the
+        # angle scan below fills those rows).
         g_prev2, g_prev = math.inf, math.inf
+        h_prev2, h_prev, h_start = math.inf, math.inf, 0.0
         n_y = 0  # lateral minima, kept in cand[MAX_START:]
+        n_h = 0  # minima of h, kept in cand[:MAX_START]
         for k in range(n_scan + 1):
+            hk = math.inf
             if k < n_scan:
                 yk = y0 + k * step
                 gk = _vertical_gap(cos_a, sin_a, r_irr, yk, rot, centre, wheel, rail, rail_range, rail_irr, rail_map)
+                if gk < 0.0:
+                    hk = distance(alpha_mid, yk, *args, h_start)
+                    if math.isfinite(hk):
+                        h_start = hk
             else:
                 gk = math.inf
             # the previous sample is a minimum: below its left neighbour, not above its right one
             if k >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < limit:
                 n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, y0 + (k - 1) * step, g_prev)
+            if k >= 1 and h_prev < h_prev2 and h_prev <= hk:
+                n_h = _keep_lowest(cand, 0, n_h, alpha_mid, y0 + (k - 1) * step, h_prev)
             g_prev2, g_prev = g_prev, gk
+            h_prev2, h_prev = h_prev, hk
+        n_vertical = n_y
+        for i in range(n_h):
+            new = True
+            for j in range(MAX_START, MAX_START + n_vertical):
+                if abs(cand[j, 1] - cand[i, 1]) <= 1.5 * step:
+                    new = False
+            if new:
+                n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, cand[i, 1], cand[i, 3])
         # at each lateral minimum, the minima over the angle (search_side's alpha grid: e.g. both edges of a flat)
         n_a, half = int(sp[s, S_APTS]), sp[s, S_AHALF]
         for j in range(MAX_START, MAX_START + n_y):
@@ -311,7 +342,6 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
             cand[n_start, 3] = m
             n_start += 1
     failed = 0
-    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
     for j in range(n_start):
         m = int(cand[j, 3])
         cand[j, 7] = 0.0

@@ -1,6 +1,9 @@
 """SearchProvider: the 3-D contact search (rigid_dynamics.contact.search, eq 5-11) per side and pose, with
 irregularities; patches ordered by contact angle (slot 0 the tread side), at most two per side; a side with
-no patch gets a gap candidate (approach = -smallest gap) so that wheel lift is seen.
+no patch gets a gap candidate (approach = -smallest gap) so that wheel lift is seen. The lateral relative
+curvature B is floored at MIN_LATERAL_CURVATURE_1_PER_M as the profile section's (conformal contacts, e.g. the
+R13 flange root of S1002 on the R13 gauge corner of UIC60, have B ~ 0: Hertz's force would be unbounded; the
+patch's ContactGeometry keeps the search's own value).
 
 Reuse of the last search (SearchProvider ``reuse_m``): a pose identical to the last one searched (the RK4 output
 sample and the next step's first stage) returns the last patches unchanged (exact). With ``reuse_m`` > 0 a pose
@@ -21,7 +24,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
 from rigid_dynamics.wheelset.providers.patches import SIDE_SIGNS, SIDES, PatchSet
-from rigid_dynamics.wheelset.providers.surfaces import ABSENT_GAP_M, build_surfaces
+from rigid_dynamics.wheelset.providers.surfaces import ABSENT_GAP_M, MIN_LATERAL_CURVATURE_1_PER_M, build_surfaces
 
 
 class SearchProvider:
@@ -147,7 +150,11 @@ class SearchProvider:
             point_m=np.array([g.point_m for g in geometries], float),
             normal=np.array([g.frame[:, 2] for g in geometries], float),
             curvature_long_1_per_m=np.array([g.curvature_long_1_per_m for g in geometries]),
-            curvature_lat_1_per_m=np.array([g.curvature_lat_1_per_m for g in geometries]),
+            # floored as the profile section's B (MIN_LATERAL_CURVATURE_1_PER_M): conformal contacts (equal radii of
+            # flange root and gauge corner) have B ~ 0, whose Hertz stiffness is unbounded
+            curvature_lat_1_per_m=np.maximum(
+                [g.curvature_lat_1_per_m for g in geometries], MIN_LATERAL_CURVATURE_1_PER_M
+            ),
             approach_m=np.array([g.approach_m for g in geometries]),
             rolling_radius_m=np.array([g.rolling_radius_m for g in geometries]),
             contact_angle_rad=np.array([g.contact_angle_rad for g in geometries]),
