@@ -100,8 +100,9 @@ class Recorder:
             raise Stop(
                 "derailed", f"|y| = {abs(state[1]):.4g} m exceeds {self.limit_y:.4g} m at t = {t:.6g} s", t, state
             )
-        if self.model.elastic:
-            rail = float(np.max(np.abs(self._summary(np.asarray(full_state, float)[None])[0, :2])))
+        summary = self._summary(np.asarray(full_state, float)[None]) if self.model.elastic else None
+        if summary is not None:
+            rail = float(np.max(np.abs(summary[0, :2])))
             if rail > MAX_RAIL_DEFLECTION_M:
                 raise Stop(
                     "blow-up",
@@ -136,7 +137,7 @@ class Recorder:
         self.potential.append(np.array([self.model.potential_energy_J(state) + track_potential], float))
         if self.model.elastic:
             self.track.append(np.asarray(full_state[TRACK], float)[None].copy())
-            self.track_summary.append(self._summary(full_state[None]))
+            self.track_summary.append(summary)
         self.work_contact.append(np.array([full_state[12]], float))
         self.work_exterior.append(np.array([full_state[13]], float))
         self.errors.append(np.array([error], float))
@@ -158,8 +159,9 @@ class Recorder:
         bad |= ~np.all(np.isfinite(normal), axis=1)
         bad |= np.max(normal, axis=1) > self.limit_force
         bad |= np.abs(full_states[:, 1]) > self.limit_y
-        if self.model.elastic:
-            bad |= np.max(np.abs(self._summary(full_states)[:, :2]), axis=1) > MAX_RAIL_DEFLECTION_M
+        summary = self._summary(full_states) if self.model.elastic else None
+        if summary is not None:
+            bad |= np.max(np.abs(summary[:, :2]), axis=1) > MAX_RAIL_DEFLECTION_M
         touching = normal > 0
         if self.scene.integrator.stop_at_wheel_lift:
             bad |= ~np.all(touching, axis=1)
@@ -220,7 +222,7 @@ class Recorder:
         self.potential.append(-self.model.mass * self.model.gravity * states[:, 2] + track_potential)
         if self.model.elastic:
             self.track.append(np.asarray(full_states[:, TRACK], float).copy())
-            self.track_summary.append(self._summary(full_states))
+            self.track_summary.append(summary)
         self.work_contact.append(full_states[:, 12].copy())
         self.work_exterior.append(full_states[:, 13].copy())
         self.errors.append(np.asarray(errors, float).copy())
