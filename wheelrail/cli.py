@@ -247,6 +247,7 @@ def cmd_run(args) -> int:
             result = simulate(scene, progress=progress)
         finally:
             close()
+        _check_terminated()
         timing = {  # wall_time_s is the model's own work; what came before it is reported apart
             "startup_s": before - getattr(args, "started_at", before),
             "setup_s": time.perf_counter() - before - result.wall_time_s,
@@ -263,15 +264,18 @@ def cmd_run(args) -> int:
 
 
 def _progress_bar(quiet: bool, label: str):
-    """A tqdm bar driven by fraction callbacks; off when quiet or not on a terminal."""
+    """A tqdm bar driven by fraction callbacks (off when quiet or not on a terminal), and the check for a swallowed
+    termination at every report (:func:`_check_terminated`).
+    """
     if quiet or not sys.stderr.isatty():
-        return None, lambda: None
+        return lambda fraction: _check_terminated(), lambda: None
     from tqdm import tqdm
 
     bar = tqdm(total=1000, desc=label, unit="‰", leave=False, mininterval=0.5, delay=2.0)
     state = {"last": 0}
 
     def update(fraction: float) -> None:
+        _check_terminated()
         target = int(1000 * min(max(fraction, 0.0), 1.0))
         if target > state["last"]:
             bar.update(target - state["last"])
@@ -549,8 +553,21 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_TERMINATION = {"requested": False}
+
+
 def _terminate(signum, frame):
+    _TERMINATION["requested"] = True
     raise SystemExit(EXIT_TERMINATED)  # unwinds like Ctrl-C: temporary files removed, lock released
+
+
+def _check_terminated() -> None:
+    """Raise the termination again if SIGTERM came and the run goes on: a signal handler's exception that lands in a
+    finalizer or weakref callback (numba's type cache has one) is printed as "Exception ignored" and swallowed.
+    Called at every progress report of a run and before its outputs are written.
+    """
+    if _TERMINATION["requested"]:
+        raise SystemExit(EXIT_TERMINATED)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -592,6 +609,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"wheelrail: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     finally:
+        _TERMINATION["requested"] = False
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
