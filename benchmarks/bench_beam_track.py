@@ -51,7 +51,7 @@ from comparisons.wheelflat_fe_beam import fe_track_from_scene, simulate_passage_
 from comparisons.wheelflat_vertical import from_scene  # noqa: E402
 from rigid_dynamics.files import write_text  # noqa: E402
 from rigid_dynamics.wheelset import DynamicsScene, Irregularities, TrackDynamics, simulate  # noqa: E402
-from rigid_dynamics.wheelset.track import TrackSystem, beam_layout  # noqa: E402
+from rigid_dynamics.wheelset.track import TrackSystem, beam_layout, travel_m  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results"
 JENKINS_KT, JENKINS_MT = 150.0e6, 245.0
@@ -106,7 +106,7 @@ def _eb(scene):
 
 
 def _fe(scene, result, speed, elements=6, step=1e-5, flat=True):
-    layout = beam_layout(scene.track_dynamics, scene.speed_m_per_s * scene.duration_s)
+    layout = beam_layout(scene.track_dynamics, travel_m(scene))
     wheel = from_scene(
         replace(scene, track_dynamics=replace(scene.track_dynamics, model="lumped")),
         hertz_constant(result),
@@ -205,7 +205,7 @@ def discretisation() -> list:
         step = min(STEP_S, 1.25e-5 if cutoff > 5000 else STEP_S)
         scene = replace(scene, integrator=replace(scene.integrator, fixed_step_s=step, output_step_s=STEP_S))
         result = simulate(scene)
-        layout = beam_layout(scene.track_dynamics, scene.speed_m_per_s * scene.duration_s)
+        layout = beam_layout(scene.track_dynamics, travel_m(scene))
         rows.append({
             "cutoff_Hz": cutoff, "margin_m": margin, "status": result.status, "peak_N": peak_vertical_N(result),
             "modes": layout.n_modes, "seats": layout.n_sleepers, "wall_s": result.wall_time_s,

@@ -585,12 +585,12 @@ class DynamicsScene:
             )
 
         if self.track_dynamics.model == "beam":
-            from rigid_dynamics.wheelset.track import MAX_BEAM_STATES, beam_layout
+            from rigid_dynamics.wheelset.track import MAX_BEAM_STATES, beam_layout, travel_m
 
-            layout = beam_layout(self.track_dynamics, self.speed_m_per_s * self.duration_s)
+            layout = beam_layout(self.track_dynamics, travel_m(self))
             if 2 * layout.n_positions > MAX_BEAM_STATES:
                 raise ValueError(
-                    f"track_dynamics.model = 'beam' over {self.speed_m_per_s * self.duration_s:.4g} m "
+                    f"track_dynamics.model = 'beam' over {travel_m(self):.4g} m "
                     f"(speed_m_per_s x duration_s): a beam of {layout.n_modes} modes and {layout.n_sleepers} seats "
                     f"per rail, {2 * layout.n_positions} states: expected at most {MAX_BEAM_STATES} (its cost grows "
                     "with the square of the length: shorten the run, lower cutoff_frequency_Hz, or use model 'lumped')"

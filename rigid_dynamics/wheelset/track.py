@@ -217,17 +217,13 @@ class TrackDynamics:
 def flexural_frequency_rad_per_s(track: TrackDynamics, wavenumber_1_per_m):
     """Free rail's lower (flexural) natural frequency at the wavenumber k, rad/s: Euler-Bernoulli
     k^2 sqrt(EI / rho A); Timoshenko the lower root of
-    (kGA k^2 - rho A w^2)(EI k^2 + kGA - rho I w^2) = (kGA k)^2.
+    (kGA k^2 - rho A w^2)(EI k^2 + kGA - rho I w^2) = (kGA k)^2 (the compiled :func:`_flexural_omega` per
+    wavenumber, the one the rail damping of the compiled rates uses).
     """
     k = np.asarray(wavenumber_1_per_m, float)
-    ei, ra = track.rail_bending_stiffness_N_m2, track.rail_mass_per_length_kg_per_m
-    if not track.timoshenko:
-        return k * k * np.sqrt(ei / ra)
-    ga, ri = track.rail_shear_stiffness_N, track.rail_rotary_inertia_kg_m
-    a = ra * ri
-    b = ga * k * k * ri + ra * (ei * k * k + ga)
-    c = ga * k * k * (ei * k * k + ga) - (ga * k) ** 2
-    return np.sqrt((b - np.sqrt(b * b - 4.0 * a * c)) / (2.0 * a))
+    rail = (track.rail_bending_stiffness_N_m2, track.rail_mass_per_length_kg_per_m, track.rail_shear_stiffness_N,
+            track.rail_rotary_inertia_kg_m, track.timoshenko)  # fmt: skip
+    return np.array([_flexural_omega(float(x), *rail) for x in k.ravel()]).reshape(k.shape)
 
 
 @dataclass(frozen=True)
@@ -457,7 +453,7 @@ def _beam_rates(par, y, rail_f0, rail_f1, out, p_ext):
 
 @njit(cache=True, _nrt=False)
 def _flexural_omega(k, ei, ra, ga, ri, timo):
-    """flexural_frequency_rad_per_s at one wavenumber (compiled)."""
+    """Free rail's flexural frequency at one wavenumber k, rad/s (:func:`flexural_frequency_rad_per_s`)."""
     if not timo:
         return k * k * math.sqrt(ei / ra)
     a = ra * ri
