@@ -90,9 +90,14 @@ def curve_scene(direction="right", radius=R_CURVE, cant=CANT_M, speed=SPEED, **t
     )
 
 
-def quasi_static(scene: DynamicsScene):
+def quasi_static(scene: DynamicsScene, elastic: bool = False):
     """The independent steady curving solution (module docstring): dict of y, psi, per-wheel (left, right) normal
     loads N, contact-frame creep forces Tx, Ty and the creepages, all from the textbook model written here.
+
+    ``elastic``: on the scene's elastic track at rest (``track_dynamics``: static springs only, the rails at rest in
+    a steady state): each rail lowered by w = F_z / k_v and moved by u = F_y / k_y, F the force of its wheel on it
+    (k_v the vertical pad and ballast in series, k_y the lateral stiffness; 0 for a rigid lateral track); w and u
+    join the unknowns (returned as "rail_vertical", "rail_lateral", left and right).
     """
     from scipy.optimize import fsolve
 
@@ -115,8 +120,14 @@ def quasi_static(scene: DynamicsScene):
     omega_frame = kappa * v * np.array([0.0, s, c])  # the track frame's angular velocity (about the true vertical)
     j_body = np.diag([jt, ja, jt])
 
+    track = scene.track_dynamics
+    k_v = track.static_stiffness_N_per_m if elastic else 0.0
+    k_y = track.lateral_stiffness_N_per_m if elastic and track.lateral else 0.0
+
     def wheel_state(x):
-        y, psi, spin, n_l, n_r, theta, z_c = x
+        y, psi, spin, n_l, n_r, theta, z_c = x[:7]
+        rail_w = x[7:9] if elastic else np.zeros(2)
+        rail_u = x[9:11] if elastic else np.zeros(2)
         rot = np.array(
             [
                 [math.cos(psi), -math.sin(psi) * math.cos(theta), math.sin(psi) * math.sin(theta)],
@@ -132,13 +143,15 @@ def quasi_static(scene: DynamicsScene):
         force = np.zeros(3)
         moment = np.zeros(3)
         rows = []
-        for sign, load in ((-1.0, n_l), (1.0, n_r)):
+        track_residual = []
+        for side, (sign, load) in enumerate(((-1.0, n_l), (1.0, n_r))):
             # cone R(y_d) = r0 + lambda (e0 - sign y_d) on a circular head: the normal is the cone's, turned by the
             # roll; the rail contact is where the head's slope equals it (the head's point of that normal)
             delta = delta0 + (theta if sign < 0 else -theta)
             normal = np.array([0.0, -sign * math.sin(delta), -math.cos(delta)])  # rail into wheel
             rail_y = sign * (e0 + tr.rail_head_radius_m * math.sin(delta0)) + tr.rail_head_radius_m * normal[1]
             rail_z = tr.rail_head_radius_m * (math.cos(delta0) + normal[2])
+            rail_y, rail_z = rail_y + rail_u[side], rail_z + rail_w[side]  # the rail moved by its track (z down)
             y_d = sign * e0
             for _ in range(4):  # the wheel's point above it (lever = y_d axle + R(y_d) x perpendicular, lowest line)
                 radius = r0 + lam * (e0 - sign * y_d)
@@ -165,6 +178,9 @@ def quasi_static(scene: DynamicsScene):
             ty = -gmod * ab * float(cc.c22[0]) * eta - gmod * ab**1.5 * float(cc.c23[0]) * sp
             mz = gmod * ab**1.5 * float(cc.c23[0]) * eta - gmod * ab**2 * float(cc.c33[0]) * sp
             f = tx * e_x + ty * e_y + load * normal
+            if elastic:  # the rail at rest on its springs under -f, the force of the wheel on it
+                track_residual += [(k_v * rail_w[side] + f[2]) / 1e3]
+                track_residual += [(k_y * rail_u[side] + f[1]) / 1e3 if k_y > 0 else rail_u[side] * 1e3]
             force += f
             moment += np.cross(lever, f) + mz * normal
             rows.append((load, tx, ty, xi, eta, sp))
@@ -184,8 +200,9 @@ def quasi_static(scene: DynamicsScene):
         accel = kappa * h * v * v * np.array([0.0, c, -s])
         precession = np.cross(omega_frame, rot @ j_body @ rot.T @ omega_a)
         residual = np.concatenate(
-            [(force - m * accel)[1:] / 1e3, (moment - precession) / 1e3, np.array(geometry) * 1e3]
-        )
+            [(force - m * accel)[1:] / 1e3, (moment - precession) / 1e3, np.array(geometry) * 1e3,
+             np.array(track_residual)]
+        )  # fmt: skip
         return residual, rows
 
     def equations(x):
@@ -193,13 +210,15 @@ def quasi_static(scene: DynamicsScene):
         return res  # y-force, z-force, roll, spin, yaw, the two wheels' contact
 
     w0 = 0.5 * (m * g + scene.loads.axle_load_N)
-    x0 = np.array([-0.003, -0.002, v / r0, w0, w0, 0.0, -r0])
+    x0 = np.array([-0.003, -0.002, v / r0, w0, w0, 0.0, -r0] + ([0.0] * 4 if elastic else []))
     x, info, ok, msg = fsolve(equations, x0, full_output=True, xtol=1e-13)
     assert ok == 1, msg
     res, rows = wheel_state(x)
     assert np.max(np.abs(res)) < 1e-6
     rows = np.array(rows)
     return {
+        "rail_vertical": x[7:9] if elastic else np.zeros(2),
+        "rail_lateral": x[9:11] if elastic else np.zeros(2),
         "y": x[0],
         "psi": x[1],
         "N": rows[:, 0],

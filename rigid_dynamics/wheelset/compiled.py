@@ -66,7 +66,7 @@ from rigid_dynamics.wheelset.state import (
     WORK_EXTERIOR,
     n_states,
 )
-from rigid_dynamics.wheelset.track import rail_under_wheel
+from rigid_dynamics.wheelset.track import rail_lateral_under_wheel, rail_under_wheel
 from rigid_dynamics.wheelset.track import track_rates as _track_rates
 
 MODEL_CODES = {"hertz": 0, "linear": 1, "vermeulen-johnson": 2, "fastsim": 3}
@@ -353,11 +353,30 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
     """
     xc, yc, zc = y[0], y[1], y[2]
     sps = math.sin(y[3])
-    _lookup(table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]), yc, y[4], work)
     zref = par.z_ref_m
     rail0, _ = rail_under_wheel(par, y, 0)
     rail1, _ = rail_under_wheel(par, y, 1)
-    for c in range(table.shape[1]):
+    lat0, _ = rail_lateral_under_wheel(par, y, 0)
+    lat1, _ = rail_lateral_under_wheel(par, y, 1)
+    passes = 2 if par.lateral_track > 0.5 else 1
+    for sweep in range(passes):
+        # a rail moved laterally by u: the wheelset at y - u relative to that rail (one look-up per side)
+        _lookup(
+            table, grid[0], grid[1], int(grid[2]), grid[3], grid[4], int(grid[5]),
+            yc - (0.0 if passes == 1 else (lat0 if sweep == 0 else lat1)), y[4], work,
+        )  # fmt: skip
+        _table_candidates(y, par, slots, sides, work, res, geo, bg, cg, sps, zref, rail0, rail1, sweep, passes)
+
+
+@njit(cache=True, _nrt=False)
+def _table_candidates(y, par, slots, sides, work, res, geo, bg, cg, sps, zref, rail0, rail1, sweep, passes):
+    """The candidates of _table_geometry from one look-up in ``work``: all of them (``passes`` 1) or those of side
+    ``sweep`` (the lateral track: one look-up per side).
+    """
+    xc, zc = y[0], y[2]
+    for c in range(cg.shape[0]):
+        if passes == 2 and sides[c] != sweep:
+            continue
         zs = zc - (rail0 if sides[c] == 0 else rail1)  # the rail lowered by w: the centre raised for this side
         q = work[0, c] + (zs - zref) * work[1, c]
         if slots[c] > 0 and work[11, c] + (zs - zref) * work[1, c] > 0:
@@ -384,16 +403,18 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
 
 
 @njit(cache=True, _nrt=False)
-def _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey):
+def _patch_creepages(lever, n, om, vx, vy, vz, rail_vy, rail_vz, vel, ex, ey):
     """Contact frame and creepages of one patch (eq 39-49; the formulas of contact.creepage): e_x = v_p/|v_p| with
     v_p the rolling velocity [x', 0, 0] projected on the contact plane, e_y = n x e_x; V = |v_p|; xi = v_w . e_x / V,
     eta = v_w . e_y / V, spin = omega . n / V with v_w = x_t' + omega x r_con (eq 44) less the rail's vertical
-    velocity ``rail_vz``. Fills vel (v_w), ex, ey; returns (V, xi, eta, spin); V not > 0: creepages undefined
+    velocity ``rail_vz`` and lateral velocity ``rail_vy``. Fills vel (v_w), ex, ey; returns (V, xi, eta, spin); V
+    not > 0: creepages undefined
     (xi, eta, spin 0, ex, ey not set).
     """
     vel[0] = vx + om[1] * lever[2] - om[2] * lever[1]
     vel[1] = vy + om[2] * lever[0] - om[0] * lever[2]
     vel[2] = vz + om[0] * lever[1] - om[1] * lever[0]
+    vel[1] -= rail_vy
     vel[2] -= rail_vz
     nv = n[0] * vx
     vp0, vp1, vp2 = vx - nv * n[0], 0.0 - nv * n[1], 0.0 - nv * n[2]
@@ -411,15 +432,15 @@ def _patch_creepages(lever, n, om, vx, vy, vz, rail_vz, vel, ex, ey):
 
 
 @njit(cache=True)
-def patch_creepages(lever, normal, om, v_c, rail_vz, frames, out):
+def patch_creepages(lever, normal, om, v_c, rail_vy, rail_vz, frames, out):
     """:func:`_patch_creepages` of n patches for the Python right-hand side: lever, normal (n, 3), angular velocity
-    om (3), centre velocity v_c (3), rail vertical velocity per patch (n); frames (n, 3, 3) get the columns e_x,
+    om (3), centre velocity v_c (3), rail lateral and vertical velocity per patch (n); frames (n, 3, 3) get the columns e_x,
     e_y, n, out (4, n) the rows V, xi, eta, spin (NaN where V is not > 0).
     """
     vel, ex, ey = np.empty(3), np.empty(3), np.empty(3)
     for k in range(lever.shape[0]):
         speed, xi, eta, spin = _patch_creepages(
-            lever[k], normal[k], om, v_c[0], v_c[1], v_c[2], rail_vz[k], vel, ex, ey
+            lever[k], normal[k], om, v_c[0], v_c[1], v_c[2], rail_vy[k], rail_vz[k], vel, ex, ey
         )
         if not speed > 0.0:
             xi = eta = spin = ex[0] = ex[1] = ex[2] = ey[0] = ey[1] = ey[2] = np.nan
@@ -512,10 +533,10 @@ def _assemble_curve(y, par, force, moment, fe0, fe1, fe2, me0, me1, me2, om, rzx
 
 
 @njit(cache=True, _nrt=False)
-def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
+def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, rail_fy0, rail_fy1, om, rzx, out):
     """The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track: d/dt of the full
     state into ``out`` from the summed contact force and moment about the centre (main frame, N and N m), the
-    contact power ``p_con`` (W), the vertical contact forces on the rails (left, right; elastic track) and the
+    contact power ``p_con`` (W), the vertical and lateral contact forces on the rails (left, right; elastic track) and the
     angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: every
     right-hand side (the RK4 loop, the DP54/BS32 pairs, and equations.WheelsetModel.derivative for scipy's
     methods) ends here through :func:`_forces`.
@@ -588,7 +609,7 @@ def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out):
     out[11] = (al0 * sps - al1 * cps + yr * rr + rr * sr * sth) / cth
     out[10] = al0 * cps + al1 * sps - yr * sr * cth
     if par.elastic_track > 0:
-        p_ext = _track_rates(par, y, rail_f0, rail_f1, out, p_ext)
+        p_ext = _track_rates(par, y, rail_f0, rail_f1, rail_fy0, rail_fy1, out, p_ext)
     out[WORK_CONTACT], out[WORK_EXTERIOR] = p_con, p_ext
 
 
@@ -606,8 +627,11 @@ def _rotation(y, om, rzx):
 
 @njit(cache=True)
 def track_rates(par, y, rail_force, out):
-    """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``); returns the dampers' power."""
-    return _track_rates(par, y, rail_force[0], rail_force[1], out, 0.0)
+    """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``) under ``rail_force``
+    (vertical left, right[, lateral left, right]); returns the dampers' power.
+    """
+    fy0, fy1 = (rail_force[2], rail_force[3]) if rail_force.shape[0] > 2 else (0.0, 0.0)
+    return _track_rates(par, y, rail_force[0], rail_force[1], fy0, fy1, out, 0.0)
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -837,7 +861,9 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
     p_con = 0.0
     _, rail_v0 = rail_under_wheel(par, y, 0)
     _, rail_v1 = rail_under_wheel(par, y, 1)
-    rail_f0, rail_f1 = 0.0, 0.0
+    _, rail_vy0 = rail_lateral_under_wheel(par, y, 0)
+    _, rail_vy1 = rail_lateral_under_wheel(par, y, 1)
+    rail_f0, rail_f1, rail_fy0, rail_fy1 = 0.0, 0.0, 0.0, 0.0
     ncand = cg.shape[0]
     for c in range(ncand):
         g = cg[c]
@@ -858,7 +884,8 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         if not q > 0.0:
             continue
         rail_vz = rail_v0 if sides[c] == 0 else rail_v1  # creepages relative to the rail (0: rigid track)
-        speed, xi, eta, spin = _patch_creepages(lever, n, oma, vxa, vy, vz, rail_vz, vel, ex, ey)
+        rail_vy = rail_vy0 if sides[c] == 0 else rail_vy1
+        speed, xi, eta, spin = _patch_creepages(lever, n, oma, vxa, vy, vz, rail_vy, rail_vz, vel, ex, ey)
         if not speed > 0.0:
             return 4
         if par.model_code == CALLBACK_CODE:
@@ -892,8 +919,10 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
         p_con += fc[0] * vel[0] + fc[1] * vel[1] + fc[2] * vel[2] + mc[0] * om[0] + mc[1] * om[1] + mc[2] * om[2]
         if sides[c] == 0:
             rail_f0 -= fc[2]
+            rail_fy0 -= fc[1]
         else:
             rail_f1 -= fc[2]
+            rail_fy1 -= fc[1]
         if record:
             for k in range(3):
                 side_force[sides[c], k] += fc[k]
@@ -906,7 +935,7 @@ def _forces(t, y, par, cg, sides, hz, kk, rec, record, dummy, sc, out):
             rec[c, 6] = spin
             rec[c, 12] = sa
             rec[c, 13] = sb
-    _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, om, rzx, out)
+    _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, rail_fy0, rail_fy1, om, rzx, out)
     if record:
         for sd in range(2):
             for k in range(3):
@@ -937,8 +966,10 @@ def _geometry(y, par, sides, mode, targs, sargs, ws, full):
         if par.elastic_track > 0:
             rail0, _ = rail_under_wheel(par, y, 0)
             rail1, _ = rail_under_wheel(par, y, 1)
+            lat0, _ = rail_lateral_under_wheel(par, y, 0)
+            lat1, _ = rail_lateral_under_wheel(par, y, 1)
             search_geometry_on_track(
-                y, rail0, rail1, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15]
+                y, rail0, rail1, lat0, lat1, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, ws[5][15]
             )
         else:
             search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)

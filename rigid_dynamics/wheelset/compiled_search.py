@@ -473,16 +473,21 @@ def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, c
 
 @njit(cache=True, _nrt=False)
 def search_geometry_on_track(
-    y, rail_left_m, rail_right_m, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg, centre
+    y, rail_left_m, rail_right_m, lateral_left_m, lateral_right_m, sp, tabs, irrs, mem, n_mem, full, cand, order,
+    vb, rot, cg, centre
 ):
-    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels (left, right):
-    each side is searched at the wheelset centre raised by its rail's deflection (centre: a scratch 3-vector), and
-    the levers (contact point - centre) are those of the raised pose (a rigid vertical shift of the rail).
+    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels (left, right)
+    and moved laterally by its lateral displacements (left, right; 0 without the lateral track): each side is
+    searched at the wheelset centre raised by its rail's deflection and moved by minus its lateral displacement
+    (centre: a scratch 3-vector), and the levers (contact point - centre) are those of that pose (a rigid shift of
+    the rail).
     """
     rotation(y[3], y[4], y[5], rot)
     failed = 0
     for s in range(2):
-        centre[0], centre[1], centre[2] = y[0], y[1], y[2] - (rail_left_m if s == 0 else rail_right_m)
+        centre[0] = y[0]
+        centre[1] = y[1] - (lateral_left_m if s == 0 else lateral_right_m)
+        centre[2] = y[2] - (rail_left_m if s == 0 else rail_right_m)
         failed += search_side(s, centre, rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
     return failed
 

@@ -137,10 +137,11 @@ def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     lever = np.ascontiguousarray(lever, float)
     normal = np.ascontiguousarray(normal, float)
     n = len(lever)
-    rail_vz = np.zeros(n) if rail_velocity is None else np.ascontiguousarray(np.asarray(rail_velocity, float)[:, 2])
+    rail = np.zeros((n, 3)) if rail_velocity is None else np.asarray(rail_velocity, float)
+    rail_vy, rail_vz = np.ascontiguousarray(rail[:, 1]), np.ascontiguousarray(rail[:, 2])
     frames = np.empty((n, 3, 3))
     out = np.empty((4, n))
-    patch_creepages(lever, normal, np.asarray(omega, float), np.asarray(v_c, float), rail_vz, frames, out)
+    patch_creepages(lever, normal, np.asarray(omega, float), np.asarray(v_c, float), rail_vy, rail_vz, frames, out)
     return frames, out[0], out[1], out[2], out[3]
 
 
@@ -354,23 +355,38 @@ class WheelsetModel:
                 out[side], out[2 + side] = track_model.rail_under_wheel(self.par, full, side)
         return out
 
-    def patches_on_track(self, centre, yaw, roll, spin, shift=None):
-        """The provider's patches with the rails lowered by ``shift`` (left, right), m (None: rigid track).
-
-        A rail lowered by w is the wheelset raised by w for that side's contact: the provider is asked at the centre
-        raised by w per side and the contact points are moved back down by w (levers unchanged).
+    def rail_lateral_under_wheels(self, full: np.ndarray) -> np.ndarray:
+        """The rails' lateral displacement (left, right) and velocity (left, right) under the wheels at a full state,
+        (4,), m and m/s, y along the track's lateral axis (track.rail_lateral_under_wheel; zeros without the lateral
+        track).
         """
-        if shift is None or (shift[0] == 0.0 and shift[1] == 0.0):
+        out = np.zeros(4)
+        if self.elastic and self.track.lateral:
+            for side in (0, 1):
+                out[side], out[2 + side] = track_model.rail_lateral_under_wheel(self.par, full, side)
+        return out
+
+    def patches_on_track(self, centre, yaw, roll, spin, shift=None, lateral=None):
+        """The provider's patches with the rails lowered by ``shift`` (left, right), m, and moved laterally by
+        ``lateral`` (left, right), m (None: rigid track, no lateral track).
+
+        A rail lowered by w and moved by u is the wheelset raised by w and moved by -u for that side's contact: the
+        provider is asked at the centre so moved per side and the contact points are moved back (levers unchanged).
+        """
+        offsets = np.zeros((2, 3))
+        if shift is not None:
+            offsets[:, 2] = -np.asarray(shift, float)
+        if lateral is not None:
+            offsets[:, 1] = -np.asarray(lateral, float)
+        if not np.any(offsets):
             return self.provider.patches(centre, yaw, roll, spin)
         from dataclasses import replace
 
         from rigid_dynamics.wheelset.providers import PatchSet
 
         sets = []
-        for w in (shift[0],) if shift[0] == shift[1] else (shift[0], shift[1]):
-            raised = np.array(centre, float)
-            raised[2] -= w
-            sets.append(self.provider.patches(raised, yaw, roll, spin))
+        for offset in (offsets[0],) if np.array_equal(offsets[0], offsets[1]) else (offsets[0], offsets[1]):
+            sets.append(self.provider.patches(np.array(centre, float) + offset, yaw, roll, spin))
         pick = [np.arange(len(sets[0]))] if len(sets) == 1 else [np.flatnonzero(sets[i].side == i) for i in (0, 1)]
         fields = {}
         for name in (
@@ -382,16 +398,14 @@ class WheelsetModel:
                 fields[name] = None
                 continue
             fields[name] = np.concatenate([np.array(v)[k] for v, k in zip(parts, pick, strict=True)])
-        moved = np.asarray(shift, float)[fields["side"]]
-        fields["point_m"][:, 2] += moved
+        fields["point_m"] = fields["point_m"] - offsets[fields["side"]]
         geometries = None
         if sets[0].geometries is not None:
             geometries = []
             for p, k in zip(sets, pick, strict=True):
                 for i in k:
                     g = p.geometries[i]
-                    point = np.array(g.point_m, float)
-                    point[2] += shift[int(p.side[i])]
+                    point = np.array(g.point_m, float) - offsets[int(p.side[i])]
                     geometries.append(replace(g, point_m=point))
         return PatchSet(geometries=geometries, **fields)
 
@@ -421,7 +435,8 @@ class WheelsetModel:
         rows without a candidate NaN) and their sampled geometries (if any) to the callback.
         """
         track = self.rail_under_wheels(full)[0:2] if self.elastic else None
-        patches = self.patches_on_track(full[0:3], full[3], full[4], full[5], track)
+        lateral = self.rail_lateral_under_wheels(full)[0:2] if self.elastic and self.track.lateral else None
+        patches = self.patches_on_track(full[0:3], full[3], full[4], full[5], track, lateral)
         cg = self._cg
         cg[:, :] = np.nan
         geometries = {}
@@ -486,6 +501,7 @@ class WheelsetModel:
         rail_velocity = np.zeros((len(present), 3))
         if self.elastic:
             rail_velocity[:, 2] = self.rail_under_wheels(full)[2:4][sides[present]]
+            rail_velocity[:, 1] = self.rail_lateral_under_wheels(full)[2:4][sides[present]]
         velocity = velocity - rail_velocity
         frames, _, _, _, _ = _creepages(lever, normal, omega, v_c, rail_velocity)
         active = np.nan_to_num(rec[:, 0], nan=0.0) > 0
@@ -545,7 +561,8 @@ class WheelsetModel:
         (track.rail_under_wheel, linear in the modes: b(xi)). So column j of the track is
         A e_j + sum_k G_k dq_k/dy_j, q = (w left, w right, v left, v right) under the wheels, with G_k the
         difference quotient along a track direction d_k that moves q_k alone (by one), less A d_k; 8 more
-        evaluations instead of two per track state. Other tracks: all columns by differences.
+        evaluations instead of two per track state; the lateral track's 4 columns by differences. Other tracks: all
+        columns by differences.
         """
         from rigid_dynamics.wheelset.stability import jacobian
 
@@ -553,9 +570,13 @@ class WheelsetModel:
         n = len(y)
         if not self.elastic or self.track_system.layout is None:
             return jacobian(fun, y, rel_step)
-        jac = jacobian(fun, y, rel_step, columns=range(N_RIGID))
         system = self.track_system
         npos = system.n_positions
+        lateral = []  # the lateral track's columns: by differences (4 of them)
+        if system.lateral:
+            lateral = [int(N_RIGID + offset + r) for offset in (0, npos) for r in system.lateral_rows()]
+        jac = jacobian(fun, y, rel_step, columns=list(range(N_RIGID)) + lateral)
+        vertical = np.setdiff1d(np.arange(2 * npos), np.array(lateral, int) - N_RIGID)
         xi = float(y[0]) - self.frame_x0 + system.start_position_m()
         b = system.load_vector(xi)  # the rail's deflection under the wheel is b . q of its rows
         linear = np.zeros((2 * npos, 2 * npos))
@@ -571,7 +592,7 @@ class WheelsetModel:
                 coupling = np.zeros(2 * npos)
                 coupling[offset + r] = b
                 probes.append((d, coupling))
-        jac[N_RIGID:, N_RIGID:] = linear
+        jac[N_RIGID:, N_RIGID + vertical] = linear[:, vertical]
         for d, coupling in probes:
             full_d = np.zeros(n)
             full_d[N_RIGID:] = d

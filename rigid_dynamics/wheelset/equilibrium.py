@@ -74,8 +74,9 @@ def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deep
     """:func:`consistent_start` with the elastic track at rest under the wheels (the rigid track: that alone).
 
     The track starts deflected by the static wheel load (``model.track_rest``), then wheelset equilibrium and
-    track deflection under the contact forces found are alternated until the rail forces change by < 1e-6 of the
-    static wheel load (at most 8 rounds; each round solves the wheelset's equilibrium on a fixed track).
+    track deflection under the contact forces found (vertical, and lateral with the lateral track) are alternated
+    until the rail forces change by < 1e-6 of the static wheel load (at most 8 rounds; each round solves the
+    wheelset's equilibrium on a fixed track).
     """
     if not model.elastic:
         return consistent_start(model, state, derivative, deepest, rolling)
@@ -83,7 +84,7 @@ def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deep
     model.track_rest = model.static_track([load, load])
     derivative_ = model.derivative if derivative is None else derivative
     out = (state, False, "no rounds")
-    before = np.array([load, load], float)
+    before = np.array([load, load] + ([0.0, 0.0] if model.track.lateral else []), float)
     for _ in range(8):
         out = consistent_start(model, state, derivative, deepest, rolling)
         if not out[1]:
@@ -98,8 +99,9 @@ def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deep
 
 
 def _rail_forces(model: WheelsetModel, state: np.ndarray, derivative) -> np.ndarray:
-    """Vertical contact force on each rail (left, right) at a 12-state on ``track_rest``, N, from the track
-    acceleration the right-hand side gives (at rest b F = M q'' + K q: track.TrackSystem.rail_forces_at_rest).
+    """Vertical contact force on each rail (left, right; then the lateral ones with the lateral track) at a 12-state
+    on ``track_rest``, N, from the track acceleration the right-hand side gives (at rest b F = M q'' + K q:
+    track.TrackSystem.rail_forces_at_rest).
     """
     d = derivative(0.0, model.full_state(state))
     return model.track_system.rail_forces_at_rest(model.track_rest, d[TRACK])

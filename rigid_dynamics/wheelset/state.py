@@ -9,10 +9,12 @@ The full state is, in order,
 * with an elastic track its states (:data:`TRACK`: everything after the work integrals), positions then their
   rates, z down from the unloaded track: for ``track_dynamics.model = "lumped"`` 8 states, rail and sleeper
   deflection per side (left, right) and their rates (:data:`TRACK_STATE_NAMES`); for "beam" the modes and rail
-  seats of both rails (track.BeamLayout), as many as the run's beam needs.
+  seats of both rails (track.BeamLayout), as many as the run's beam needs; with ``lateral_model = "lumped"``
+  the rails' lateral displacements (left, right) end the positions and their rates end the rates
+  (:data:`LATERAL_STATE_NAMES`).
 
 Module-level integers are compile-time constants in numba, so the compiled right-hand side indexes with these
-names at no cost (``y[RAIL_VELOCITY + side]``). A new state is added here (its slice and names), in the
+names at no cost (``y[RAIL + side]``). A new state is added here (its slice and names), in the
 right-hand side and in the module of its physics.
 """
 
@@ -44,7 +46,16 @@ TRACK_STATE_NAMES = (
     "sleeper_left_velocity_m_per_s",
     "sleeper_right_velocity_m_per_s",
 )
-"""Names of the elastic track's states (z down, from the unloaded track), in order."""
+"""Names of the lumped track's states (z down, from the unloaded track), in order."""
+
+LATERAL_STATE_NAMES = (
+    "rail_left_lateral_m",
+    "rail_right_lateral_m",
+    "rail_left_lateral_velocity_m_per_s",
+    "rail_right_lateral_velocity_m_per_s",
+)
+"""Names of the lateral track's states (y along the track's lateral axis): the last two of the track's positions
+and the last two of its rates (track.rail_lateral_under_wheel)."""
 
 # mechanical states: positions, then rates
 X, Y, Z, YAW, ROLL, SPIN = range(6)
@@ -62,10 +73,11 @@ N_RIGID = 14
 
 TRACK = slice(N_RIGID, None)
 """Where an elastic track's states sit in the full state (after the 12 mechanical states and 2 work integrals)."""
-# the lumped track: first index of each pair (left, right)
-RAIL, SLEEPER, RAIL_VELOCITY, SLEEPER_VELOCITY = 14, 16, 18, 20
+# the lumped track: first index of each pair (left, right); the rates follow all the track's positions (with
+# the lateral track at 20, 22, else at 18, 20: track.track_rates indexes them from the track's size)
+RAIL, SLEEPER = 14, 16
 N_LUMPED = 22
-"""Length of the full state with the lumped track."""
+"""Length of the full state with the lumped track (without the lateral track)."""
 
 
 def n_states(track_positions: int) -> int:
@@ -94,4 +106,6 @@ def state_names(n_state: int) -> tuple[str, ...]:
     names = STATE_NAMES + ("work_contact_J", "work_exterior_J")
     if n_state == N_LUMPED:
         return names + TRACK_STATE_NAMES
+    if n_state == N_LUMPED + 4:
+        return names + TRACK_STATE_NAMES[:4] + LATERAL_STATE_NAMES[:2] + TRACK_STATE_NAMES[4:] + LATERAL_STATE_NAMES[2:]
     return names + tuple(f"track_{i}" for i in range(n_state - N_RIGID))

@@ -37,10 +37,13 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.wheelset.state import N_RIGID, RAIL, RAIL_VELOCITY, SLEEPER, SLEEPER_VELOCITY, TRACK_STATE_NAMES
+from rigid_dynamics.wheelset.state import LATERAL_STATE_NAMES, N_RIGID, RAIL, SLEEPER, TRACK_STATE_NAMES
 
 TRACK_MODELS = ("rigid", "lumped", "beam")
 """Vertical track models (:class:`TrackDynamics`)."""
+
+LATERAL_MODELS = ("rigid", "lumped")
+"""Lateral track models of an elastic track (:class:`TrackDynamics` ``lateral_model``)."""
 
 MAX_BEAM_STATES = 8000
 """The largest beam a scene may ask for (states of both rails, positions and rates): about 80 m of track with
@@ -103,6 +106,48 @@ equivalent track stiffness 150 MN/m of Jenkins et al. (1974) for concrete-sleepe
 """
 
 
+def lumped_lateral_equivalent(
+    rail_mass_per_length_kg_per_m: float,
+    rail_lateral_bending_stiffness_N_m2: float,
+    sleeper_spacing_m: float,
+    fastening_lateral_stiffness_N_per_m: float,
+    fastening_lateral_damping_N_s_per_m: float,
+) -> dict:
+    """Per-wheel lumped lateral rail from per-rail-seat data (the reduction behind TrackDynamics' lateral defaults).
+
+    The reduction of :func:`lumped_track_equivalent` in the lateral plane: the rail, bending about its vertical axis
+    (E I_z), on the fastenings' lateral springs smeared over the sleeper spacing (k_f = k_y / a) is a Winkler beam
+    with beta = (k_f / (4 E I_z))^(1/4) and the static point stiffness 2 k_f / beta; n = 2 / (beta a) rail seats
+    carry the wheel, the lumped rail has the rail mass of n spacings. The sleepers are held laterally (the
+    ballast's lateral stiffness per sleeper is not in the model).
+    """
+    k_f = fastening_lateral_stiffness_N_per_m / sleeper_spacing_m
+    beta = (k_f / (4.0 * rail_lateral_bending_stiffness_N_m2)) ** 0.25
+    n = 2.0 / (beta * sleeper_spacing_m)
+    return {
+        "lateral_rail_mass_kg": rail_mass_per_length_kg_per_m * n * sleeper_spacing_m,
+        "lateral_stiffness_N_per_m": n * fastening_lateral_stiffness_N_per_m,
+        "lateral_damping_N_s_per_m": n * fastening_lateral_damping_N_s_per_m,
+    }
+
+
+UIC60_LATERAL_SEAT = {
+    "rail_mass_per_length_kg_per_m": 60.21,
+    "rail_lateral_bending_stiffness_N_m2": 210.0e9 * 5.24e-6,
+    "sleeper_spacing_m": 0.6,
+    "fastening_lateral_stiffness_N_per_m": 1.5e7,
+    "fastening_lateral_damping_N_s_per_m": 5.0e4,
+}
+"""Per-rail-seat lateral data of a 60 kg/m rail from which TrackDynamics' lateral defaults are reduced
+(:func:`lumped_lateral_equivalent`): the rail's second moment of area about its vertical axis I_z = 5.24e-6 m^4,
+the fastening's lateral stiffness 1.5e7 N/m and lateral damping 5.0e4 N s/m per rail seat, as tabulated for a
+60 kg/m rail in vehicle-track coupled models (Advances in Civil Engineering 2021, article 8847633, Table 2;
+the same fastening values in Shock and Vibration 2019, article 2015465, Table 2), with E = 210 GPa, the rail mass
+and sleeper spacing of :data:`UIC60_RAIL_SEAT`. Result: 32.4 MN/m and 78 kg per wheel, a free lateral rail
+frequency of 103 Hz, critically damped (damping ratio 1.07).
+"""
+
+
 UIC60_BEAM = {
     "rail_shear_stiffness_N": 0.4 * 80.77e9 * 76.70e-4,
     "rail_rotary_inertia_kg_m": 7850.0 * 3038.3e-8,
@@ -124,7 +169,14 @@ class TrackDynamics:
     component of the wheel's contact forces acts on it. "beam": each rail a Timoshenko (``rail_theory``, or
     Euler-Bernoulli) beam on discrete rail seats (pad, half sleeper, ballast) every ``sleeper_spacing_m``, fixed
     in space; the rail's deflection under the wheel lowers its surface and the vertical contact force acts on the
-    beam where the wheel is. Lateral track: rigid in both.
+    beam where the wheel is.
+
+    ``lateral_model`` = "lumped" (an elastic ``model`` only): under each wheel the rail's lateral mass on the
+    fastenings' lateral spring and damper (the sleeper held laterally), moving with the wheelset, added to either
+    vertical model; the rail's lateral displacement (y, the track's lateral axis) shifts that rail's profile in the
+    contact geometry, and the lateral component of the wheel's contact forces acts on it. "rigid" (the default):
+    the rails do not move laterally. Defaults: :data:`UIC60_LATERAL_SEAT` reduced by
+    :func:`lumped_lateral_equivalent` (32.4 MN/m, 78 kg, 1.08e5 N s/m per wheel). A lateral beam is not built.
 
     The lumped defaults are the per-wheel equivalent of a UIC60 track on concrete sleepers
     (:data:`UIC60_RAIL_SEAT` reduced by :func:`lumped_track_equivalent`): static stiffness 150 MN/m per wheel,
@@ -149,6 +201,9 @@ class TrackDynamics:
             ch. 3); without it the pinned-pinned mode, which the pads do not touch, would ring undamped.
         cutoff_frequency_Hz: the beam's modes up to this frequency are kept (the flexural branch; beam).
         end_margin_m: the beam reaches this far beyond the run at each end (beam).
+        lateral_model: "rigid" or "lumped" (the lateral track of an elastic track).
+        lateral_rail_mass_kg, lateral_stiffness_N_per_m, lateral_damping_N_s_per_m: the lumped lateral rail per
+            wheel, its spring and damper to the sleeper.
     """
 
     model: str = "rigid"
@@ -172,6 +227,10 @@ class TrackDynamics:
     rail_loss_factor: float = 0.02
     cutoff_frequency_Hz: float = 5000.0
     end_margin_m: float = 6.0
+    lateral_model: str = "rigid"
+    lateral_rail_mass_kg: float = 78.0
+    lateral_stiffness_N_per_m: float = 3.24e7
+    lateral_damping_N_s_per_m: float = 1.08e5
 
     def __post_init__(self) -> None:
         from rigid_dynamics.wheelset.parameters import _check_finite  # parameters imports this module
@@ -182,22 +241,35 @@ class TrackDynamics:
                 "rail_mass_kg", "pad_stiffness_N_per_m", "sleeper_mass_kg", "ballast_stiffness_N_per_m",
                 "rail_mass_per_length_kg_per_m", "rail_bending_stiffness_N_m2", "rail_shear_stiffness_N",
                 "rail_rotary_inertia_kg_m", "sleeper_spacing_m", "seat_pad_stiffness_N_per_m", "seat_sleeper_mass_kg",
-                "seat_ballast_stiffness_N_per_m", "cutoff_frequency_Hz", "end_margin_m",
+                "seat_ballast_stiffness_N_per_m", "cutoff_frequency_Hz", "end_margin_m", "lateral_rail_mass_kg",
+                "lateral_stiffness_N_per_m",
             ],
             nonnegative=[
                 "pad_damping_N_s_per_m", "ballast_damping_N_s_per_m", "seat_pad_damping_N_s_per_m",
-                "seat_ballast_damping_N_s_per_m", "rail_loss_factor",
+                "seat_ballast_damping_N_s_per_m", "rail_loss_factor", "lateral_damping_N_s_per_m",
             ],
         )  # fmt: skip
         if self.model not in TRACK_MODELS:
             raise ValueError(f"model = {self.model!r}: expected one of {', '.join(TRACK_MODELS)}")
         if self.rail_theory not in RAIL_THEORIES:
             raise ValueError(f"rail_theory = {self.rail_theory!r}: expected one of {', '.join(RAIL_THEORIES)}")
+        if self.lateral_model not in LATERAL_MODELS:
+            raise ValueError(f"lateral_model = {self.lateral_model!r}: expected one of {', '.join(LATERAL_MODELS)}")
+        if self.lateral_model != "rigid" and self.model == "rigid":
+            raise ValueError(
+                f"lateral_model = {self.lateral_model!r}: expected 'rigid' with model = 'rigid' (the lateral track "
+                "joins an elastic vertical track: model = 'lumped' or 'beam')"
+            )
 
     @property
     def elastic(self) -> bool:
         """True for a track with states (not rigid)."""
         return self.model != "rigid"
+
+    @property
+    def lateral(self) -> bool:
+        """True for a track with lateral states (lateral_model "lumped" on an elastic track)."""
+        return self.elastic and self.lateral_model == "lumped"
 
     @property
     def static_stiffness_N_per_m(self) -> float:
@@ -293,6 +365,10 @@ PARAMETER_FIELDS = (
     ("seat_ballast_stiffness_N_per_m", "beam: ballast per seat"),
     ("seat_ballast_damping_N_s_per_m", "beam: ballast damping per seat"),
     ("rail_loss_factor", "beam: the rail's loss factor"),
+    ("lateral_track", "1: lumped lateral rail per wheel (the last 2 positions and the last 2 rates), 0: none"),
+    ("lateral_rail_mass_kg", "lateral rail mass per wheel"),
+    ("lateral_stiffness_N_per_m", "lateral fastening stiffness per wheel"),
+    ("lateral_damping_N_s_per_m", "lateral fastening damping per wheel"),
 )
 """The track's fields of the compiled parameter record (compiled.PARAMETER_FIELDS): (field, meaning), SI units."""
 
@@ -313,12 +389,15 @@ def travel_m(scene) -> float:
 
 
 def n_positions(track: TrackDynamics, travel: float) -> int:
-    """Number of the track's position states (as many rates follow): 0 rigid, 4 lumped, the beam's layout."""
+    """Number of the track's position states (as many rates follow): 0 rigid, 4 lumped, the beam's layout; 2 more
+    with the lateral track (its rails' lateral displacements, left and right, last).
+    """
     if track.model == "rigid":
         return 0
+    lateral = 2 if track.lateral else 0
     if track.model == "lumped":
-        return 4
-    return beam_layout(track, travel).n_positions
+        return 4 + lateral
+    return beam_layout(track, travel).n_positions + lateral
 
 
 def pack_parameters(par, track: TrackDynamics, travel: float) -> None:
@@ -337,6 +416,10 @@ def pack_parameters(par, track: TrackDynamics, travel: float) -> None:
         par["beam_modes"], par["beam_sleepers"] = float(layout.n_modes), float(layout.n_sleepers)
         par["beam_timoshenko"] = 1.0 if layout.timoshenko else 0.0
         par["beam_length_m"], par["beam_margin_m"] = layout.length_m, layout.margin_m
+    par["lateral_track"] = 1.0 if track.lateral else 0.0
+    if track.lateral:
+        for name in ("lateral_rail_mass_kg", "lateral_stiffness_N_per_m", "lateral_damping_N_s_per_m"):
+            par[name] = getattr(track, name)
 
 
 @njit(cache=True, _nrt=False)
@@ -354,7 +437,7 @@ def rail_under_wheel(par, y, side):
     if par.elastic_track < 0.5:
         return 0.0, 0.0
     if par.elastic_track < 1.5:
-        return y[RAIL + side], y[RAIL_VELOCITY + side]
+        return y[RAIL + side], y[N_RIGID + int(par.track_positions) + side]
     n_modes = int(par.beam_modes)
     per_rail = n_modes * (2 if par.beam_timoshenko > 0 else 1) + int(par.beam_sleepers)
     base = N_RIGID + side * per_rail
@@ -370,19 +453,41 @@ def rail_under_wheel(par, y, side):
 
 
 @njit(cache=True, _nrt=False)
-def track_rates(par, y, rail_f0, rail_f1, out, p_ext):
-    """The elastic track's equations of motion under the vertical contact forces on the rails (left, right), N (z
-    down, acting on the rail under the wheel): its rates into ``out`` (the full state's track part). Returns
-    ``p_ext`` less the power of the pad and ballast dampers.
+def rail_lateral_under_wheel(par, y, side):
+    """(lateral displacement m, lateral velocity m/s) of the rail of ``side`` (0 left, 1 right) under the wheel, y
+    along the track's lateral axis, at the full state ``y``: the lumped lateral rail (the last two positions and the
+    last two rates of the track). (0, 0) without the lateral track.
     """
-    if par.elastic_track < 1.5:
+    if par.lateral_track < 0.5:
+        return 0.0, 0.0
+    n_pos = int(par.track_positions)
+    return y[N_RIGID + n_pos - 2 + side], y[N_RIGID + 2 * n_pos - 2 + side]
+
+
+@njit(cache=True, _nrt=False)
+def track_rates(par, y, rail_f0, rail_f1, rail_fy0, rail_fy1, out, p_ext):
+    """The elastic track's equations of motion under the vertical contact forces on the rails (left, right), N (z
+    down, acting on the rail under the wheel), and the lateral ones (rail_fy0, rail_fy1, N, along y; the lateral
+    track): its rates into ``out`` (the full state's track part). Returns ``p_ext`` less the power of the pad,
+    ballast and lateral fastening dampers.
+    """
+    n_pos = int(par.track_positions)
+    if par.lateral_track > 0.5:
+        m_y, k_y, c_y = par.lateral_rail_mass_kg, par.lateral_stiffness_N_per_m, par.lateral_damping_N_s_per_m
         for sd in range(2):
-            zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[RAIL_VELOCITY + sd], y[SLEEPER_VELOCITY + sd]
+            u, v = y[N_RIGID + n_pos - 2 + sd], y[N_RIGID + 2 * n_pos - 2 + sd]
+            out[N_RIGID + n_pos - 2 + sd] = v
+            out[N_RIGID + 2 * n_pos - 2 + sd] = ((rail_fy0 if sd == 0 else rail_fy1) - k_y * u - c_y * v) / m_y
+            p_ext -= c_y * v * v
+    if par.elastic_track < 1.5:
+        rv = N_RIGID + n_pos  # the rates: rail left, right, sleeper left, right
+        for sd in range(2):
+            zr, zs_, vr, vs = y[RAIL + sd], y[SLEEPER + sd], y[rv + sd], y[rv + 2 + sd]
             pad = par.pad_stiffness_N_per_m * (zr - zs_) + par.pad_damping_N_s_per_m * (vr - vs)
             ballast = par.ballast_stiffness_N_per_m * zs_ + par.ballast_damping_N_s_per_m * vs
             out[RAIL + sd], out[SLEEPER + sd] = vr, vs
-            out[RAIL_VELOCITY + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
-            out[SLEEPER_VELOCITY + sd] = (pad - ballast) / par.sleeper_mass_kg
+            out[rv + sd] = ((rail_f0 if sd == 0 else rail_f1) - pad) / par.rail_mass_kg
+            out[rv + 2 + sd] = (pad - ballast) / par.sleeper_mass_kg
             p_ext -= par.pad_damping_N_s_per_m * (vr - vs) ** 2 + par.ballast_damping_N_s_per_m * vs * vs
         return p_ext
     return _beam_rates(par, y, rail_f0, rail_f1, out, p_ext)
@@ -486,19 +591,25 @@ class TrackSystem:
         self.track = track
         self.model = track.model
         self.layout = None
+        self.lateral = track.lateral
         if track.model == "lumped":
             kp, kb, cp, cb = (track.pad_stiffness_N_per_m, track.ballast_stiffness_N_per_m,
                               track.pad_damping_N_s_per_m, track.ballast_damping_N_s_per_m)  # fmt: skip
             self.mass = np.array([track.rail_mass_kg, track.sleeper_mass_kg])
             self.stiffness = np.array([[kp, -kp], [-kp, kp + kb]])
             self.damping = np.array([[cp, -cp], [-cp, cp + cb]])
-            self.n_positions = 4
-            self.summary_names = TRACK_STATE_NAMES
+            self.n_vertical = 4
+            self.n_positions = 4 + (2 if self.lateral else 0)
+            lat = LATERAL_STATE_NAMES
+            self.summary_names = (
+                TRACK_STATE_NAMES[:4] + lat[:2] + TRACK_STATE_NAMES[4:] + lat[2:] if self.lateral else TRACK_STATE_NAMES
+            )
             return
         layout = self.layout = beam_layout(track, travel)
         nm, ns, length = layout.n_modes, layout.n_sleepers, layout.length_m
-        self.n_positions = layout.n_positions
-        self.summary_names = BEAM_SUMMARY_NAMES
+        self.n_vertical = layout.n_positions
+        self.n_positions = layout.n_positions + (2 if self.lateral else 0)
+        self.summary_names = BEAM_SUMMARY_NAMES + (LATERAL_STATE_NAMES if self.lateral else ())
         k = np.arange(1, nm + 1) * math.pi / length
         self.wavenumber_1_per_m = k
         self.seat_m = (np.arange(ns) + 1.0) * track.sleeper_spacing_m
@@ -550,33 +661,47 @@ class TrackSystem:
         """Where the wheelset is along the beam at t = 0 (xi = margin; 0 for the lumped track)."""
         return 0.0 if self.layout is None else self.layout.margin_m
 
+    def lateral_rows(self) -> np.ndarray:
+        """The lateral rails' positions (left, right) within the track's positions (their rates: + n_positions)."""
+        return self.n_vertical + np.arange(2)
+
     def rest_state(self, rail_force_N, xi_m: float | None = None) -> np.ndarray:
         """The track's states (positions, then zero rates) at rest under the vertical rail forces (left, right), N,
-        applied at xi (default: the start): K q = b F per rail.
+        applied at xi (default: the start): K q = b F per rail; with the lateral track and 4 forces (vertical left,
+        right, lateral left, right) the lateral rails at F_y / k_y.
         """
         xi = self.start_position_m() if xi_m is None else xi_m
         out = np.zeros(2 * self.n_positions)
         b = self.load_vector(xi)
         for side in (0, 1):
             out[self.rows(side)] = np.linalg.solve(self.stiffness, b * float(rail_force_N[side]))
+        if self.lateral and len(rail_force_N) > 2:
+            out[self.lateral_rows()] = np.asarray(rail_force_N[2:4], float) / self.track.lateral_stiffness_N_per_m
         return out
 
     def rail_forces_at_rest(self, rest, rates, xi_m: float | None = None) -> np.ndarray:
         """The vertical contact force on each rail (left, right), N, of a track at rest in ``rest`` whose rates the
-        right-hand side gives as ``rates`` (track part of the full state): b F = M q'' + K q (least squares in F).
+        right-hand side gives as ``rates`` (track part of the full state): b F = M q'' + K q (least squares in F);
+        with the lateral track then the lateral ones (left, right), m_y u'' + k_y u.
         """
         xi = self.start_position_m() if xi_m is None else xi_m
         b = self.load_vector(xi)
         rest, rates = np.asarray(rest, float), np.asarray(rates, float)
-        force = np.zeros(2)
+        force = np.zeros(4 if self.lateral else 2)
         for side in (0, 1):
             r = self.rows(side)
             lhs = self.mass * rates[self.n_positions + r] + self.stiffness @ rest[r]
             force[side] = float(b @ lhs / (b @ b))
+        if self.lateral:
+            r = self.lateral_rows()
+            tr = self.track
+            force[2:4] = tr.lateral_rail_mass_kg * rates[self.n_positions + r] + tr.lateral_stiffness_N_per_m * rest[r]
         return force
 
     def rates(self, track_state, rail_force_N, xi_m: float) -> np.ndarray:
-        """The track's rates M^-1 (b F - C v - K q) (the matrices' version of :func:`track_rates`)."""
+        """The track's rates M^-1 (b F - C v - K q) (the matrices' version of :func:`track_rates`); ``rail_force_N``
+        (left, right) vertical, then (left, right) lateral with the lateral track (absent: 0).
+        """
         y = np.asarray(track_state, float)
         out = np.zeros_like(y)
         b = self.load_vector(xi_m)
@@ -587,6 +712,14 @@ class TrackSystem:
             out[self.n_positions + r] = (
                 b * float(rail_force_N[side]) - self.damping @ v - self.stiffness @ q
             ) / self.mass
+        if self.lateral:
+            r, tr = self.lateral_rows(), self.track
+            u, v = y[r], y[self.n_positions + r]
+            force = np.asarray(rail_force_N, float)[2:4] if len(rail_force_N) > 2 else np.zeros(2)
+            out[r] = v
+            out[self.n_positions + r] = (
+                force - tr.lateral_damping_N_s_per_m * v - tr.lateral_stiffness_N_per_m * u
+            ) / tr.lateral_rail_mass_kg
         return out
 
     def energy_J(self, states) -> tuple:
@@ -601,6 +734,11 @@ class TrackSystem:
             q, v = t[..., r], t[..., self.n_positions + r]
             kinetic = kinetic + 0.5 * np.sum(self.mass * v * v, axis=-1)
             potential = potential + 0.5 * np.sum(q * (q @ self.stiffness), axis=-1)
+        if self.lateral:
+            r, tr = self.lateral_rows(), self.track
+            u, v = t[..., r], t[..., self.n_positions + r]
+            kinetic = kinetic + 0.5 * tr.lateral_rail_mass_kg * np.sum(v * v, axis=-1)
+            potential = potential + 0.5 * tr.lateral_stiffness_N_per_m * np.sum(u * u, axis=-1)
         return kinetic, potential
 
     def under_wheel(self, states, xi_m) -> np.ndarray:
@@ -622,11 +760,17 @@ class TrackSystem:
         return out
 
     def summary(self, states, xi_m) -> np.ndarray:
-        """What a run records of the track (``summary_names``): the lumped track's 8 states, or the beam's rail
-        deflection and velocity under each wheel (BEAM_SUMMARY_NAMES).
+        """What a run records of the track (``summary_names``): the lumped track's states, or the beam's rail
+        deflection and velocity under each wheel (BEAM_SUMMARY_NAMES); with the lateral track its states too.
         """
         t = np.atleast_2d(np.asarray(states, float))
-        return t.copy() if self.layout is None else self.under_wheel(t, xi_m)
+        if self.layout is None:
+            return t.copy()
+        out = self.under_wheel(t, xi_m)
+        if self.lateral:
+            r = self.lateral_rows()
+            out = np.concatenate([out, t[:, r], t[:, self.n_positions + r]], axis=1)
+        return out
 
     def deflection_m(self, track_state, x_m) -> np.ndarray:
         """The beam's deflection of each rail (2, len(x)) at positions x along it, m (lumped: the rail mass)."""
