@@ -122,7 +122,7 @@ def quasi_static(scene: DynamicsScene, elastic: bool = False):
 
     track = scene.track_dynamics
     k_v = track.static_stiffness_N_per_m if elastic else 0.0
-    k_y = track.lateral_stiffness_N_per_m if elastic and track.lateral else 0.0
+    k_y = track.lateral_rail_stiffness_N_per_m if elastic and track.lateral else 0.0
 
     def wheel_state(x):
         y, psi, spin, n_l, n_r, theta, z_c = x[:7]

@@ -36,13 +36,13 @@ def test_lateral_defaults_are_the_reduced_rail_seat_data():
     eq = lumped_lateral_equivalent(**UIC60_LATERAL_SEAT)
     track = TrackDynamics()
     assert track.lateral_rail_mass_kg == pytest.approx(eq["lateral_rail_mass_kg"], rel=0.005)
-    assert track.lateral_stiffness_N_per_m == pytest.approx(eq["lateral_stiffness_N_per_m"], rel=0.005)
-    assert track.lateral_damping_N_s_per_m == pytest.approx(eq["lateral_damping_N_s_per_m"], rel=0.005)
+    assert track.lateral_rail_stiffness_N_per_m == pytest.approx(eq["lateral_rail_stiffness_N_per_m"], rel=0.005)
+    assert track.lateral_rail_damping_N_s_per_m == pytest.approx(eq["lateral_rail_damping_N_s_per_m"], rel=0.005)
     # Timoshenko's Winkler beam: w0 = P beta / (2 k_f)
     d = UIC60_LATERAL_SEAT
     k_f = d["fastening_lateral_stiffness_N_per_m"] / d["sleeper_spacing_m"]
     beta = (k_f / (4.0 * d["rail_lateral_bending_stiffness_N_m2"])) ** 0.25
-    assert eq["lateral_stiffness_N_per_m"] == pytest.approx(2.0 * k_f / beta, rel=1e-12)
+    assert eq["lateral_rail_stiffness_N_per_m"] == pytest.approx(2.0 * k_f / beta, rel=1e-12)
 
 
 def test_lateral_stiffness_against_the_discretely_supported_lateral_beam():
@@ -60,7 +60,7 @@ def test_lateral_stiffness_against_the_discretely_supported_lateral_beam():
         end_margin_m=12.0,
     )  # fmt: skip
     system = TrackSystem(beam, 0.0)
-    lumped = TrackDynamics().lateral_stiffness_N_per_m
+    lumped = TrackDynamics().lateral_rail_stiffness_N_per_m
     a = d["sleeper_spacing_m"]
     seat = system.seat_m[len(system.seat_m) // 2]
     stiffness = []
@@ -131,8 +131,8 @@ def test_bad_lateral_input():
         TrackDynamics(model="lumped", lateral_model="beam")
     with pytest.raises(ValueError, match="lateral_model = 'lumped': expected 'rigid' with model = 'rigid'"):
         TrackDynamics(model="rigid", lateral_model="lumped")
-    with pytest.raises(ValueError, match="lateral_stiffness_N_per_m"):
-        TrackDynamics(model="lumped", lateral_model="lumped", lateral_stiffness_N_per_m=-1.0)
+    with pytest.raises(ValueError, match="lateral_rail_stiffness_N_per_m"):
+        TrackDynamics(model="lumped", lateral_model="lumped", lateral_rail_stiffness_N_per_m=-1.0)
 
 
 def test_lateral_track_frequency_closed_form():
@@ -156,8 +156,9 @@ def test_lateral_track_frequency_closed_form():
     rows = np.r_[r, wm.track_system.n_positions + r]
     sub = jac[np.ix_(rows, rows)]
     t = LATERAL
-    w0 = math.sqrt(t.lateral_stiffness_N_per_m / t.lateral_rail_mass_kg)
-    zeta = t.lateral_damping_N_s_per_m / (2.0 * math.sqrt(t.lateral_stiffness_N_per_m * t.lateral_rail_mass_kg))
+    w0 = math.sqrt(t.lateral_rail_stiffness_N_per_m / t.lateral_rail_mass_kg)
+    k_y, m_y = t.lateral_rail_stiffness_N_per_m, t.lateral_rail_mass_kg
+    zeta = t.lateral_rail_damping_N_s_per_m / (2.0 * math.sqrt(k_y * m_y))
     expected = sorted([-zeta * w0 + w0 * math.sqrt(zeta**2 - 1.0), -zeta * w0 - w0 * math.sqrt(zeta**2 - 1.0)] * 2)
     np.testing.assert_allclose(sorted(np.linalg.eigvals(sub).real), expected, rtol=1e-10)
     assert w0 / (2 * math.pi) == pytest.approx(102.6, abs=0.1)
@@ -182,7 +183,7 @@ def test_flange_curve_on_the_lateral_track():
     fine = runs[1e-4]
     names = list(fine.track_state_names)
     last = fine.track_states[-1]
-    k_y = LATERAL.lateral_stiffness_N_per_m
+    k_y = LATERAL.lateral_rail_stiffness_N_per_m
     for side, name in enumerate(("rail_left_lateral_m", "rail_right_lateral_m")):
         assert last[names.index(name)] == pytest.approx(-fine.contact_force_N[-1, side, 1] / k_y, rel=1e-6)
     assert last[names.index("rail_left_lateral_m")] < -5e-4  # the outer (left) rail, 0.82 mm out
@@ -230,3 +231,24 @@ def test_structured_jacobian_with_the_lateral_track():
     assert np.max(rel) < 1e-4
     r = model.track_system.lateral_rows() + 14
     assert np.max(np.abs(slow[:, r])) > 0  # the lateral columns are there
+
+
+def test_lateral_input_is_checked(capsys, tmp_path):
+    """Bad lateral keys get one line naming the key, the value and what was expected (CLI, exit 2)."""
+    from hardening_helpers import assert_error, run, write
+
+    from wheelrail.scenes import resolve_scene_path
+
+    base = resolve_scene_path("wheel-flat").read_text(encoding="utf-8")
+    for key, value, fragment in (
+        ("lateral_model", '"beam"', "expected one of rigid, lumped"),
+        ("lateral_rail_stiffness_N_per_m", "1.0", "100000 to 1e+11"),
+        ("lateral_rail_mass_kg", "0.0", "1 to 10000"),
+        ("lateral_rail_damping_N_s_per_m", "-1.0", "0 to 1e+08"),
+    ):
+        text = base.replace('model = "beam"', f'model = "beam"\n{key} = {value}')
+        code, _, err = run(capsys, "run", write(tmp_path, text, f"{key}.toml"), "--out", tmp_path / key, "--quiet")
+        assert_error(code, err, key, fragment)
+    text = base.replace('model = "beam"', 'model = "rigid"\nlateral_model = "lumped"')
+    code, _, err = run(capsys, "run", write(tmp_path, text, "rigid.toml"), "--out", tmp_path / "rigid", "--quiet")
+    assert_error(code, err, "lateral_model", "expected 'rigid' with model = 'rigid'")

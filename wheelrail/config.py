@@ -88,8 +88,8 @@ PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
     "cutoff_frequency_Hz": (500.0, 5.0e4, "Hz: the beam's modes up to it; 5 kHz resolves a wheel-flat impact"),
     "end_margin_m": (1.0, 100.0, "m of beam beyond the run at each end: the default is 6 m"),
     "lateral_rail_mass_kg": (1.0, 1.0e4, "kg per wheel: the default is 78 kg"),
-    "lateral_stiffness_N_per_m": (1.0e5, 1.0e11, "N/m per wheel: the default is 3.24e7"),
-    "lateral_damping_N_s_per_m": (0.0, 1.0e8, "N s/m per wheel: the default is 1.08e5"),
+    "lateral_rail_stiffness_N_per_m": (1.0e5, 1.0e11, "N/m per wheel: the default is 3.24e7"),
+    "lateral_rail_damping_N_s_per_m": (0.0, 1.0e8, "N s/m per wheel: the default is 1.08e5"),
 }
 """Key name -> (lowest, highest, why): numbers outside are bad input however well typed (the range and
 the reason are in the message). Applied to every key of that name in scene and case files."""

@@ -351,7 +351,7 @@ def _table_geometry(y, par, table, grid, slots, sides, work, res, geo, bg, cg):
     """Candidate geometry from the tables (providers.TableProvider) and the running-direction irregularities,
     into cg (ncand, N_GEO) (q, lever, normal, A, B, rolling radius, wheel lateral, contact angle).
     """
-    xc, yc, zc = y[0], y[1], y[2]
+    yc = y[1]
     sps = math.sin(y[3])
     zref = par.z_ref_m
     rail0, _ = rail_under_wheel(par, y, 0)
@@ -434,8 +434,8 @@ def _patch_creepages(lever, n, om, vx, vy, vz, rail_vy, rail_vz, vel, ex, ey):
 @njit(cache=True)
 def patch_creepages(lever, normal, om, v_c, rail_vy, rail_vz, frames, out):
     """:func:`_patch_creepages` of n patches for the Python right-hand side: lever, normal (n, 3), angular velocity
-    om (3), centre velocity v_c (3), rail lateral and vertical velocity per patch (n); frames (n, 3, 3) get the columns e_x,
-    e_y, n, out (4, n) the rows V, xi, eta, spin (NaN where V is not > 0).
+    om (3), centre velocity v_c (3), rail lateral and vertical velocity per patch (n); frames (n, 3, 3) get the
+    columns e_x, e_y, n, out (4, n) the rows V, xi, eta, spin (NaN where V is not > 0).
     """
     vel, ex, ey = np.empty(3), np.empty(3), np.empty(3)
     for k in range(lever.shape[0]):
@@ -536,8 +536,8 @@ def _assemble_curve(y, par, force, moment, fe0, fe1, fe2, me0, me1, me2, om, rzx
 def _assemble(t, y, par, force, moment, p_con, rail_f0, rail_f1, rail_fy0, rail_fy1, om, rzx, out):
     """The equations of motion (eq 59-71 with the gyroscopic term), the suspension and the track: d/dt of the full
     state into ``out`` from the summed contact force and moment about the centre (main frame, N and N m), the
-    contact power ``p_con`` (W), the vertical and lateral contact forces on the rails (left, right; elastic track) and the
-    angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: every
+    contact power ``p_con`` (W), the vertical and lateral contact forces on the rails (left, right; elastic track) and
+    the angular velocity ``om`` and rotation R_z R_x ``rzx`` of :func:`_rotation`. The one implementation: every
     right-hand side (the RK4 loop, the DP54/BS32 pairs, and equations.WheelsetModel.derivative for scipy's
     methods) ends here through :func:`_forces`.
     """

@@ -475,7 +475,7 @@ def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, c
 def search_geometry_on_track(
     y, rail_left_m, rail_right_m, lateral_left_m, lateral_right_m, sp, tabs, irrs, mem, n_mem, full, cand, order,
     vb, rot, cg, centre
-):
+):  # fmt: skip
     """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels (left, right)
     and moved laterally by its lateral displacements (left, right; 0 without the lateral track): each side is
     searched at the wheelset centre raised by its rail's deflection and moved by minus its lateral displacement

@@ -126,8 +126,8 @@ def lumped_lateral_equivalent(
     n = 2.0 / (beta * sleeper_spacing_m)
     return {
         "lateral_rail_mass_kg": rail_mass_per_length_kg_per_m * n * sleeper_spacing_m,
-        "lateral_stiffness_N_per_m": n * fastening_lateral_stiffness_N_per_m,
-        "lateral_damping_N_s_per_m": n * fastening_lateral_damping_N_s_per_m,
+        "lateral_rail_stiffness_N_per_m": n * fastening_lateral_stiffness_N_per_m,
+        "lateral_rail_damping_N_s_per_m": n * fastening_lateral_damping_N_s_per_m,
     }
 
 
@@ -202,8 +202,8 @@ class TrackDynamics:
         cutoff_frequency_Hz: the beam's modes up to this frequency are kept (the flexural branch; beam).
         end_margin_m: the beam reaches this far beyond the run at each end (beam).
         lateral_model: "rigid" or "lumped" (the lateral track of an elastic track).
-        lateral_rail_mass_kg, lateral_stiffness_N_per_m, lateral_damping_N_s_per_m: the lumped lateral rail per
-            wheel, its spring and damper to the sleeper.
+        lateral_rail_mass_kg, lateral_rail_stiffness_N_per_m, lateral_rail_damping_N_s_per_m: the lumped lateral
+            rail per wheel, its spring and damper to the sleeper.
     """
 
     model: str = "rigid"
@@ -229,8 +229,8 @@ class TrackDynamics:
     end_margin_m: float = 6.0
     lateral_model: str = "rigid"
     lateral_rail_mass_kg: float = 78.0
-    lateral_stiffness_N_per_m: float = 3.24e7
-    lateral_damping_N_s_per_m: float = 1.08e5
+    lateral_rail_stiffness_N_per_m: float = 3.24e7
+    lateral_rail_damping_N_s_per_m: float = 1.08e5
 
     def __post_init__(self) -> None:
         from rigid_dynamics.wheelset.parameters import _check_finite  # parameters imports this module
@@ -242,11 +242,11 @@ class TrackDynamics:
                 "rail_mass_per_length_kg_per_m", "rail_bending_stiffness_N_m2", "rail_shear_stiffness_N",
                 "rail_rotary_inertia_kg_m", "sleeper_spacing_m", "seat_pad_stiffness_N_per_m", "seat_sleeper_mass_kg",
                 "seat_ballast_stiffness_N_per_m", "cutoff_frequency_Hz", "end_margin_m", "lateral_rail_mass_kg",
-                "lateral_stiffness_N_per_m",
+                "lateral_rail_stiffness_N_per_m",
             ],
             nonnegative=[
                 "pad_damping_N_s_per_m", "ballast_damping_N_s_per_m", "seat_pad_damping_N_s_per_m",
-                "seat_ballast_damping_N_s_per_m", "rail_loss_factor", "lateral_damping_N_s_per_m",
+                "seat_ballast_damping_N_s_per_m", "rail_loss_factor", "lateral_rail_damping_N_s_per_m",
             ],
         )  # fmt: skip
         if self.model not in TRACK_MODELS:
@@ -367,8 +367,8 @@ PARAMETER_FIELDS = (
     ("rail_loss_factor", "beam: the rail's loss factor"),
     ("lateral_track", "1: lumped lateral rail per wheel (the last 2 positions and the last 2 rates), 0: none"),
     ("lateral_rail_mass_kg", "lateral rail mass per wheel"),
-    ("lateral_stiffness_N_per_m", "lateral fastening stiffness per wheel"),
-    ("lateral_damping_N_s_per_m", "lateral fastening damping per wheel"),
+    ("lateral_rail_stiffness_N_per_m", "lateral fastening stiffness per wheel"),
+    ("lateral_rail_damping_N_s_per_m", "lateral fastening damping per wheel"),
 )
 """The track's fields of the compiled parameter record (compiled.PARAMETER_FIELDS): (field, meaning), SI units."""
 
@@ -418,7 +418,7 @@ def pack_parameters(par, track: TrackDynamics, travel: float) -> None:
         par["beam_length_m"], par["beam_margin_m"] = layout.length_m, layout.margin_m
     par["lateral_track"] = 1.0 if track.lateral else 0.0
     if track.lateral:
-        for name in ("lateral_rail_mass_kg", "lateral_stiffness_N_per_m", "lateral_damping_N_s_per_m"):
+        for name in ("lateral_rail_mass_kg", "lateral_rail_stiffness_N_per_m", "lateral_rail_damping_N_s_per_m"):
             par[name] = getattr(track, name)
 
 
@@ -473,7 +473,7 @@ def track_rates(par, y, rail_f0, rail_f1, rail_fy0, rail_fy1, out, p_ext):
     """
     n_pos = int(par.track_positions)
     if par.lateral_track > 0.5:
-        m_y, k_y, c_y = par.lateral_rail_mass_kg, par.lateral_stiffness_N_per_m, par.lateral_damping_N_s_per_m
+        m_y, k_y, c_y = par.lateral_rail_mass_kg, par.lateral_rail_stiffness_N_per_m, par.lateral_rail_damping_N_s_per_m
         for sd in range(2):
             u, v = y[N_RIGID + n_pos - 2 + sd], y[N_RIGID + 2 * n_pos - 2 + sd]
             out[N_RIGID + n_pos - 2 + sd] = v
@@ -676,7 +676,7 @@ class TrackSystem:
         for side in (0, 1):
             out[self.rows(side)] = np.linalg.solve(self.stiffness, b * float(rail_force_N[side]))
         if self.lateral and len(rail_force_N) > 2:
-            out[self.lateral_rows()] = np.asarray(rail_force_N[2:4], float) / self.track.lateral_stiffness_N_per_m
+            out[self.lateral_rows()] = np.asarray(rail_force_N[2:4], float) / self.track.lateral_rail_stiffness_N_per_m
         return out
 
     def rail_forces_at_rest(self, rest, rates, xi_m: float | None = None) -> np.ndarray:
@@ -695,7 +695,9 @@ class TrackSystem:
         if self.lateral:
             r = self.lateral_rows()
             tr = self.track
-            force[2:4] = tr.lateral_rail_mass_kg * rates[self.n_positions + r] + tr.lateral_stiffness_N_per_m * rest[r]
+            force[2:4] = (
+                tr.lateral_rail_mass_kg * rates[self.n_positions + r] + tr.lateral_rail_stiffness_N_per_m * rest[r]
+            )
         return force
 
     def rates(self, track_state, rail_force_N, xi_m: float) -> np.ndarray:
@@ -718,7 +720,7 @@ class TrackSystem:
             force = np.asarray(rail_force_N, float)[2:4] if len(rail_force_N) > 2 else np.zeros(2)
             out[r] = v
             out[self.n_positions + r] = (
-                force - tr.lateral_damping_N_s_per_m * v - tr.lateral_stiffness_N_per_m * u
+                force - tr.lateral_rail_damping_N_s_per_m * v - tr.lateral_rail_stiffness_N_per_m * u
             ) / tr.lateral_rail_mass_kg
         return out
 
@@ -738,7 +740,7 @@ class TrackSystem:
             r, tr = self.lateral_rows(), self.track
             u, v = t[..., r], t[..., self.n_positions + r]
             kinetic = kinetic + 0.5 * tr.lateral_rail_mass_kg * np.sum(v * v, axis=-1)
-            potential = potential + 0.5 * tr.lateral_stiffness_N_per_m * np.sum(u * u, axis=-1)
+            potential = potential + 0.5 * tr.lateral_rail_stiffness_N_per_m * np.sum(u * u, axis=-1)
         return kinetic, potential
 
     def under_wheel(self, states, xi_m) -> np.ndarray:
