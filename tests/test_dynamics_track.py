@@ -229,11 +229,24 @@ def test_dipped_joint_refused_on_the_search():
 
 
 def test_track_states_sit_in_their_slice():
-    from rigid_dynamics.wheelset.state import RAIL, RAIL_VELOCITY, n_states, track_positions, track_velocities
+    from rigid_dynamics.wheelset.state import (
+        LATERAL_STATE_NAMES,
+        RAIL,
+        SLEEPER,
+        TRACK_STATE_NAMES,
+        n_states,
+        state_names,
+        track_positions,
+        track_velocities,
+    )
 
     assert TRACK == slice(14, None) and n_states(4) == 22 and n_states(0) == 14
     assert track_positions(22) == slice(14, 18) and track_velocities(22) == slice(18, 22)
-    assert (RAIL, RAIL_VELOCITY) == (14, 18)
+    assert (RAIL, SLEEPER) == (14, 16)
+    # with the lateral track: its positions end the positions, its rates end the rates
+    names = state_names(n_states(6))
+    assert names[14:20] == TRACK_STATE_NAMES[:4] + LATERAL_STATE_NAMES[:2]
+    assert names[20:26] == TRACK_STATE_NAMES[4:] + LATERAL_STATE_NAMES[2:]
 
 
 def test_compiled_search_equals_the_python_search_on_the_elastic_track():
