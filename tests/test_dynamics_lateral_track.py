@@ -187,6 +187,10 @@ def test_flange_curve_on_the_lateral_track():
     for side, name in enumerate(("rail_left_lateral_m", "rail_right_lateral_m")):
         assert last[names.index(name)] == pytest.approx(-fine.contact_force_N[-1, side, 1] / k_y, rel=1e-6)
     assert last[names.index("rail_left_lateral_m")] < -5e-4  # the outer (left) rail, 0.82 mm out
+    peaks = fine.summary()["peak_rail_lateral_displacement_m"]
+    column = fine.track_states[:, names.index("rail_left_lateral_m")]
+    assert peaks["left"] == column[np.argmax(np.abs(column))] and peaks["left"] < -5e-4
+    assert runs[5e-4].summary()["peak_rail_lateral_displacement_m"] is not None
     assert fine.states[-1, 1] < -7.0e-3  # the wheelset follows its rail out: -7.11 mm against -6.28 mm rigid
     left = simulate(
         replace(scene, track=replace(scene.track, curve_direction="left"),

@@ -50,7 +50,8 @@ class SimulationResult:
             that on wheel and rail together and the exterior work includes the track dampers'.
         track_states: what the run records of the elastic track at the output times, named by
             ``track_state_names`` (z down): the lumped track's 8 states (state.TRACK_STATE_NAMES), or the beam's
-            rail deflection and velocity under each wheel (track.BEAM_SUMMARY_NAMES); None for the rigid track.
+            rail deflection and velocity under each wheel (track.BEAM_SUMMARY_NAMES); with the lateral track its
+            states too (state.LATERAL_STATE_NAMES); None for the rigid track.
         track_state_names: the names of ``track_states``' columns.
         track_full_states: every state of the elastic track at the output times (n, k) (the beam's modes and rail
             seats: track.BeamLayout); None for the rigid track.
@@ -259,9 +260,22 @@ class SimulationResult:
                 if self.track_states is not None and len(self.track_states)
                 else None
             ),
+            "peak_rail_lateral_displacement_m": self._lateral_rail_peaks(num),
             **self._error_summary(num),
             **self._auto_summary(),
         }
+
+    def _lateral_rail_peaks(self, num):
+        """Per rail the largest |lateral displacement| of the lateral track (signed, y along the track's lateral
+        axis), m; None without the lateral track."""
+        names = list(self.track_state_names) if self.track_state_names is not None else []
+        if self.track_states is None or not len(self.track_states) or "rail_left_lateral_m" not in names:
+            return None
+        out = {}
+        for side in SIDES:
+            column = self.track_states[:, names.index(f"rail_{side}_lateral_m")]
+            out[side] = num(column[int(np.argmax(np.abs(column)))])
+        return out
 
     def _auto_summary(self) -> dict:
         """``auto``'s choices over the run (empty for other models): per rung (contact.auto.AUTO_RUNGS) the share of
