@@ -267,7 +267,8 @@ class SimulationResult:
 
     def _lateral_rail_peaks(self, num):
         """Per rail the largest |lateral displacement| of the lateral track (signed, y along the track's lateral
-        axis), m; None without the lateral track."""
+        axis), m; None without the lateral track.
+        """
         names = list(self.track_state_names) if self.track_state_names is not None else []
         if self.track_states is None or not len(self.track_states) or "rail_left_lateral_m" not in names:
             return None
