@@ -218,16 +218,20 @@ def test_wheelset_on_the_beam_starts_at_rest_on_its_static_deflection():
     assert np.max(np.abs(beam.energy_residual_J)) < 1e-6 * scale
 
 
-def test_structured_jacobian_equals_the_difference_quotients():
+@pytest.mark.parametrize("lateral", ["rigid", "lumped"])
+def test_structured_jacobian_equals_the_difference_quotients(lateral):
     """Regression (two ways to the same matrix): WheelsetModel.state_jacobian (differences in the mechanical states,
-    the beam's columns from its linear equations and the rail under the wheels) against central differences in
-    every state, at the rest state of a short run on the beam; and the RK4 step limit from both."""
+    the beam's columns from its linear equations and the rail under the wheels; the lateral track's 4 columns by
+    differences) against central differences in every state, at the rest state of a short run on the beam; and the
+    RK4 step limit from both."""
     from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
     from rigid_dynamics.wheelset.stability import jacobian, rk4_stable_step
 
-    scene = _scene(duration_s=0.001, track_dynamics=_beam(cutoff_frequency_Hz=2000.0, end_margin_m=1.2))
+    scene = _scene(
+        duration_s=0.001, track_dynamics=_beam(cutoff_frequency_Hz=2000.0, end_margin_m=1.2, lateral_model=lateral)
+    )
     law = get_contact_model(scene.contact_model)
     model = WheelsetModel(scene, build_provider(scene), law, model_options(law.name, scene))
     state, ok, _ = elastic_start(model, initial_state(scene))

@@ -9,7 +9,8 @@
   k_v, u = F_y / k_y, unknowns of the textbook model): wheelset position and yaw, loads, creep forces and the
   rails' lateral and vertical displacements.
 * The energy balance and the mirror image on a flange-contact curve with the 3-D search; the compiled track rates
-  against the matrices (regression); the structured Jacobian against full differences (regression); bad input.
+  against the matrices (regression); bad input. The structured Jacobian with the lateral track: tests/
+  test_dynamics_beam.py.
 """
 
 from __future__ import annotations
@@ -201,40 +202,6 @@ def test_flange_curve_on_the_lateral_track():
     assert left.states[-1, 3] == pytest.approx(-fine.states[-1, 3], rel=1e-6)
     lat = [names.index("rail_left_lateral_m"), names.index("rail_right_lateral_m")]
     assert left.track_states[-1, lat] == pytest.approx(-last[lat][::-1], rel=1e-7)
-
-
-def test_structured_jacobian_with_the_lateral_track():
-    """Regression (two ways to the same matrix): WheelsetModel.state_jacobian on the beam with the lateral track
-    (its 4 columns by differences, the beam's from its equations) against central differences in every state."""
-    from rigid_dynamics.wheelset import DynamicsScene, IntegratorSettings
-    from rigid_dynamics.wheelset.equations import WheelsetModel
-    from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
-    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
-    from rigid_dynamics.wheelset.stability import jacobian
-
-    scene = DynamicsScene(
-        contact_provider="tables", contact_model="linear", speed_m_per_s=20.0, duration_s=0.001,
-        integrator=IntegratorSettings(method="RK4", fixed_step_s=2.5e-5, output_step_s=1e-3),
-        track_dynamics=TrackDynamics(model="beam", lateral_model="lumped", cutoff_frequency_Hz=2000.0,
-                                     end_margin_m=1.2),
-    )  # fmt: skip
-    law = get_contact_model(scene.contact_model)
-    model = WheelsetModel(scene, build_provider(scene), law, model_options(law.name, scene))
-    state, ok, _ = elastic_start(model, initial_state(scene))
-    assert ok
-    y = model.full_state(state)
-
-    def fun(v):
-        return model.derivative(0.0, v)
-
-    fast = model.state_jacobian(fun, y)
-    slow = jacobian(fun, y)
-    scale = np.max(np.abs(slow), axis=1, keepdims=True) + 1e-30
-    rel = np.abs(fast - slow) / scale
-    rel[12:14] = 0.0  # the work integrals' rows
-    assert np.max(rel) < 1e-4
-    r = model.track_system.lateral_rows() + 14
-    assert np.max(np.abs(slow[:, r])) > 0  # the lateral columns are there
 
 
 def test_lateral_input_is_checked(capsys, tmp_path):

@@ -53,6 +53,15 @@ RAIL_THEORIES = ("timoshenko", "euler-bernoulli")
 """Beam theories of the rail in the discretely supported model."""
 
 
+def _seats_carrying_the_wheel(seat_stiffness_N_per_m, sleeper_spacing_m, bending_stiffness_N_m2) -> float:
+    """N = 2 / (beta a) of the Winkler beam (k_f = k_seat / a, beta = (k_f / (4 EI))^(1/4)): the number of rail seats
+    whose springs, n k_seat, give the beam's static point stiffness 2 k_f / beta.
+    """
+    k_f = seat_stiffness_N_per_m / sleeper_spacing_m
+    beta = (k_f / (4.0 * bending_stiffness_N_m2)) ** 0.25
+    return 2.0 / (beta * sleeper_spacing_m)
+
+
 def lumped_track_equivalent(
     rail_mass_per_length_kg_per_m: float,
     rail_bending_stiffness_N_m2: float,
@@ -73,9 +82,7 @@ def lumped_track_equivalent(
     equals the beam's exactly; the masses are an approximation (a beam's participating mass depends on frequency).
     """
     k_series = 1.0 / (1.0 / pad_stiffness_N_per_m + 1.0 / ballast_stiffness_N_per_m)
-    k_f = k_series / sleeper_spacing_m
-    beta = (k_f / (4.0 * rail_bending_stiffness_N_m2)) ** 0.25
-    n = 2.0 / (beta * sleeper_spacing_m)
+    n = _seats_carrying_the_wheel(k_series, sleeper_spacing_m, rail_bending_stiffness_N_m2)
     return {
         "rail_mass_kg": rail_mass_per_length_kg_per_m * n * sleeper_spacing_m,
         "pad_stiffness_N_per_m": n * pad_stiffness_N_per_m,
@@ -121,9 +128,9 @@ def lumped_lateral_equivalent(
     carry the wheel, the lumped rail has the rail mass of n spacings. The sleepers are held laterally (the
     ballast's lateral stiffness per sleeper is not in the model).
     """
-    k_f = fastening_lateral_stiffness_N_per_m / sleeper_spacing_m
-    beta = (k_f / (4.0 * rail_lateral_bending_stiffness_N_m2)) ** 0.25
-    n = 2.0 / (beta * sleeper_spacing_m)
+    n = _seats_carrying_the_wheel(
+        fastening_lateral_stiffness_N_per_m, sleeper_spacing_m, rail_lateral_bending_stiffness_N_m2
+    )
     return {
         "lateral_rail_mass_kg": rail_mass_per_length_kg_per_m * n * sleeper_spacing_m,
         "lateral_rail_stiffness_N_per_m": n * fastening_lateral_stiffness_N_per_m,
