@@ -435,8 +435,9 @@ class WheelsetModel:
         rows without a candidate NaN) and their sampled geometries (if any) to the callback.
         """
         track = self.rail_under_wheels(full)[0:2] if self.elastic else None
-        lateral = self.rail_lateral_under_wheels(full)[0:2] if self.elastic and self.track.lateral else None
-        patches = self.patches_on_track(full[0:3], full[3], full[4], full[5], track, lateral)
+        patches = self.patches_on_track(
+            full[0:3], full[3], full[4], full[5], track, self.rail_lateral_under_wheels(full)[0:2]
+        )  # zero offsets (rigid or no lateral track): the provider's own patches
         cg = self._cg
         cg[:, :] = np.nan
         geometries = {}

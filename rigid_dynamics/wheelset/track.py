@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.wheelset.state import LATERAL_STATE_NAMES, N_RIGID, RAIL, SLEEPER, TRACK_STATE_NAMES
+from rigid_dynamics.wheelset.state import LATERAL_STATE_NAMES, N_RIGID, RAIL, SLEEPER, n_states, state_names
 
 TRACK_MODELS = ("rigid", "lumped", "beam")
 """Vertical track models (:class:`TrackDynamics`)."""
@@ -607,10 +607,7 @@ class TrackSystem:
             self.damping = np.array([[cp, -cp], [-cp, cp + cb]])
             self.n_vertical = 4
             self.n_positions = 4 + (2 if self.lateral else 0)
-            lat = LATERAL_STATE_NAMES
-            self.summary_names = (
-                TRACK_STATE_NAMES[:4] + lat[:2] + TRACK_STATE_NAMES[4:] + lat[2:] if self.lateral else TRACK_STATE_NAMES
-            )
+            self.summary_names = state_names(n_states(self.n_positions))[N_RIGID:]  # every state, named by state.py
             return
         layout = self.layout = beam_layout(track, travel)
         nm, ns, length = layout.n_modes, layout.n_sleepers, layout.length_m
