@@ -232,6 +232,11 @@ def local_dask_client(workers: int) -> Iterator:
     The cluster and client are closed on exit. No dashboard is started, and the scheduler's small HTTP server
     listens on a free port of 127.0.0.1 (not dask's default 8787, which a second cluster would contend for).
 
+    Security: the scheduler, the nannies and the workers speak TLS with mutual authentication, on credentials made
+    for this cluster alone (``distributed.security.Security.temporary()``: a fresh certificate held in memory and
+    handed to the worker processes, never written to disk). Another local process that connects to the scheduler's
+    port (``Client(address).run_on_scheduler(...)``) fails the handshake instead of running code in this process.
+
     Raises:
         ValueError: ``workers`` is not an integer >= 1.
         ImportError: dask.distributed is not installed.
@@ -239,16 +244,21 @@ def local_dask_client(workers: int) -> Iterator:
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers = {workers!r}: expected an integer >= 1")
     from distributed import Client, LocalCluster
+    from distributed.security import Security
 
+    security = Security.temporary()  # needs the package cryptography (a dependency of wheelrail)
     with (
         LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
+            protocol="tls://",
+            host="127.0.0.1",
+            security=security,
             dashboard_address=None,
             scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
         ) as cluster,
-        Client(cluster) as client,
+        Client(cluster, security=security) as client,
     ):
         yield client
 

@@ -151,6 +151,14 @@ def _read_solver(table: dict) -> dict:
     for key, value in table.items():
         if isinstance(value, float) and not math.isfinite(value):
             raise ConfigError(f"key 'solver.{key}' = {value!r}: expected a finite number")
+    model = table.get("model")
+    for key, value in (("output_dir", table.get("output_dir")), ("model.output_dir", (model or {}).get("output_dir")
+                       if isinstance(model, dict) else None)):  # fmt: skip
+        if value is not None:
+            raise ConfigError(
+                f"key 'solver.{key}' = {value!r}: not allowed in a case file (a command writes only under its output "
+                "folder: give --out DIR, the FEA files go to DIR/fea)"
+            )
     return dict(table)
 
 

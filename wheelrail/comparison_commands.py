@@ -16,6 +16,9 @@ from pathlib import Path
 
 from wheelrail.config import ConfigError
 
+COMPARE_SUMMARIES = ("compare.json", "report.md", "report.html")
+"""The files of a compare that say what the folder holds (removed before a new compare into the same folder)."""
+
 DEMO_TOLERANCE = 0.1
 """auto's contact_tolerance in the demo's run: at the polygonal-wheel scene's own 0.05 the measured thresholds send
 39 % of the patches (tread patches at saturation 0.08-0.16 and spin share 0.17-0.19) to BEM, and 2 s would take
@@ -46,7 +49,7 @@ def _bar(total: int, label: str):
 def cmd_bench(args) -> int:
     from comparisons.bench import MODELS, bench_plan, run_bench, write_bench
     from wheelrail.named_cases import load_named_cases, named_case_names
-    from wheelrail.output import new_output_dir
+    from wheelrail.output import output_folder
 
     if args.list:
         for name in named_case_names():
@@ -54,14 +57,15 @@ def cmd_bench(args) -> int:
         return 0
     models = _check_models(args.models, MODELS)
     cases = load_named_cases(args.cases)
-    out_dir = new_output_dir(args.out, "bench-quick" if args.quick else "bench")
-    bar, update = _bar(len(bench_plan(cases, models, args.quick)), "bench")
-    start = time.perf_counter()
-    try:
-        runs = run_bench(cases, models, args.quick, progress=update)
-    finally:
-        bar.close()
-    summary = write_bench(runs, cases, out_dir, args.quick, time.perf_counter() - start)
+    summaries = ("bench.json", "bench.md", "bench.csv")
+    with output_folder(args.out, "bench-quick" if args.quick else "bench", summaries=summaries) as out_dir:
+        bar, update = _bar(len(bench_plan(cases, models, args.quick)), "bench")
+        start = time.perf_counter()
+        try:
+            runs = run_bench(cases, models, args.quick, progress=update)
+        finally:
+            bar.close()
+        summary = write_bench(runs, cases, out_dir, args.quick, time.perf_counter() - start)
     failed = [r for r in runs if r.status != "ok"]
     print(f"bench: {len(runs)} runs over {len(cases)} cases in {summary['wall_time_s']:.0f} s, {len(failed)} not ok")
     for case, row in summary["tolerance_table"].items():
@@ -75,13 +79,14 @@ def cmd_bench(args) -> int:
 def cmd_compare(args) -> int:
     from comparisons.compare import COMPARE_MODELS, run_compare
     from wheelrail.named_cases import load_named_case
-    from wheelrail.output import copy_input, new_output_dir
+    from wheelrail.output import copy_input, output_folder
 
     models = _check_models(args.models, COMPARE_MODELS)
     named = load_named_case(args.case)
-    out_dir = new_output_dir(args.out, f"compare-{named.name}")
-    copy_input(named.case_path, out_dir, "case.toml")
-    report = run_compare(named, out_dir, models=models)
+    # locked (one compare per folder at a time); an earlier compare's report and compare.json are removed first
+    with output_folder(args.out, f"compare-{named.name}", summaries=COMPARE_SUMMARIES) as out_dir:
+        copy_input(named.case_path, out_dir, "case.toml")
+        report = run_compare(named, out_dir, models=models)
     for line in report["headlines"]:
         print(line)
     print(f"report: {Path(out_dir) / 'report.md'} (and report.html)")
@@ -90,13 +95,9 @@ def cmd_compare(args) -> int:
 
 def cmd_demo(args) -> int:
     """The default demo (``make demo``): polygonal-wheel run, compare at the peak normal force, report."""
-    from comparisons.compare import COMPARE_MODELS, _html, run_compare
-    from comparisons.demo import peak_patch_case
-    from comparisons.files import write_text_atomic
-    from comparisons.named_cases import NamedCase
-    from rigid_dynamics.wheelset import simulate
-    from wheelrail.output import new_output_dir
-    from wheelrail.scenes import load_scene, resolve_scene_path, write_run_outputs
+    from comparisons.compare import COMPARE_MODELS
+    from wheelrail.output import output_folder
+    from wheelrail.scenes import load_scene, resolve_scene_path
 
     models = _check_models(args.models, COMPARE_MODELS)
     from dataclasses import replace
@@ -113,14 +114,27 @@ def cmd_demo(args) -> int:
         scene = replace(scene, contact_model=args.contact_model)
     if args.tolerance is not None:
         scene = replace(scene, contact_tolerance=args.tolerance)
-    out_dir = new_output_dir(args.out, f"demo-{source.stem}")
+    with output_folder(args.out, f"demo-{source.stem}", summaries=("report.md", "report.html")) as out_dir:
+        return _demo(scene, source, models, out_dir)
+
+
+def _demo(scene, source, models, out_dir) -> int:
+    """The work of :func:`cmd_demo` in its checked, locked folder."""
+    from comparisons.compare import _html, run_compare
+    from comparisons.demo import peak_patch_case
+    from comparisons.files import write_text_atomic
+    from comparisons.named_cases import NamedCase
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.output import subfolder
+    from wheelrail.scenes import write_run_outputs
+
     start = time.perf_counter()
     law = scene.contact_model + (
         f" (contact_tolerance {scene.contact_tolerance:g})" if scene.contact_model == "auto" else ""
     )
     print(f"demo 1/3: {source.stem}, {scene.duration_s:g} s with {law} (3-D contact search)")
     result = simulate(scene)
-    summary = write_run_outputs(result, source, out_dir / "run")
+    summary = write_run_outputs(result, source, subfolder(out_dir, "run"))
     if not result.success:
         print(f"demo: the run ended with {result.status}: {result.message}")
         return 1
@@ -136,7 +150,7 @@ def cmd_demo(args) -> int:
     )
     named = NamedCase("peak-contact", out_dir, "none (no reference: the BEM is the most exact rung here)", "single",
                       {}, note=note, case=patch)  # fmt: skip
-    compare = run_compare(named, out_dir / "compare", models=models)
+    compare = run_compare(named, subfolder(out_dir, "compare"), models=models)
     print("demo 3/3: report")
     models = compare["models"]
 

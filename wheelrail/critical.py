@@ -12,9 +12,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 
-from wheelrail.config import ConfigError
+from wheelrail.config import PHYSICAL_RANGES, ConfigError
+
+MAX_SPEED_M_PER_S = PHYSICAL_RANGES["speed_m_per_s"][1]
+MAX_STEPS = 1000
+"""Continuation steps at most (each is a run of --duration: 1000 x 3 s is hours already)."""
 
 
 def linear_critical_speed(scene) -> dict:
@@ -77,25 +80,35 @@ def cmd_critical_speed(args) -> int:
             "expected a straight track without cant for critical-speed (the analyses are about the straight track's "
             "centred state)"
         )
+    from wheelrail.config import check_physical_range
+
+    for name, key in (("high", "speed_m_per_s"), ("low", "speed_m_per_s"), ("duration", "duration_s")):
+        if getattr(args, name) is not None:
+            check_physical_range(f"--{name}", getattr(args, name), key)
+    if args.steps > MAX_STEPS:
+        raise ConfigError(f"--steps {args.steps!r}: expected an integer from 1 to {MAX_STEPS}")
     if args.low is not None and args.high is not None and not args.low < args.high:
         raise ConfigError(f"--low {args.low!r}: expected a speed below --high {args.high!r}")
     from functools import partial
 
     from rigid_dynamics.wheelset import build_provider, simulate
 
+    # the linear speed (quick, writes nothing) fixes the default range: a bad --low is refused before any file
+    linear = linear_critical_speed(scene)
+    v_lin = linear["speed_m_per_s"]
+    high = args.high or min(1.2 * v_lin if v_lin else 2.0 * scene.speed_m_per_s, MAX_SPEED_M_PER_S)
+    low = args.low or 0.4 * high
+    if not low < high:
+        given = "--low" if args.low is not None else "the default --low (0.4 x --high)"
+        raise ConfigError(f"{given} {low!r}: expected a speed below --high {high!r} (1.2 x the linear speed)")
+    try:
+        provider = build_provider(scene)  # the contact geometry does not depend on the speed: build it once
+    except ValueError as exc:
+        raise ConfigError(f"scene {args.scene!r}: {exc}") from None
+
     with output_folder(args.out, f"critical-speed-{source.stem}") as out_dir:  # checked before the work
         copy_input(source, out_dir, "scene.toml")
-        linear = linear_critical_speed(scene)
         print(f"{source.stem}: linear critical speed {_speed(linear['speed_m_per_s'])} ({linear['model']})")
-        v_lin = linear["speed_m_per_s"]
-        high = args.high or (1.2 * v_lin if v_lin else 2.0 * scene.speed_m_per_s)
-        low = args.low or 0.4 * high
-        if not low < high:
-            raise ConfigError(f"--low {low!r}: expected a speed below --high {high!r}")
-        try:
-            provider = build_provider(scene)  # the contact geometry does not depend on the speed: build it once
-        except ValueError as exc:
-            raise ConfigError(f"scene {args.scene!r}: {exc}") from None
         nonlinear = limit_cycle_search(
             scene,
             high,
@@ -120,6 +133,8 @@ def _speed(value) -> str:
 
 def register(sub) -> None:
     """Add the ``critical-speed`` sub-command to the CLI's sub-parsers."""
+    from wheelrail.cli import out_path
+
     parser = sub.add_parser("critical-speed", help="linear and nonlinear (limit-cycle) critical speed of a scene")
     parser.add_argument("scene", help="embedded scene name or TOML file")
     parser.add_argument("--high", type=float, help="start speed of the limit-cycle search, m/s (default 1.2 x linear)")
@@ -129,6 +144,6 @@ def register(sub) -> None:
     parser.add_argument(
         "--threshold-mm", type=float, default=1.0, help="smallest lateral amplitude counted as a cycle, mm (default 1)"
     )
-    parser.add_argument("--out", type=Path, help="output folder")
+    parser.add_argument("--out", type=out_path, help="output folder")
     parser.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene key (repeatable)")
     parser.set_defaults(func=cmd_critical_speed)

@@ -20,8 +20,12 @@ def named_case_names() -> list[str]:
 
 
 def _csv_rows(path: Path) -> list[dict]:
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(line for line in handle if not line.startswith("#")))
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            rows = list(csv.DictReader(line for line in handle if not line.startswith("#")))
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        reason = getattr(exc, "strerror", None) or exc
+        raise ConfigError(f"{str(path)!r}: cannot be read as a CSV table ({reason})") from None
     if not rows:
         raise ConfigError(f"{path}: no data row")
     return rows
@@ -32,14 +36,22 @@ def _contact_grid_reference(folder: Path) -> tuple[dict, dict]:
     path = folder / "contact_grid.csv"
     try:
         return contact_grid_reference(_csv_rows(path))
-    except (KeyError, ValueError) as exc:
+    except ConfigError:
+        raise
+    except (KeyError, TypeError, ValueError) as exc:
         raise ConfigError(f"{path}: {exc}") from None
 
 
 def _contact_reference(folder: Path) -> dict:
     """Sum of the published CONTACT rows of ``contact_reference.csv`` (N, Fx, Fy summed; max p; summed area)."""
-    rows = _csv_rows(folder / "contact_reference.csv")
-    parts = [contact_row_reference(r) for r in rows]
+    path = folder / "contact_reference.csv"
+    rows = _csv_rows(path)
+    try:
+        parts = [contact_row_reference(r) for r in rows]
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ConfigError(
+            f"{str(path)!r}: expected CONTACT's columns with numbers ({type(exc).__name__}: {exc})"
+        ) from None
     out = {k: sum(p[k] for p in parts) for k in ("normal_force_N", "creep_force_long_N", "creep_force_lat_N")}
     out["max_pressure_Pa"] = max(p["max_pressure_Pa"] for p in parts)
     out["contact_area_m2"] = sum(p["contact_area_m2"] for p in parts)
@@ -59,16 +71,24 @@ def load_named_case(name_or_folder: str | Path) -> NamedCase:
     try:
         with open(path, "rb") as handle:
             doc = tomllib.load(handle)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot be read ({exc.strerror or exc})") from None
     source = doc.get("source")
     if source not in SOURCES:
         raise ConfigError(f"key 'source' = {source!r} in {path}: expected one of {', '.join(SOURCES)}")
-    reference = {}
-    for key, value in doc.get("reference", {}).items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ConfigError(f"key 'reference.{key}' = {value!r} in {path}: expected a finite number")
-        reference[key] = float(value)
+    if not (folder / "case.toml").is_file():
+        raise ConfigError(f"case {str(name_or_folder)!r}: {str(folder / 'case.toml')!r} not found (expected the case)")
+    for key, kind, what in (("reference", dict, "a table"), ("uncertainty", dict, "a table"), ("tags", list, "a list"),
+                            ("side", str, "a string"), ("note", str, "a string")):  # fmt: skip
+        if key in doc and not isinstance(doc[key], kind):
+            raise ConfigError(f"key {key!r} = {doc[key]!r} in {path}: expected {what}")
+    for table in ("reference", "uncertainty"):
+        for key, value in doc.get(table, {}).items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ConfigError(f"key '{table}.{key}' = {value!r} in {path}: expected a finite number")
+    reference = {k: float(v) for k, v in doc.get("reference", {}).items()}
     uncertainty = {k: float(v) for k, v in doc.get("uncertainty", {}).items()}
     if source == "contact-published":
         reference = {**_contact_reference(folder), **reference}

@@ -11,7 +11,14 @@ written (``--out ""``, a path that is a file or lies under a file, a read-only p
 ConfigError naming ``--out`` and the value), takes a lock file so that two runs never write into the same
 folder, removes a summary left by an earlier run (a folder's ``summary.json`` is always the last run's, and
 is written last), and on leaving releases the lock and removes the folder again if it created it and
-nothing was written.
+nothing was written. Every command (``run``, ``contact``, ``sweep``, ``critical-speed``, ``stress``, ``compare``,
+``bench``, ``demo``, ``manchester``) takes its folder here, once, before any work.
+
+Nothing is written outside the folder: a folder name made from an input file (a case's ``name``) is sanitised
+(:func:`safe_name`: no separators, no ``..``), a folder holding a symbolic link (planted by someone else: a run
+never makes one) is refused, sub-folders are made by :func:`subfolder` (which refuses a link in their place), and a
+path that cannot be encoded (for the file system, for the UTF-8 of ``summary.json`` or for the terminal) is refused
+before anything is written.
 """
 
 from __future__ import annotations
@@ -38,7 +45,9 @@ __all__ = [
     "copy_input",
     "new_output_dir",
     "output_folder",
+    "safe_name",
     "save_figure",
+    "subfolder",
     "to_json",
     "write_json",
     "write_npz",
@@ -96,6 +105,35 @@ def write_npz(path: str | Path, **arrays) -> Path:
     return atomic_write(path, writer)
 
 
+def safe_name(text: str) -> str:
+    """A name from an input file made safe as one path component: separators, ``..``, control characters and
+    leading dots replaced (``"../../x"`` -> ``"x"``), at most 80 characters, never empty.
+    """
+    import re
+
+    cleaned = re.sub(r"[^A-Za-z0-9._+-]+", "_", str(text))
+    cleaned = re.sub(r"\.{2,}", "_", cleaned).strip("._-")
+    return cleaned[:80] or "case"
+
+
+def check_encodable(text: str, what: str) -> None:
+    """ConfigError unless ``text`` (a path) can be encoded for the file system, as UTF-8 (the JSON summaries) and
+    for this process's standard output (the printed folder): found before anything is written.
+    """
+    import sys
+
+    targets = [("the file system", None), ("UTF-8", "utf-8")]
+    encoding = getattr(sys.stdout, "encoding", None)
+    if encoding:
+        targets.append((f"the terminal's encoding {encoding}", encoding))
+    for name, codec in targets:
+        try:
+            os.fsencode(text) if codec is None else text.encode(codec)
+        except (UnicodeEncodeError, LookupError):
+            shown = text.encode("ascii", "backslashreplace").decode("ascii")
+            raise ConfigError(f"{what} {shown!r}: cannot be encoded for {name} (choose a plain path)") from None
+
+
 def _check_out(base: str | Path, option: str) -> Path:
     """The path of ``--out`` if it can be a folder (ConfigError naming the option and the value otherwise)."""
     text = str(base)
@@ -103,6 +141,7 @@ def _check_out(base: str | Path, option: str) -> Path:
         raise ConfigError(
             f"{option} {text!r}: expected a folder path (an empty path would write into the current folder)"
         )
+    check_encodable(text, option)
     out = Path(base)
     if out.exists() and not out.is_dir():
         raise ConfigError(f"{option} {text!r}: expected a folder, found a file")
@@ -131,10 +170,12 @@ def new_output_dir(base: str | Path | None, name: str, *, option: str = "--out")
     Raises:
         ConfigError: ``base`` is empty, a file, under a file, or cannot be created.
     """
+    name = safe_name(name)
     if base is not None:
         out = _check_out(base, option)
         _create(out, option, str(base), exclusive=False)
         return out
+    check_encodable(str(Path.cwd()), "the current folder")
     stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
     for attempt in range(1, 1000):
         out = Path("wheelrail-out") / (f"{name}-{stamp}" if attempt == 1 else f"{name}-{stamp}-{attempt}")
@@ -204,10 +245,13 @@ def output_folder(
         ConfigError: the folder is not usable (empty path, a file, under a file, cannot be created or written,
             held by another run).
     """
+    if base is not None:
+        _check_out(base, option)  # an empty or unencodable path is refused before anything is created
     existed = base is not None and Path(base).is_dir()
     out = new_output_dir(base, name, option=option)
     text = str(base) if base is not None else str(out)
     try:
+        _refuse_links(out, option, text)
         lock = _lock(out, option, text)
     except ConfigError:
         if not existed:
@@ -224,9 +268,47 @@ def output_folder(
     try:
         yield out
     finally:
-        lock.unlink(missing_ok=True)
+        try:
+            lock.unlink(missing_ok=True)
+        except OSError as exc:  # the folder turned read-only (or went away) during the run
+            import sys
+
+            if sys.exc_info()[0] is None:
+                raise WriteError(exc.errno, exc.strerror or str(exc), str(lock)) from None
         if not existed:
             _remove_if_empty(out)
+
+
+def _refuse_links(out: Path, option: str, text: str) -> None:
+    """ConfigError if the folder holds a symbolic link anywhere below it (a run never makes one: following it could
+    write outside the folder).
+    """
+    for root, dirs, files in os.walk(out, followlinks=False):
+        for name in dirs + files:
+            path = Path(root) / name
+            if path.is_symlink():
+                raise ConfigError(
+                    f"{option} {text!r}: holds the symbolic link {str(path)!r}; a run writes only inside its folder "
+                    "and does not follow links (remove it or choose another folder)"
+                )
+
+
+def subfolder(out: Path, name: str) -> Path:
+    """The sub-folder ``name`` of an output folder, created if missing; never a symbolic link (WriteError if a link
+    or a file is in its place, e.g. planted after the folder was checked).
+    """
+    path = Path(out) / name
+    try:
+        path.mkdir(exist_ok=True)
+    except FileExistsError:
+        pass
+    except OSError as exc:
+        raise WriteError(exc.errno, exc.strerror or str(exc), str(path)) from None
+    if path.is_symlink() or not path.is_dir():
+        import errno
+
+        raise WriteError(errno.ENOTDIR, "a symbolic link or a file where the run makes its sub-folder", str(path))
+    return path
 
 
 def _remove_if_empty(out: Path) -> None:

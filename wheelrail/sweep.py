@@ -19,19 +19,24 @@ A sweep file::
 
 Any key of the scene or case can be a parameter: speed, friction, irregularity amplitude or wavelength
 (``irregularities.polygon_amplitude_m``), ``contact_model``, lateral shift (``geometry.lateral_shift_m``),
-profile pairs (``track.wheel_profile``, ``geometry.rail_profile``). Each point is validated like a file
-(a bad value is a point with status ``invalid-input``), run on a worker, and recorded as one row.
+profile pairs (``track.wheel_profile``, ``geometry.rail_profile``). Every point is validated like a file before
+any worker starts (a bad value in ``[grid]``, ``[set]``, ``[[points]]`` or ``--set``, an unknown method or model:
+exit status 2 naming the point and the key, nothing written), then run on a worker and recorded as one row. A
+case point's status is the one ``wheelrail contact`` gives on the same input (``beyond-friction-limit`` is not ok).
 
 Outputs in the folder: ``points/<id>.json`` per finished point (written as it finishes, atomically), the
 tidy table ``sweep.csv`` and ``sweep.parquet`` (one row per point: ``point``, the parameters by their dotted
 keys, ``status``, ``message``, ``success`` and every scalar result with its unit in the name), ``sweep.png``
 (each metric against each varied numeric parameter; failed points marked) and ``summary.json``.
 
-Resume: a rerun into the same folder skips the points that have a file in ``points/`` (a point's id is a hash
-of its parameters, so an extended grid runs only its new points). A numerical failure is a finished point
-(its status and message are kept); a point whose worker was lost is recorded as ``worker-lost`` but not
-kept, so a rerun tries it again. Runs on a dask.distributed LocalCluster of ``--workers`` single-threaded
-processes (default 2), or on the cluster at ``--scheduler ADDRESS``.
+Resume: a rerun into the same folder skips the points that have a file in ``points/``. A point's id is a hash of
+the whole resolved point (the base file's content with ``[set]``, ``--set`` and the point's parameters applied, the
+method, the folder its relative file names refer to), so an extended grid runs only its new points and a changed
+setting or method runs every point again instead of reusing numbers of other settings. A numerical failure is a
+finished point (its status and message are kept); a point whose worker was lost is recorded as ``worker-lost`` but
+not kept, so a rerun tries it again. Runs on a dask.distributed LocalCluster of ``--workers`` single-threaded
+processes (default 2; TLS on credentials made for it alone, see comparisons.stress.local_dask_client: no other
+local process can run code in it), or on the cluster at ``--scheduler ADDRESS`` (trusted: see the README).
 """
 
 from __future__ import annotations
@@ -54,17 +59,53 @@ RETRIED_STATUSES = ("worker-lost",)
 """Statuses of points that are not kept as finished (a rerun runs them again)."""
 
 
+SCHEDULER_TIMEOUT_S = 10.0
+"""Seconds to reach a ``--scheduler`` (connection and handshake) before giving up with one line."""
+
+
 def point_id(parameters: dict) -> str:
-    """A stable 12-hex-digit id of a point's parameters."""
+    """A stable 12-hex-digit id of a JSON-able mapping (a point's resolved description, :func:`resolved_point`)."""
     text = json.dumps(parameters, sort_keys=True, default=str)
     return hashlib.sha1(text.encode("utf-8")).hexdigest()[:12]
 
 
-def load_sweep(path: str | Path) -> dict:
-    """Read and check a sweep file; returns the spec (kind, base path, base document, method, points, metrics).
+def resolved_point(spec: dict, parameters: dict) -> dict:
+    """The whole description of one point (what its id hashes): kind, resolved document, method, base folder.
 
     Raises:
-        ConfigError: bad keys or values (the message names the key).
+        ConfigError: a bad value or an unknown key, method or model (naming the point's parameters and the key).
+    """
+    from wheelrail.overrides import apply_overrides
+
+    values = dict(parameters)
+    method = values.pop("method", spec["method"]) if spec["kind"] == "case" else None
+    base_dir = spec["base_path"].parent
+    try:
+        doc = apply_overrides(spec["base_doc"], values)
+        if spec["kind"] == "scene":
+            from wheelrail.scenes import parse_scene
+
+            parse_scene(doc, base_dir=base_dir)
+        else:
+            from wheelrail.cases import check_solver_options, parse_case
+
+            if not isinstance(method, str):
+                raise ConfigError(f"key 'method' = {method!r}: expected a contact model name")
+            check_solver_options(parse_case(doc, name=spec["base_path"].stem, base_dir=base_dir), method)
+    except ConfigError as exc:
+        shown = ", ".join(f"{k} = {v!r}" for k, v in parameters.items())
+        raise ConfigError(f"sweep point ({shown}): {exc}".replace("--method", "method")) from None
+    return {"kind": spec["kind"], "doc": doc, "method": method, "base_dir": str(base_dir)}
+
+
+def load_sweep(path: str | Path, overrides: dict | None = None) -> dict:
+    """Read and check a sweep file and every one of its points; returns the spec (kind, base path, base document,
+    method, points, metrics).
+
+    ``overrides``: dotted keys applied to every point after the file's ``[set]`` (the CLI's ``--set``).
+
+    Raises:
+        ConfigError: bad keys or values, in the file or in any point (the message names the key).
     """
     from wheelrail.overrides import apply_overrides
 
@@ -91,21 +132,29 @@ def load_sweep(path: str | Path) -> dict:
     fixed = doc.get("set", {})
     if not isinstance(fixed, dict):
         raise ConfigError(f"key 'set' = {fixed!r}: expected a table of dotted keys")
-    base_doc = apply_overrides(read_toml(base_path, f"{kind} file"), _flatten(fixed))
+    settings = {**_flatten(fixed), **(overrides or {})}
+    base_doc = apply_overrides(read_toml(base_path, f"{kind} file"), settings)
     points = _points(doc)
     metrics = doc.get("metrics", list(DEFAULT_METRICS[kind]))
     if not (isinstance(metrics, list) and all(isinstance(m, str) for m in metrics)):
         raise ConfigError(f"key 'metrics' = {metrics!r}: expected a list of column names")
-    return {
+    spec = {
         "kind": kind,
         "base_path": base_path,
         "base_doc": base_doc,
         "method": method,
         "points": points,
         "metrics": metrics,
-        "set": _flatten(fixed),
+        "set": settings,
         "description": str(doc.get("description", "")),
     }
+    point_ids(spec)  # every point validated here, before any work
+    return spec
+
+
+def point_ids(spec: dict) -> list[str]:
+    """The id of every point of ``spec`` (each validated: ConfigError on the first bad one)."""
+    return [point_id(resolved_point(spec, parameters)) for parameters in spec["points"]]
 
 
 def _flatten(table: dict, prefix: str = "") -> dict:
@@ -140,14 +189,10 @@ def _points(doc: dict) -> list[dict]:
 
 def run_point(task: dict) -> dict:
     """Run one point (module-level: runs on a dask worker). Never raises: trouble is a status in the record."""
-    from wheelrail.overrides import apply_overrides
-
     parameters = task["parameters"]
     record = {"point": task["id"], **parameters}
     try:
-        values = dict(parameters)
-        method = values.pop("method", task["method"]) if task["kind"] == "case" else None
-        doc = apply_overrides(task["base_doc"], values)
+        doc, method = task["doc"], task["method"]
         if task["kind"] == "scene":
             from rigid_dynamics.wheelset import simulate
             from wheelrail.scenes import parse_scene
@@ -170,13 +215,29 @@ def run_point(task: dict) -> dict:
     return record
 
 
+def case_status(record: dict) -> str:
+    """The status of a contact solution record as ``wheelrail contact`` judges it (its exit status 0 only for
+    ``ok``): ``failed`` if the solve failed, else the first patch status that is not ok or ``no-contact``
+    (``beyond-friction-limit``, ``warning``, ...), else ``ok``.
+    """
+    from wheelrail.cli import OK_PATCH_STATUSES
+
+    if not record["success"]:
+        return "failed"
+    for patch in record["patches"]:
+        if patch["status"] not in OK_PATCH_STATUSES:
+            return patch["status"]
+    return "ok"
+
+
 def _case_numbers(record: dict, method: str) -> dict:
+    status = case_status(record)
     out = {
-        "status": "ok" if record["success"] else "failed",
+        "status": status,
         "message": record["message"],
         "method": method,
         "wall_time_s": record["wall_time_s"],
-        "success": record["success"],
+        "success": status == "ok",
     }
     for k, patch in enumerate(record["patches"]):
         for key, value in patch.items():
@@ -227,42 +288,28 @@ def run_sweep(
     Returns:
         The summary (also written to ``summary.json``): ``points``, ``ran``, ``skipped``, ``statuses``, ``files``.
     """
+    from wheelrail.output import subfolder
+
     out = Path(out_dir)
-    (out / "points").mkdir(parents=True, exist_ok=True)
+    out.mkdir(parents=True, exist_ok=True)
+    points_dir = subfolder(out, "points")  # never a planted link: a point file lands inside the folder
+    resolved = [resolved_point(spec, parameters) for parameters in spec["points"]]
+    ids = [point_id(point) for point in resolved]
     tasks, kept = [], []
-    for parameters in spec["points"]:
-        pid = point_id(parameters)
-        stored = out / "points" / f"{pid}.json"
-        if stored.is_file():
-            kept.append(json.loads(stored.read_text(encoding="utf-8")))
+    for pid, parameters, point in zip(ids, spec["points"], resolved, strict=True):
+        stored = points_dir / f"{pid}.json"
+        if stored.is_file() and not stored.is_symlink():
+            kept.append(_stored_record(stored, pid))
             continue
-        tasks.append(
-            {
-                "id": pid,
-                "kind": spec["kind"],
-                "parameters": parameters,
-                "base_doc": spec["base_doc"],
-                "base_dir": str(spec["base_path"].parent),
-                "name": spec["base_path"].stem,
-                "method": spec["method"],
-            }
-        )
+        tasks.append({"id": pid, "parameters": parameters, "name": spec["base_path"].stem, **point})
     new_records = []
     if tasks:
         if client is not None:
             new_records = _run_on(client, tasks, out, on_record)
         else:
-            from distributed import Client
-
-            if scheduler:
-                with Client(scheduler) as remote:
-                    new_records = _run_on(remote, tasks, out, on_record)
-            else:
-                from comparisons.stress import local_dask_client
-
-                with local_dask_client(workers) as local:
-                    new_records = _run_on(local, tasks, out, on_record)
-    order = {point_id(p): i for i, p in enumerate(spec["points"])}
+            with sweep_client(workers, scheduler) as chosen:
+                new_records = _run_on(chosen, tasks, out, on_record)
+    order = {pid: i for i, pid in enumerate(ids)}
     records = sorted(kept + new_records, key=lambda r: order.get(r["point"], len(order)))
     files = _write_outputs(records, spec, out)
     statuses: dict[str, int] = {}
@@ -282,6 +329,61 @@ def run_sweep(
 
     write_json(out / "summary.json", summary)
     return summary
+
+
+def _stored_record(path: Path, pid: str) -> dict:
+    """The record of a finished point (a point file that does not parse is a user's edit: WriteError-free refusal)."""
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"sweep resume: the point file {str(path)!r} cannot be read ({exc}); remove it") from None
+    if not isinstance(record, dict) or record.get("point") != pid or "status" not in record:
+        raise ConfigError(f"sweep resume: the point file {str(path)!r} is not a record of point {pid}; remove it")
+    return record
+
+
+def check_scheduler(address) -> str:
+    """A ``--scheduler`` address (``[tcp|tls]://HOST:PORT`` or ``HOST:PORT``), checked; ConfigError naming it."""
+    import re
+
+    text = "" if address is None else str(address)
+    match = re.fullmatch(r"(?:(tcp|tls)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):([0-9]{1,5})", text.strip())
+    if not match or not 1 <= int(match.group(3)) <= 65535:
+        raise ConfigError(
+            f"--scheduler {text!r}: expected the address of a running dask scheduler, [tcp|tls]://HOST:PORT or "
+            "HOST:PORT with a port 1-65535 (leave the option out to run on a local cluster)"
+        )
+    return text.strip()
+
+
+def sweep_client(workers: int, scheduler: str | None = None):
+    """A context manager giving the dask Client of a sweep: the cluster at ``scheduler`` (reached within
+    :data:`SCHEDULER_TIMEOUT_S`; ConfigError naming ``--scheduler`` if it cannot be reached), else a local TLS
+    cluster of ``workers`` processes (comparisons.stress.local_dask_client).
+    """
+    from contextlib import contextmanager
+
+    @contextmanager
+    def remote(address):
+        import dask
+        from distributed import Client
+
+        try:
+            with dask.config.set({"distributed.comm.timeouts.connect": f"{SCHEDULER_TIMEOUT_S}s"}):
+                client = Client(address, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
+        except (OSError, TimeoutError) as exc:
+            raise ConfigError(
+                f"--scheduler {address!r}: no dask scheduler answered within {SCHEDULER_TIMEOUT_S:g} s "
+                f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'no answer'})"
+            ) from None
+        with client:
+            yield client
+
+    if scheduler is not None:
+        return remote(check_scheduler(scheduler))
+    from comparisons.stress import local_dask_client
+
+    return local_dask_client(workers)
 
 
 def _run_on(client, tasks: list[dict], out: Path, on_record) -> list[dict]:
@@ -395,35 +497,31 @@ def cmd_sweep(args) -> int:
     """``wheelrail sweep``: run a sweep file (module docstring)."""
     import importlib.util
 
+    from wheelrail.cli import positive_int_option
     from wheelrail.output import copy_input, output_folder
     from wheelrail.overrides import parse_sets
 
-    try:
-        workers = int(args.workers)
-    except ValueError:
-        workers = 0
-    if workers < 1:
-        raise ConfigError(f"--workers {args.workers!r}: expected an integer >= 1")
+    workers = positive_int_option("--workers", args.workers)
+    scheduler = None if args.scheduler is None else check_scheduler(args.scheduler)
     if importlib.util.find_spec("distributed") is None:
         raise ConfigError("wheelrail sweep needs dask.distributed (pip install 'dask[distributed]')")
     path = Path(args.sweep)
     if not path.is_file():
         raise ConfigError(f"sweep file {str(path)!r}: not found (expected a TOML file)")
-    spec = load_sweep(path)
-    overrides = parse_sets(args.set)
-    if overrides:
-        from wheelrail.overrides import apply_overrides
+    spec = load_sweep(path, parse_sets(args.set))  # every point validated: bad input found before any work
+    if scheduler is None:
+        from wheelrail.cli import check_local_workers
 
-        spec["base_doc"] = apply_overrides(spec["base_doc"], overrides)
-        spec["set"] = {**spec["set"], **overrides}
+        check_local_workers("--workers", workers)
 
     def report(record, done, total):
         if not args.quiet:
             print(f"[{done}/{total}] point {record['point']}: {record['status']}", flush=True)
 
     with output_folder(args.out, f"sweep-{path.stem}") as out_dir:  # checked and locked: one sweep per folder
-        copy_input(path, out_dir, "sweep.toml")
-        summary = run_sweep(spec, out_dir, workers=workers, scheduler=args.scheduler, on_record=report)
+        with sweep_client(workers, scheduler) as client:  # an unreachable --scheduler: one line, nothing written
+            copy_input(path, out_dir, "sweep.toml")
+            summary = run_sweep(spec, out_dir, client=client, on_record=report)
     counts = ", ".join(f"{n} {status}" for status, n in sorted(summary["statuses"].items()))
     print(
         f"sweep {path.stem}: {summary['points']} points ({counts}); ran {summary['ran']}, "
@@ -435,9 +533,11 @@ def cmd_sweep(args) -> int:
 
 def register(sub) -> None:
     """Add the ``sweep`` sub-command to the CLI's sub-parsers."""
+    from wheelrail.cli import out_path
+
     parser = sub.add_parser("sweep", help="parameter study over a scene or case on dask.distributed")
     parser.add_argument("sweep", help="sweep TOML file")
-    parser.add_argument("--out", type=Path, help="output folder (reuse one to resume; default: wheelrail-out/...)")
+    parser.add_argument("--out", type=out_path, help="output folder (reuse one to resume; default: wheelrail-out/...)")
     parser.add_argument("--workers", default="2", metavar="N", help="LocalCluster worker processes (default 2)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on the dask scheduler at ADDRESS instead")
     parser.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a base key (repeatable)")
