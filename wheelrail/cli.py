@@ -109,7 +109,7 @@ def cmd_contact(args) -> int:
     from contextlib import ExitStack
 
     from wheelrail.cases import resolve_case_path, solution_record, solve_case
-    from wheelrail.output import copy_input, output_folder, to_json, write_json
+    from wheelrail.output import copy_input, output_folder, safe_name, to_json, write_json
     from wheelrail.overrides import load_case_with
 
     # checks --method and [solver] against the model's options; --set overrides before validation
@@ -121,7 +121,7 @@ def cmd_contact(args) -> int:
         out_dir, refused = None, None
         if wants_output and _mpi_rank() == 0:
             try:
-                out_dir = stack.enter_context(output_folder(args.out, f"contact-{case.name or 'case'}"))
+                out_dir = stack.enter_context(output_folder(args.out, f"contact-{safe_name(case.name)}"))
             except ConfigError as exc:
                 refused = exc
         elif wants_output:

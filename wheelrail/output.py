@@ -112,7 +112,7 @@ def safe_name(text: str) -> str:
     import re
 
     cleaned = re.sub(r"[^A-Za-z0-9._+-]+", "_", str(text))
-    cleaned = re.sub(r"\.{2,}", "_", cleaned).strip("._-")
+    cleaned = re.sub(r"_+", "_", re.sub(r"\.{2,}", "_", cleaned)).strip("._-")
     return cleaned[:80] or "case"
 
 

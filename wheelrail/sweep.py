@@ -365,18 +365,34 @@ def sweep_client(workers: int, scheduler: str | None = None):
 
     @contextmanager
     def remote(address):
+        import threading
+
         import dask
         from distributed import Client
 
-        try:
-            with dask.config.set({"distributed.comm.timeouts.connect": f"{SCHEDULER_TIMEOUT_S}s"}):
-                client = Client(address, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
-        except (OSError, TimeoutError) as exc:
+        # dask's own timeout does not bound a port that accepts and never answers: the connection is made in a
+        # thread given the timeout (left behind, as a daemon, if it hangs)
+        outcome: dict = {}
+
+        def connect():
+            try:
+                with dask.config.set({"distributed.comm.timeouts.connect": f"{SCHEDULER_TIMEOUT_S}s"}):
+                    outcome["client"] = Client(address, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
+            except Exception as exc:  # reported below in one line
+                outcome["error"] = exc
+
+        thread = threading.Thread(target=connect, name="wheelrail-scheduler-connect", daemon=True)
+        thread.start()
+        thread.join(SCHEDULER_TIMEOUT_S + 1.0)
+        if "client" not in outcome:
+            exc = outcome.get("error")
+            reason = (
+                "no answer" if exc is None else f"{type(exc).__name__}: {(str(exc) or 'no answer').splitlines()[0]}"
+            )
             raise ConfigError(
-                f"--scheduler {address!r}: no dask scheduler answered within {SCHEDULER_TIMEOUT_S:g} s "
-                f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'no answer'})"
-            ) from None
-        with client:
+                f"--scheduler {address!r}: no dask scheduler answered within {SCHEDULER_TIMEOUT_S:g} s ({reason})"
+            )
+        with outcome["client"] as client:
             yield client
 
     if scheduler is not None:

@@ -91,8 +91,25 @@ def case_options(method: str, check_model=None) -> dict:
                 return float
             return tuple if isinstance(v, (tuple, list)) else type(v)
 
+        def bounds(k, v):
+            """Counts, lengths, angles, tolerances, margins and scales are not negative; steps are > 0."""
+            if isinstance(v, bool) or not isinstance(v, (int, float)) and v is not None:
+                return {}
+            if k.endswith("_points"):
+                return {"minimum": 3, "maximum": 1001}
+            if k.endswith("_iterations"):
+                return {"minimum": 1, "maximum": 1000}
+            if "step" in k:
+                return {"minimum": 0, "exclusive_minimum": True}
+            if k.endswith(("_m", "_rad", "tolerance", "_margin", "_scale")):
+                return {"minimum": 0}
+            return {}
+
         declared = declare(
-            *(Option(k, kind(v), v, f"{what} option", allow_none=v is None) for k, v in defaults.items())
+            *(
+                Option(k, kind(v), v, f"{what} option", allow_none=v is None, **bounds(k, v))
+                for k, v in defaults.items()
+            )
         )
 
         def check(value, key):
