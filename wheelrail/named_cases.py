@@ -95,6 +95,7 @@ def load_named_case(name_or_folder: str | Path) -> NamedCase:
     elif source == "contact-converged":
         grid, grid_uncertainty = _contact_grid_reference(folder)
         reference, uncertainty = {**grid, **reference}, {**grid_uncertainty, **uncertainty}
+    _check_reference_field(folder / "reference_field.npz")
     return NamedCase(
         name=folder.name,
         folder=folder,
@@ -106,6 +107,25 @@ def load_named_case(name_or_folder: str | Path) -> NamedCase:
         tags=tuple(doc.get("tags", ())),
         case=load_case(folder / "case.toml"),
     )
+
+
+def _check_reference_field(path: Path) -> None:
+    """A stored reference field (x_m, y_m, pressure_Pa on its grid) must load: checked before any work."""
+    if not path.exists():
+        return
+    import numpy as np
+
+    try:
+        with np.load(path) as data:
+            x, y, p = (np.asarray(data[k], float) for k in ("x_m", "y_m", "pressure_Pa"))
+    except Exception as exc:  # a zip that is not one, a missing array, an object array: all a bad input file
+        raise ConfigError(
+            f"{str(path)!r}: expected an NPZ file with the arrays x_m, y_m and pressure_Pa ({type(exc).__name__})"
+        ) from None
+    if x.ndim != 1 or y.ndim != 1 or p.shape != (len(y), len(x)):
+        raise ConfigError(
+            f"{str(path)!r}: pressure_Pa of shape {p.shape}: expected (len(y_m), len(x_m)) = ({len(y)}, {len(x)})"
+        )
 
 
 def load_named_cases(names=None) -> list[NamedCase]:

@@ -51,7 +51,10 @@ def timeseries_columns(
 
     t = np.asarray(t, float)
     n = len(t)
-    states = np.asarray(states, float).reshape(n, -1)
+    states = np.asarray(states, float)
+    if states.size != n * len(STATE_NAMES):  # (a run stopped before its first sample has n = 0: no -1 to infer)
+        raise ValueError(f"states of shape {states.shape}: expected (n, {len(STATE_NAMES)})")
+    states = states.reshape(n, len(STATE_NAMES))
     if states.shape[1] != len(STATE_NAMES):
         raise ValueError(f"states of shape {states.shape}: expected (n, {len(STATE_NAMES)})")
     columns = {"time_s": t}
@@ -60,7 +63,8 @@ def timeseries_columns(
     for i, side in enumerate(SIDES):
         for j, slot in enumerate(SLOT_NAMES):
             for name, values in patches.items():
-                columns[f"{side}_{slot}_{name}"] = np.asarray(values, float).reshape(n, len(SIDES), -1)[:, i, j]
+                shaped = np.asarray(values, float).reshape(n, len(SIDES), len(SLOT_NAMES))
+                columns[f"{side}_{slot}_{name}"] = shaped[:, i, j]
     forces = np.asarray(contact_force_N, float).reshape(n, len(SIDES), 3)
     for i, side in enumerate(SIDES):
         for k, axis in enumerate(AXES):
