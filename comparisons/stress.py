@@ -226,6 +226,48 @@ def _map_on_client(client, tasks: list, progress: Callable[[float], None] | None
 
 
 @contextmanager
+def _workers_ignore_sigint() -> Iterator[None]:
+    """SIGINT ignored while the cluster starts its worker processes, which inherit that (and Python then installs no
+    KeyboardInterrupt handler in them): a Ctrl-C in the terminal reaches the whole process group, and the workers
+    would each print a traceback. Only this process stops on it; closing the cluster ends the workers.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextmanager
+def _quiet_dask_logs() -> Iterator[None]:
+    """Dask's own log lines at ERROR (workers: CRITICAL) and above only, here and in the workers started inside
+    (they read ``DASK_LOGGING__DISTRIBUTED`` at start-up): a cancelled task or a worker stopped on Ctrl-C is not
+    news to the user, whose sweep reports every point's status (a lost worker as ``worker-lost``) itself.
+    """
+    import logging
+    import os
+
+    logger = logging.getLogger("distributed")
+    level, variable = logger.level, os.environ.get("DASK_LOGGING__DISTRIBUTED")
+    logger.setLevel(logging.ERROR)
+    os.environ["DASK_LOGGING__DISTRIBUTED"] = "critical"  # a worker stopped mid-heartbeat logs an ERROR
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+        if variable is None:
+            os.environ.pop("DASK_LOGGING__DISTRIBUTED", None)
+        else:
+            os.environ["DASK_LOGGING__DISTRIBUTED"] = variable
+
+
+@contextmanager
 def local_dask_client(workers: int) -> Iterator:
     """A ``dask.distributed`` Client of a LocalCluster of ``workers`` single-threaded worker processes.
 
@@ -246,9 +288,12 @@ def local_dask_client(workers: int) -> Iterator:
     from distributed import Client, LocalCluster
     from distributed.security import Security
 
+    from rigid_dynamics.files import ignore_sigpipe
+
+    ignore_sigpipe()  # an earlier FEA run (dolfinx, gmsh) may have reset it: a closing TLS peer must not kill us
     security = Security.temporary()  # needs the package cryptography (a dependency of wheelrail)
-    with (
-        LocalCluster(
+    with _quiet_dask_logs(), _workers_ignore_sigint():  # Ctrl-C stops this process (which closes the cluster)
+        cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
@@ -257,9 +302,8 @@ def local_dask_client(workers: int) -> Iterator:
             security=security,
             dashboard_address=None,
             scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-        ) as cluster,
-        Client(cluster, security=security) as client,
-    ):
+        )
+    with _quiet_dask_logs(), cluster, Client(cluster, security=security) as client:
         yield client
 
 

@@ -29,10 +29,12 @@ def gmsh_model(name: str = "wheelrail"):
 
     owner = not gmsh.isInitialized()
     if owner:
-        ignored = _sigpipe_ignored()
+        from rigid_dynamics.files import ignore_sigpipe, sigpipe_ignored
+
+        ignored = sigpipe_ignored()
         gmsh.initialize(interruptible=False)
         if ignored:
-            _ignore_sigpipe()
+            ignore_sigpipe()  # gmsh.initialize resets it to its default (the process dies on a closed pipe)
     saved = {key: gmsh.option.getNumber(key) for key in ("General.Terminal", *_SIZE_OPTIONS)}
     gmsh.option.setNumber("General.Terminal", 0)
     for key, value in _SIZE_OPTIONS.items():
@@ -51,37 +53,6 @@ def gmsh_model(name: str = "wheelrail"):
             gmsh.option.setNumber(key, value)
         if owner:
             gmsh.finalize()
-
-
-def _sigpipe_ignored() -> bool:
-    """Whether SIGPIPE is ignored in this process (Python's setting at start-up), read from /proc (Linux)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("SigIgn:"):
-                    return bool(int(line.split()[1], 16) >> 12 & 1)  # bit SIGPIPE - 1 = 12
-    except (OSError, ValueError, IndexError):
-        pass
-    return False
-
-
-def _ignore_sigpipe() -> None:
-    """Ignore SIGPIPE again: gmsh.initialize resets it to its default, after which a write to a closed socket or pipe
-    (a dask TLS connection closing, a reader that went away) kills the process instead of raising BrokenPipeError.
-    Process-wide, from any thread (a dask worker runs its task outside the main thread).
-    """
-    import signal
-    import threading
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
-        return
-    import ctypes
-
-    try:
-        ctypes.CDLL(None).signal(int(signal.SIGPIPE), ctypes.c_void_p(1))  # SIG_IGN
-    except (OSError, AttributeError):  # pragma: no cover - no libc signal(): nothing to restore with
-        pass
 
 
 def generate(model, dim: int = 3, optimize: bool = True) -> None:

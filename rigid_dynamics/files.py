@@ -7,6 +7,9 @@ fails (full disk, file-size limit, read-only folder), therefore never leaves a f
 that is not whole. The file gets the permissions of a normally created file (0666 minus the umask), not
 the 0600 of a temporary file.
 
+:func:`ignore_sigpipe` restores Python's start-up setting (SIGPIPE ignored) that gmsh and dolfinx reset: with it at
+its default, a write to a closed pipe or socket kills the process mid-write instead of raising BrokenPipeError.
+
 It lives in the lowest layer (stdlib only) so that every package can use it: ``wheelrail.output``
 re-exports it, the plots of ``comparisons`` and ``fea`` save through :func:`save_figure`.
 """
@@ -84,3 +87,35 @@ def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:
     path = Path(path)
     fmt = path.suffix.lstrip(".").lower() or "png"
     return atomic_write(path, lambda tmp: fig.savefig(tmp, format=fmt, **savefig_kwargs))
+
+
+def sigpipe_ignored() -> bool:
+    """Whether SIGPIPE is ignored in this process (Python's setting at start-up), read from /proc (Linux)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as handle:
+            for line in handle:
+                if line.startswith("SigIgn:"):
+                    return bool(int(line.split()[1], 16) >> 12 & 1)  # bit SIGPIPE - 1 = 12
+    except (OSError, ValueError, IndexError):
+        pass
+    return False
+
+
+def ignore_sigpipe() -> None:
+    """Ignore SIGPIPE again, as Python does at start-up: gmsh.initialize and importing dolfinx (PETSc) reset it to its
+    default, after which a write to a closed socket or pipe (a dask TLS connection closing, a reader that went away)
+    kills the process instead of raising BrokenPipeError. Process-wide, from any thread (a dask worker runs its task
+    outside the main thread).
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+        return
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).signal(int(signal.SIGPIPE), ctypes.c_void_p(1))  # SIG_IGN
+    except (OSError, AttributeError):  # pragma: no cover - no libc signal(): nothing to restore with
+        pass

@@ -97,8 +97,10 @@ def _case_folder(tmp_path, name="hertz-ab-1"):
         (lambda f: (f / "case.toml").unlink(), ("case.toml", "not found")),
         (lambda f: (f / "reference.toml").write_bytes(b'source = "closed-form"\n\xff\xfe = 1\n'), ("not valid TOML",)),
         (lambda f: (f / "reference.toml").write_text('source = "closed-form"\nreference = 3\n'), ("'reference' = 3",)),
-        (lambda f: (f / "reference.toml").write_text('source = "closed-form"\n[uncertainty]\nx = "a"\n'),
-         ("'uncertainty.x' = 'a'",)),
+        (
+            lambda f: (f / "reference.toml").write_text('source = "closed-form"\n[uncertainty]\nx = "a"\n'),
+            ("'uncertainty.x' = 'a'",),
+        ),
         (lambda f: (f / "reference.toml").write_text('source = "closed-form"\ntags = "x"\n'), ("'tags' = 'x'",)),
         (lambda f: (f / "reference_field.npz").write_bytes(b"not a zip"), ("reference_field.npz", "NPZ")),
     ],

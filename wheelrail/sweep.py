@@ -209,6 +209,10 @@ def run_point(task: dict) -> dict:
         return {**record, "status": "invalid-input", "success": False, "message": str(exc)}
     except Exception as exc:
         return {**record, "status": "error", "success": False, "message": f"{type(exc).__name__}: {exc}"}
+    finally:
+        from rigid_dynamics.files import ignore_sigpipe
+
+        ignore_sigpipe()  # an FEA point (dolfinx, gmsh) resets it: the worker's closing connection must not kill it
     for key, value in _scalars(numbers).items():
         record.setdefault(key, value)
     record.setdefault("success", record.get("status") == "ok")
