@@ -46,7 +46,9 @@ print(summary)
 # +
 table = pd.read_csv(OUT / "run" / "sweep.csv")
 print(table.pivot(index="material.friction_coefficient", columns="method", values="patch0_creep_force_long_N"))
-assert summary["statuses"] == {"ok": 9}
+# the linear theory (full adhesion) gives |F_t| above mu N at friction 0.1 and 0.2: those points are marked
+# beyond-friction-limit, as `wheelrail contact` marks them (not ok: the theory is outside its range there)
+assert summary["statuses"] == {"ok": 7, "beyond-friction-limit": 2}
 linear = table[table["method"] == "linear"]["patch0_creep_force_long_N"]
 assert linear.nunique() == 1  # the linear theory does not see friction
 again = run_sweep(load_sweep(study), OUT / "run", client=client)
