@@ -128,6 +128,14 @@ class SimulationResult:
             return energy
         return energy - energy[0] - self.work_contact_J - self.work_exterior_J
 
+    @property
+    def energy_balance_relative(self) -> float:
+        """The largest |energy_residual_J| over the largest kinetic energy (at least 1 J); NaN without samples."""
+        if len(self.t) == 0:
+            return math.nan
+        scale = max(float(np.max(np.abs(self.kinetic_energy_J))), 1.0)
+        return float(np.max(np.abs(self.energy_residual_J))) / scale
+
     def to_dataframe(self):
         """The time series as a tidy pandas DataFrame, one column per named quantity (see wheelset.table)."""
         from rigid_dynamics.wheelset.table import to_dataframe
@@ -219,8 +227,6 @@ class SimulationResult:
         """
         lateral = self.states[:, 1] if len(self.t) else np.zeros(0)
         wavelength = dominant_wavelength_m(self.states[:, 0], lateral) if len(self.t) > 4 else math.nan
-        residual = self.energy_residual_J
-        scale = max(float(np.max(np.abs(self.kinetic_energy_J))) if len(self.t) else 0.0, 1.0)
 
         def num(value):
             value = float(value)
@@ -243,7 +249,7 @@ class SimulationResult:
             "max_abs_lateral_displacement_m": num(np.max(np.abs(lateral))) if len(self.t) else None,
             "dominant_lateral_wavelength_m": num(wavelength),
             "distance_travelled_m": num(self.states[-1, 0] - self.states[0, 0]) if len(self.t) else None,
-            "energy_balance_relative": num(np.max(np.abs(residual)) / scale) if len(self.t) else None,
+            "energy_balance_relative": num(self.energy_balance_relative) if len(self.t) else None,
             "events": [{"kind": k, "side": s, "time_s": num(t)} for k, s, t in self.events],
             "rhs_evaluations": int(self.rhs_evaluations),
             "steps": int(self.steps),
