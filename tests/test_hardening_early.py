@@ -134,3 +134,13 @@ def test_a_value_error_during_the_work_is_a_failure_not_bad_input(capsys, tmp_pa
     monkeypatch.setattr(wheelrail.cases, "solve_case", broken)
     code, _, err = run(capsys, "contact", "hertz-quadric")
     assert_error(code, err, "the work failed: ValueError: a check deep inside the solver failed", status=1)
+
+
+def test_huge_sweep_grid_is_refused_with_the_estimate(capsys, tmp_path):
+    """A 1000 x 1000 grid raised MemoryError (or ran for hours); now refused before any point is built."""
+    values = ", ".join(f"{v}.0" for v in range(1, 1001))
+    sweep = write(tmp_path, f'scene = "hunting-conical"\n[grid]\nspeed_m_per_s = [{values}]\nduration_s = [{values}]\n')
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "sweep", sweep, "--out", out)
+    assert_error(code, err, "table [grid] (1000 x 1000 = 1000000 points)", "at most 100000", "minutes")
+    assert not out.exists()

@@ -44,6 +44,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 from collections.abc import Callable
 from contextlib import suppress
 from pathlib import Path
@@ -55,6 +56,10 @@ DEFAULT_METRICS = {
     "scene": ("max_abs_lateral_displacement_m", "left_peak_normal_force_N"),
     "case": ("patch0_creep_force_long_N", "patch0_max_pressure_Pa"),
 }
+MAX_POINTS = 100_000
+"""Points of one sweep at most (a grid of 1000 x 1000 values is refused before anything is built)."""
+VALIDATION_S_PER_POINT = 5.5e-3
+"""Time to validate one point before the work (hunting-conical, measured on the shared 2-core machine)."""
 RETRIED_STATUSES = ("worker-lost",)
 """Statuses of points that are not kept as finished (a rerun runs them again)."""
 
@@ -177,10 +182,19 @@ def _points(doc: dict) -> list[dict]:
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             raise ConfigError(f"key 'grid.{key}' = {values!r}: expected a non-empty list of values")
-    points = [dict(zip(grid, combo, strict=True)) for combo in itertools.product(*grid.values())] if grid else []
     explicit = doc.get("points", [])
     if not (isinstance(explicit, list) and all(isinstance(p, dict) for p in explicit)):
         raise ConfigError(f"key 'points' = {explicit!r}: expected [[points]] tables")
+    count = math.prod(len(values) for values in grid.values()) if grid else 0
+    if count + len(explicit) > MAX_POINTS:
+        sizes = " x ".join(str(len(values)) for values in grid.values()) or "0"
+        raise ConfigError(
+            f"table [grid] ({sizes} = {count} points) and {len(explicit)} [[points]]: expected at most {MAX_POINTS} "
+            f"points in one sweep (each is a run; validating them alone would take about "
+            f"{(count + len(explicit)) * VALIDATION_S_PER_POINT / 60:.3g} minutes before the first run starts); "
+            "split the study into several sweeps"
+        )
+    points = [dict(zip(grid, combo, strict=True)) for combo in itertools.product(*grid.values())] if grid else []
     points += [_flatten(p) for p in explicit]
     if not points:
         raise ConfigError("sweep file: expected a [grid] table or [[points]] tables (no point to run)")
