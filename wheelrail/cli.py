@@ -610,6 +610,47 @@ def _check_terminated() -> None:
         raise SystemExit(EXIT_TERMINATED)
 
 
+def _unreadable_cache_files(exc: BaseException) -> list[Path]:
+    """The numba cache files (index ``.nbi``, data ``.nbc``) whose loading raised ``exc`` (empty if it came from
+    elsewhere): read from the frames of numba's cache loader in the traceback.
+    """
+    files = []
+    tb = exc.__traceback__
+    while tb is not None:
+        frame = tb.tb_frame
+        if frame.f_code.co_filename.replace("\\", "/").endswith("numba/core/caching.py"):
+            owner = frame.f_locals.get("self")
+            for candidate in (getattr(owner, "_index_path", None), frame.f_locals.get("path")):
+                if isinstance(candidate, str) and candidate.endswith((".nbi", ".nbc")):
+                    files.append(Path(candidate))
+        tb = tb.tb_next
+    return list(dict.fromkeys(files))
+
+
+def _run_rebuilding_cache(args) -> int:
+    """``args.func(args)``; a numba cache file that cannot be read (corrupted: UnpicklingError, EOFError, ...) is
+    removed with a one-line note and the command runs once more, compiling the kernel again (its cache is rewritten).
+    """
+    try:
+        return args.func(args)
+    except Exception as exc:
+        files = _unreadable_cache_files(exc)
+        if not files:
+            raise
+        for path in files:
+            try:
+                path.unlink(missing_ok=True)
+            except OSError:
+                raise exc from None  # cannot repair it: the original error
+        names = ", ".join(str(p) for p in files)
+        print(
+            f"wheelrail: note: the compiled-code cache {names} could not be read ({type(exc).__name__}: {exc}); "
+            "removed, compiling again (this run takes longer)",
+            file=sys.stderr,
+        )
+    return args.func(args)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``wheelrail`` console script; returns the exit status (module docstring)."""
     import signal
@@ -624,7 +665,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = build_parser().parse_args(argv)
         args.started_at = start
-        return args.func(args)
+        return _run_rebuilding_cache(args)
     except ConfigError as exc:
         print(f"wheelrail: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
