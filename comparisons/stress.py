@@ -227,9 +227,12 @@ def _map_on_client(client, tasks: list, progress: Callable[[float], None] | None
 
 @contextmanager
 def _workers_ignore_sigint() -> Iterator[None]:
-    """SIGINT ignored while the cluster starts its worker processes, which inherit that (and Python then installs no
-    KeyboardInterrupt handler in them): a Ctrl-C in the terminal reaches the whole process group, and the workers
-    would each print a traceback. Only this process stops on it; closing the cluster ends the workers.
+    """SIGINT ignored while the cluster starts its worker processes, which inherit that across exec (and Python then
+    installs no KeyboardInterrupt handler in them): a Ctrl-C in the terminal reaches the whole process group, and each
+    worker would print a traceback. Only this process stops on it; closing the cluster ends the workers.
+
+    The cost: a Ctrl-C during the cluster's start (a second or two) is lost. Blocking SIGINT instead does not reach
+    the workers (they are spawned from dask's event-loop thread), and both together still lose it to that thread.
     """
     import signal
     import threading
