@@ -144,3 +144,14 @@ def test_huge_sweep_grid_is_refused_with_the_estimate(capsys, tmp_path):
     code, _, err = run(capsys, "sweep", sweep, "--out", out)
     assert_error(code, err, "table [grid] (1000 x 1000 = 1000000 points)", "at most 100000", "minutes")
     assert not out.exists()
+
+
+def test_beam_over_an_enormous_travel_is_refused_at_once(capsys, tmp_path):
+    """wheel-flat's beam track over a day of travel (1440 km): the modes were counted one by one before the size
+    check (minutes); now refused in well under a second of work, naming the beam's size."""
+    out = tmp_path / "out"
+    start = time.perf_counter()
+    code, _, err = run(capsys, "run", "wheel-flat", "--set", "duration_s=86400", "--out", out, "--quiet")
+    assert time.perf_counter() - start < 30.0
+    assert_error(code, err, "track_dynamics.model = 'beam'", "expected at most 8000")
+    assert not out.exists()

@@ -591,8 +591,9 @@ class DynamicsScene:
             if 2 * layout.n_positions > MAX_BEAM_STATES:
                 raise ValueError(
                     f"track_dynamics.model = 'beam' over {travel_m(self):.4g} m "
-                    f"(speed_m_per_s x duration_s): a beam of {layout.n_modes} modes and {layout.n_sleepers} seats "
-                    f"per rail, {2 * layout.n_positions} states: expected at most {MAX_BEAM_STATES} (its cost grows "
+                    f"(speed_m_per_s x duration_s): a beam of {layout.n_sleepers} seats and at least {layout.n_modes} "
+                    f"modes per rail, at least {2 * layout.n_positions} states: expected at most {MAX_BEAM_STATES} "
+                    "(its cost grows "
                     "with the square of the length: shorten the run, lower cutoff_frequency_Hz, or use model 'lumped')"
                 )
         if self.irregularities.joint_dip_angle_rad > 0 and (

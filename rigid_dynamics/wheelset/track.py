@@ -335,14 +335,18 @@ class BeamLayout:
 def beam_layout(track: TrackDynamics, travel_m: float) -> BeamLayout:
     """The beam for a run of ``travel_m``: it holds the travel (with 10 % and one sleeper spacing to spare) and
     ``end_margin_m`` at each end, in whole sleeper spacings; its modes are those whose flexural frequency
-    (:func:`flexural_frequency_rad_per_s`) is at most ``cutoff_frequency_Hz``.
+    (:func:`flexural_frequency_rad_per_s`) is at most ``cutoff_frequency_Hz`` (counted up to one past the size
+    that :data:`MAX_BEAM_STATES` allows).
     """
     a = track.sleeper_spacing_m
     n_sleepers = int(math.ceil((1.1 * max(travel_m, 0.0) + a + 2.0 * track.end_margin_m) / a)) - 1
     length = (n_sleepers + 1) * a
     cutoff = 2.0 * math.pi * track.cutoff_frequency_Hz
+    # counted up to one mode past MAX_BEAM_STATES (the scene's check refuses such a beam; an enormous travel would
+    # otherwise count millions of modes one by one first)
+    most = max(0, (MAX_BEAM_STATES // 4 - n_sleepers) // (2 if track.timoshenko else 1)) + 1
     n = 0
-    while float(flexural_frequency_rad_per_s(track, (n + 1) * math.pi / length)) <= cutoff:
+    while n < most and float(flexural_frequency_rad_per_s(track, (n + 1) * math.pi / length)) <= cutoff:
         n += 1
     return BeamLayout(max(n, 1), n_sleepers, length, track.end_margin_m, track.timoshenko)
 
