@@ -140,3 +140,14 @@ def test_every_command_honours_the_lock(capsys, tmp_path, command):
         code, _, err = run(capsys, *_argv(command, tmp_path), "--out", out)
         assert_error(code, err, f"--out {str(out)!r}", "another wheelrail run", LOCK_NAME)
         assert sorted(p.name for p in out.iterdir()) == [LOCK_NAME]
+
+
+def test_unrelated_links_in_a_users_folder_are_left_alone(capsys, tmp_path):
+    """Only the sub-folders a run writes into are searched for links: ``--out .`` in a project with a virtual
+    environment's links works, and the link is not followed or touched."""
+    out = tmp_path / "project"
+    (out / "venv").mkdir(parents=True)
+    (out / "venv" / "python").symlink_to("/usr/bin/env")
+    code, _, err = run(capsys, "contact", "hertz-quadric", "--out", out)
+    assert code == 0, err
+    assert (out / "summary.json").is_file() and (out / "venv" / "python").is_symlink()

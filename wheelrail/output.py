@@ -15,10 +15,10 @@ nothing was written. Every command (``run``, ``contact``, ``sweep``, ``critical-
 ``bench``, ``demo``, ``manchester``) takes its folder here, once, before any work.
 
 Nothing is written outside the folder: a folder name made from an input file (a case's ``name``) is sanitised
-(:func:`safe_name`: no separators, no ``..``), a folder holding a symbolic link (planted by someone else: a run
-never makes one) is refused, sub-folders are made by :func:`subfolder` (which refuses a link in their place), and a
-path that cannot be encoded (for the file system, for the UTF-8 of ``summary.json`` or for the terminal) is refused
-before anything is written.
+(:func:`safe_name`: no separators, no ``..``), a folder whose run sub-folders hold a symbolic link (planted by
+someone else: a run never makes one) is refused, sub-folders are made by :func:`subfolder` (which refuses a link in
+their place), and a path that cannot be encoded (for the file system, for the UTF-8 of ``summary.json`` or for
+the terminal) is refused before anything is written.
 """
 
 from __future__ import annotations
@@ -279,18 +279,36 @@ def output_folder(
             _remove_if_empty(out)
 
 
+RUN_SUBFOLDERS = ("points", "fea", "run", "compare")
+"""The sub-folders commands write into (sweep points, FEA files, the demo's run and comparison)."""
+
+
 def _refuse_links(out: Path, option: str, text: str) -> None:
-    """ConfigError if the folder holds a symbolic link anywhere below it (a run never makes one: following it could
-    write outside the folder).
+    """ConfigError if a sub-folder a run writes into (:data:`RUN_SUBFOLDERS`), or anything below one, is a symbolic
+    link: a run never makes one, and following it could write outside the folder. (Files in the folder itself are
+    replaced by name, a link among them is replaced, not followed; the rest of a user's folder is not searched.)
     """
-    for root, dirs, files in os.walk(out, followlinks=False):
-        for name in dirs + files:
-            path = Path(root) / name
-            if path.is_symlink():
-                raise ConfigError(
-                    f"{option} {text!r}: holds the symbolic link {str(path)!r}; a run writes only inside its folder "
-                    "and does not follow links (remove it or choose another folder)"
-                )
+    for name in RUN_SUBFOLDERS:
+        top = out / name
+        if top.is_symlink():
+            found = top
+        elif top.is_dir():
+            found = next(
+                (
+                    Path(root) / n
+                    for root, dirs, files in os.walk(top)
+                    for n in dirs + files
+                    if (Path(root) / n).is_symlink()
+                ),
+                None,
+            )
+        else:
+            found = None
+        if found is not None:
+            raise ConfigError(
+                f"{option} {text!r}: holds the symbolic link {str(found)!r}; a run writes only inside its folder "
+                "and does not follow links (remove it or choose another folder)"
+            )
 
 
 def subfolder(out: Path, name: str) -> Path:
