@@ -418,7 +418,10 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
             "note": "main BEM patch only, BEM normal force",
             "resolution": _fea_resolution(fea_result),
         }
-    report = _report(named, models, solved, sources, cuts, pictures, notes)
+    from comparisons.rung_differences import explain
+
+    differences = explain(solved, getattr(named.case, "material", None), options)
+    report = _report(named, models, solved, sources, cuts, pictures, notes, differences)
     write_text_atomic(out_dir / "report.md", report["markdown"])
     write_text_atomic(out_dir / "report.html", report["html"])
     summary = {
@@ -429,6 +432,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
         "pictures": pictures,
         "notes": notes,
         "headlines": report["headlines"],
+        "rung_differences": [d.removeprefix("- ") for d in differences],
     }
     write_json_atomic(out_dir / "compare.json", summary)
     return summary
@@ -443,13 +447,22 @@ def _fea_resolution(result) -> str:
     return text + (f", {cells} cells" if cells else "")
 
 
-def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
+def _source_file(named) -> str | None:
+    """The case's SOURCE.md as the report cites it, or None when the case has none (e.g. the demo's peak patch)."""
+    folder = getattr(named, "folder", None)
+    if folder is None or not (Path(folder) / "SOURCE.md").is_file():
+        return None
+    return f"comparisons/cases/{named.name}/SOURCE.md"
+
+
+def _report(named, models, solved, sources, cuts, pictures, notes, differences=()) -> dict:
     ref = named.reference
     lines = [
         f"# {named.name}: Hertz, FASTSIM, BEM and FEA side by side",
         "",
-        f"{named.note}. Reference: {named.source} (comparisons/cases/{named.name}/SOURCE.md). Side compared: "
-        f"{named.side}.",
+        f"{named.note}. Reference: {named.source}"
+        + (f" ({_source_file(named)})" if _source_file(named) else "")
+        + f". Side compared: {named.side}.",
         "",
         "| model | grid / mesh | status | time | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm2] | err N | err F | "
         "err p | err area |",
@@ -476,6 +489,16 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
             f"{_pct(err.get('err_max_pressure'))} | {_pct(err.get('err_area'))} |"
         )
     lines += ["", "Times: whole case (a wheelset case includes search and equilibrium); FEA: one patch.", ""]
+    if differences:
+        lines += [
+            "## Where the rungs differ from the BEM",
+            "",
+            "Main patch; differences above 5 % (N, p max, area) or 5 % of mu N (creep forces), each with its measured "
+            "cause (comparisons/rung_differences.py).",
+            "",
+            *differences,
+            "",
+        ]
     for key, caption in (
         ("pressure", "Pressure on one colour scale with the contact outlines, and the difference to the BEM"),
         ("fields", "Tractions and slip/adhesion (FASTSIM, BEM)"),
