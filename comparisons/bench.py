@@ -464,7 +464,7 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
             plots[named.name] = name
     from comparisons.claims import claims_markdown, evaluate_claims
 
-    claims = evaluate_claims(runs)
+    claims = evaluate_claims(runs, {c.name: max(c.uncertainty.values(), default=0.0) for c in cases})
     table = tolerance_table(runs)
     summary = {
         "quick": quick,
