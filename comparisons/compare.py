@@ -644,44 +644,15 @@ def _report(named, models, solved, sources, cuts, pictures, notes, differences=(
 
 
 def _html(markdown: str, title: str) -> str:
-    """A small Markdown -> HTML rendering (headings, paragraphs, tables, images, lists) for this report."""
-    body, table = [], []
+    """The report as a standalone HTML page (markdown-it-py, CommonMark with tables; images scale to the page)."""
+    from markdown_it import MarkdownIt
 
-    def flush_table():
-        if not table:
-            return
-        rows = [r.strip("|").split("|") for r in table if not set(r.replace("|", "").strip()) <= {"-"}]
-        out = ["<table>"]
-        for k, row in enumerate(rows):
-            tag = "th" if k == 0 else "td"
-            out.append("<tr>" + "".join(f"<{tag}>{html.escape(c.strip())}</{tag}>" for c in row) + "</tr>")
-        out.append("</table>")
-        body.append("\n".join(out))
-        table.clear()
-
-    for line in markdown.splitlines():
-        if line.startswith("|"):
-            table.append(line)
-            continue
-        flush_table()
-        if line.startswith("#"):
-            level = len(line) - len(line.lstrip("#"))
-            body.append(f"<h{level}>{html.escape(line[level:].strip())}</h{level}>")
-        elif line.startswith("!["):
-            alt, src = line[2:].split("](", 1)
-            body.append(
-                f'<p><img src="{html.escape(src.rstrip(")"))}" alt="{html.escape(alt)}" style="max-width:100%"></p>'
-            )
-        elif line.startswith("- "):
-            body.append(f"<ul><li>{html.escape(line[2:])}</li></ul>")
-        elif line.strip():
-            body.append(f"<p>{html.escape(line)}</p>")
-    flush_table()
+    body = MarkdownIt("commonmark", {"html": False}).enable("table").render(markdown)
     style = (
         "body{font-family:sans-serif;max-width:1100px;margin:2em auto;}table{border-collapse:collapse;font-size:90%}"
-        "td,th{border:1px solid #bbb;padding:3px 6px;text-align:right}th{background:#eee}"
+        "td,th{border:1px solid #bbb;padding:3px 6px;text-align:right}th{background:#eee}img{max-width:100%}"
     )
     return (
         f"<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-        f"<style>{style}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n"
+        f"<style>{style}</style></head><body>\n{body}</body></html>\n"
     )
