@@ -7,7 +7,9 @@ For each patch ``<side>-<k>`` of a solved case the output folder gets
   ``in_slip``, ``in_adhesion`` (bool masks), each (ny, nx) with ``[j, i]`` at ``(x_m[i], y_m[j])``;
   ``outline_m`` (k, 2): the contact outline (the 0.5 level of ``in_contact``), closed curves separated by
   rows of NaN; ``point_m`` (3,) and ``frame`` (3, 3) of the patch (track frame, columns = contact axes);
-  ``method``, ``source`` and ``units`` as strings. Fields a model does not give are absent.
+  ``method`` and ``source`` as strings; ``units`` and ``dims`` as JSON strings (``json.loads(f["units"][()])``):
+  each array's SI unit ("Pa", "m/s", "1" for masks) and its axis names (``["y", "x"]`` for the fields: row j is
+  ``y_m[j]``, column i is ``x_m[i]``). Fields a model does not give are absent.
 * ``fields-<side>-<k>.vtu``: the same grid as one quad surface (VTK unstructured grid) placed in the track
   frame (point = ``point_m + frame @ (x, y, 0)``, m), every field as point data with its unit in the name
   (masks as 0/1 integers), the contact-frame coordinates as ``contact_frame_xy_m``.
@@ -24,6 +26,7 @@ Every file is written atomically (:func:`wheelrail.output.atomic_write`); meshio
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -111,6 +114,17 @@ def _track_points(xy: np.ndarray, geometry) -> np.ndarray:
     return point + local @ frame.T
 
 
+_UNIT_SUFFIXES = (("_m_per_s", "m/s"), ("_Pa", "Pa"), ("_N", "N"), ("_m2", "m^2"), ("_m", "m"), ("_s", "s"))
+
+
+def unit_of(name: str) -> str:
+    """The SI unit a name's suffix states (``slip_m_per_s`` -> "m/s", ``pressure_Pa`` -> "Pa"); "1" for none."""
+    for suffix, unit in _UNIT_SUFFIXES:
+        if name.endswith(suffix):
+            return unit
+    return "1"
+
+
 def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactResult) -> dict[str, str]:
     """Write the NPZ, VTU and outline files of one patch; return {kind: file name} ({} if it has no fields)."""
     import meshio
@@ -124,8 +138,12 @@ def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactR
     arrays = field_arrays(fields)
     curves = outline_curves(fields)
     outline = np.concatenate([np.vstack([c, [[np.nan, np.nan]]]) for c in curves])[:-1] if curves else np.zeros((0, 2))
-    units = {name: name.rsplit("_", 1)[-1] if name not in MASK_NAMES else "1 (mask)" for name in arrays}
-    units.update({"x_m": "m", "y_m": "m", "outline_m": "m", "point_m": "m"})
+    units = {key: "1" if key in MASK_NAMES else unit_of(key) for key in arrays}
+    units.update({"x_m": "m", "y_m": "m", "outline_m": "m", "point_m": "m", "frame": "1"})
+    dims = {key: ["y", "x"] for key in arrays}
+    dims.update(
+        {"x_m": ["x"], "y_m": ["y"], "outline_m": ["point", "xy"], "point_m": ["xyz"], "frame": ["xyz", "axis"]}
+    )
     point = np.asarray(getattr(geometry, "point_m", np.zeros(3)), float)
     frame = np.asarray(getattr(geometry, "frame", np.eye(3)), float)
     files = {}
@@ -138,7 +156,8 @@ def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactR
         frame=frame,
         method=np.array(result.method),
         source=np.array(source),
-        units=np.array(repr(units)),
+        units=np.array(json.dumps(units)),
+        dims=np.array(json.dumps(dims)),
         **arrays,
     )
     files["npz"] = npz.name
