@@ -98,6 +98,9 @@ def test_conicity_command(capsys):
     code, record = run_json(capsys, "conicity", "--json")
     assert code == 0
     assert 0.05 < record["equivalent_conicity"] < 0.4
+    # the default pair is the scenes' (S1002 on UIC60), not the Manchester benchmark's files (0.1836 there)
+    code, same = run_json(capsys, "conicity", "--json", "--wheel", "S1002", "--rail", "UIC60")
+    assert code == 0 and same["equivalent_conicity"] == record["equivalent_conicity"]
 
 
 @pytest.mark.fea

@@ -462,8 +462,12 @@ def _add_contact(sub) -> None:
 
 def _add_conicity(sub) -> None:
     conicity = sub.add_parser("conicity", help="equivalent conicity (EN 15302 method)")
-    conicity.add_argument("--wheel", default="MBench_S1002_v3", help="wheel profile: built-in name or file")
-    conicity.add_argument("--rail", default="MBench_UIC60_v3", help="rail profile: built-in name or file")
+    conicity.add_argument(
+        "--wheel", default="S1002", help="wheel profile: built-in name or file (default S1002, as the scenes)"
+    )
+    conicity.add_argument(
+        "--rail", default="UIC60", help="rail profile: built-in name or file (default UIC60, as the scenes)"
+    )
     number = finite_float
     conicity.add_argument("--gauge-m", type=number("--gauge-m"), default=1.435)
     conicity.add_argument("--gauge-height-m", type=number("--gauge-height-m"), default=0.014)
