@@ -641,11 +641,31 @@ def _json_safe(value):
 _SKIP = object()
 
 
+OK_PATCH_STATUSES = ("ok", "no-contact")
+"""Patch statuses of a case that ends ``ok`` (exit 0)."""
+
+
+def solution_status(solution: CaseSolution) -> str:
+    """The case's one status, as printed, in the JSON and by the exit code: "ok" when the solver succeeded and every
+    patch is ok or out of contact; else the first patch status that is not (e.g. "beyond-friction-limit": the
+    linear theory's number, outside its range), or "failed".
+    """
+    for patch in solution.patches:
+        if patch[3].status not in OK_PATCH_STATUSES:
+            return patch[3].status
+    return "ok" if solution.success else "failed"
+
+
 def solution_record(solution: CaseSolution) -> dict:
-    """The JSON object printed by ``wheelrail contact --json``."""
+    """The JSON object printed by ``wheelrail contact --json``: ``status`` and ``success`` (status == "ok") agree
+    with the exit code; ``solver_converged`` is the solver's own flag.
+    """
+    status = solution_status(solution)
     return {
         "method": solution.method,
-        "success": bool(solution.success),
+        "status": status,
+        "success": status == "ok",
+        "solver_converged": bool(solution.success),
         "message": solution.message,
         "wall_time_s": solution.wall_time_s,
         "setup_s": solution.setup_s,

@@ -39,8 +39,6 @@ from wheelrail.config import ConfigError
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_OUTPUT_FAILED = 0, 1, 2, 3
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
-OK_PATCH_STATUSES = ("ok", "no-contact")
-"""Patch statuses of a contact run that keep exit status 0."""
 
 
 MPI_RANK_VARIABLES = ("PMI_RANK", "OMPI_COMM_WORLD_RANK", "PMIX_RANK")
@@ -150,9 +148,7 @@ def cmd_contact(args) -> int:
         _print(_contact_table(record))
         if out_dir is not None:
             _print(f"output written to {out_dir}")
-    statuses = [p["status"] for p in record["patches"]]
-    ok = solution.success and all(status in OK_PATCH_STATUSES for status in statuses)
-    return EXIT_OK if ok else EXIT_FAILED
+    return EXIT_OK if record["status"] == "ok" else EXIT_FAILED
 
 
 def _mpi_broadcast(value):
@@ -207,7 +203,7 @@ def _fea_views(solution, out_dir: Path) -> list[str]:
 
 
 def _contact_table(record: dict) -> str:
-    lines = [f"method {record['method']}: {'ok' if record['success'] else 'FAILED'} - {record['message']}"]
+    lines = [f"method {record['method']}: {record['status']} - {record['message']}"]
     keys = [
         ("normal_force_N", "N [N]", 1.0),
         ("creep_force_long_N", "Fx [N]", 1.0),
