@@ -131,3 +131,20 @@ def test_contact_status_json_and_exit_code_agree_beyond_the_friction_limit(capsy
     assert record["solver_converged"] is True
     assert main(["contact", "hertz-quadric", "--method", "linear"]) == 1
     assert "method linear: beyond-friction-limit" in capsys.readouterr().out
+
+
+def test_one_case_namespace_for_every_command(capsys, tmp_path):
+    """`wheelrail cases` lists the benchmark cases too, `contact` solves them, and `compare`/`bench` take the cases
+    without a reference (no error columns): `contact large-spin` and `compare hertz-quadric` ended with exit 2."""
+    from wheelrail.named_cases import load_named_case, named_case_names
+
+    assert main(["cases"]) == 0
+    listed = capsys.readouterr().out
+    for name in ("hertz-quadric", "manchester-a22", *named_case_names()):
+        assert f"\n{name} " in listed or listed.startswith(f"{name} "), name
+    code, record = run_json(capsys, "contact", "large-spin", "--method", "fastsim", "--json")
+    assert code == 0 and record["patches"][0]["normal_force_N"] == pytest.approx(82000.0)
+    named = load_named_case("hertz-quadric")
+    assert named.source == "none" and named.reference == {} and named.case_path.name == "hertz-quadric.toml"
+    argv = ["bench", "--quick", "--cases", "hertz-quadric", "--models", "hertz", "--out", str(tmp_path / "b")]
+    assert main(argv) == 0

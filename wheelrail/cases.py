@@ -448,8 +448,16 @@ CASES_DIR = Path(__file__).parent / "cases"
 
 
 def embedded_cases() -> dict[str, Path]:
-    """Embedded contact cases: name -> path."""
-    return {p.stem: p for p in sorted(CASES_DIR.glob("*.toml"))}
+    """Every named contact case, one namespace for every command: name -> case file.
+
+    The cases of ``wheelrail/cases/*.toml`` (no reference) and the benchmark cases of
+    ``comparisons/cases/<name>/case.toml`` (with a reference for ``bench`` and ``compare``), sorted by name.
+    """
+    from comparisons.named_cases import CASES_ROOT
+
+    found = {p.stem: p for p in CASES_DIR.glob("*.toml")}
+    found.update({p.parent.name: p for p in CASES_ROOT.glob("*/case.toml")})
+    return dict(sorted(found.items()))
 
 
 def resolve_case_path(path: str | Path) -> Path:

@@ -95,8 +95,13 @@ def cmd_cases(args) -> int:
 
     cases = embedded_cases()
     width = max((len(n) for n in cases), default=0)
+    _print(f"{'case':<{width}}  {'reference':<17}  description")
     for name, path in cases.items():
-        _print(f"{name:<{width}}  {read_toml(path).get('description', '')}")
+        ref = path.parent / "reference.toml"
+        source = read_toml(ref).get("source", "?") if ref.is_file() else "none"
+        _print(f"{name:<{width}}  {source:<17}  {read_toml(path).get('description', '')}")
+    _print("every command takes these names (contact, compare, bench --cases); bench and compare state errors only "
+           "against a reference")  # fmt: skip
     return EXIT_OK
 
 
