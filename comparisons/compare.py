@@ -424,7 +424,8 @@ def _plot_3d(cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
         plotter.add_text(source["source"], font_size=9)
         path = out_dir / "subsurface_3d.png"
         tmp = out_dir / ".subsurface_3d.tmp.png"
-        plotter.screenshot(str(tmp))
+        with pv.vtk_verbosity("off"):  # no "bad X server connection" warning on a machine without a display
+            plotter.screenshot(str(tmp))
         plotter.close()
         tmp.replace(path)
         return path.name, "ok"
