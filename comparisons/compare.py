@@ -383,7 +383,14 @@ def _plot_3d(cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
     """3-D view (pyvista, off-screen) of the two von Mises cuts of ``source`` below the pressure map."""
     try:
         import pyvista as pv
+    except Exception as exc:  # pyvista is an optional plotting dependency
+        return None, f"{type(exc).__name__}: {exc}"
+    with pv.vtk_verbosity("off"):  # no "bad X server connection" warning on a machine without a display
+        return _render_3d(pv, cuts, source, pressure_fields, out_dir)
 
+
+def _render_3d(pv, cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
+    try:
         n_xz, d = cuts["n_xz"], cuts["depth"] * 1e3
         vm = source["von_mises"] / 1e6
         planes = []
@@ -424,8 +431,7 @@ def _plot_3d(cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
         plotter.add_text(source["source"], font_size=9)
         path = out_dir / "subsurface_3d.png"
         tmp = out_dir / ".subsurface_3d.tmp.png"
-        with pv.vtk_verbosity("off"):  # no "bad X server connection" warning on a machine without a display
-            plotter.screenshot(str(tmp))
+        plotter.screenshot(str(tmp))
         plotter.close()
         tmp.replace(path)
         return path.name, "ok"
