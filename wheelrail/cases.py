@@ -485,6 +485,26 @@ class CaseSolution:
         """The JSON record of ``wheelrail contact --json`` (:func:`solution_record`)."""
         return solution_record(self)
 
+    def _repr_markdown_(self) -> str:
+        """A table for notebooks: one row per patch, forces on the wheel in the contact frame."""
+
+        def cell(value, scale=1.0):
+            return "-" if value is None else f"{value * scale:.5g}"
+
+        lines = [
+            f"**{self.method}**: {solution_status(self)} in {self.wall_time_s:.3g} s"
+            + (f" ({self.message})" if self.message else ""),
+            "",
+            "| side | status | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm^2] |",
+            "|---|---|---:|---:|---:|---:|---:|",
+        ]
+        for side, _, _, r in self.patches:
+            lines.append(
+                f"| {side} | {r.status} | {cell(r.normal_force_N)} | {cell(r.creep_force_long_N)} | "
+                f"{cell(r.creep_force_lat_N)} | {cell(r.max_pressure_Pa, 1e-6)} | {cell(r.contact_area_m2, 1e6)} |"
+            )
+        return "\n".join(lines) + "\n"
+
     def to_dataframe(self):
         """One row per patch: side, model, forces, pressure, semi-axes, creepages (units in the names)."""
         import pandas as pd
@@ -526,8 +546,8 @@ def warm_up(method: str, material: Material) -> float:
     return time.perf_counter() - start
 
 
-def solve_case(case: ContactCase, method: str) -> CaseSolution:
-    """Solve a validated case with the contact model ``method``.
+def solve_case(case: ContactCase | str | Path, method: str) -> CaseSolution:
+    """Solve a validated case (or a case's name or file, read by :func:`load_case`) with the model ``method``.
 
     The model is imported and its compiled kernels loaded (:func:`warm_up`) before the clock starts, so
     ``wall_time_s`` measures the solve; that preparation is ``setup_s``. For a wheelset case the clock
@@ -536,6 +556,8 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
     from rigid_dynamics.contact.registry import get_model
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
 
+    if isinstance(case, (str, Path)):
+        case = load_case(case)
     prepare = time.perf_counter()
     model = get_model(method)
     warm_up(method, case.material)

@@ -201,8 +201,11 @@ def write_solution_files(solution, out_dir: str | Path) -> list[dict]:
     return written
 
 
-def plot_patch(result: ContactResult, path: str | Path) -> Path | None:
-    """PNG of a patch: the model's fields, or for an analytic model Hertz's ellipse and pressure; None if neither."""
+def plot_patch(result: ContactResult, path: str | Path | None = None):
+    """PNG of a patch: the model's fields, or for an analytic model Hertz's ellipse and pressure; None if neither.
+
+    ``path`` None returns the matplotlib Figure (shown inline in a notebook) instead of writing a file.
+    """
     if result.fields is not None:
         from comparisons.contact_plots import plot_contact_fields
 
@@ -210,15 +213,11 @@ def plot_patch(result: ContactResult, path: str | Path) -> Path | None:
     fields = hertz_fields(result)
     if fields is None:
         return None
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from wheelrail.output import atomic_write
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend is left alone
 
     a, b = result.semi_axis_long_m, result.semi_axis_lat_m
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig = Figure(figsize=(6, 4.5))
+    ax = fig.subplots()
     p = np.ma.masked_where(fields.pressure_Pa <= 0, fields.pressure_Pa)
     mesh = ax.pcolormesh(1e3 * fields.x_m, 1e3 * fields.y_m, p / 1e6, shading="auto", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="Hertz pressure [MPa]", shrink=0.85)
@@ -232,7 +231,10 @@ def plot_patch(result: ContactResult, path: str | Path) -> Path | None:
         f"{result.method}: a = {1e3 * a:.3g} mm, b = {1e3 * b:.3g} mm, p0 = {result.max_pressure_Pa / 1e6:.4g} MPa",
         fontsize=9,
     )
+    if path is None:
+        return fig
+    from wheelrail.output import atomic_write
+
     path = Path(path)
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=120, bbox_inches="tight", format="png"))
-    plt.close(fig)
     return path
