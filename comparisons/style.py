@@ -61,3 +61,40 @@ def seconds_axis(axis, low: float, high: float) -> None:
         axis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     else:
         axis.set_minor_formatter(NullFormatter())
+
+
+_UNIT_SUFFIXES = (
+    ("_m_per_s", "m/s"), ("_1_per_m", "1/m"), ("_N_per_m", "N/m"), ("_Pa", "Pa"), ("_Nm", "N m"), ("_N", "N"),
+    ("_m2", "m^2"), ("_rad", "rad"), ("_kg", "kg"), ("_Hz", "Hz"), ("_m", "m"), ("_s", "s"),
+)  # fmt: skip
+_READABLE = {"m": ("mm", 1e3), "Pa": ("MPa", 1e-6), "m^2": ("mm^2", 1e6), "rad": ("mrad", 1e3)}
+_NAMES = {
+    "energy_balance_relative": "relative energy residual",
+    "max_force_ratio": "largest normal force / static load",
+}
+
+
+def unit_of(name: str) -> str:
+    """The SI unit a name's suffix states (``slip_m_per_s`` -> "m/s", ``pressure_Pa`` -> "Pa"); "1" for none."""
+    for suffix, unit in _UNIT_SUFFIXES:
+        if name.endswith(suffix):
+            return unit
+    return "1"
+
+
+def label_of(name: str) -> tuple[str, float]:
+    """An axis label for a column name and the factor that converts its values: ``y_amplitude_m`` ->
+    ("y amplitude [mm]", 1e3); metres, pascals and radians in the units a railway engineer reads (mm, MPa, mrad).
+    """
+    if name in _NAMES:
+        return _NAMES[name], 1.0
+    if "." in name:  # a dotted scene key: its last part names the quantity
+        name = name.rsplit(".", 1)[-1]
+    unit = unit_of(name)
+    stem = name
+    if unit != "1":
+        suffix = next(sfx for sfx, u in _UNIT_SUFFIXES if u == unit and name.endswith(sfx))
+        stem = name[: -len(suffix)]
+    shown, scale = _READABLE.get(unit, (unit, 1.0))
+    text = stem.replace("_", " ").strip()
+    return (f"{text} [{shown}]" if unit != "1" else text), scale

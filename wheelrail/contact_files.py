@@ -114,17 +114,6 @@ def _track_points(xy: np.ndarray, geometry) -> np.ndarray:
     return point + local @ frame.T
 
 
-_UNIT_SUFFIXES = (("_m_per_s", "m/s"), ("_Pa", "Pa"), ("_N", "N"), ("_m2", "m^2"), ("_m", "m"), ("_s", "s"))
-
-
-def unit_of(name: str) -> str:
-    """The SI unit a name's suffix states (``slip_m_per_s`` -> "m/s", ``pressure_Pa`` -> "Pa"); "1" for none."""
-    for suffix, unit in _UNIT_SUFFIXES:
-        if name.endswith(suffix):
-            return unit
-    return "1"
-
-
 def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactResult) -> dict[str, str]:
     """Write the NPZ, VTU and outline files of one patch; return {kind: file name} ({} if it has no fields)."""
     import meshio
@@ -138,6 +127,8 @@ def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactR
     arrays = field_arrays(fields)
     curves = outline_curves(fields)
     outline = np.concatenate([np.vstack([c, [[np.nan, np.nan]]]) for c in curves])[:-1] if curves else np.zeros((0, 2))
+    from comparisons.style import unit_of
+
     units = {key: "1" if key in MASK_NAMES else unit_of(key) for key in arrays}
     units.update({"x_m": "m", "y_m": "m", "outline_m": "m", "point_m": "m", "frame": "1"})
     dims = {key: ["y", "x"] for key in arrays}
