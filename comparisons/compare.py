@@ -219,6 +219,80 @@ def subsurface(named, bem_main, fea_options=None, with_fea: bool = True):
     return cuts, sources, fea_result
 
 
+_MAP_METADATA = {"Description": "pressure maps: x (rolling) and y (lateral) in mm, equal aspect; pressure in MPa"}
+
+
+def _patch_box(fields, margin: float = 0.15) -> tuple[float, float, float, float]:
+    """(x0, x1, y0, y1) in mm: the union of the fields' contact areas (p > 0), padded by ``margin`` of its size."""
+    xs, ys = [], []
+    for f in fields:
+        on = np.asarray(f.pressure_Pa) > 0
+        if on.any():
+            gx, gy = np.meshgrid(f.x_m, f.y_m)
+            xs += [gx[on].min(), gx[on].max()]
+            ys += [gy[on].min(), gy[on].max()]
+    if not xs:
+        xs = [min(f.x_m.min() for f in fields), max(f.x_m.max() for f in fields)]
+        ys = [min(f.y_m.min() for f in fields), max(f.y_m.max() for f in fields)]
+    x0, x1, y0, y1 = (1e3 * v for v in (min(xs), max(xs), min(ys), max(ys)))
+    pad_x, pad_y = margin * max(x1 - x0, 1e-3), margin * max(y1 - y0, 1e-3)
+    return x0 - pad_x, x1 + pad_x, y0 - pad_y, y1 + pad_y
+
+
+MAX_MAP_RATIO = 4.0
+"""A patch longer than this many times its width (a flange patch: 13 x 0.7 mm) is drawn with y stretched so that
+the panel is at most this elongated, and the title says by how much (an equal-aspect sliver shows nothing)."""
+
+
+def _stretch(box) -> float:
+    """The factor by which y (or x) is stretched in the maps of ``box``: 1 (equal aspect) unless the patch is more
+    elongated than :data:`MAX_MAP_RATIO`; > 1 stretches y, < 1 stretches x.
+    """
+    width, height = box[1] - box[0], box[3] - box[2]
+    if width <= 0 or height <= 0:
+        return 1.0
+    ratio = width / height
+    if ratio > MAX_MAP_RATIO:
+        return ratio / MAX_MAP_RATIO
+    if ratio < 1 / MAX_MAP_RATIO:
+        return ratio * MAX_MAP_RATIO
+    return 1.0
+
+
+def _map_axes(n: int, box):
+    """A row of ``n`` map panels sized to the patch's aspect (a long flange patch gets tall panels, not slivers);
+    panels wider than 3:1 are stacked in a column.
+    """
+    import matplotlib.pyplot as plt
+
+    width, height = box[1] - box[0], box[3] - box[2]
+    ratio = height * _stretch(box) / width if width > 0 else 1.0  # drawn height over width
+    if ratio < 1 / 2:  # wide, flat patches: one panel per row
+        fig, axes = plt.subplots(
+            n, 1, figsize=(7.0, (max(1.6, 7.0 * ratio) + 0.5) * n), squeeze=False, layout="constrained"
+        )
+    else:
+        panel = 3.4
+        size = (panel * n + 1.2, min(max(panel * ratio, 2.4), 9.0))
+        fig, axes = plt.subplots(1, n, figsize=size, squeeze=False, layout="constrained")
+    axes = list(axes.flat)
+    for ax in axes:
+        ax.set_xlabel("x (rolling) [mm]")
+        ax.set_ylabel("y (lateral) [mm]")
+    return fig, axes
+
+
+def _zoom(ax, box) -> None:
+    """Limits of the patch's box; equal aspect, or the stretch of :func:`_stretch` said in the title."""
+    ax.set_xlim(box[0], box[1])
+    ax.set_ylim(box[2], box[3])
+    stretch = _stretch(box)
+    ax.set_aspect(stretch)
+    if stretch != 1.0:
+        what = f"y stretched x{stretch:.3g}" if stretch > 1 else f"x stretched x{1 / stretch:.3g}"
+        ax.set_title(f"{ax.get_title()} ({what})", fontsize=9)
+
+
 def _plot_pressures(entries, bem_fields, out_dir):
     import matplotlib
 
@@ -231,20 +305,15 @@ def _plot_pressures(entries, bem_fields, out_dir):
     names = [n for n, f in entries if f is not None]
     fields = [f for _, f in entries if f is not None]
     vmax = max(float(np.max(f.pressure_Pa)) for f in fields) / 1e6
-    xs = np.concatenate([f.x_m for f in fields]) * 1e3
-    ys = np.concatenate([f.y_m for f in fields]) * 1e3
-    fig, axes = plt.subplots(1, len(fields), figsize=(3.6 * len(fields), 3.6), squeeze=False)
-    for ax, name, f in zip(axes[0], names, fields, strict=True):
+    box = _patch_box(fields)
+    fig, axes = _map_axes(len(fields), box)
+    for ax, name, f in zip(axes, names, fields, strict=True):
         mesh = ax.pcolormesh(f.x_m * 1e3, f.y_m * 1e3, f.pressure_Pa / 1e6, vmin=0, vmax=vmax, shading="auto")
         ax.contour(f.x_m * 1e3, f.y_m * 1e3, (f.pressure_Pa > 0).astype(float), levels=[0.5], colors="w", linewidths=1)
-        ax.set_title(name)
-        ax.set_xlim(xs.min(), xs.max())
-        ax.set_ylim(ys.min(), ys.max())
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (rolling) [mm]")
-    axes[0][0].set_ylabel("y (lateral) [mm]")
-    fig.colorbar(mesh, ax=axes[0].tolist(), label="pressure [MPa] (one scale)")
-    save_figure_atomic(fig, out_dir / "pressure.png", dpi=110, bbox_inches="tight")
+        ax.set_title(name, fontsize=9)
+        _zoom(ax, box)
+    fig.colorbar(mesh, ax=list(axes), label="pressure [MPa] (one scale)", shrink=0.9)
+    save_figure_atomic(fig, out_dir / "pressure.png", dpi=110, bbox_inches="tight", metadata=_MAP_METADATA)
     plt.close(fig)
     if bem_fields is None:
         return ["pressure.png"]
@@ -257,18 +326,16 @@ def _plot_pressures(entries, bem_fields, out_dir):
     if not diffs:
         return ["pressure.png"]
     lim = max(float(np.abs(d).max()) for _, d in diffs) / 1e6 or 1.0
-    fig, axes = plt.subplots(1, len(diffs), figsize=(3.6 * len(diffs), 3.6), squeeze=False)
-    for ax, (name, d) in zip(axes[0], diffs, strict=True):
+    fig, axes = _map_axes(len(diffs), box)
+    for ax, (name, d) in zip(axes, diffs, strict=True):
         mesh = ax.pcolormesh(gx * 1e3, gy * 1e3, d / 1e6, vmin=-lim, vmax=lim, cmap="RdBu_r", shading="auto")
         ax.contour(
             gx * 1e3, gy * 1e3, (bem_fields.pressure_Pa > 0).astype(float), levels=[0.5], colors="k", linewidths=0.8
         )
-        ax.set_title(f"{name} - bem")
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (rolling) [mm]")
-    axes[0][0].set_ylabel("y (lateral) [mm]")
-    fig.colorbar(mesh, ax=axes[0].tolist(), label="p - p_BEM [MPa] (black: BEM outline)")
-    save_figure_atomic(fig, out_dir / "pressure_difference.png", dpi=110, bbox_inches="tight")
+        ax.set_title(f"{name} - bem", fontsize=9)
+        _zoom(ax, box)
+    fig.colorbar(mesh, ax=list(axes), label="p - p_BEM [MPa] (black: BEM outline)", shrink=0.9)
+    save_figure_atomic(fig, out_dir / "pressure_difference.png", dpi=110, bbox_inches="tight", metadata=_MAP_METADATA)
     plt.close(fig)
     return ["pressure.png", "pressure_difference.png"]
 
@@ -316,7 +383,14 @@ def _plot_3d(cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
     """3-D view (pyvista, off-screen) of the two von Mises cuts of ``source`` below the pressure map."""
     try:
         import pyvista as pv
+    except Exception as exc:  # pyvista is an optional plotting dependency
+        return None, f"{type(exc).__name__}: {exc}"
+    with pv.vtk_verbosity("off"):  # no "bad X server connection" warning on a machine without a display
+        return _render_3d(pv, cuts, source, pressure_fields, out_dir)
 
+
+def _render_3d(pv, cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
+    try:
         n_xz, d = cuts["n_xz"], cuts["depth"] * 1e3
         vm = source["von_mises"] / 1e6
         planes = []
@@ -331,11 +405,29 @@ def _plot_3d(cuts, source, pressure_fields, out_dir) -> tuple[str | None, str]:
         px, py = np.meshgrid(f.x_m * 1e3, f.y_m * 1e3)
         top = pv.StructuredGrid(px[..., None], py[..., None], np.zeros_like(px)[..., None])
         top.point_data["pressure [MPa]"] = (f.pressure_Pa / 1e6)[..., None].ravel(order="F")
-        plotter = pv.Plotter(off_screen=True, window_size=(900, 650))
+        plotter = pv.Plotter(off_screen=True, window_size=(1000, 700))
+        bar = {"fmt": "%.0f", "n_labels": 4, "title_font_size": 14, "label_font_size": 12, "width": 0.35}
         for grid in planes:
-            plotter.add_mesh(grid, scalars="von Mises [MPa]", cmap="inferno", clim=(0, float(np.nanmax(vm))))
-        plotter.add_mesh(top, scalars="pressure [MPa]", cmap="viridis", opacity=0.6)
-        plotter.show_grid(xtitle="x [mm]", ytitle="y [mm]", ztitle="-depth [mm]")
+            plotter.add_mesh(
+                grid, scalars="von Mises [MPa]", cmap="inferno", clim=(0, float(np.nanmax(vm))),
+                scalar_bar_args={**bar, "position_x": 0.6, "position_y": 0.05},
+            )  # fmt: skip
+        plotter.add_mesh(
+            top, scalars="pressure [MPa]", cmap="viridis", opacity=0.6,
+            scalar_bar_args={**bar, "position_x": 0.6, "position_y": 0.24},
+        )  # fmt: skip
+        # depth drawn at a scale that shows it beside a long patch; the axis title says the scale
+        extent = max(np.ptp(px), np.ptp(py), 1e-3)
+        zscale = max(1.0, round(extent / (3.0 * max(float(d.max()), 1e-3))))
+        plotter.set_scale(zscale=zscale)
+        # the axes label the true coordinates (axes_ranges), not the drawn, depth-stretched ones
+        ranges = [px.min(), px.max(), py.min(), py.max(), -float(d.max()), 0.0]
+        plotter.show_grid(
+            axes_ranges=ranges, xtitle="x [mm]", ytitle="y [mm]",
+            ztitle=f"-depth [mm] (drawn x{zscale:g})" if zscale != 1 else "-depth [mm]",
+            n_xlabels=4, n_ylabels=3, n_zlabels=3, fmt="%.2f", font_size=10,
+        )  # fmt: skip
+        plotter.view_isometric()
         plotter.add_text(source["source"], font_size=9)
         path = out_dir / "subsurface_3d.png"
         tmp = out_dir / ".subsurface_3d.tmp.png"
@@ -418,7 +510,10 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
             "note": "main BEM patch only, BEM normal force",
             "resolution": _fea_resolution(fea_result),
         }
-    report = _report(named, models, solved, sources, cuts, pictures, notes)
+    from comparisons.rung_differences import explain
+
+    differences = explain(solved, getattr(named.case, "material", None), options)
+    report = _report(named, models, solved, sources, cuts, pictures, notes, differences)
     write_text_atomic(out_dir / "report.md", report["markdown"])
     write_text_atomic(out_dir / "report.html", report["html"])
     summary = {
@@ -429,6 +524,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
         "pictures": pictures,
         "notes": notes,
         "headlines": report["headlines"],
+        "rung_differences": [d.removeprefix("- ") for d in differences],
     }
     write_json_atomic(out_dir / "compare.json", summary)
     return summary
@@ -443,13 +539,22 @@ def _fea_resolution(result) -> str:
     return text + (f", {cells} cells" if cells else "")
 
 
-def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
+def _source_file(named) -> str | None:
+    """The case's SOURCE.md as the report cites it, or None when the case has none (e.g. the demo's peak patch)."""
+    folder = getattr(named, "folder", None)
+    if folder is None or not (Path(folder) / "SOURCE.md").is_file():
+        return None
+    return f"comparisons/cases/{named.name}/SOURCE.md"
+
+
+def _report(named, models, solved, sources, cuts, pictures, notes, differences=()) -> dict:
     ref = named.reference
     lines = [
         f"# {named.name}: Hertz, FASTSIM, BEM and FEA side by side",
         "",
-        f"{named.note}. Reference: {named.source} (comparisons/cases/{named.name}/SOURCE.md). Side compared: "
-        f"{named.side}.",
+        f"{named.note}. Reference: {named.source}"
+        + (f" ({_source_file(named)})" if _source_file(named) else "")
+        + f". Side compared: {named.side}.",
         "",
         "| model | grid / mesh | status | time | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm2] | err N | err F | "
         "err p | err area |",
@@ -476,6 +581,16 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
             f"{_pct(err.get('err_max_pressure'))} | {_pct(err.get('err_area'))} |"
         )
     lines += ["", "Times: whole case (a wheelset case includes search and equilibrium); FEA: one patch.", ""]
+    if differences:
+        lines += [
+            "## Where the rungs differ from the BEM",
+            "",
+            "Main patch; differences above 5 % (N, p max, area) or 5 % of mu N (creep forces), each with its measured "
+            "cause (comparisons/rung_differences.py).",
+            "",
+            *differences,
+            "",
+        ]
     for key, caption in (
         ("pressure", "Pressure on one colour scale with the contact outlines, and the difference to the BEM"),
         ("fields", "Tractions and slip/adhesion (FASTSIM, BEM)"),
@@ -536,44 +651,15 @@ def _report(named, models, solved, sources, cuts, pictures, notes) -> dict:
 
 
 def _html(markdown: str, title: str) -> str:
-    """A small Markdown -> HTML rendering (headings, paragraphs, tables, images, lists) for this report."""
-    body, table = [], []
+    """The report as a standalone HTML page (markdown-it-py, CommonMark with tables; images scale to the page)."""
+    from markdown_it import MarkdownIt
 
-    def flush_table():
-        if not table:
-            return
-        rows = [r.strip("|").split("|") for r in table if not set(r.replace("|", "").strip()) <= {"-"}]
-        out = ["<table>"]
-        for k, row in enumerate(rows):
-            tag = "th" if k == 0 else "td"
-            out.append("<tr>" + "".join(f"<{tag}>{html.escape(c.strip())}</{tag}>" for c in row) + "</tr>")
-        out.append("</table>")
-        body.append("\n".join(out))
-        table.clear()
-
-    for line in markdown.splitlines():
-        if line.startswith("|"):
-            table.append(line)
-            continue
-        flush_table()
-        if line.startswith("#"):
-            level = len(line) - len(line.lstrip("#"))
-            body.append(f"<h{level}>{html.escape(line[level:].strip())}</h{level}>")
-        elif line.startswith("!["):
-            alt, src = line[2:].split("](", 1)
-            body.append(
-                f'<p><img src="{html.escape(src.rstrip(")"))}" alt="{html.escape(alt)}" style="max-width:100%"></p>'
-            )
-        elif line.startswith("- "):
-            body.append(f"<ul><li>{html.escape(line[2:])}</li></ul>")
-        elif line.strip():
-            body.append(f"<p>{html.escape(line)}</p>")
-    flush_table()
+    body = MarkdownIt("commonmark", {"html": False}).enable("table").render(markdown)
     style = (
         "body{font-family:sans-serif;max-width:1100px;margin:2em auto;}table{border-collapse:collapse;font-size:90%}"
-        "td,th{border:1px solid #bbb;padding:3px 6px;text-align:right}th{background:#eee}"
+        "td,th{border:1px solid #bbb;padding:3px 6px;text-align:right}th{background:#eee}img{max-width:100%}"
     )
     return (
         f"<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-        f"<style>{style}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n"
+        f"<style>{style}</style></head><body>\n{body}</body></html>\n"
     )

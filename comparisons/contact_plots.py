@@ -21,7 +21,7 @@ def _edges(centres: np.ndarray) -> np.ndarray:
     return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
 
 
-def plot_contact_fields(result: ContactResult, path: str | Path, *, title: str | None = None) -> Path:
+def plot_contact_fields(result: ContactResult, path: str | Path | None = None, *, title: str | None = None):
     """Write a PNG with the pressure, tangential traction and slip/adhesion maps of ``result``.
 
     Panels (contact frame, x rolling to the right, y lateral up, mm):
@@ -34,21 +34,19 @@ def plot_contact_fields(result: ContactResult, path: str | Path, *, title: str |
 
     Args:
         result: a solved patch with ``fields`` set.
-        path: output file (PNG); parent directories are created.
+        path: output file (PNG); parent directories are created. None returns the Figure (shown inline in a
+            notebook) instead.
         title: figure title (default: method, forces).
 
     Returns:
-        The path written.
+        The path written, or the matplotlib Figure when ``path`` is None.
 
     Raises:
         ValueError: ``result.fields`` is None.
     """
     if result.fields is None:
         raise ValueError(f"result.fields is None for method {result.method!r}: expected surface fields to plot")
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend (a notebook's inline one) is left alone
 
     f = result.fields
     x_mm, y_mm = 1e3 * np.asarray(f.x_m), 1e3 * np.asarray(f.y_m)
@@ -62,8 +60,8 @@ def plot_contact_fields(result: ContactResult, path: str | Path, *, title: str |
     span_y = ye[-1] - ye[0]
     width = 4.2 * panels
     height = max(2.6, min(6.0, 4.2 * span_y / max(span_x, 1e-12))) + 1.0
-    fig, axes = plt.subplots(1, panels, figsize=(width, height), squeeze=False)
-    axes = axes[0]
+    fig = Figure(figsize=(width, height))
+    axes = fig.subplots(1, panels, squeeze=False)[0]
 
     def outline(ax):
         if contact.any() and contact.shape[0] > 1 and contact.shape[1] > 1:
@@ -116,9 +114,8 @@ def plot_contact_fields(result: ContactResult, path: str | Path, *, title: str |
         title = ", ".join(parts)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
+    if path is None:
+        return fig
     from rigid_dynamics.files import save_figure
 
-    try:
-        return save_figure(fig, path, dpi=110)  # atomic: a killed run leaves no half PNG under the final name
-    finally:
-        plt.close(fig)
+    return save_figure(fig, path, dpi=110)  # atomic: a killed run leaves no half PNG under the final name

@@ -10,6 +10,7 @@ parameter value, failed runs marked).
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -97,28 +98,40 @@ def plot_stress(records: list[dict], path: str | Path | None = None):
     if path is not None:
         matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
+
+    from comparisons.style import label_of
 
     parameters = list(dict.fromkeys(r["parameter"] for r in records))
     fig, axes = plt.subplots(2, max(len(parameters), 1), figsize=(3.2 * max(len(parameters), 1), 6), squeeze=False)
     for j, name in enumerate(parameters):
-        rows = [r for r in records if r["parameter"] == name]
+        rows = [r for r in records if r["parameter"] == name and r["value"] is not None]
+        xlabel, xscale = label_of(name)
         for i, key in enumerate(("energy_balance_relative", "max_force_ratio")):
             ax = axes[i, j]
             kinds = (("ok", "o", "k"), ("warning", "^", "tab:orange"), ("stopped", "x", "tab:red"))
             for kind, marker, color in kinds:
                 pts = [
-                    (r["value"], r[key])
+                    (r["value"] * xscale, r[key])
                     for r in rows
-                    if r[key] is not None and (r["status"] if r["status"] in ("ok", "warning") else "stopped") == kind
+                    if r[key] is not None
+                    and math.isfinite(r[key])
+                    and (r["status"] if r["status"] in ("ok", "warning") else "stopped") == kind
                 ]
                 if pts:
                     xs, ys = zip(*pts, strict=True)
                     ax.plot(xs, ys, marker, color=color, label=kind)
+            missing = [r["value"] * xscale for r in rows if r[key] is None or not math.isfinite(r[key])]
+            if missing:  # no number (a run stopped before it): drawn on the axis, not dropped
+                ax.plot(missing, [0.0 if key != "energy_balance_relative" else 1e-16] * len(missing), "s",
+                        mfc="none", color="tab:red", label="no value")  # fmt: skip
             ax.set_xscale("log" if all((r["value"] or 0) > 0 for r in rows) else "linear")
             if key == "energy_balance_relative":
                 ax.set_yscale("log")
-            ax.set_xlabel(name)
-            ax.set_ylabel(key)
+                ax.yaxis.set_minor_formatter(NullFormatter())
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(label_of(key)[0])
             ax.grid(True, alpha=0.3)
     axes[0, 0].legend(fontsize=8)
     fig.tight_layout()

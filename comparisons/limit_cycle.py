@@ -26,6 +26,10 @@ from dataclasses import replace
 
 import numpy as np
 
+PERSIST_RATIO = 0.9
+"""Default of ``limit_cycle_search``'s ``persist_ratio``: a run whose amplitude ratio (last sixth / sixth before)
+is below it is decaying."""
+
 
 def cycle_amplitude(result) -> tuple[float, float]:
     """(amplitude, persistence) of y(t): max |y - mean| over the last third; ratio last sixth / sixth before."""
@@ -67,7 +71,7 @@ def limit_cycle_search(
     duration_s: float = 2.0,
     disturbance_m: float = 0.006,
     threshold_m: float = 1e-3,
-    persist_ratio: float = 0.9,
+    persist_ratio: float = PERSIST_RATIO,
     bisections: int = 3,
     extensions: int = 2,
     simulate=None,
@@ -184,20 +188,32 @@ def _outcome(success, status, message, speed, runs, branch=(), bracket=None) -> 
     }
 
 
-def plot_branch(outcome: dict, path, linear_speed_m_per_s: float | None = None):
-    """PNG of the cycle amplitude against speed (the runs with and without a cycle, the linear speed)."""
-    import matplotlib
+def plot_branch(outcome: dict, path, linear_speed_m_per_s: float | None = None, persist_ratio: float | None = None):
+    """PNG of the cycle amplitude against speed (the runs with and without a cycle, the linear speed).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Each run is labelled with its persistence ratio (the amplitude of the last sixth over the sixth before), the
+    number that decided "limit cycle" or "decays": a run with a large amplitude drawn as "decays" is one whose
+    oscillation was still shrinking. Runs without a usable amplitude (a failed run: NaN) are drawn on the axis
+    as "no amplitude", not dropped.
+    """
+    from matplotlib.figure import Figure
 
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = Figure(figsize=(6.4, 4.2))
+    ax = fig.subplots()
     runs = outcome["runs"]
+    finite = [r["amplitude_m"] for r in runs if math.isfinite(r["amplitude_m"])]
     for cycle, style, label in ((True, "o", "limit cycle"), (False, "x", "decays / none")):
-        pts = [(r["speed_m_per_s"], r["amplitude_m"]) for r in runs if r["cycle"] == cycle]
+        pts = [(r["speed_m_per_s"], r["amplitude_m"], r["persistence"]) for r in runs if r["cycle"] == cycle]
+        pts = [p for p in pts if math.isfinite(p[1])]
         if pts:
-            speeds, amps = zip(*pts, strict=True)
+            speeds, amps, ratios = zip(*pts, strict=True)
             ax.plot(speeds, np.array(amps) * 1e3, style, label=label)
+            for v, a, ratio in pts:
+                if math.isfinite(ratio):
+                    ax.annotate(f"{ratio:.2f}", (v, a * 1e3), fontsize=6, xytext=(3, 3), textcoords="offset points")
+    missing = [r["speed_m_per_s"] for r in runs if not math.isfinite(r["amplitude_m"])]
+    if missing:
+        ax.plot(missing, np.zeros(len(missing)), "s", mfc="none", color="tab:red", label="no amplitude (failed run)")
     if outcome["branch"]:
         ax.plot(
             [b["speed_m_per_s"] for b in outcome["branch"]], [b["amplitude_m"] * 1e3 for b in outcome["branch"]], "C0-"
@@ -207,11 +223,13 @@ def plot_branch(outcome: dict, path, linear_speed_m_per_s: float | None = None):
     if linear_speed_m_per_s:
         ax.axvline(linear_speed_m_per_s, color="C3", ls=":", label="linear critical speed")
     ax.set_xlabel("speed [m/s]")
-    ax.set_ylabel("lateral amplitude [mm]")
+    ax.set_ylabel("lateral amplitude over the last third [mm]")
+    rule = f" (a cycle: ratio >= {persist_ratio:g})" if persist_ratio else ""
+    ax.set_title(f"numbers: persistence ratio, last sixth / sixth before{rule}", fontsize=8)
+    if finite:
+        ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     from rigid_dynamics.files import save_figure
 
-    try:
-        return save_figure(fig, path, dpi=110, bbox_inches="tight")  # atomic
-    finally:
-        plt.close(fig)
+    return save_figure(fig, path, dpi=110, bbox_inches="tight")  # atomic

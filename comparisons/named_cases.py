@@ -59,6 +59,7 @@ class NamedCase:
         tags: labels used by the research claims ("hertz", "creep", "spin", "flange", "irregular", ...).
         case: the validated contact case of ``case.toml`` (``wheelrail.cases.ContactCase``; read by
             ``wheelrail.named_cases``, since TOML is read only in wheelrail).
+        case_file: the case's TOML file where it is not ``folder/case.toml`` (the cases of ``wheelrail/cases``).
     """
 
     name: str
@@ -70,10 +71,12 @@ class NamedCase:
     note: str = ""
     tags: tuple = ()
     case: object = None
+    case_file: Path | None = None
 
     @property
     def case_path(self) -> Path:
-        return self.folder / "case.toml"
+        """The case file: ``case_file`` when given (a case without a reference folder), else ``folder/case.toml``."""
+        return self.case_file if self.case_file is not None else self.folder / "case.toml"
 
     def reference_grid(self) -> tuple[np.ndarray, np.ndarray] | None:
         """Points (x_m, y_m) on which the reference pressure field is compared, or None (no reference field).

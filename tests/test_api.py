@@ -82,3 +82,31 @@ def test_contact_results_have_dict_dataframe_and_short_repr():
     assert len(row) == 1 and row["normal_force_N"][0] == result.normal_force_N
     assert "method='fastsim'" in repr(result) and len(repr(result)) < 400
     assert "CaseSolution(method='fastsim'" in repr(solution) and len(repr(solution)) < 400
+
+
+def test_notebook_use_names_accepted_rich_display_and_figures_returned():
+    """In a notebook: case and scene names are accepted where objects were (an AttributeError before), results show
+    as Markdown tables, and the plot functions return a Figure when no path is given, without switching the
+    caller's matplotlib backend (a notebook's inline backend stays)."""
+    import matplotlib
+
+    backend = matplotlib.get_backend()
+    solution = wr.solve_case("hertz-quadric", "fastsim")
+    table = solution._repr_markdown_()
+    assert "| single | ok |" in table and "p max [MPa]" in table
+    result = solution.patches[0][3]
+    assert "max pressure" in result._repr_markdown_() and "MPa" in result._repr_markdown_()
+    figure = wr.plot_patch(result)
+    assert type(figure).__name__ == "Figure" and figure.axes
+    assert wr.plot_patch(wr.solve_case("hertz-quadric", "hertz").patches[0][3]).axes
+    assert matplotlib.get_backend() == backend
+
+
+def test_simulate_takes_a_scene_file_name(tmp_path):
+    """wr.simulate reads a scene given by its file (or embedded name) instead of failing on a string."""
+    text = wr.embedded_scenes()["hunting-conical"].read_text()
+    lines = [("duration_s = 0.02" if line.startswith("duration_s") else line) for line in text.splitlines()]
+    path = tmp_path / "short.toml"
+    path.write_text("\n".join(lines) + "\n")
+    run = wr.simulate(str(path))
+    assert run.success and run.t[-1] == pytest.approx(0.02)

@@ -92,3 +92,39 @@ def test_failed_run_is_a_status_not_a_number(monkeypatch):
     run = bench.run_one(named, "bem", "8x8", {})
     assert run.status == "error" and "diverged" in run.message and run.error is None and not run.values
     assert math.isnan(run.wall_time_s) or run.wall_time_s >= 0
+
+
+def test_plots_one_style_per_rung_percent_axis_overview_and_front_over_answering_rungs(tmp_path):
+    """The Pareto front leaves out a normal-contact rung (Hertz, 100 % on a creep case: no creep forces); every plot
+    draws a rung in one colour and marker, the error axis in %, and an overview of all cases is written."""
+    from PIL import Image
+
+    from comparisons.style import RUNG_COLOURS
+
+    hertz = BenchRun("creep", "s", "hertz", "-", "ok", "", 1e-5, errors={"err_creep_force": 1.0}, error=1.0)
+    assert not bench.answers_question(hertz)
+    assert bench.answers_question(BenchRun("hertz-case", "s", "hertz", "-", "ok", "", 1e-5, errors={}, error=0.0))
+    runs = [
+        hertz,
+        BenchRun("creep", "s", "fastsim", "10x10", "ok", "", 1e-3, errors={"err_creep_force": 0.05}, error=0.05),
+        BenchRun("creep", "s", "bem", "16x16", "ok", "", 1e-2, errors={"err_creep_force": 0.01}, error=0.01),
+        BenchRun("other", "s", "bem", "16x16", "ok", "", 1e-2, errors={}, error=0.02),
+    ]
+    assert bench.plot_overview(runs, tmp_path / "overview.png")
+    assert bench.plot_case(runs, "creep", tmp_path / "creep.png")
+    for name in ("overview.png", "creep.png"):
+        info = Image.open(tmp_path / name).info
+        assert "%" in info["Description"] and "[s]" in info["Description"]
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    bench._draw_case(ax, runs[:3], 1e-6, annotate=False)
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    assert lines["bem"].get_color() == RUNG_COLOURS["bem"]
+    front = lines["Pareto front"]
+    assert 1e-5 not in list(front.get_xdata())  # Hertz not on the front
+    assert ax.yaxis.get_major_formatter()(0.05, 0) == "5 %"
+    plt.close(fig)

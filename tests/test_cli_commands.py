@@ -56,8 +56,9 @@ def test_contact_json_contract_quadric(capsys, method):
     # the linear theory gives |F_t| = 1.1 mu N on this case: a number outside its range, exit status 1
     assert code == (1 if method == "linear" else 0)
     assert record["patches"][0]["status"] == ("beyond-friction-limit" if method == "linear" else "ok")
-    assert {"method", "success", "message", "wall_time_s", "patches"} <= set(record)
-    assert record["method"] == method and record["success"] is True
+    assert {"method", "status", "success", "message", "wall_time_s", "patches"} <= set(record)
+    assert record["method"] == method and record["success"] is (code == 0)  # JSON, printed status and exit agree
+    assert record["status"] == ("ok" if code == 0 else "beyond-friction-limit")
     (patch,) = record["patches"]
     assert PATCH_KEYS <= set(patch)
     assert patch["normal_force_N"] > 0
@@ -98,6 +99,9 @@ def test_conicity_command(capsys):
     code, record = run_json(capsys, "conicity", "--json")
     assert code == 0
     assert 0.05 < record["equivalent_conicity"] < 0.4
+    # the default pair is the scenes' (S1002 on UIC60), not the Manchester benchmark's files (0.1836 there)
+    code, same = run_json(capsys, "conicity", "--json", "--wheel", "S1002", "--rail", "UIC60")
+    assert code == 0 and same["equivalent_conicity"] == record["equivalent_conicity"]
 
 
 @pytest.mark.fea
@@ -116,3 +120,31 @@ def test_contact_fea_plot_writes_stress_maps(tmp_path, capsys):
     assert diagnostics["max_shear_Pa"] > 0 and diagnostics["max_shear_depth_m"] > 0
     assert diagnostics["axis_max_shear_depth_m"] > 0
     assert (out / summary["field_files"][0]["vtu"]).stat().st_size > 0
+
+
+def test_contact_status_json_and_exit_code_agree_beyond_the_friction_limit(capsys):
+    """The linear theory beyond mu N: its number is given but the case is not ok; the printed status, the JSON's
+    status and success, and the exit code say the same (it printed "ok" and success true with exit 1)."""
+    code, record = run_json(capsys, "contact", "hertz-quadric", "--method", "linear", "--json")
+    assert code == 1
+    assert record["status"] == "beyond-friction-limit" and record["success"] is False
+    assert record["solver_converged"] is True
+    assert main(["contact", "hertz-quadric", "--method", "linear"]) == 1
+    assert "method linear: beyond-friction-limit" in capsys.readouterr().out
+
+
+def test_one_case_namespace_for_every_command(capsys, tmp_path):
+    """`wheelrail cases` lists the benchmark cases too, `contact` solves them, and `compare`/`bench` take the cases
+    without a reference (no error columns): `contact large-spin` and `compare hertz-quadric` ended with exit 2."""
+    from wheelrail.named_cases import load_named_case, named_case_names
+
+    assert main(["cases"]) == 0
+    listed = capsys.readouterr().out
+    for name in ("hertz-quadric", "manchester-a22", *named_case_names()):
+        assert f"\n{name} " in listed or listed.startswith(f"{name} "), name
+    code, record = run_json(capsys, "contact", "large-spin", "--method", "fastsim", "--json")
+    assert code == 0 and record["patches"][0]["normal_force_N"] == pytest.approx(82000.0)
+    named = load_named_case("hertz-quadric")
+    assert named.source == "none" and named.reference == {} and named.case_path.name == "hertz-quadric.toml"
+    argv = ["bench", "--quick", "--cases", "hertz-quadric", "--models", "hertz", "--out", str(tmp_path / "b")]
+    assert main(argv) == 0

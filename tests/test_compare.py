@@ -85,3 +85,35 @@ def test_fea_surface_traction_option_is_validated():
         )
     with pytest.raises(ValueError, match="missing"):
         FeaOptions.from_mapping({"surface_traction": {"x_m": [0.0]}})
+
+
+def test_pressure_maps_zoom_to_the_patch_with_equal_or_stated_aspect(tmp_path):
+    """Readable maps: each panel zooms to the union of the contact areas (not the potential area), equal aspect for
+    a round patch and a stated stretch for a flange sliver (13 x 0.7 mm), labels in mm and MPa in the PNG's
+    metadata."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from PIL import Image
+
+    from rigid_dynamics.contact.types import ContactFields
+
+    def field(a, b):
+        x, y = np.linspace(-2 * a, 2 * a, 81), np.linspace(-2 * b, 2 * b, 41)
+        xx, yy = np.meshgrid(x, y)
+        p = 1e9 * np.sqrt(np.clip(1 - (xx / a) ** 2 - (yy / b) ** 2, 0, None))
+        return ContactFields(x_m=x, y_m=y, pressure_Pa=p, in_contact=p > 0)
+
+    round_box = compare._patch_box([field(3e-3, 3e-3)])
+    assert round_box[1] - round_box[0] == pytest.approx(1.3 * 5.7, rel=0.01)  # the 5.7 mm of p > 0 nodes + 2 x 15 %
+    assert round_box[1] - round_box[0] < 8  # not the 12 mm of the potential area
+    assert compare._stretch(round_box) == 1.0
+    sliver = compare._patch_box([field(6.5e-3, 0.35e-3)])
+    assert compare._stretch(sliver) > 2
+    fig, axes = compare._map_axes(2, sliver)
+    compare._zoom(axes[0], sliver)
+    assert "stretched" in axes[0].get_title()
+    assert axes[0].get_xlabel() == "x (rolling) [mm]" and axes[0].get_ylabel() == "y (lateral) [mm]"
+    names = compare._plot_pressures([("hertz", field(3e-3, 2e-3)), ("bem", field(3e-3, 2.1e-3))], None, tmp_path)
+    info = Image.open(tmp_path / names[0]).info
+    assert "MPa" in info["Description"] and "mm" in info["Description"]

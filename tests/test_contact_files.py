@@ -55,6 +55,9 @@ def test_fastsim_files_hold_traction_slip_and_adhesion(tmp_path):
         assert data[name].shape == data["pressure_Pa"].shape
     assert data["in_adhesion"].any() and data["in_slip"].any()  # partial slip at this creepage
     assert not (data["in_adhesion"] & data["in_slip"]).any()
+    units, dims = json.loads(data["units"][()]), json.loads(data["dims"][()])  # parsed by a reader, not eval
+    assert units["slip_m_per_s"] == "m/s" and units["pressure_Pa"] == "Pa" and units["in_slip"] == "1"
+    assert dims["pressure_Pa"] == ["y", "x"] and dims["x_m"] == ["x"]
     x, y = data["x_m"], data["y_m"]
     cell = (x[1] - x[0]) * (y[1] - y[0])
     fx = data["traction_long_Pa"].sum() * cell

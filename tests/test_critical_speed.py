@@ -93,3 +93,22 @@ def test_cli_bad_options(tmp_path, capsys, extra, pattern):
     assert main(["critical-speed", str(SCENE_PATH), "--out", str(tmp_path / "x"), *extra]) == 2
     err = capsys.readouterr().err
     assert err.startswith("wheelrail: error:") and pattern in err, err
+
+
+def test_branch_plot_shows_the_deciding_persistence_and_failed_runs(tmp_path):
+    """The amplitude plot labels each run with the persistence ratio that decided it and draws a run without an
+    amplitude (NaN: a failed run) instead of dropping it."""
+    import math
+
+    from PIL import Image
+
+    from comparisons.limit_cycle import plot_branch
+
+    runs = [
+        {"speed_m_per_s": 60.0, "amplitude_m": 5e-3, "persistence": 0.99, "cycle": True, "status": "ok"},
+        {"speed_m_per_s": 50.0, "amplitude_m": 6e-3, "persistence": 0.7, "cycle": False, "status": "ok"},
+        {"speed_m_per_s": 45.0, "amplitude_m": math.nan, "persistence": math.nan, "cycle": False, "status": "blow-up"},
+    ]
+    outcome = {"runs": runs, "branch": [{"speed_m_per_s": 60.0, "amplitude_m": 5e-3}], "speed_m_per_s": 55.0}
+    path = plot_branch(outcome, tmp_path / "branch.png", 70.0, persist_ratio=0.9)
+    assert Image.open(path).size[0] > 400

@@ -226,3 +226,14 @@ def test_cli_stress_bad_workers(tmp_path, capsys, value):
     assert code == 2 and "Traceback" not in captured.err
     assert captured.err == f"wheelrail: error: --workers {value!r}: expected an integer >= 1\n"
     assert not (tmp_path / "out").exists()  # fails before any work
+
+
+def test_axis_labels_read_as_quantities_with_units():
+    """Plots label columns as quantities in the units an engineer reads: mm, MPa, mrad (not raw column names)."""
+    from comparisons.style import label_of
+
+    assert label_of("energy_balance_relative") == ("relative energy residual", 1.0)
+    assert label_of("fixed_step_s") == ("fixed step [s]", 1.0)
+    assert label_of("irregularities.flat_depth_m") == ("flat depth [mm]", 1e3)
+    assert label_of("max_pressure_Pa") == ("max pressure [MPa]", 1e-6)
+    assert label_of("speed_m_per_s") == ("speed [m/s]", 1.0)

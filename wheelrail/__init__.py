@@ -21,10 +21,9 @@ Outputs and plots
 Example::
 
     import wheelrail as wr
-    case = wr.load_case("hertz-quadric")
-    solution = wr.solve_case(case, "fastsim")
+    solution = wr.solve_case("hertz-quadric", "fastsim")   # a case, or its name or file
     solution.to_dataframe()                      # one row per patch
-    run = wr.simulate(wr.load_scene("hunting-conical"))
+    run = wr.simulate("hunting-conical")         # a scene, or its name or file
     run.to_dataframe()                           # one row per output time, units in the column names
 """
 
@@ -61,7 +60,7 @@ _API: dict[str, tuple[str, str, str]] = {
     "load_scene": ("wheelrail.scenes", "load_scene", "read a scene TOML file or embedded scene"),
     "embedded_scenes": ("wheelrail.scenes", "embedded_scenes", "embedded dynamics scenes: name -> path"),
     "Irregularities": ("rigid_dynamics.wheelset", "Irregularities", "wheel and rail irregularities of a scene"),
-    "simulate": ("rigid_dynamics.wheelset", "simulate", "run a dynamics scene"),
+    "simulate": ("wheelrail.scenes", "simulate", "run a dynamics scene (a scene, or its name or file)"),
     "SimulationResult": ("rigid_dynamics.wheelset", "SimulationResult", "time series and status of a run"),
     "linear_model_for_scene": ("rigid_dynamics.wheelset", "linear_model_for_scene", "linearised wheelset"),
     "critical_speed": ("rigid_dynamics.wheelset", "critical_speed", "linear critical speed (eigenvalues)"),

@@ -456,8 +456,16 @@ CASES_DIR = Path(__file__).parent / "cases"
 
 
 def embedded_cases() -> dict[str, Path]:
-    """Embedded contact cases: name -> path."""
-    return {p.stem: p for p in sorted(CASES_DIR.glob("*.toml"))}
+    """Every named contact case, one namespace for every command: name -> case file.
+
+    The cases of ``wheelrail/cases/*.toml`` (no reference) and the benchmark cases of
+    ``comparisons/cases/<name>/case.toml`` (with a reference for ``bench`` and ``compare``), sorted by name.
+    """
+    from comparisons.named_cases import CASES_ROOT
+
+    found = {p.stem: p for p in CASES_DIR.glob("*.toml")}
+    found.update({p.parent.name: p for p in CASES_ROOT.glob("*/case.toml")})
+    return dict(sorted(found.items()))
 
 
 def resolve_case_path(path: str | Path) -> Path:
@@ -484,6 +492,26 @@ class CaseSolution:
     def to_dict(self) -> dict:
         """The JSON record of ``wheelrail contact --json`` (:func:`solution_record`)."""
         return solution_record(self)
+
+    def _repr_markdown_(self) -> str:
+        """A table for notebooks: one row per patch, forces on the wheel in the contact frame."""
+
+        def cell(value, scale=1.0):
+            return "-" if value is None else f"{value * scale:.5g}"
+
+        lines = [
+            f"**{self.method}**: {solution_status(self)} in {self.wall_time_s:.3g} s"
+            + (f" ({self.message})" if self.message else ""),
+            "",
+            "| side | status | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm^2] |",
+            "|---|---|---:|---:|---:|---:|---:|",
+        ]
+        for side, _, _, r in self.patches:
+            lines.append(
+                f"| {side} | {r.status} | {cell(r.normal_force_N)} | {cell(r.creep_force_long_N)} | "
+                f"{cell(r.creep_force_lat_N)} | {cell(r.max_pressure_Pa, 1e-6)} | {cell(r.contact_area_m2, 1e6)} |"
+            )
+        return "\n".join(lines) + "\n"
 
     def to_dataframe(self):
         """One row per patch: side, model, forces, pressure, semi-axes, creepages (units in the names)."""
@@ -526,8 +554,8 @@ def warm_up(method: str, material: Material) -> float:
     return time.perf_counter() - start
 
 
-def solve_case(case: ContactCase, method: str) -> CaseSolution:
-    """Solve a validated case with the contact model ``method``.
+def solve_case(case: ContactCase | str | Path, method: str) -> CaseSolution:
+    """Solve a validated case (or a case's name or file, read by :func:`load_case`) with the model ``method``.
 
     The model is imported and its compiled kernels loaded (:func:`warm_up`) before the clock starts, so
     ``wall_time_s`` measures the solve; that preparation is ``setup_s``. For a wheelset case the clock
@@ -536,6 +564,8 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
     from rigid_dynamics.contact.registry import get_model
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
 
+    if isinstance(case, (str, Path)):
+        case = load_case(case)
     prepare = time.perf_counter()
     model = get_model(method)
     warm_up(method, case.material)
@@ -649,11 +679,31 @@ def _json_safe(value):
 _SKIP = object()
 
 
+OK_PATCH_STATUSES = ("ok", "no-contact")
+"""Patch statuses of a case that ends ``ok`` (exit 0)."""
+
+
+def solution_status(solution: CaseSolution) -> str:
+    """The case's one status, as printed, in the JSON and by the exit code: "ok" when the solver succeeded and every
+    patch is ok or out of contact; else the first patch status that is not (e.g. "beyond-friction-limit": the
+    linear theory's number, outside its range), or "failed".
+    """
+    for patch in solution.patches:
+        if patch[3].status not in OK_PATCH_STATUSES:
+            return patch[3].status
+    return "ok" if solution.success else "failed"
+
+
 def solution_record(solution: CaseSolution) -> dict:
-    """The JSON object printed by ``wheelrail contact --json``."""
+    """The JSON object printed by ``wheelrail contact --json``: ``status`` and ``success`` (status == "ok") agree
+    with the exit code; ``solver_converged`` is the solver's own flag.
+    """
+    status = solution_status(solution)
     return {
         "method": solution.method,
-        "success": bool(solution.success),
+        "status": status,
+        "success": status == "ok",
+        "solver_converged": bool(solution.success),
         "message": solution.message,
         "wall_time_s": solution.wall_time_s,
         "setup_s": solution.setup_s,

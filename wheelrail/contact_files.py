@@ -7,7 +7,9 @@ For each patch ``<side>-<k>`` of a solved case the output folder gets
   ``in_slip``, ``in_adhesion`` (bool masks), each (ny, nx) with ``[j, i]`` at ``(x_m[i], y_m[j])``;
   ``outline_m`` (k, 2): the contact outline (the 0.5 level of ``in_contact``), closed curves separated by
   rows of NaN; ``point_m`` (3,) and ``frame`` (3, 3) of the patch (track frame, columns = contact axes);
-  ``method``, ``source`` and ``units`` as strings. Fields a model does not give are absent.
+  ``method`` and ``source`` as strings; ``units`` and ``dims`` as JSON strings (``json.loads(f["units"][()])``):
+  each array's SI unit ("Pa", "m/s", "1" for masks) and its axis names (``["y", "x"]`` for the fields: row j is
+  ``y_m[j]``, column i is ``x_m[i]``). Fields a model does not give are absent.
 * ``fields-<side>-<k>.vtu``: the same grid as one quad surface (VTK unstructured grid) placed in the track
   frame (point = ``point_m + frame @ (x, y, 0)``, m), every field as point data with its unit in the name
   (masks as 0/1 integers), the contact-frame coordinates as ``contact_frame_xy_m``.
@@ -24,6 +26,7 @@ Every file is written atomically (:func:`wheelrail.output.atomic_write`); meshio
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -124,8 +127,14 @@ def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactR
     arrays = field_arrays(fields)
     curves = outline_curves(fields)
     outline = np.concatenate([np.vstack([c, [[np.nan, np.nan]]]) for c in curves])[:-1] if curves else np.zeros((0, 2))
-    units = {name: name.rsplit("_", 1)[-1] if name not in MASK_NAMES else "1 (mask)" for name in arrays}
-    units.update({"x_m": "m", "y_m": "m", "outline_m": "m", "point_m": "m"})
+    from comparisons.style import unit_of
+
+    units = {key: "1" if key in MASK_NAMES else unit_of(key) for key in arrays}
+    units.update({"x_m": "m", "y_m": "m", "outline_m": "m", "point_m": "m", "frame": "1"})
+    dims = {key: ["y", "x"] for key in arrays}
+    dims.update(
+        {"x_m": ["x"], "y_m": ["y"], "outline_m": ["point", "xy"], "point_m": ["xyz"], "frame": ["xyz", "axis"]}
+    )
     point = np.asarray(getattr(geometry, "point_m", np.zeros(3)), float)
     frame = np.asarray(getattr(geometry, "frame", np.eye(3)), float)
     files = {}
@@ -138,7 +147,8 @@ def write_patch_files(out_dir: str | Path, name: str, geometry, result: ContactR
         frame=frame,
         method=np.array(result.method),
         source=np.array(source),
-        units=np.array(repr(units)),
+        units=np.array(json.dumps(units)),
+        dims=np.array(json.dumps(dims)),
         **arrays,
     )
     files["npz"] = npz.name
@@ -182,8 +192,11 @@ def write_solution_files(solution, out_dir: str | Path) -> list[dict]:
     return written
 
 
-def plot_patch(result: ContactResult, path: str | Path) -> Path | None:
-    """PNG of a patch: the model's fields, or for an analytic model Hertz's ellipse and pressure; None if neither."""
+def plot_patch(result: ContactResult, path: str | Path | None = None):
+    """PNG of a patch: the model's fields, or for an analytic model Hertz's ellipse and pressure; None if neither.
+
+    ``path`` None returns the matplotlib Figure (shown inline in a notebook) instead of writing a file.
+    """
     if result.fields is not None:
         from comparisons.contact_plots import plot_contact_fields
 
@@ -191,15 +204,11 @@ def plot_patch(result: ContactResult, path: str | Path) -> Path | None:
     fields = hertz_fields(result)
     if fields is None:
         return None
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from wheelrail.output import atomic_write
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend is left alone
 
     a, b = result.semi_axis_long_m, result.semi_axis_lat_m
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig = Figure(figsize=(6, 4.5))
+    ax = fig.subplots()
     p = np.ma.masked_where(fields.pressure_Pa <= 0, fields.pressure_Pa)
     mesh = ax.pcolormesh(1e3 * fields.x_m, 1e3 * fields.y_m, p / 1e6, shading="auto", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="Hertz pressure [MPa]", shrink=0.85)
@@ -213,7 +222,10 @@ def plot_patch(result: ContactResult, path: str | Path) -> Path | None:
         f"{result.method}: a = {1e3 * a:.3g} mm, b = {1e3 * b:.3g} mm, p0 = {result.max_pressure_Pa / 1e6:.4g} MPa",
         fontsize=9,
     )
+    if path is None:
+        return fig
+    from wheelrail.output import atomic_write
+
     path = Path(path)
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=120, bbox_inches="tight", format="png"))
-    plt.close(fig)
     return path

@@ -63,7 +63,7 @@ def linear_critical_speed(scene) -> dict:
 
 def cmd_critical_speed(args) -> int:
     """``wheelrail critical-speed``: print and write the linear and nonlinear critical speeds."""
-    from comparisons.limit_cycle import limit_cycle_search, plot_branch
+    from comparisons.limit_cycle import PERSIST_RATIO, limit_cycle_search, plot_branch
     from wheelrail.output import copy_input, output_folder, write_json
     from wheelrail.overrides import load_scene_with
 
@@ -120,7 +120,7 @@ def cmd_critical_speed(args) -> int:
         )
         speed = _speed(nonlinear["speed_m_per_s"])
         print(f"{source.stem}: nonlinear critical speed {speed}: {nonlinear['message']}")
-        png = plot_branch(nonlinear, out_dir / "critical_speed.png", v_lin)
+        png = plot_branch(nonlinear, out_dir / "critical_speed.png", v_lin, persist_ratio=PERSIST_RATIO)
         summary = {"linear": linear, "nonlinear": nonlinear, "overrides": overrides, "files": [png.name]}
         write_json(out_dir / "summary.json", summary)  # last
     print(f"output written to {out_dir}")

@@ -60,13 +60,16 @@ def _contact_reference(folder: Path) -> dict:
 
 def load_named_case(name_or_folder: str | Path) -> NamedCase:
     """Read a named case: a name under ``comparisons/cases`` or a folder path holding case.toml + reference.toml."""
-    from wheelrail.cases import load_case
+    from wheelrail.cases import embedded_cases, load_case
 
     folder = Path(name_or_folder)
     if not (folder / "reference.toml").is_file():
         folder = CASES_ROOT / str(name_or_folder)
     if not (folder / "reference.toml").is_file():
-        raise ConfigError(f"case {str(name_or_folder)!r}: expected one of {', '.join(named_case_names())}")
+        cases = embedded_cases()
+        if str(name_or_folder) in cases:  # a case without a reference: compared rung against rung, no error columns
+            return _unreferenced_case(str(name_or_folder), cases[str(name_or_folder)])
+        raise ConfigError(f"case {str(name_or_folder)!r}: expected one of {', '.join(cases)}")
     path = folder / "reference.toml"
     try:
         with open(path, "rb") as handle:
@@ -126,6 +129,26 @@ def _check_reference_field(path: Path) -> None:
         raise ConfigError(
             f"{str(path)!r}: pressure_Pa of shape {p.shape}: expected (len(y_m), len(x_m)) = ({len(y)}, {len(x)})"
         )
+
+
+def _unreferenced_case(name: str, path: Path) -> NamedCase:
+    """A named case without a reference (``wheelrail/cases``): source "none", the right wheel for a wheelset case
+    (the side of CONTACT's published A-2.2 solution).
+    """
+    from wheelrail.cases import load_case
+    from wheelrail.config import read_toml
+
+    case = load_case(path)
+    return NamedCase(
+        name=name,
+        folder=path.parent,
+        source="none",
+        side="single" if case.kind == "quadric" else "right",
+        reference={},
+        note=str(read_toml(path).get("description", name)),
+        case=case,
+        case_file=path,
+    )
 
 
 def load_named_cases(names=None) -> list[NamedCase]:

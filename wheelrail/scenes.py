@@ -124,6 +124,17 @@ def load_scene(path: str | Path):
     return parse_scene(read_toml(path, "scene file"), base_dir=Path(path).parent)
 
 
+def simulate(scene, progress=None, **options):
+    """Run a dynamics scene: a :class:`~rigid_dynamics.wheelset.DynamicsScene`, or a scene's name or TOML file
+    (read by :func:`load_scene`); the keyword arguments of :func:`rigid_dynamics.wheelset.simulate` pass through.
+    """
+    from rigid_dynamics.wheelset import simulate as run
+
+    if isinstance(scene, (str, Path)):
+        scene = load_scene(scene)
+    return run(scene, progress, **options)
+
+
 def write_run_outputs(result, scene_path: Path, out_dir: Path, plots: bool = True, extra: dict | None = None) -> dict:
     """Write scene.toml, summary.json, timeseries.npz/.csv/.parquet (atomic) and plots; return the summary.
 

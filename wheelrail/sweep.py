@@ -233,23 +233,8 @@ def run_point(task: dict) -> dict:
     return record
 
 
-def case_status(record: dict) -> str:
-    """The status of a contact solution record as ``wheelrail contact`` judges it (its exit status 0 only for
-    ``ok``): ``failed`` if the solve failed, else the first patch status that is not ok or ``no-contact``
-    (``beyond-friction-limit``, ``warning``, ...), else ``ok``.
-    """
-    from wheelrail.cli import OK_PATCH_STATUSES
-
-    if not record["success"]:
-        return "failed"
-    for patch in record["patches"]:
-        if patch["status"] not in OK_PATCH_STATUSES:
-            return patch["status"]
-    return "ok"
-
-
 def _case_numbers(record: dict, method: str) -> dict:
-    status = case_status(record)
+    status = record["status"]  # the case's one status, as `contact` prints it and exits with
     out = {
         "status": status,
         "message": record["message"],

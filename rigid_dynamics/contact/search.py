@@ -512,14 +512,14 @@ def ellipticity_error(undeformed: UndeformedDistance, a_1_per_m, b_1_per_m, angl
     return float(np.max(np.abs(g[region] - quadric[region])) / approach_m)
 
 
-def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, x_range, y_range, npts, iterations):
-    """Gap along n between the wheel and the rail surfaces on a grid of the contact plane (vectorised).
+def _gap_at(geo: _SideGeometry, alpha0, y0, centre, frame, gx, gy, iterations):
+    """Gap along n between the wheel and the rail surfaces at contact-plane points (gx, gy) (vectorised).
 
-    ``x_range``, ``y_range``: (lower, upper) contact-frame coordinates of the grid, m; npts points per direction.
+    ``gx``, ``gy``: contact-frame coordinates, m, arrays of one shape; the same shape is returned (+inf where the
+    wheel point leaves the profile). Each point is solved from the surfaces themselves (no interpolation), so a
+    solver's elements see the exact undeformed distance at their centres.
     """
-    xs = np.linspace(x_range[0], x_range[1], npts)
-    ys = np.linspace(y_range[0], y_range[1], npts)
-    gx, gy = np.meshgrid(xs, ys)
+    gx, gy = np.broadcast_arrays(np.asarray(gx, float), np.asarray(gy, float))
     e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
     base = centre + gx[..., None] * e_x + gy[..., None] * e_y
     # Rail: p = base + t n on z = N(x, y)  (n points from the rail into the wheel).
@@ -536,8 +536,25 @@ def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, x_range, y_rang
         delta = np.linalg.solve(jac, -residual[..., None])[..., 0]
         alpha, lat, s = alpha + delta[..., 0], lat + delta[..., 1], s + delta[..., 2]
     inside = (lat >= geo.y_range[0]) & (lat <= geo.y_range[1])
-    gap = np.where(inside, s - t_rail, np.inf)
-    return UndeformedDistance(x_m=xs, y_m=ys, distance_m=gap)
+    return np.where(inside, s - t_rail, np.inf)
+
+
+def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, x_range, y_range, npts, iterations):
+    """The gap (:func:`_gap_at`) on an npts x npts grid of the contact plane, with ``exact`` evaluating any point.
+
+    ``x_range``, ``y_range``: (lower, upper) contact-frame coordinates of the grid, m. The grid sizes the potential
+    contact area and serves the ellipticity check; a solver evaluates its element centres through ``exact``
+    (bilinear interpolation of the grid overestimates a convex gap between its nodes: the pressure then peaks on
+    the grid's node lines, in stripes that grow with the solver's refinement).
+    """
+    xs = np.linspace(x_range[0], x_range[1], npts)
+    ys = np.linspace(y_range[0], y_range[1], npts)
+    gx, gy = np.meshgrid(xs, ys)
+
+    def exact(x_m, y_m):
+        return _gap_at(geo, alpha0, y0, centre, frame, x_m, y_m, iterations)
+
+    return UndeformedDistance(x_m=xs, y_m=ys, distance_m=exact(gx, gy), exact=exact)
 
 
 _FIELD_LIMITS_M = (0.05, 0.03)  # largest |x|, |y| of the sampled field, m

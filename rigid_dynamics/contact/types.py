@@ -275,6 +275,31 @@ class ContactResult:
         row.update({f"extra.{k}": v for k, v in self.extra.items() if isinstance(v, (int, float, str, bool))})
         return pd.DataFrame([row])
 
+    def _repr_markdown_(self) -> str:
+        """A table for notebooks: the forces on the wheel (contact frame), max pressure, patch size, in N, MPa, mm."""
+
+        def cell(value, scale=1.0):
+            return "-" if value is None else f"{value * scale:.5g}"
+
+        rows = (
+            ("normal force N", self.normal_force_N, 1.0, "N"),
+            ("creep force Fx (on the wheel)", self.creep_force_long_N, 1.0, "N"),
+            ("creep force Fy (on the wheel)", self.creep_force_lat_N, 1.0, "N"),
+            ("spin moment Mz", self.spin_moment_Nm, 1.0, "N m"),
+            ("max pressure", self.max_pressure_Pa, 1e-6, "MPa"),
+            ("semi-axis a (rolling)", self.semi_axis_long_m, 1e3, "mm"),
+            ("semi-axis b (lateral)", self.semi_axis_lat_m, 1e3, "mm"),
+            ("contact area", self.contact_area_m2, 1e6, "mm^2"),
+        )
+        lines = [
+            f"**{self.method}**: {self.status}" + (f" ({self.message})" if self.message else ""),
+            "",
+            "| quantity | value | unit |",
+            "|---|---:|---|",
+            *(f"| {name} | {cell(value, scale)} | {unit} |" for name, value, scale, unit in rows),
+        ]
+        return "\n".join(lines) + "\n"
+
     def __repr__(self) -> str:
         def num(value, scale=1.0, unit=""):
             return "None" if value is None else f"{value * scale:.5g}{unit}"
