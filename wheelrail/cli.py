@@ -16,7 +16,8 @@ Commands:
     wheelrail demo                   the default demo (make demo): a run, its peak contact through every rung
 
 Exit statuses (README, "What a run tells you"): 0 every result ok; 1 the work ran but a result is not ok
-(its status and message say why; the outputs are written); 2 bad input, found before any work: one line
+(its status and message say why; the outputs are written), or the work failed on an error that is not bad input
+(one line ``wheelrail: error: the work failed: ...``); 2 bad input, found before any work: one line
 ``wheelrail: error: ...`` on stderr naming the key or option, the value and what was expected; 3 an output
 could not be written (one line naming the file; no summary is written); 130 interrupted (Ctrl-C), 143
 terminated (SIGTERM). No traceback for any of these.
@@ -407,8 +408,9 @@ def positive_int_option(option: str, value) -> int:
 
 
 WORKER_MEMORY_BYTES = 400 * 2**20
-"""Resident memory of one local dask worker process running a sweep point or a stress run (measured about 300 MiB
-with numpy, scipy, numba and the compiled core loaded; rounded up)."""
+"""Resident memory of one local dask worker process running a sweep point or a stress run: a hunting-conical point
+peaked at 294 MiB (numpy, scipy, numba, dask and the compiled core loaded); rounded up. A lower bound for points of
+the 3-D search or FEA, which need more."""
 
 
 def _available_memory_bytes() -> int | None:
