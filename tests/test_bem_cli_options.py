@@ -31,12 +31,12 @@ def test_bad_bem_solver_options(tmp_path, capsys, solver, pattern):
 
 def test_element_size_through_the_cli(tmp_path, capsys):
     """A case with ``element_size_m`` runs: the grid in the JSON output has that element size and its grid-error
-    estimate; the named grid is coarser than the default ``grid_tolerance`` asks (area estimate ~5 %): status
+    estimate; the named grid (17 x 13 elements) is coarser than the default ``grid_tolerance`` asks: status
     ``warning``, exit 1, the estimate in the message; with ``grid_tolerance = 0.1`` it is ``ok``, exit 0."""
     import json
 
     path = tmp_path / "case.toml"
-    path.write_text(CASE + "element_size_m = 0.5e-3\n")
+    path.write_text(CASE + "element_size_m = 1e-3\n")
     code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
     data = json.loads(capsys.readouterr().out)
     patch = data["patches"][0]
@@ -44,8 +44,8 @@ def test_element_size_through_the_cli(tmp_path, capsys):
     assert "estimated grid error above grid_tolerance 0.02" in patch["message"] and "contact area" in patch["message"]
     grid = patch["diagnostics"]["grid_error"]
     assert 0.02 < grid["largest_relative"] == patch["diagnostics"]["grid_error_estimate"] < 0.1
-    assert patch["diagnostics"]["dx_m"] == pytest.approx(0.5e-3) and grid["refinements"] == 0
-    path.write_text(CASE + "element_size_m = 0.5e-3\ngrid_tolerance = 0.1\n")
+    assert patch["diagnostics"]["dx_m"] == pytest.approx(1e-3) and grid["refinements"] == 0
+    path.write_text(CASE + "element_size_m = 1e-3\ngrid_tolerance = 0.1\n")
     code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out2")])
     data = json.loads(capsys.readouterr().out)
     assert code == 0 and data["success"] and data["patches"][0]["status"] == "ok", data

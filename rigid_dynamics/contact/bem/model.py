@@ -484,7 +484,12 @@ class BemModel:
         )
         semi_long = semi_lat = None
         if geometry.is_elliptic:
-            semi_long, semi_lat = _elliptic_semi_axes(x, y, p, contact, dx, dy)
+            semi_long, semi_lat, fitted = _elliptic_semi_axes(x, y, p, contact, dx, dy)
+        # a quadric patch's area from the fitted ellipse (converges smoothly, within 0.4 % of Hertz from 10 x 10
+        # elements); the element count jumps by several % as the edge crosses element centres. A sampled field's
+        # pressure need not be elliptic: its area is the element count, as CONTACT's.
+        quadric = semi_long is not None and fitted and geometry.undeformed is None
+        contact_area = math.pi * semi_long * semi_lat if quadric else contact.sum() * area
         success = bool(norm.converged and tang.converged)
         if success:
             status, message = "ok", "NORM and TANG converged"
@@ -511,7 +516,7 @@ class BemModel:
             max_pressure_Pa=float(p.max()),
             semi_axis_long_m=semi_long,
             semi_axis_lat_m=semi_lat,
-            contact_area_m2=float(contact.sum() * area),
+            contact_area_m2=float(contact_area),
             approach_m=float(geometry.approach_m + norm.approach_shift_m),
             creepage=creepage,
             fields=fields,
@@ -757,7 +762,7 @@ def _with_grid_error(result: ContactResult, estimate, tolerance: float, refineme
     return dataclasses.replace(result, status=status, message=message, extra=extra, wall_time_s=wall_time_s)
 
 
-def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
+def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float, bool]:
     """Semi-axes (along x, y) of an elliptic patch from a least-squares fit of the pressure field.
 
     For Hertzian pressure p^2 = p0^2 (1 - (x - xc)^2/a^2 - (y - yc)^2/b^2) (Johnson 1985, eq 4.22), so
@@ -769,12 +774,12 @@ def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
     jj, ii = np.nonzero(contact)
     extents = (float(0.5 * (x[ii].max() - x[ii].min() + dx)), float(0.5 * (y[jj].max() - y[jj].min() + dy)))
     if len(ii) < 6:
-        return extents
+        return (*extents, False)
     weights = pressure[jj, ii]
     xc = float(np.sum(weights * x[ii]) / np.sum(weights))
     yc = float(np.sum(weights * y[jj]) / np.sum(weights))
     design = np.stack([np.ones(len(ii)), (x[ii] - xc) ** 2, (y[jj] - yc) ** 2], axis=1)
     c0, c1, c2 = np.linalg.lstsq(design, weights**2, rcond=None)[0]
     if not (c0 > 0 and c1 < 0 and c2 < 0):
-        return extents
-    return float(np.sqrt(-c0 / c1)), float(np.sqrt(-c0 / c2))
+        return (*extents, False)
+    return float(np.sqrt(-c0 / c1)), float(np.sqrt(-c0 / c2)), True
