@@ -33,9 +33,7 @@ def _case(name):
     m, g, k = case["material"], case["geometry"], case["kinematics"]
     material = Material(m["shear_modulus_Pa"], m["poisson_ratio"], m["friction_coefficient"])
     geometry = ContactGeometry.quadric(g["radius_long_m"], g["radius_lat_m"])
-    creepage = Creepage(
-        k["creepage_long"], k["creepage_lat"], k["spin_creepage_1_per_m"], k["rolling_speed_m_per_s"]
-    )
+    creepage = Creepage(k["creepage_long"], k["creepage_lat"], k["spin_creepage_1_per_m"], k["rolling_speed_m_per_s"])
     return geometry, creepage, material, case["loading"]["normal_force_N"], reference
 
 
@@ -121,9 +119,7 @@ def test_auto_holds_the_bem_to_its_tolerance():
     """``auto`` at a 0.1 % tolerance chooses the BEM for the large-spin case; the BEM cannot meet 0.1 % within its
     refinements and says so (``warning``), instead of an ``ok`` on a 40 x 40 grid."""
     geometry, creepage, material, force, _ = _case("large-spin")
-    res = get_model("auto").solve(
-        geometry, creepage, material, normal_force_N=force, options={"tolerance": 0.001}
-    )
+    res = get_model("auto").solve(geometry, creepage, material, normal_force_N=force, options={"tolerance": 0.001})
     assert res.extra["selected_model"] == "bem"
     assert res.status == "warning" and "above grid_tolerance 0.001" in res.message
     assert res.extra["grid_error"]["tolerance"] == 0.001
@@ -143,9 +139,7 @@ def test_element_sizes_dx_dy():
     """dx_m, dy_m (CONTACT's DX, DY): rectangular elements of those sides; dy_m defaults to dx_m; bad combinations
     raise ValueError naming the options."""
     geometry, creepage, material, force, _ = _case("creep-long-mid")
-    res = BemModel().solve(
-        geometry, creepage, material, normal_force_N=force, options={"dx_m": 0.2e-3, "dy_m": 0.1e-3}
-    )
+    res = BemModel().solve(geometry, creepage, material, normal_force_N=force, options={"dx_m": 0.2e-3, "dy_m": 0.1e-3})
     assert res.extra["dx_m"] == pytest.approx(0.2e-3) and res.extra["dy_m"] == pytest.approx(0.1e-3)
     square = BemModel().solve(geometry, creepage, material, normal_force_N=force, options={"dx_m": 0.2e-3})
     assert square.extra["dy_m"] == pytest.approx(0.2e-3)

@@ -726,7 +726,8 @@ def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
 
 def _with_grid_error(result: ContactResult, estimate, tolerance: float, refinements: int, wall_time_s: float):
     """``result`` with ``extra["grid_error"]`` (and ``grid_error_estimate``, the largest relative estimate) and,
-    when the estimate is missing or above ``tolerance``, status "warning" with the reason in the message."""
+    when the estimate is missing or above ``tolerance``, status "warning" with the reason in the message.
+    """
     import dataclasses
 
     extra = dict(result.extra)
