@@ -90,7 +90,7 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   (counts doubled, the finer solution taking the place of the fine one and the two coarser companions reused)
   while the largest relative estimate exceeds ``grid_tolerance``, at most ``max_refinements`` times. A grid the
   caller names is solved as named. A solution whose estimate still exceeds ``grid_tolerance``, or whose grid is
-  too coarse for the estimate (fewer than 4 elements along x or y), ends with status ``"warning"`` (``success``
+  too coarse for the estimate (fewer than 6 elements along x or y), ends with status ``"warning"`` (``success``
   True, the numbers are the solution's) and a message naming the estimate and the tolerance;
 * a patch whose ``undeformed.potential_area_m`` is given (the wheelset case's CONTACT-style patches: a rectangle
   holding the whole rigid overlap) is solved on that area, without the margin rule and its enlargements;
@@ -131,6 +131,10 @@ PROBLEMS = ("rolling", "shift", "transient")
 
 ROLLING_SLIP_POINTS = {"centre": 0.0, "midpoint": 0.5}
 """Offset of the rigid slip from the element centre, in elements along x (option ``rolling_slip_point``)."""
+
+MIN_COMPANION_ELEMENTS = 3
+"""Fewest elements along x or y of a coarse companion grid of the error estimate (a coarser one says nothing of
+the fine grid: it is left out, and without the companion twice as coarse the error is not estimated)."""
 
 MAX_ELEMENTS = 4_000_000
 """Largest grid ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
@@ -290,10 +294,10 @@ class BemModel:
             return self._solve(geometry, creepage, material, normal_force_N, grid_opts, area, start)
 
         def coarser(result: ContactResult, factor: int) -> ContactResult | None:
-            nx, ny = result.extra["nx"], result.extra["ny"]
-            if nx < 2 * factor or ny < 2 * factor:
+            nx, ny = round(result.extra["nx"] / factor), round(result.extra["ny"] / factor)
+            if min(nx, ny) < MIN_COMPANION_ELEMENTS:
                 return None
-            return on_grid(max(round(nx / factor), 1), max(round(ny / factor), 1))
+            return on_grid(nx, ny)
 
         tolerance = float(opts["grid_tolerance"])
         levels = [fine, coarser(fine, 2), coarser(fine, 4)]
@@ -740,7 +744,7 @@ def _with_grid_error(result: ContactResult, estimate, tolerance: float, refineme
             status = "warning"
         message += (
             f"; the grid error is not estimated: {nx} x {ny} elements are too few for a companion grid twice as "
-            "coarse (or it failed); expected at least 4 x 4 elements"
+            f"coarse (or it failed); expected at least {2 * MIN_COMPANION_ELEMENTS} elements along x and y"
         )
     else:
         extra["grid_error"] = {**estimate, "tolerance": tolerance, "refinements": refinements, "estimated": True}
