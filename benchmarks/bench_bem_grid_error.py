@@ -48,7 +48,8 @@ CASES = (
     "large-spin",
 )
 LARGE_SPIN = {"converged": -0.6254, "CONTACT": -0.6215}
-CONTACT_FINEST = {  # contact_grid.md: CONTACT's step (a22_case(step - 1)) -> (case, DX mm, FN, FX, FS, PMAX MPa, area mm2)
+# contact_grid.md: CONTACT's step (our a22_case(step - 1)) -> (case, DX mm, FN, FX, FS, PMAX MPa, area mm2)
+CONTACT_FINEST = {
     6: ("a22-tread", 0.05, 9787.0, -456.2, -2900.0, 730.6, 20.24),
     11: ("a22-flange-root", 0.05, 9619.0, -762.5, -2738.0, 1572.0, 14.96),
     17: ("a22-flange", 0.025, 12730.0, -2073.0, -3194.0, 2597.0, 7.428),
@@ -114,8 +115,12 @@ def _a22_rows():
     rows = []
     for step, (name, dx_mm, fn, fx, fs, pmax, area) in CONTACT_FINEST.items():
         options = {"model": {"element_size_m": 0.2e-3}, "sides": ("right",)}
-        sol, wall = _timed(lambda step=step, options=options: solve_wheelset_case(a22_case(step - 1, "deck"), MATERIAL,
-                                                                                  "bem", options), repeats=1)
+        sol, wall = _timed(
+            lambda step=step, options=options: solve_wheelset_case(
+                a22_case(step - 1, "deck"), MATERIAL, "bem", options
+            ),
+            repeats=1,
+        )
         (patch,) = [p.result for p in sol.patches if p.side == "right"]
         grid = patch.extra["grid_error"]
         mu_fn = MATERIAL.friction_coefficient * fn
