@@ -156,7 +156,6 @@ def hertz_ellipse(
         (a_x, b_y, p0, F_N, approach): semi-axes along x and y (m), maximum pressure (Pa),
         normal force (N), approach (m).
     """
-    from scipy.optimize import brentq
     from scipy.special import ellipe, ellipk
 
     if (normal_force_N is None) == (approach_m is None):
@@ -180,7 +179,17 @@ def hertz_ellipse(
         k, e = ellipk(e2), ellipe(e2)
         return (e / (1.0 - e2) - k) / (k - e) - ratio
 
-    e2 = brentq(mismatch, 1e-12, 1.0 - 1e-15, xtol=1e-15, rtol=1e-14)
+    # the ratio grows monotonically with e^2 from 1 to infinity: bisection to the last bit (no scipy.optimize,
+    # whose import costs a small command a fifth of its start-up)
+    low, high = 1e-12, 1.0 - 1e-15
+    while True:
+        e2 = 0.5 * (low + high)
+        if not low < e2 < high:
+            break
+        if mismatch(e2) < 0.0:
+            low = e2
+        else:
+            high = e2
     k, e = float(ellipk(e2)), float(ellipe(e2))
     if normal_force_N is not None:
         a = (3.0 * normal_force_N * (k - e) / (2.0 * math.pi * combined_modulus_Pa * small * e2)) ** (1.0 / 3.0)
