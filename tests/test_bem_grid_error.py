@@ -164,3 +164,15 @@ def test_estimator_rules():
     assert _smooth_error(1.00, 1.02, 0.98) == pytest.approx(0.02, rel=1e-9)  # oscillating
     assert _smooth_error(1.00, 1.001, 1.5) == pytest.approx(0.2495, rel=1e-9)  # d1 small by chance
     assert grid_error_estimate([None, None, None], 0.3) is None
+
+
+def test_bench_row_carries_the_bem_estimate():
+    """The bench's row of a BEM run carries the BEM's own grid-error estimate beside the measured error (Hertz
+    closed form for hertz-ab-1): at 16 x 16 the estimate covers the error of the max pressure and the area."""
+    from comparisons import bench
+    from wheelrail.named_cases import load_named_case
+
+    run = bench.run_one(load_named_case("hertz-ab-1"), "bem", "16x16", {"nx": 16, "ny": 16})
+    row = run.row()
+    assert row["grid_error_estimate"] is not None and row["grid_error_estimate"] > 0
+    assert row["grid_error_estimate"] >= max(row["err_max_pressure"], row["err_area"]), row
