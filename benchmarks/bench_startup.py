@@ -32,6 +32,7 @@ COMMANDS = {
         "-m", "wheelrail.cli", "contact", "hertz-quadric", "--method", "bem", "--json",
     ],
     "python -c pass": ["-c", "pass"],
+    "python -c 'import numba, scipy.fft' (the floor with numba)": ["-c", "import numba, scipy.fft"],
     "python -c 'import numpy'": ["-c", "import numpy"],
 }  # fmt: skip
 
