@@ -207,7 +207,14 @@ def _fea_views(solution, out_dir: Path) -> list[str]:
 
 
 def _contact_table(record: dict) -> str:
-    lines = [f"method {record['method']}: {'ok' if record['success'] else 'FAILED'} - {record['message']}"]
+    statuses = {patch["status"] for patch in record["patches"]} - set(OK_PATCH_STATUSES)
+    # the same verdict as the exit status: a patch ending "warning" (e.g. a BEM grid coarser than its tolerance)
+    verdict = "FAILED" if not record["success"] else ", ".join(sorted(s.upper() for s in statuses)) or "ok"
+    lines = [f"method {record['method']}: {verdict} - {record['message']}"]
+    for patch in record["patches"]:
+        if patch["status"] not in OK_PATCH_STATUSES:
+            said = "" if patch["message"] == record["message"] else f" - {patch['message']}"
+            lines.append(f"  {patch['side']}: {patch['status']}{said}")
     keys = [
         ("normal_force_N", "N [N]", 1.0),
         ("creep_force_long_N", "Fx [N]", 1.0),
