@@ -27,6 +27,7 @@ the combined modulus G/(1 - nu)::
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Mapping
@@ -55,6 +56,8 @@ OPTIONS = declare(
            minimum=0.0, exclusive_minimum=True),
     Option("max_refinements", int, 2, "halvings of the default grid's elements while the estimate exceeds "
            "grid_tolerance", minimum=0, maximum=5),
+    Option("estimate_grid_error", bool, True, "estimate the grid error (false: for the inner solves of an "
+           "iteration whose final patches are estimated by with_grid_error)"),
     Option("margin", float, 1.15, "potential contact area in Hertz semi-axes", minimum=1.0),
     Option("tolerance", float, 1e-6, "relative tolerance of NORM and TANG", minimum=0.0, exclusive_minimum=True),
     Option("max_iterations", int, 500, "NORM CG iterations and TANG Newton steps, each", minimum=1),
@@ -92,6 +95,9 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   caller names is solved as named. A solution whose estimate still exceeds ``grid_tolerance``, or whose grid is
   too coarse for the estimate (fewer than 6 elements along x or y), ends with status ``"warning"`` (``success``
   True, the numbers are the solution's) and a message naming the estimate and the tolerance;
+* ``estimate_grid_error`` (bool, default True): False skips the companions and the refinement (the result says
+  it is not estimated); for an iterative caller, which then estimates its final patches with
+  :meth:`BemModel.with_grid_error` (the wheelset case does);
 * a patch whose ``undeformed.potential_area_m`` is given (the wheelset case's CONTACT-style patches: a rectangle
   holding the whole rigid overlap) is solved on that area, without the margin rule and its enlargements;
 * ``margin`` (>= 1): margin m of the potential area (module docstring);
@@ -291,6 +297,46 @@ class BemModel:
         fine = self._solve(geometry, creepage, material, normal_force_N, opts, None, start)
         if fine.status == "no-contact" or not fine.success:
             return fine
+        if not opts["estimate_grid_error"]:
+            if opts["extrapolate"]:
+                fine = self._extrapolated(geometry, creepage, material, normal_force_N, opts, fine, start)
+            return _without_grid_error(fine, "estimate_grid_error = false", time.perf_counter() - start)
+        return self._estimate(geometry, creepage, material, normal_force_N, opts, fine, start, refine=True)
+
+    def with_grid_error(
+        self,
+        geometry: ContactGeometry,
+        creepage: Creepage,
+        material: Material,
+        result: ContactResult,
+        *,
+        normal_force_N: float | None = None,
+        options: Mapping | None = None,
+    ) -> ContactResult:
+        """``result`` (this model's, solved with ``estimate_grid_error = false`` and the same arguments) with its
+        grid-error estimate, status and message as :meth:`solve` gives them, without refining its grid (an
+        iterative caller such as the wheelset case estimates only its final patches; the numbers stay the ones its
+        equilibrium holds). An extrapolated result is returned as it is (not estimated).
+        """
+        start = time.perf_counter()
+        opts = _options(options)
+        if result.status == "no-contact" or not result.success or opts["extrapolate"]:
+            return result
+        out = self._estimate(geometry, creepage, material, normal_force_N, opts, result, start, refine=False)
+        return dataclasses.replace(out, wall_time_s=result.wall_time_s + time.perf_counter() - start)
+
+    def _extrapolated(self, geometry, creepage, material, normal_force_N, opts, fine, start) -> ContactResult:
+        """Richardson extrapolation of ``fine`` with the merged grid (option ``extrapolate``)."""
+        x0, x1, y0, y1 = fine.extra["potential_area_m"]
+        coarse_opts = dict(opts, nx=fine.extra["nx"] // 2, ny=max(fine.extra["ny"] // 2, 1), element_sizes_m=None,
+                           extrapolate=False)  # fmt: skip
+        coarse = self._solve(geometry, creepage, material, normal_force_N, coarse_opts, ((x0, x1), (y0, y1)), start)
+        return _richardson(fine, coarse, time.perf_counter() - start)
+
+    def _estimate(self, geometry, creepage, material, normal_force_N, opts, fine, start, refine) -> ContactResult:
+        """The grid-error estimate of ``fine`` from its companions, refining the default grid (``refine`` and no
+        grid named) while it exceeds ``grid_tolerance``; see :data:`DEFAULT_OPTIONS`.
+        """
         x0, x1, y0, y1 = fine.extra["potential_area_m"]
         area = ((x0, x1), (y0, y1))
 
@@ -313,7 +359,8 @@ class BemModel:
         estimate = grid_error_estimate(levels, material.friction_coefficient)
         refinements = 0
         while (
-            not opts["grid_named"]
+            refine
+            and not opts["grid_named"]
             and refinements < opts["max_refinements"]
             and (estimate is None or estimate["largest_relative"] > tolerance)
             and 4 * fine.extra["nx"] * fine.extra["ny"] <= MAX_ELEMENTS
@@ -616,8 +663,6 @@ def _richardson(fine: ContactResult, coarse: ContactResult, wall_time_s: float) 
     F = 2 F_h - F_2h; the fine grid's estimated error F_h - F = F_2h - F_h is reported per quantity. The
     normal solution, the fields and the other outputs are the fine grid's.
     """
-    import dataclasses
-
     names = ("creep_force_long_N", "creep_force_lat_N", "spin_moment_Nm")
     values = {k: 2.0 * getattr(fine, k) - getattr(coarse, k) for k in names}
     success = bool(fine.success and coarse.success)
@@ -737,12 +782,19 @@ def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
     }
 
 
+def _without_grid_error(result: ContactResult, reason: str, wall_time_s: float) -> ContactResult:
+    """``result`` marked as not estimated (``extra["grid_error"]["estimated"]`` False, the reason in the message)."""
+    extra = dict(result.extra)
+    extra["grid_error"] = {"estimated": False, "reason": reason}
+    extra["grid_error_estimate"] = None
+    message = f"{result.message}; grid error not estimated ({reason})"
+    return dataclasses.replace(result, message=message, extra=extra, wall_time_s=wall_time_s)
+
+
 def _with_grid_error(result: ContactResult, estimate, tolerance: float, refinements: int, wall_time_s: float):
     """``result`` with ``extra["grid_error"]`` (and ``grid_error_estimate``, the largest relative estimate) and,
     when the estimate is missing or above ``tolerance``, status "warning" with the reason in the message.
     """
-    import dataclasses
-
     extra = dict(result.extra)
     nx, ny = extra["nx"], extra["ny"]
     status, message = result.status, result.message
