@@ -176,3 +176,31 @@ def test_bench_row_carries_the_bem_estimate():
     row = run.row()
     assert row["grid_error_estimate"] is not None and row["grid_error_estimate"] > 0
     assert row["grid_error_estimate"] >= max(row["err_max_pressure"], row["err_area"]), row
+
+
+def test_estimate_for_the_final_patches_only():
+    """``estimate_grid_error = false`` skips the companions (the result says so); ``with_grid_error`` then gives the
+    same estimate and status as a solve on that grid (regression between two of our paths), and the wheelset case
+    (Manchester A-2.2, tread, CONTACT's 0.2 mm elements) reports the estimate of its final patches."""
+    geometry, creepage, material, force, _ = _case("creep-long-mid")
+    opts = {"nx": 40, "ny": 40}
+    plain = BemModel().solve(
+        geometry, creepage, material, normal_force_N=force, options={**opts, "estimate_grid_error": False}
+    )
+    assert plain.status == "ok" and not plain.extra["grid_error"]["estimated"]
+    assert "grid error not estimated" in plain.message
+    later = BemModel().with_grid_error(geometry, creepage, material, plain, normal_force_N=force, options=opts)
+    direct = BemModel().solve(geometry, creepage, material, normal_force_N=force, options=opts)
+    assert later.status == direct.status == "warning"
+    assert later.extra["grid_error"]["relative"] == pytest.approx(direct.extra["grid_error"]["relative"], rel=1e-9)
+    assert later.creep_force_long_N == plain.creep_force_long_N
+
+    from comparisons.manchester import MATERIAL, a22_case
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    options = {"model": {"element_size_m": 0.2e-3}, "sides": ("right",)}
+    solution = solve_wheelset_case(a22_case(5, "deck"), MATERIAL, "bem", options)
+    assert solution.success
+    for patch in solution.patches:
+        grid = patch.result.extra["grid_error"]
+        assert grid["estimated"] and grid["largest_relative"] == patch.result.extra["grid_error_estimate"]
