@@ -373,8 +373,12 @@ class BemModel:
             refinements += 1
             estimate = grid_error_estimate(levels, material.friction_coefficient)
         result = fine
-        if opts["extrapolate"] and levels[1] is not None:
-            result = _richardson(fine, levels[1], time.perf_counter() - start)
+        if opts["extrapolate"]:  # the companion twice as coarse is the merged grid (unless it was too small)
+            result = (
+                _richardson(fine, levels[1], time.perf_counter() - start)
+                if levels[1] is not None
+                else self._extrapolated(geometry, creepage, material, normal_force_N, opts, fine, start)
+            )
         return _with_grid_error(result, estimate, tolerance, refinements, time.perf_counter() - start)
 
     def _solve(self, geometry, creepage, material, normal_force_N, opts, fixed_area, start) -> ContactResult:
