@@ -147,3 +147,15 @@ def test_bad_options():
         get_model("kpec").solve(geometry, Creepage(), STEEL, options={"element_size_m": 1e-9})
     res = get_model("kpec").solve(ContactGeometry.quadric(0.46, 0.3, approach_m=-1e-6), Creepage(), STEEL)
     assert res.status == "no-contact" and res.normal_force_N == 0.0
+
+
+def test_analyn_on_a_quadric_is_hertz():
+    """ANALYN's rows on h = A x^2 + B y^2 - q: half-length a sqrt(1 - y^2/b^2) and peak p0 sqrt(1 - y^2/b^2), i.e.
+    Hertz's pressure (up to the grid): force and p_max within 0.5 % at 80 x 80."""
+    geometry0 = ContactGeometry.quadric(0.46, 0.3)
+    a, b, p0, force, approach = _hertz(geometry0, normal_force_N=1e5)
+    geometry = ContactGeometry.quadric(0.46, 0.3, approach_m=approach)
+    res = get_model("analyn").solve(geometry, Creepage(), STEEL, options={"nx": 80, "ny": 80})
+    assert res.success and res.method == "analyn"
+    assert res.normal_force_N == pytest.approx(force, rel=5e-3) and res.max_pressure_Pa == pytest.approx(p0, rel=5e-3)
+    assert res.extra["equivalent_ellipse_m"] == [None, None]

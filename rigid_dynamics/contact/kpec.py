@@ -237,6 +237,97 @@ def kpec_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact
 
 
 @njit(cache=True)
+def _hertz_force(curv_long, curv_lat, combined_modulus_Pa, approach_m):
+    """(a, b, F_N) of Hertz's ellipse of h = A x^2 + B y^2 at approach q (as :func:`hertz_semi_axes`), m, m, N."""
+    a_min = min(curv_long, curv_lat)
+    p, _, _ = _shape(max(curv_long, curv_lat) / a_min, 1e-14, 60)
+    k, d, _, _ = _kdbc(p)
+    major = math.sqrt(approach_m * d / (k * a_min))
+    force = 2.0 * math.pi * major * combined_modulus_Pa * approach_m / (3.0 * k)
+    minor = major * math.sqrt(p)
+    if curv_long <= curv_lat:
+        return major, minor, force
+    return minor, major, force
+
+
+@njit(cache=True)
+def _row_curvature(h, j, i, dx):
+    """x-curvature of h at (j, i): least-squares parabola over i +- k, k grown while h stays below 0.3 h[j, i] < 0
+    (at most 10), 1/m.
+    """
+    nx = h.shape[1]
+    k = 1
+    while True:
+        if k >= 10 or i - k <= 0 or i + k >= nx - 1 or h[j, i] >= 0.0:
+            break
+        if max(h[j, i - k - 1], h[j, i + k + 1]) > 0.3 * h[j, i]:
+            break
+        k += 1
+    s0 = 0.0
+    s2 = 0.0
+    s4 = 0.0
+    b0 = 0.0
+    b2 = 0.0
+    for m in range(-k, k + 1):
+        v = h[j, min(max(i + m, 0), nx - 1)]
+        s0 += 1.0
+        s2 += m * m
+        s4 += m**4
+        b0 += v
+        b2 += v * m * m
+    return (s0 * b2 - s2 * b0) / (s0 * s4 - s2 * s2) / (dx * dx)
+
+
+@njit(cache=True)
+def analyn_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
+    """ANALYN as CONTACT's B = 6 ("a modified ANALYN"; M. Sh. Sichani, R. Enblom, M. Berg, VSD 52 (2014) 1752-64):
+    per row j, with pen = -min h, the row's deepest element i_j (x_c = x[i_j], gap g = h[j, i_j] + pen), local
+    curvatures A_j (least-squares parabola along x, :func:`_row_curvature`) and B_j (second difference along y at
+    i_j), both at least 1e-4 1/mm: Hertz's ellipse (a_j, b_j) of (A_j, B_j) at pen gives the shape factors
+    alpha = pen/(A_j a_j^2), beta = pen/(B_j b_j^2); the row's local penetration pen_j = pen - beta g; where
+    pen_j > 0 the row is in contact over |x - x_c| < l_j = sqrt(pen_j/(alpha A_j)) with the pressure
+    p_j sqrt(1 - ((x - x_c)/l_j)^2), p_j = 3 F/(2 pi a b) of Hertz's ellipse of (A_j, B_j) at pen_j.
+
+    Fills ``pressure`` (Pa) and ``in_contact`` (ny, nx); returns the normal force, N (0 when min h >= 0).
+    """
+    ny, nx = h.shape
+    dx = x[1] - x[0] if nx > 1 else 1.0
+    dy = y[1] - y[0] if ny > 1 else 1.0
+    e_star = shear_modulus_Pa / (1.0 - poisson_ratio)
+    pen = -h.min()
+    total = 0.0
+    for j in range(ny):
+        for i in range(nx):
+            pressure[j, i] = 0.0
+            in_contact[j, i] = False
+    if not pen > 0.0 or nx < 3 or ny < 3:
+        return 0.0
+    for j in range(ny):
+        i0 = min(max(np.argmin(h[j]), 1), nx - 2)
+        gap = h[j, i0] + pen
+        curv_a = max(_row_curvature(h, j, i0, dx), MIN_LATERAL_CURVATURE_1_PER_M)
+        jc = min(max(j, 1), ny - 2)
+        curv_b = 0.5 * (h[jc + 1, i0] - 2.0 * h[jc, i0] + h[jc - 1, i0]) / (dy * dy)
+        curv_b = max(curv_b, MIN_LATERAL_CURVATURE_1_PER_M)
+        a, b, _ = _hertz_force(curv_a, curv_b, e_star, pen)
+        alpha = pen / (curv_a * a * a)
+        beta = pen / (curv_b * b * b)
+        local = pen - beta * gap
+        if local <= 1e-30:
+            continue
+        half = math.sqrt(local / (alpha * curv_a))
+        a_l, b_l, force = _hertz_force(curv_a, curv_b, e_star, local)
+        peak = 1.5 * force / (math.pi * a_l * b_l)
+        for i in range(nx):
+            u = (x[i] - x[i0]) / half
+            if abs(u) < 1.0:
+                in_contact[j, i] = True
+                pressure[j, i] = peak * math.sqrt(max(0.0, 1.0 - u * u))
+                total += pressure[j, i]
+    return total * dx * dy
+
+
+@njit(cache=True)
 def simplified_flexibilities(in_contact, dx, dy, normal_force_N, shear_modulus_Pa, poisson_ratio, mu, xi, eta, phi):
     """Step 6 of the module docstring: (L1, L2, L3) in m/Pa and the equivalent ellipse (a, b) in m."""
     ny, nx = in_contact.shape

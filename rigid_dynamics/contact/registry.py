@@ -53,6 +53,7 @@ MODELS: dict[str, tuple[str, str]] = {
     "fastsim": ("rigid_dynamics.contact.models:FastsimModel", "Hertz + Kalker's FASTSIM (simplified theory)"),
     "fastrip": ("rigid_dynamics.contact.fastrip:FastripModel", "Hertz + FaStrip (strip theory with spin)"),
     "kpec": ("rigid_dynamics.contact.semi_hertzian:KpecModel", "CONTACT's KPEC semi-Hertzian normal + FASTSIM"),
+    "analyn": ("rigid_dynamics.contact.semi_hertzian:AnalynModel", "CONTACT's ANALYN semi-Hertzian normal + FASTSIM"),
     "bem": ("rigid_dynamics.contact.bem.model:BemModel", "boundary elements: CONTACT-style NORM + TANG"),
     "fea": ("fea.model:FeaModel", "finite elements (FEniCSx): normal contact, subsurface stresses"),
     "auto": ("rigid_dynamics.contact.models:AutoModel", "cheapest model meeting the tolerance for the patch"),

@@ -63,7 +63,7 @@ class KpecModel:
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
-        from rigid_dynamics.contact.kpec import fastsim_strips, kpec_pressure, simplified_flexibilities
+        from rigid_dynamics.contact.kpec import fastsim_strips, simplified_flexibilities
         from rigid_dynamics.contact.models import _options
         from rigid_dynamics.contact.types import ContactFields, ContactResult
 
@@ -87,7 +87,7 @@ class KpecModel:
             h = np.where(np.isfinite(h), h, 1.0)  # off the surfaces: far from contact
             p = np.zeros(h.shape)
             contact = np.zeros(h.shape, dtype=np.bool_)
-            out = kpec_pressure(h, x, y, g_mod, nu, p, contact)
+            out = self._normal(h, x, y, g_mod, nu, p, contact)
             return x, y, h, p, contact, out
 
         iterations = 0
@@ -114,6 +114,9 @@ class KpecModel:
         if not contact.any():
             return _no_contact(self.name, geometry, creepage, start, "KPEC found no element in contact")
         converged = normal_force_N is None or abs(force / normal_force_N - 1.0) < 1e-8
+        message = f"{self.name.upper()} + FASTSIM"
+        if not converged:
+            message = f"force control did not converge in {iterations} steps: F_N = {force!r} N"
         dx, dy = x[1] - x[0], y[1] - y[0]
         fn_kpec, p_max, curv_a, curv_b, y_mid, a_eq, b_eq, penetration = out
         l1, l2, l3, a_fl, b_fl = simplified_flexibilities(
@@ -133,14 +136,14 @@ class KpecModel:
             method=self.name,
             success=bool(converged),
             status="ok" if converged else "not-converged",
-            message="KPEC + FASTSIM" if converged else f"force control did not converge in {iterations} steps",
+            message=message,
             normal_force_N=force,
             creep_force_long_N=float(fx),
             creep_force_lat_N=float(fy),
             spin_moment_Nm=float(mz),
             max_pressure_Pa=float(p.max()),
-            semi_axis_long_m=float(a_eq) if geometry.is_elliptic else None,
-            semi_axis_lat_m=float(b_eq) if geometry.is_elliptic else None,
+            semi_axis_long_m=_finite(a_eq, a_fl) if geometry.is_elliptic else None,
+            semi_axis_lat_m=_finite(b_eq, b_fl) if geometry.is_elliptic else None,
             contact_area_m2=float(contact.sum() * dx * dy),
             approach_m=float(geometry.approach_m + (penetration + h_min)),
             creepage=creepage,
@@ -151,9 +154,9 @@ class KpecModel:
                 "nx": int(x.size),
                 "ny": int(y.size),
                 "element_size_m": [float(dx), float(dy)],
-                "equivalent_ellipse_m": [float(a_eq), float(b_eq)],
-                "equivalent_curvatures_1_per_m": [float(curv_a), float(curv_b)],
-                "ellipse_centre_lat_m": float(y_mid),
+                "equivalent_ellipse_m": [_finite(a_eq), _finite(b_eq)],
+                "equivalent_curvatures_1_per_m": [_finite(curv_a), _finite(curv_b)],
+                "ellipse_centre_lat_m": _finite(y_mid),
                 "penetration_m": float(penetration),
                 "flexibilities_m_per_Pa": [float(l1), float(l2), float(l3)],
                 "flexibility_ellipse_m": [float(a_fl), float(b_fl)],
@@ -161,6 +164,38 @@ class KpecModel:
                 "method_error": "not estimated (approximate method; benchmarks/results/kpec.md)",
             },
         )
+
+
+    @staticmethod
+    def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
+        """The normal kernel: (F_N for the flexibilities, p_max, A, B, y_m, a, b, penetration) (kpec.py)."""
+        from rigid_dynamics.contact.kpec import kpec_pressure
+
+        return kpec_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact)
+
+
+class AnalynModel(KpecModel):
+    """CONTACT's modified ANALYN normal method (B = 6) + FASTSIM per strip: the registered model ``analyn``.
+
+    As :class:`KpecModel` with :func:`~rigid_dynamics.contact.kpec.analyn_pressure` for the normal problem (no
+    equivalent ellipse: ``extra`` reports NaN for its fields).
+    """
+
+    name = "analyn"
+    description = "CONTACT's ANALYN semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
+
+    @staticmethod
+    def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
+        from rigid_dynamics.contact.kpec import analyn_pressure
+
+        force = analyn_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact)
+        nan = math.nan
+        return force, float(pressure.max()), nan, nan, nan, nan, nan, float(-h.min())
+
+
+def _finite(value, fallback=None):
+    """float(value), or ``fallback`` when it is not finite (ANALYN has no equivalent ellipse)."""
+    return float(value) if math.isfinite(value) else fallback
 
 
 def _force(p, x, y) -> float:
