@@ -131,6 +131,7 @@ def main():
     options = {"model": {"element_size_m": ELEMENT_M}, "sides": ("right",)}
     kpec, bem, analyn = get_model("kpec"), get_model("bem"), get_model("analyn")
     opts = options["model"]
+    strip_opts = dict(opts, tangential="fastrip")
     for method in ("kpec", "bem", "analyn"):  # warm-up (numba cache, FFT plans)
         solve_wheelset_case(a22_case(0, "deck"), MATERIAL, method, options, track=track)
     rows = []
@@ -150,6 +151,8 @@ def main():
         patch = pk[0]
         t_patch = median_time(lambda p=patch: kpec.solve(p.geometry, p.creepage, MATERIAL, options=opts))
         t_kernel = kernel_time(patch.result, patch.geometry, patch.creepage)
+        t_patch_f = median_time(lambda p=patch: kpec.solve(p.geometry, p.creepage, MATERIAL, options=strip_opts))
+        fastrip_res = kpec.solve(patch.geometry, patch.creepage, MATERIAL, options=strip_opts)
         t_patch_a = median_time(lambda p=pa[0]: analyn.solve(p.geometry, p.creepage, MATERIAL, options=opts))
         analyn_mine = ours(pa[0].result, pa[0].geometry)
         t0 = time.perf_counter()
@@ -176,12 +179,16 @@ def main():
             "bem_vs_contact_full": differences(ours(pb[0].result, pb[0].geometry), reference[case + 6]),
             "kpec_vs_bem_case": differences(mine, ours(pb[0].result, pb[0].geometry)),
             "kpec_vs_bem_same_gap": differences(mine, ours(same_gap, patch.geometry)),
+            "kpec_fastrip_vs_bem_same_gap": differences(
+                ours(fastrip_res, patch.geometry), ours(same_gap, patch.geometry)
+            ),
             "time_s": {
                 "kpec_case": t_case_k,
                 "bem_case": t_case_b,
                 "analyn_case": t_case_a,
                 "kpec_patch": t_patch,
                 "analyn_patch": t_patch_a,
+                "kpec_fastrip_patch": t_patch_f,
                 "kpec_kernels": t_kernel,
                 "bem_patch": t_bem_patch,
             },
@@ -232,6 +239,7 @@ def write(rows):
         ("contact_analyn_vs_contact_full", "CONTACT's ANALYN against CONTACT's full solution"),
         ("bem_vs_contact_full", "Our BEM (wheelset case, same grid) against CONTACT's full solution"),
         ("kpec_vs_bem_same_gap", "Our KPEC against our BEM on the same patch (same gap, creepages, F_N)"),
+        ("kpec_fastrip_vs_bem_same_gap", "Our KPEC with FaStrip per strip against our BEM on the same patch"),
     ):
         lines += ["", f"## {title}", "", head, rule]
         for r in rows:
@@ -244,15 +252,16 @@ def write(rows):
         "## Time (in process, warm; median of repeats for the patch and kernels)",
         "",
         "| case | y_ws mm | grid | kpec wheelset case s | analyn wheelset case s | bem wheelset case s | "
-        "kpec patch ms | analyn patch ms | kpec kernels ms | bem same patch ms | bem/kpec per patch |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "kpec patch ms | kpec+fastrip patch ms | analyn patch ms | kpec kernels ms | bem same patch ms | "
+        "bem/kpec per patch |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         t = r["time_s"]
         lines.append(
             f"| {r['case']} | {r['lateral_shift_mm']:g} | {r['grid'][0]} x {r['grid'][1]} | {t['kpec_case']:.2f} | "
             f"{t['analyn_case']:.2f} | {t['bem_case']:.2f} | {1e3 * t['kpec_patch']:.2f} | "
-            f"{1e3 * t['analyn_patch']:.2f} | {1e3 * t['kpec_kernels']:.3f} | "
+            f"{1e3 * t['kpec_fastrip_patch']:.2f} | {1e3 * t['analyn_patch']:.2f} | {1e3 * t['kpec_kernels']:.3f} | "
             f"{1e3 * t['bem_patch']:.1f} | {t['bem_patch'] / t['kpec_patch']:.0f} |"
         )
     write_text(out / "kpec.md", "\n".join(lines) + "\n")

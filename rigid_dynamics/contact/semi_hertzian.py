@@ -1,10 +1,13 @@
-"""The semi-Hertzian rung ``kpec``: CONTACT's KPEC normal method with FASTSIM per strip, on the sampled gap.
+"""The semi-Hertzian rungs ``kpec`` and ``analyn``: CONTACT's KPEC or ANALYN normal method with FASTSIM (or
+FaStrip) per strip, on the sampled gap.
 
 The method and its compiled kernels are in :mod:`rigid_dynamics.contact.kpec` (equal to the open-source CONTACT
-program's KPEC, B = 5, with its FASTSIM, M = 3: tests/test_kpec_contact.py against its ``mbench_a22_kpec``
-example). This module is the static driver: it chooses the grid, evaluates the gap at the element centres from
-the patch geometry (``ContactGeometry.gap_m``: for the wheelset case's CONTACT-style patches the undeformed distance
-evaluated exactly from the surfaces, the one sampler the BEM uses too), runs the kernels, and returns a
+program's KPEC, B = 5, and ANALYN, B = 6, with its FASTSIM, M = 3: tests/test_kpec_contact.py against its
+``mbench_a22_kpec`` example; option ``tangential = "fastrip"``: FaStrip per strip, CONTACT's M = 5, which has no
+published output to compare with: tested against Kalker's linear theory, Coulomb's bound and our Hertz + FaStrip).
+This module is the static driver: it chooses the grid, evaluates the gap at the element centres from the patch
+geometry (``ContactGeometry.gap_m``: for the wheelset case's CONTACT-style patches the undeformed distance evaluated
+exactly from the surfaces, the one sampler the BEM uses too), runs the kernels, and returns a
 :class:`~rigid_dynamics.contact.types.ContactResult`.
 
 Grid (options): ``element_size_m`` (CONTACT's DX = DS) gives square elements whose centres lie at integer
@@ -33,6 +36,9 @@ import numpy as np
 from rigid_dynamics.contact.options import Option, declare
 from rigid_dynamics.contact.options import defaults as option_defaults
 
+TANGENTIAL = ("fastsim", "fastrip")
+"""Per-strip tangential methods of the option ``tangential``: FASTSIM (CONTACT's M = 3) or FaStrip (M = 5)."""
+
 OPTIONS = declare(
     Option("nx", int, 40, "elements along x over the potential contact area", minimum=4, maximum=4096),
     Option("ny", int, 40, "elements along y over the potential contact area", minimum=4, maximum=4096),
@@ -40,9 +46,12 @@ OPTIONS = declare(
            "(CONTACT's DX = DS) instead of nx, ny, m", minimum=0, exclusive_minimum=True, allow_none=True),
     Option("margin", float, 1.1, "enlargement of the rigid-overlap region (no given potential area)", minimum=1.0),
     Option("max_iterations", int, 40, "force control: secant steps", minimum=1),
+    Option("tangential", str, "fastsim", "per-strip tangential method", choices=TANGENTIAL),
 )  # fmt: skip
 """Options of :class:`KpecModel` (module docstring): grid ``nx`` x ``ny`` (>= 4) or ``element_size_m``,
-``margin`` (>= 1) of the rigid-overlap box, ``max_iterations`` of force control."""
+``margin`` (>= 1) of the rigid-overlap box, ``max_iterations`` of force control, ``tangential``: ``"fastsim"``
+(FASTSIM per strip, :func:`~rigid_dynamics.contact.kpec.fastsim_strips`, as CONTACT's KPEC example) or
+``"fastrip"`` (FaStrip per strip, :func:`~rigid_dynamics.contact.kpec.fastrip_strips`)."""
 DEFAULTS: dict = option_defaults(OPTIONS)
 
 MAX_ELEMENTS = 4_000_000
@@ -63,7 +72,7 @@ class KpecModel:
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
-        from rigid_dynamics.contact.kpec import fastsim_strips, simplified_flexibilities
+        from rigid_dynamics.contact.kpec import fastrip_strips, fastsim_strips, simplified_flexibilities
         from rigid_dynamics.contact.models import _options
         from rigid_dynamics.contact.types import ContactFields, ContactResult
 
@@ -114,7 +123,7 @@ class KpecModel:
         if not contact.any():
             return _no_contact(self.name, geometry, creepage, start, "KPEC found no element in contact")
         converged = normal_force_N is None or abs(force / normal_force_N - 1.0) < 1e-8
-        message = f"{self.name.upper()} + FASTSIM"
+        message = f"{self.name.upper()} + {'FaStrip' if opts['tangential'] == 'fastrip' else 'FASTSIM'} per strip"
         if not converged:
             message = f"force control did not converge in {iterations} steps: F_N = {force!r} N"
         dx, dy = x[1] - x[0], y[1] - y[0]
@@ -124,10 +133,18 @@ class KpecModel:
         )
         tx, ty = np.zeros(p.shape), np.zeros(p.shape)
         slip = np.zeros(p.shape, dtype=np.bool_)
-        fx, fy, mz = fastsim_strips(
-            p, contact, x, y, mu, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m, l1, l2, l3, tx, ty,
-            slip,
-        )  # fmt: skip
+        xi, eta, phi = creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m
+        if opts["tangential"] == "fastrip":
+            from rigid_dynamics.contact.fastrip import strip_creepages
+
+            xi_s, eta_s, phi_s, p0, *_ = strip_creepages(
+                a_fl, b_fl, fn_kpec, xi, eta, phi, shear_modulus_Pa=g_mod, poisson_ratio=nu, friction_coefficient=mu
+            )
+            fx, fy, mz = fastrip_strips(
+                p, contact, x, y, mu, nu, a_fl, p0, xi_s, eta_s, phi_s, xi, eta, phi, l1, l2, l3, tx, ty, slip
+            )
+        else:
+            fx, fy, mz = fastsim_strips(p, contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
         edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
         fields = ContactFields(
             x_m=x, y_m=y, pressure_Pa=p, traction_long_Pa=tx, traction_lat_Pa=ty, in_contact=contact, in_slip=slip
@@ -164,7 +181,6 @@ class KpecModel:
                 "method_error": "not estimated (approximate method; benchmarks/results/kpec.md)",
             },
         )
-
 
     @staticmethod
     def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
