@@ -28,7 +28,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_gallery_src", "**/.ipynb_checkpoints"]
+exclude_patterns = ["_build", "_gallery_src", "_generated", "**/.ipynb_checkpoints"]
 myst_enable_extensions = ["dollarmath"]
 myst_heading_anchors = 3
 # Docstrings name fields that several classes share (success, message, patches): an ambiguous link is no error.

@@ -7,6 +7,9 @@
   sphinx-gallery's text blocks take (headings, inline code, links). The examples are not executed here.
 - ``benchmarks/results/*.md`` (and ``benchmarks/results/*/*.md``) are collected into ``docs/results.md``, one
   section per file, their headings moved one level down and image paths made relative to ``docs/``.
+- The registered contact models and their declared options (what ``wheelrail models`` prints) are written to
+  ``docs/_generated/models.md`` for the contact-models page, and ``wheelrail``'s public names (``wr.api()``)
+  to ``docs/_generated/facade.rst`` for the API page.
 
 Both run on ``builder-inited`` ahead of sphinx-gallery, so the generated files exist before any page is read.
 The generated files are not part of the repository (``docs/.gitignore``).
@@ -25,6 +28,7 @@ EXAMPLES = ROOT / "examples"
 GALLERY_SOURCE = DOCS / "_gallery_src"
 RESULTS = ROOT / "benchmarks" / "results"
 RESULTS_PAGE = DOCS / "results.md"
+GENERATED = DOCS / "_generated"
 
 GALLERY_HEADER = """\
 Examples
@@ -131,7 +135,9 @@ def results_files() -> list[Path]:
 
 def write_results_page(app=None) -> None:
     """Write ``docs/results.md`` from the recorded results (images relinked per file)."""
-    _write_if_changed(RESULTS_PAGE, results_page([(path, path.read_text(encoding="utf-8")) for path in results_files()]))
+    _write_if_changed(
+        RESULTS_PAGE, results_page([(path, path.read_text(encoding="utf-8")) for path in results_files()])
+    )
 
 
 def results_page(pieces: list[tuple[Path, str]]) -> str:
@@ -154,6 +160,52 @@ def results_page(pieces: list[tuple[Path, str]]) -> str:
             parts += [f"## {name}", "", _shift_headings(text, 1)]
         parts.append("")
     return "\n".join(parts)
+
+
+def models_listing() -> str:
+    """The registered contact models with their options, as ``wheelrail models`` lists them (Markdown)."""
+    from rigid_dynamics.contact.registry import MODELS, model_options
+
+    parts = []
+    for name, (target, description) in MODELS.items():
+        parts += [f"### `{name}`", "", f"{description} (`{target}`).", ""]
+        options = model_options(name)
+        if options:
+            parts += ["Options:", ""] + [f"- {option.describe()}".replace("*", "\\*") for option in options.values()]
+        else:
+            parts.append("No options.")
+        parts.append("")
+    return "\n".join(parts)
+
+
+def facade_listing() -> str:
+    """``wheelrail``'s public names (``wr.api()``) as an rST list table, each linked to where it is defined."""
+    import importlib
+
+    import wheelrail
+
+    rows = [
+        ".. list-table::",
+        "   :header-rows: 1",
+        "   :widths: 25 45 30",
+        "",
+        "   * - name",
+        "     - what",
+        "     - defined in",
+    ]
+    for name, (module_name, attr, what) in wheelrail._API.items():
+        obj = getattr(importlib.import_module(module_name), attr)
+        home = getattr(obj, "__module__", None) if callable(obj) else None
+        target = f":py:obj:`{home}.{obj.__qualname__}`" if home else f":py:mod:`{module_name}`"
+        rows += [f"   * - ``wr.{name}``", f"     - {what}", f"     - {target}"]
+    return "\n".join(rows) + "\n"
+
+
+def write_generated_includes(app=None) -> None:
+    """Write the listings that pages include from ``docs/_generated/`` (model registry, ``wheelrail``'s names)."""
+    GENERATED.mkdir(exist_ok=True)
+    _write_if_changed(GENERATED / "models.md", models_listing())
+    _write_if_changed(GENERATED / "facade.rst", facade_listing())
 
 
 def _write_if_changed(path: Path, text: str) -> None:
@@ -206,7 +258,7 @@ def escape_bars(app, what, name, obj, options, lines):
     and inline literals.
     """
     literal_indent = None
-    expect_literal = False
+    expect_literal, base_indent = False, 0
     for i, line in enumerate(lines):
         indent = len(line) - len(line.lstrip())
         if literal_indent is not None:
@@ -238,4 +290,5 @@ def setup(app):
     app.connect("autodoc-skip-member", skip_tuple_fields)
     app.connect("builder-inited", write_gallery_sources, priority=100)
     app.connect("builder-inited", write_results_page, priority=100)
+    app.connect("builder-inited", write_generated_includes, priority=100)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
