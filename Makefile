@@ -3,7 +3,7 @@ VENV := .venv
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: demo test lint setup clean clean-numba
+.PHONY: demo test lint docs setup clean clean-numba
 
 $(STAMP): pyproject.toml tools/setup_venv.sh
 	bash tools/setup_venv.sh
@@ -18,6 +18,10 @@ test: $(STAMP)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .
+
+# the documentation site in docs/_build/html (warnings are errors; tests/test_docs.py builds it in `make test`)
+docs: $(STAMP)
+	$(VENV)/bin/python -m sphinx -b html -W --keep-going docs docs/_build/html
 
 clean:
 	rm -rf $(VENV) out .pytest_cache

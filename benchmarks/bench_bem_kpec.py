@@ -2,7 +2,7 @@
 
 For each step of the Manchester benchmark A-2.2 (right and left wheel, shift k x 0.5 mm, yaw k x 1.2 mrad) the
 wheelset case is solved with the BEM (``solve_wheelset_case(..., "bem")``); every BEM patch (its ContactGeometry,
-creepages and BEM normal force) is then solved by ``kpec`` (sampled undeformed distance), ``fastrip`` and
+creepages and BEM normal force) is then solved by ``kpec`` (CONTACT's KPEC on the sampled gap), ``fastrip`` and
 ``fastsim`` (Hertz on the patch's quadric) in force control with the BEM's normal force. Differences: creep forces
 in units of mu F_N, maximum pressure and contact area relative to the BEM's; in-process time per patch.
 The comparison depends on the wheelset case (load, creepages, gap sampling): rerun after changes to it.
@@ -31,6 +31,7 @@ import numpy as np  # noqa: E402
 from comparisons.manchester import MATERIAL, a22_case  # noqa: E402
 from rigid_dynamics.contact.registry import get_model  # noqa: E402
 from rigid_dynamics.contact.wheelset_case import solve_wheelset_case  # noqa: E402
+from rigid_dynamics.files import write_text as write_atomic  # noqa: E402
 
 FAST = ("kpec", "fastrip", "fastsim")
 
@@ -63,12 +64,6 @@ def compare_patch(patch, material) -> dict:
             "wall_s": wall,
         }
     return row
-
-
-def write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
 
 
 def main(steps):

@@ -55,6 +55,9 @@ KEYS = (
 
 def _record(result) -> dict:
     out = {k: getattr(result, k) for k in KEYS}
+    # the model's own estimate of its discretisation error (bem: largest relative; None for the others)
+    out["status"] = result.status
+    out["grid_error_estimate"] = result.extra.get("grid_error_estimate")
     return {
         k: (float(v) if isinstance(v, (int, float, np.floating)) and not isinstance(v, bool) else v)
         for k, v in out.items()
@@ -219,9 +222,9 @@ def _markdown(report: dict) -> str:
         lines.append("")
         lines.append(
             "| patch | elliptic | angle deg | model | FN kN | Fx kN | Fy kN | Mz N m | pmax MPa | area mm2 "
-            "| a mm | b mm | ok |"
+            "| a mm | b mm | ok | status | grid error est. |"
         )
-        lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for p in entry["patches"]:
             for name, m in p["models"].items():
                 lines.append(
@@ -230,7 +233,8 @@ def _markdown(report: dict) -> str:
                     f"{_fmt(m['creep_force_long_N'], 1e-3)} | {_fmt(m['creep_force_lat_N'], 1e-3)} | "
                     f"{_fmt(m['spin_moment_Nm'])} | {_fmt(m['max_pressure_Pa'], 1e-6)} | "
                     f"{_fmt(m['contact_area_m2'], 1e6)} | {_fmt(m['semi_axis_long_m'], 1e3)} | "
-                    f"{_fmt(m['semi_axis_lat_m'], 1e3)} | {_fmt(m['success'])} |"
+                    f"{_fmt(m['semi_axis_lat_m'], 1e3)} | {_fmt(m['success'])} | {m['status']} | "
+                    f"{_fmt(m['grid_error_estimate'])} |"
                 )
         lines.append("")
         for p in entry["patches"]:

@@ -77,6 +77,7 @@ class BenchRun:
     values: dict = field(default_factory=dict)
     errors: dict = field(default_factory=dict)
     error: float | None = None
+    grid_error_estimate: float | None = None
 
     def row(self) -> dict:
         out = {
@@ -91,6 +92,7 @@ class BenchRun:
         out.update({k: self.values.get(k) for k in QUANTITIES})
         out.update({k: self.errors.get(k) for k in (*ERROR_KEYS, "err_field")})
         out["error"] = self.error
+        out["grid_error_estimate"] = self.grid_error_estimate  # the model's own estimate (bem), relative
         out["message"] = self.message
         return out
 
@@ -227,6 +229,9 @@ def run_one(named, model: str, resolution: str, options: dict) -> BenchRun:
     run.values = side_values(patches, named.side)
     run.errors, run.error = case_errors(named, run.values)
     run.errors["err_field"] = field_error(named, patches)
+    estimates = [p[3].extra.get("grid_error_estimate") for p in patches if p[0] == named.side]
+    estimates = [e for e in estimates if e is not None]
+    run.grid_error_estimate = max(estimates) if estimates else None
     return run
 
 

@@ -69,7 +69,7 @@ COLUMNS = (
     "deepest_y_rail_m", "contact_y_wheel_m", "contact_angle_rad", "rolling_radius_m", "approach_m", "is_elliptic",
     "normal_force_N", "creep_force_long_N", "creep_force_lat_N", "spin_moment_Nm", "semi_axis_long_m",
     "semi_axis_lat_m", "max_pressure_Pa", "contact_area_m2", "creepage_long", "creepage_lat", "spin_creepage_1_per_m",
-    "vertical_load_N", "status",
+    "vertical_load_N", "status", "grid_error_estimate",
     *(f"contact_{k}" for k in REFERENCE_KEYS), *DIFFERENCE_KEYS,
 )  # fmt: skip
 
@@ -215,6 +215,8 @@ def sweep(method: str = "bem", steps=STEPS, model_options=None, kinematics: str 
                 "spin_creepage_1_per_m": c.spin_1_per_m,
                 "vertical_load_N": sol.wheel_vertical_load_N.get(p.side, math.nan),
                 "status": sol.status if sol.success else f"{sol.status}: {sol.message}",
+                # the model's own estimate of its discretisation error (bem: largest relative; else None)
+                "grid_error_estimate": r.extra.get("grid_error_estimate"),
             }
             matched = (
                 p.side == "right" and ref is not None and n_right == ref["n_patches"]

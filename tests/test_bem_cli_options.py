@@ -30,16 +30,25 @@ def test_bad_bem_solver_options(tmp_path, capsys, solver, pattern):
 
 
 def test_element_size_through_the_cli(tmp_path, capsys):
-    """A case with ``element_size_m`` runs: the grid in the JSON output has that element size."""
+    """A case with ``element_size_m`` runs: the grid in the JSON output has that element size and its grid-error
+    estimate; the named grid (17 x 13 elements) is coarser than the default ``grid_tolerance`` asks: status
+    ``warning``, exit 1, the estimate in the message; with ``grid_tolerance = 0.1`` it is ``ok``, exit 0."""
     import json
 
     path = tmp_path / "case.toml"
-    path.write_text(CASE + "element_size_m = 0.5e-3\n")
+    path.write_text(CASE + "element_size_m = 1e-3\n")
     code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
-    out = capsys.readouterr().out
-    assert code == 0, out
-    data = json.loads(out)
-    assert data["success"], data
+    data = json.loads(capsys.readouterr().out)
+    patch = data["patches"][0]
+    assert code == 1 and patch["status"] == "warning", patch
+    assert "estimated grid error above grid_tolerance 0.02" in patch["message"] and "contact area" in patch["message"]
+    grid = patch["diagnostics"]["grid_error"]
+    assert 0.02 < grid["largest_relative"] == patch["diagnostics"]["grid_error_estimate"] < 0.1
+    assert patch["diagnostics"]["dx_m"] == pytest.approx(1e-3) and grid["refinements"] == 0
+    path.write_text(CASE + "element_size_m = 1e-3\ngrid_tolerance = 0.1\n")
+    code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out2")])
+    data = json.loads(capsys.readouterr().out)
+    assert code == 0 and data["success"] and data["patches"][0]["status"] == "ok", data
 
 
 def test_shift_problem_and_kinetic_friction_through_the_cli(tmp_path, capsys):
@@ -48,6 +57,7 @@ def test_shift_problem_and_kinetic_friction_through_the_cli(tmp_path, capsys):
 
     path = tmp_path / "case.toml"
     solver = 'nx = 24\nny = 24\nproblem = "shift"\nshift_long_m = 1e-3\nkinetic_friction_coefficient = 0.25\n'
+    solver += "grid_tolerance = 0.1\n"  # 24 x 24: area estimate ~3 %
     path.write_text(CASE + solver)
     code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
     out = capsys.readouterr().out
@@ -64,9 +74,25 @@ def test_transient_problem_through_the_cli(tmp_path, capsys):
 
     path = tmp_path / "case.toml"
     text = CASE.replace("creepage_long = 0.0", "creepage_long = 1e-3")
-    path.write_text(text + 'nx = 12\nny = 12\nproblem = "transient"\ntransient_steps = 4\n')
+    path.write_text(text + 'nx = 12\nny = 12\nproblem = "transient"\ntransient_steps = 4\ngrid_tolerance = 0.5\n')
     code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
     out = capsys.readouterr().out
     assert code == 0, out
     data = json.loads(out)
     assert data["success"] and data["patches"][0]["creep_force_long_N"] < 0
+
+
+def test_printed_verdict_agrees_with_the_exit_status(capsys):
+    """A BEM grid coarser than its tolerance: the printed table says WARNING (not ok) with the patch's message, the
+    exit status is 1, and the JSON's patch status is "warning"."""
+    import json
+
+    code = main(["contact", "hertz-quadric", "--method", "bem", "--set", "solver.nx=20", "--set", "solver.ny=20"])
+    out = capsys.readouterr().out
+    assert code == 1 and out.startswith("method bem: WARNING - ") and "single: warning" in out, out
+    code = main(["contact", "hertz-quadric", "--method", "bem", "--set", "solver.nx=20", "--set", "solver.ny=20",
+                 "--json"])  # fmt: skip
+    data = json.loads(capsys.readouterr().out)
+    assert code == 1 and data["patches"][0]["status"] == "warning"
+    assert main(["contact", "hertz-quadric", "--method", "bem"]) == 0
+    assert capsys.readouterr().out.startswith("method bem: ok - ")

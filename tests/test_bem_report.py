@@ -21,6 +21,9 @@ def test_report_step12(tmp_path):
     for p in patches:
         m = p["models"]
         assert m["bem"]["success"]
+        # the BEM's own grid-error estimate is in the report (24 x 24 on the flange root: above 2 %, "warning")
+        assert m["bem"]["grid_error_estimate"] > 0 and m["hertz"]["grid_error_estimate"] is None
+        assert m["bem"]["status"] == ("ok" if m["bem"]["grid_error_estimate"] <= 0.02 else "warning")
         assert m["bem"]["normal_force_N"] == pytest.approx(m["hertz"]["normal_force_N"], rel=1e-9)
         assert (tmp_path / p["fields_png"]).stat().st_size > 1000
         if not p["is_elliptic"]:

@@ -185,8 +185,14 @@ def test_auto_choice_in_the_loop_is_the_documented_rule():
         assert FEATURES[deciding] == choice["deciding_feature"]
 
 
-def test_auto_below_every_level_solves_by_bem_through_the_callback():
-    """A tolerance below the smallest measured level: every patch BEM (through the callback), level NaN."""
+def test_auto_below_every_level_solves_by_bem_through_the_callback(monkeypatch):
+    """A tolerance below the smallest measured level: every patch BEM (through the callback), level NaN. The
+    choice is the subject here, not the BEM's grid: its default grid is not refined (``max_refinements`` 0; each
+    patch then ends "warning" with its grid-error estimate), which keeps the test at seconds."""
+    from rigid_dynamics.contact.bem import model as bem_model
+    from rigid_dynamics.contact.options import Option
+
+    monkeypatch.setitem(bem_model.OPTIONS, "max_refinements", Option("max_refinements", int, 0, "test", minimum=0))
     scene = replace(SCENE, contact_model="auto", contact_tolerance=0.001, duration_s=0.002)
     result = simulate(scene, compiled=True)
     assert result.success and result.compiled, result.message

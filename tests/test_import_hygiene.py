@@ -3,6 +3,8 @@
 import subprocess
 import sys
 
+import pytest
+
 HEAVY = (
     "gmsh",
     "dolfinx",
@@ -43,3 +45,36 @@ def test_core_and_front_import_no_heavy_package():
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "", f"heavy modules imported: {done.stdout.strip()}"
+
+
+CONTACT_CODE = """
+import contextlib, io, sys
+from wheelrail.cli import main
+with contextlib.redirect_stdout(io.StringIO()):
+    code = main(["contact", "hertz-quadric", "--json"{method}])
+heavy = {heavy}
+print(code, ",".join(sorted(m for m in sys.modules if m.split(".")[0] in heavy or m in heavy)))
+"""
+
+CONTACT_HEAVY = set(HEAVY) | {"meshio", "h5py", "scipy.interpolate", "scipy.optimize", "scipy.integrate"}
+"""What ``wheelrail contact <quadric case> --json`` (no output folder, no plots) must not import: the files' and
+plots' libraries, the FE stack, and the scipy packages the contact models used to import at module level (PCHIP of
+Kalker's table, the Hertz root) -- a fifth to a third of the command's start-up (benchmarks/results/startup.md)."""
+
+
+@pytest.mark.parametrize("method", [None, "hertz", "bem"])
+def test_contact_json_imports_no_heavy_module(method):
+    """``wheelrail contact hertz-quadric --json`` (auto, which chooses bem here; hertz; bem) imports none of
+    ``CONTACT_HEAVY``."""
+    extra = "" if method is None else f', "--method", "{method}"'
+    done = subprocess.run(
+        [sys.executable, "-c", CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(CONTACT_HEAVY))],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    code, _, imported = done.stdout.strip().partition(" ")
+    assert code == "0", done.stdout
+    assert imported == "", f"heavy modules imported by wheelrail contact --json: {imported}"

@@ -120,3 +120,26 @@ def test_bad_input_raises():
         kalker_coefficients(1.0, 0.6)
     with pytest.raises(ValueError, match="coefficient name"):
         KALKER_TABLE.coefficient("C12")
+
+
+def test_pchip_coefficients_are_scipys():
+    """The numpy PCHIP of the creep-coefficient table (kalker.pchip_coefficients, kept so that importing the
+    coefficients needs no scipy.interpolate) equals scipy's PchipInterpolator: on the table and on random data with
+    flat and sign-changing stretches."""
+    import numpy as np
+    from scipy.interpolate import PchipInterpolator
+
+    from rigid_dynamics.contact import kalker
+
+    x = np.log(kalker.KALKER_TABLE.a_over_b)
+    y = np.log(kalker.KALKER_TABLE.values.reshape(len(x), 12))
+    np.testing.assert_allclose(kalker._PP_C, PchipInterpolator(x, y, axis=0).c, rtol=1e-13, atol=1e-13)
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        n = int(rng.integers(3, 12))
+        x = np.sort(rng.random(n)) + np.arange(n)
+        y = np.cumsum(rng.standard_normal((n, 3)), axis=0)
+        y[int(rng.integers(1, n))] = y[0]  # a repeated value: a zero or sign-changing slope
+        np.testing.assert_allclose(
+            kalker.pchip_coefficients(x, y), PchipInterpolator(x, y, axis=0).c, rtol=1e-11, atol=1e-11
+        )

@@ -110,7 +110,8 @@ def test_auto_sampled_geometry_by_its_ellipticity():
     r = get_model("auto").solve(g, Creepage(1e-6, 0, 0), MATERIAL)
     assert r.extra["auto_features"]["ellipticity_residual"] > 0.5
     assert r.extra["selected_model"] == "bem"
-    assert r.status in ("ok", "unavailable", "not-converged")
+    # "warning": the BEM's max pressure moves with its grid on this field (bilinear between 1 mm samples)
+    assert r.status in ("ok", "warning", "unavailable", "not-converged")
 
 
 @pytest.mark.parametrize("method", ["hertz", "linear", "vermeulen-johnson", "fastsim", "auto"])

@@ -562,7 +562,6 @@ def solve_case(case: ContactCase | str | Path, method: str) -> CaseSolution:
     includes the contact search.
     """
     from rigid_dynamics.contact.registry import get_model
-    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
 
     if isinstance(case, (str, Path)):
         case = load_case(case)
@@ -590,6 +589,8 @@ def solve_case(case: ContactCase | str | Path, method: str) -> CaseSolution:
             [("single", case.geometry, case.creepage, result)],
             setup_s=setup_s,
         )
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case  # only a wheelset case needs the search
+
     solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options)
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     extra = {

@@ -211,7 +211,13 @@ def _fea_views(solution, out_dir: Path) -> list[str]:
 
 
 def _contact_table(record: dict) -> str:
-    lines = [f"method {record['method']}: {record['status']} - {record['message']}"]
+    from wheelrail.cases import OK_PATCH_STATUSES
+
+    lines = [f"method {record['method']}: {record['status']} - {record['message']}"]  # as the exit status says
+    for patch in record["patches"]:
+        if patch["status"] not in OK_PATCH_STATUSES:
+            said = "" if patch["message"] == record["message"] else f" - {patch['message']}"
+            lines.append(f"  {patch['side']}: {patch['status']}{said}")
     keys = [
         ("normal_force_N", "N [N]", 1.0),
         ("creep_force_long_N", "Fx [N]", 1.0),

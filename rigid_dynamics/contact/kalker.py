@@ -50,7 +50,6 @@ from pathlib import Path
 
 import numpy as np
 from numba import njit
-from scipy.interpolate import PchipInterpolator
 
 _DATA_FILE = Path(__file__).resolve().parent / "data" / "kalker_creep_coefficients.csv"
 COEFFICIENT_NAMES = ("C11", "C22", "C23", "C33")
@@ -112,12 +111,53 @@ def _load_table(path: Path = _DATA_FILE) -> KalkerTable:
 KALKER_TABLE = _load_table()
 """Kalker's creepage/spin coefficient table (module constant, loaded once from the package data)."""
 
-_LOG_INTERP = PchipInterpolator(
-    np.log(KALKER_TABLE.a_over_b), np.log(KALKER_TABLE.values.reshape(len(KALKER_TABLE.a_over_b), 12)), axis=0
+
+def pchip_coefficients(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Coefficients of the monotone piecewise cubic Hermite interpolant (PCHIP) of the columns of ``y`` over ``x``.
+
+    The interpolant of scipy's ``PchipInterpolator`` (Fritsch & Butland 1984: at an interior point the weighted
+    harmonic mean of the neighbouring slopes, 0 where they differ in sign; the one-sided three-point ends of
+    Moler, Numerical Computing with MATLAB, sec. 3.4), in numpy only, so that importing the creep coefficients
+    does not import scipy.interpolate (a third of a small command's start-up). ``tests/test_kalker.py`` checks it
+    against scipy's.
+
+    Args:
+        x: (n,) increasing breakpoints, n >= 3.
+        y: (n, m) values.
+
+    Returns:
+        c: (4, n - 1, m), the interval k's cubic c[0] t^3 + c[1] t^2 + c[2] t + c[3] in t = x - x[k] (scipy's
+        ``PPoly.c`` layout).
+    """
+    h = np.diff(x)[:, None]
+    slope = np.diff(y, axis=0) / h
+    d = np.zeros_like(y)
+    w1, w2 = 2.0 * h[1:] + h[:-1], h[1:] + 2.0 * h[:-1]
+    same = (np.sign(slope[1:]) == np.sign(slope[:-1])) & (slope[1:] != 0) & (slope[:-1] != 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mean = (w1 / slope[:-1] + w2 / slope[1:]) / (w1 + w2)
+        d[1:-1] = np.where(same, 1.0 / mean, 0.0)
+
+    def edge(h0, h1, m0, m1):
+        end = ((2.0 * h0 + h1) * m0 - h0 * m1) / (h0 + h1)
+        end = np.where(np.sign(end) != np.sign(m0), 0.0, end)
+        return np.where((np.sign(m0) != np.sign(m1)) & (np.abs(end) > 3.0 * np.abs(m0)), 3.0 * m0, end)
+
+    d[0] = edge(h[0], h[1], slope[0], slope[1])
+    d[-1] = edge(h[-1], h[-2], slope[-1], slope[-2])
+    c = np.empty((4, len(x) - 1, y.shape[1]))
+    c[0] = (d[:-1] + d[1:] - 2.0 * slope) / h**2
+    c[1] = (3.0 * slope - 2.0 * d[:-1] - d[1:]) / h
+    c[2] = d[:-1]
+    c[3] = y[:-1]
+    return c
+
+
+# the piecewise cubics in log(a/b) of log C_ij as plain arrays for the compiled kernels: breakpoints, coefficients
+_PP_X = np.ascontiguousarray(np.log(KALKER_TABLE.a_over_b))
+_PP_C = np.ascontiguousarray(  # (4, 18, 12): column = 3 * coefficient + nu column
+    pchip_coefficients(_PP_X, np.log(KALKER_TABLE.values.reshape(len(KALKER_TABLE.a_over_b), 12)))
 )
-# the same piecewise cubics as plain arrays for the compiled kernels: breakpoints and coefficients
-_PP_X = np.ascontiguousarray(_LOG_INTERP.x)
-_PP_C = np.ascontiguousarray(_LOG_INTERP.c)  # (4, 18, 12): column = 3 * coefficient + nu column
 _NU0, _NU1, _NU2 = TABLE_POISSON_RATIOS
 _LOG4 = math.log(4.0)
 

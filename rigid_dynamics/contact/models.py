@@ -452,9 +452,9 @@ class AutoModel:
                     wall_time_s=time.perf_counter() - start,
                     extra=record,
                 )
-            result = model.solve(
-                geometry, creepage, material, normal_force_N=normal_force_N, options=per_model.get("bem")
-            )
+            # the BEM's grid is held to auto's tolerance (a BEM grid coarser than that ends "warning")
+            bem_options = {"grid_tolerance": tol, **(per_model.get("bem") or {})}
+            result = model.solve(geometry, creepage, material, normal_force_N=normal_force_N, options=bem_options)
         result.extra.update(record)
         return dataclasses.replace(result, wall_time_s=time.perf_counter() - start)
 
@@ -620,6 +620,7 @@ def solve_batch(
                         Creepage(float(xi[idx]), float(eta[idx]), float(phi[idx])),
                         material,
                         normal_force_N=float(hz.normal_force_N[idx]),
+                        options={"grid_tolerance": opts["tolerance"]},
                     )
                     if not r.success:
                         raise ValueError(f"auto: bem failed on patch {idx}: {r.status}: {r.message}")

@@ -1,383 +1,249 @@
-"""KPEC: the semi-Hertzian normal method of Kik and Piotrowski with ellipse correction, and FASTSIM on its patch.
+"""The semi-Hertzian rungs ``kpec`` and ``analyn``: CONTACT's KPEC or ANALYN normal method with FASTSIM (or
+FaStrip) per strip, on the sampled gap.
 
-Kik-Piotrowski (W. Kik, J. Piotrowski, Proc. 2nd Mini Conf. on Contact Mechanics, Budapest 1996; J. Piotrowski,
-W. Kik, Vehicle System Dynamics 46 (2008) 27-48) with the ellipse correction of the open-source CONTACT program
-(E.A.H. Vollebregt, eve70a/CONTACT, user guide sec. "Fast or detailed solution": a variable virtual-penetration
-factor from Hertz's theory, exact for elliptic patches); compared with the BEM and ANALYN by M. Sh. Sichani,
-R. Enblom, M. Berg, Wear 314 (2014) 111-117. Written from the method's description.
+The method and its compiled kernels are in :mod:`rigid_dynamics.contact.kpec` (equal to the open-source CONTACT
+program's KPEC, B = 5, and ANALYN, B = 6, with its FASTSIM, M = 3: tests/test_kpec_contact.py against its
+``mbench_a22_kpec`` example; option ``tangential = "fastrip"``: FaStrip per strip, CONTACT's M = 5, which has no
+published output to compare with: tested against Kalker's linear theory, Coulomb's bound and our Hertz + FaStrip).
+This module is the static driver: it chooses the grid, evaluates the gap at the element centres from the patch
+geometry (``ContactGeometry.gap_m``: for the wheelset case's CONTACT-style patches the undeformed distance evaluated
+exactly from the surfaces, the one sampler the BEM uses too), runs the kernels, and returns a
+:class:`~rigid_dynamics.contact.types.ContactResult`.
 
-Given the undeformed distance h0(x, y) >= 0 (0 at the deepest point) on a regular grid and the approach delta:
+Grid (options): ``element_size_m`` (CONTACT's DX = DS) gives square elements whose centres lie at integer
+multiples of the size from the contact reference point, over the patch's potential contact area
+(``undeformed.potential_area_m``, else the rigid-overlap box widened by ``margin``), as the BEM's and CONTACT's
+grid; else ``nx`` x ``ny`` elements over that area. The rung solves the joined gap of several interpenetration
+regions itself (``solves_undeformed_distance``), so the wheelset case forms patches as CONTACT does for KPEC.
 
-1. Equivalent ellipse: A = curvature of h0 along x through the deepest point (parabola through the deepest
-   point and the first points on either side with h0 > delta/2), B = (delta/2)/w^2 with w the half-width in y
-   of {h0 <= delta/2} (rows interpolated linearly on the rows' minima of h0), centred at y_m; Hertz's ellipse
-   of h = A x^2 + B (y - y_m)^2 at approach delta gives semi-axes a (x), b (y).
-2. Contact area: {h0(x, y) <= A a^2 - (A a^2 - B b^2) ((y - y_m)/b)^2} (clipped to [0, delta]): Kik-Piotrowski's
-   virtual-penetration region with a factor varying with y so that a quadric h gives Hertz's ellipse exactly.
-3. Pressure: in each row the contact runs from x_t to x_l (edges interpolated linearly on h0), and
-   p = p_max sqrt((L_y/2)^2 - (x - x_c)^2)/(L_max/2), L_y = x_l - x_t, x_c the row's middle, L_max the longest
-   row (Hertz's distribution for a quadric h).
-4. p_max from the elastic approach: the half-space displacement (Love's rectangle coefficients,
-   :func:`~.bem.influence.rectangle_influence`) of that pressure at the deepest element equals delta.
-   Force control: delta is found by the secant method on log F(delta) (F ~ delta^1.5).
+Normal problem: approach control with the geometry's gap (the wheelset case), or force control
+(``normal_force_N``): the penetration found by a secant iteration on log F(pen) (F ~ pen^1.5), the grid following
+the rigid overlap when the geometry gives no potential area.
 
-Tangential part (model ``kpec``): FASTSIM (Kalker 1982, :mod:`.fastsim`) along every row of the KPEC patch from
-its leading edge (+x) with traction bound mu p and the flexibilities L1, L2, L3 of the equivalent ellipse a, b
-(C_ij for a/b from Kalker's table; blended towards one flexibility at large creepage as :mod:`.fastsim`'s
-default "three").
-
-Symbols: h0, delta (m); A, B (1/m); a, b (m); p (Pa); x rolling direction (leading edge at +x), y lateral.
+Accuracy: the method is approximate by nature. Its error against the exact half-space solution (the ``bem`` rung,
+or CONTACT's full solution) is measured per case in benchmarks/results/kpec.md (e.g. max pressure +31 % at the
+A-2.2 tread contact, as CONTACT's own KPEC); the result reports it in ``extra["method_error"]`` as "not
+estimated" (no per-patch estimate exists), and ``is_elliptic`` patches get the equivalent ellipse's semi-axes.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from rigid_dynamics.contact.options import Option, declare
 from rigid_dynamics.contact.options import defaults as option_defaults
 
-
-@dataclass(frozen=True, eq=False)
-class KpecSolution:
-    """Result of :func:`kpec_pressure`.
-
-    Attributes:
-        pressure_Pa: p (ny, nx), Pa; x_m (nx,), y_m (ny,): element centres, m.
-        normal_force_N: dA sum p, N.
-        approach_m: delta, m.
-        semi_axis_long_m, semi_axis_lat_m: a, b of the equivalent Hertz ellipse, m.
-        curvature_long_1_per_m, curvature_lat_1_per_m: its A, B, 1/m.
-        contact_area_m2: dA times the number of elements in contact, m^2.
-    """
-
-    pressure_Pa: np.ndarray
-    x_m: np.ndarray
-    y_m: np.ndarray
-    normal_force_N: float
-    approach_m: float
-    semi_axis_long_m: float
-    semi_axis_lat_m: float
-    curvature_long_1_per_m: float
-    curvature_lat_1_per_m: float
-    contact_area_m2: float
-
-
-def _equivalent_ellipse(h0, x, y, delta, e_star):
-    """(A, B, y_m, a, b, j_min, i_min) of step 1 (module docstring)."""
-    from rigid_dynamics.contact.bem.model import hertz_ellipse
-
-    ny, nx = h0.shape
-    j0, i0 = np.unravel_index(int(np.argmin(h0)), h0.shape)
-    half = 0.5 * delta
-    lo, hi = i0 - 1, i0 + 1
-    while lo > 0 and hi < nx - 1 and max(h0[j0, lo], h0[j0, hi]) <= half:
-        lo -= 1
-        hi += 1
-    lo, hi = max(lo, 0), min(hi, nx - 1)
-    dist = max(x[hi] - x[i0], x[i0] - x[lo])
-    curv_a = (h0[j0, hi] - 2.0 * h0[j0, i0] + h0[j0, lo]) / (2.0 * dist * dist) if dist > 0 else 0.0
-    row_min = h0.min(axis=1)
-    inside = np.nonzero(row_min <= half)[0]
-    r0, r1 = int(inside[0]), int(inside[-1])
-    dy = y[1] - y[0] if ny > 1 else 1.0
-    y_sta = y[r0] - 0.5 * dy
-    if r0 > 0 and row_min[r0 - 1] > row_min[r0]:
-        y_sta = y[r0] - (half - row_min[r0]) * dy / (row_min[r0 - 1] - row_min[r0])
-    y_end = y[r1] + 0.5 * dy
-    if r1 < ny - 1 and row_min[r1 + 1] > row_min[r1]:
-        y_end = y[r1] + (half - row_min[r1]) * dy / (row_min[r1 + 1] - row_min[r1])
-    y_mid = 0.5 * (y_sta + y_end)
-    width = max(0.5 * (y_end - y_sta), 1e-12)
-    curv_b = half / width**2
-    curv_a = max(curv_a, 1e-6 * curv_b)
-    a, b, *_ = hertz_ellipse(curv_a, curv_b, e_star, approach_m=delta)
-    return curv_a, curv_b, y_mid, a, b, j0, i0
-
-
-@njit(cache=True)
-def _kpec_rows(h0, x, threshold, pressure):
-    """Steps 2-3 with p_max = 1: threshold[j] per row; fills pressure; returns the longest row L_max (m)."""
-    ny, nx = h0.shape
-    dx = x[1] - x[0] if nx > 1 else 1.0
-    lengths = np.zeros(ny)
-    mids = np.zeros(ny)
-    for j in range(ny):
-        first = -1
-        last = -1
-        for i in range(nx):
-            if h0[j, i] <= threshold[j]:
-                if first < 0:
-                    first = i
-                last = i
-        if first < 0:
-            continue
-        if first == 0:
-            x_t = x[0] - 0.5 * dx
-        else:
-            x_t = x[first - 1] + dx * (threshold[j] - h0[j, first - 1]) / (h0[j, first] - h0[j, first - 1])
-        if last == nx - 1:
-            x_l = x[nx - 1] + 0.5 * dx
-        else:
-            x_l = x[last] + dx * (threshold[j] - h0[j, last]) / (h0[j, last + 1] - h0[j, last])
-        lengths[j] = x_l - x_t
-        mids[j] = 0.5 * (x_l + x_t)
-    l_max = lengths.max()
-    for j in range(ny):
-        half = 0.5 * lengths[j]
-        for i in range(nx):
-            pressure[j, i] = 0.0
-            if h0[j, i] <= threshold[j] and half > 0.0:
-                u = x[i] - mids[j]
-                pressure[j, i] = math.sqrt(max(0.0, half * half - u * u)) / (0.5 * l_max)
-    return l_max
-
-
-def _normal_influence_at(x, y, i0, j0, dx, dy, shear_modulus_Pa, poisson_ratio) -> np.ndarray:
-    """Displacement difference at element (j0, i0) per unit uniform pressure on each element, (ny, nx), m/Pa.
-
-    Love's rectangle coefficient (1 - nu)/(pi G) * integral of 1/r over the element, from the primitive
-    X asinh(Y/|X|) + Y asinh(X/|Y|) on the element corners (as :func:`~.bem.influence.rectangle_influence`'s zz,
-    evaluated once per corner).
-    """
-    from rigid_dynamics.contact.bem.influence import _x_asinh_y_over_x
-
-    cx = x[i0] - (x[0] - 0.5 * dx) - dx * np.arange(x.size + 1)  # X at the element edges, decreasing
-    cy = y[j0] - (y[0] - 0.5 * dy) - dy * np.arange(y.size + 1)
-    gx, gy = np.meshgrid(cx, cy)
-    prim = _x_asinh_y_over_x(gx, gy) + _x_asinh_y_over_x(gy, gx)
-    acc = prim[:-1, :-1] - prim[:-1, 1:] - prim[1:, :-1] + prim[1:, 1:]
-    return (1.0 - poisson_ratio) / (math.pi * shear_modulus_Pa) * acc
-
-
-def kpec_pressure(
-    undeformed_m: np.ndarray,
-    x_m: np.ndarray,
-    y_m: np.ndarray,
-    approach_m: float,
-    *,
-    shear_modulus_Pa: float,
-    poisson_ratio: float,
-) -> KpecSolution:
-    """KPEC (module docstring, steps 1-4) for approach control.
-
-    Args:
-        undeformed_m: h0 (ny, nx) >= 0 up to a constant (its minimum is subtracted), m, at element centres.
-        x_m (nx,), y_m (ny,): equally spaced element centres, m.
-        approach_m: delta > 0, m.
-        shear_modulus_Pa, poisson_ratio: combined G, nu of the pair.
-    """
-    h = np.asarray(undeformed_m, float)
-    h0 = h - np.nanmin(h)
-    h0 = np.where(np.isfinite(h0), h0, np.inf)
-    x, y = np.asarray(x_m, float), np.asarray(y_m, float)
-    delta = float(approach_m)
-    e_star = shear_modulus_Pa / (1.0 - poisson_ratio)
-    curv_a, curv_b, y_mid, a, b, j0, i0 = _equivalent_ellipse(h0, x, y, delta, e_star)
-    level = curv_a * a * a - (curv_a * a * a - curv_b * b * b) * ((y - y_mid) / b) ** 2
-    threshold = np.clip(level, 0.0, delta)
-    threshold[j0] = max(threshold[j0], 0.0)
-    pressure = np.zeros(h0.shape)
-    _kpec_rows(h0, x, threshold, pressure)
-    dx = x[1] - x[0] if x.size > 1 else 1.0
-    dy = y[1] - y[0] if y.size > 1 else 1.0
-    u_mid = float(np.sum(_normal_influence_at(x, y, i0, j0, dx, dy, shear_modulus_Pa, poisson_ratio) * pressure))
-    p_max = delta / u_mid if u_mid > 0 else 0.0
-    pressure *= p_max
-    contact = pressure > 0
-    return KpecSolution(
-        pressure,
-        x,
-        y,
-        float(pressure.sum() * dx * dy),
-        delta,
-        float(a),
-        float(b),
-        float(curv_a),
-        float(curv_b),
-        float(contact.sum() * dx * dy),
-    )
-
-
-@njit(cache=True)
-def _fastsim_rows(pressure, x, y, mu, xi, eta, phi, l1, l2, l3, tx_out, ty_out, slip_out):
-    """FASTSIM along each row from its leading edge (+x) with bound mu p; returns (Fx, Fy, Mz) per unit area."""
-    ny, nx = pressure.shape
-    dx = x[1] - x[0] if nx > 1 else 1.0
-    fx = 0.0
-    fy = 0.0
-    mz = 0.0
-    for j in range(ny):
-        px = 0.0
-        py = 0.0
-        x_prev = 0.0
-        started = False
-        for i in range(nx - 1, -1, -1):
-            tx_out[j, i] = 0.0
-            ty_out[j, i] = 0.0
-            slip_out[j, i] = False
-            p = pressure[j, i]
-            if p <= 0.0:
-                px = 0.0
-                py = 0.0
-                started = False
-                continue
-            if not started:
-                x_prev = x[i] + 0.5 * dx
-                started = True
-            step = x_prev - x[i]
-            xm = 0.5 * (x_prev + x[i])
-            qx = px - (xi / l1 - phi / l3 * y[j]) * step
-            qy = py - (eta / l2 + phi / l3 * xm) * step
-            g = mu * p
-            qn = math.sqrt(qx * qx + qy * qy)
-            if qn > g:
-                qx *= g / qn
-                qy *= g / qn
-                slip_out[j, i] = True
-            px = qx
-            py = qy
-            x_prev = x[i]
-            tx_out[j, i] = qx
-            ty_out[j, i] = qy
-            fx += qx
-            fy += qy
-            mz += x[i] * qy - y[j] * qx
-    return fx, fy, mz
-
+TANGENTIAL = ("fastsim", "fastrip")
+"""Per-strip tangential methods of the option ``tangential``: FASTSIM (CONTACT's M = 3) or FaStrip (M = 5)."""
 
 OPTIONS = declare(
-    Option("nx", int, 40, "elements along x over the rigid-overlap region", minimum=4, maximum=4096),
-    Option("ny", int, 40, "elements along y over the rigid-overlap region", minimum=4, maximum=4096),
-    Option("margin", float, 1.1, "enlargement of the rigid-overlap region", minimum=1.0),
-)
-"""Options of :class:`KpecModel`: grid ``nx`` x ``ny`` (int >= 4) over the rigid-overlap region of the patch
-(enlarged by ``margin`` >= 1)."""
+    Option("nx", int, 40, "elements along x over the potential contact area", minimum=4, maximum=4096),
+    Option("ny", int, 40, "elements along y over the potential contact area", minimum=4, maximum=4096),
+    Option("element_size_m", float, None, "square elements of this side aligned with the reference point "
+           "(CONTACT's DX = DS) instead of nx, ny, m", minimum=0, exclusive_minimum=True, allow_none=True),
+    Option("margin", float, 1.1, "enlargement of the rigid-overlap region (no given potential area)", minimum=1.0),
+    Option("max_iterations", int, 40, "force control: secant steps", minimum=1),
+    Option("tangential", str, "fastsim", "per-strip tangential method", choices=TANGENTIAL),
+)  # fmt: skip
+"""Options of :class:`KpecModel` (module docstring): grid ``nx`` x ``ny`` (>= 4) or ``element_size_m``,
+``margin`` (>= 1) of the rigid-overlap box, ``max_iterations`` of force control, ``tangential``: ``"fastsim"``
+(FASTSIM per strip, :func:`~rigid_dynamics.contact.kpec.fastsim_strips`, as CONTACT's KPEC example) or
+``"fastrip"`` (FaStrip per strip, :func:`~rigid_dynamics.contact.kpec.fastrip_strips`)."""
 DEFAULTS: dict = option_defaults(OPTIONS)
+
+MAX_ELEMENTS = 4_000_000
+"""Largest grid ``element_size_m`` may produce."""
 
 
 class KpecModel:
-    """KPEC normal method + FASTSIM on its patch (module docstring): the registered model ``kpec``.
+    """CONTACT's KPEC + FASTSIM per strip (module docstring): the registered model ``kpec``.
 
-    The geometry's sampled undeformed distance is used if present (``geometry.undeformed``), else its quadric.
-    The grid covers the rigid-overlap region {h <= 0} at the approach (force control: at each secant step),
-    widened by ``margin``. Forces on the wheel, contact frame; fields on the grid.
+    Forces on the wheel in the contact frame; spin moment about the contact reference point (grid origin);
+    fields on the grid.
     """
 
     name = "kpec"
-    description = "KPEC semi-Hertzian normal + FASTSIM (non-elliptic patches)"
+    description = "CONTACT's KPEC semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
     OPTIONS = OPTIONS
+    solves_undeformed_distance = True
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
-        from rigid_dynamics.contact.fastsim import effective_flexibilities
-        from rigid_dynamics.contact.kalker import kalker_coefficients
+        from rigid_dynamics.contact.kpec import fastrip_strips, fastsim_strips, simplified_flexibilities
         from rigid_dynamics.contact.models import _options
         from rigid_dynamics.contact.types import ContactFields, ContactResult
 
         start = time.perf_counter()
         opts = _options(options, self.OPTIONS, self.name)
-        for key in ("nx", "ny"):
-            value = opts[key]
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 4:
-                raise ValueError(f"kpec: option {key} = {value!r}: expected an integer >= 4")
-        margin = opts["margin"]
-        if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not margin >= 1:
-            raise ValueError(f"kpec: option margin = {margin!r}: expected a number >= 1")
+        if opts["element_size_m"] is not None and any(k in (options or {}) for k in ("nx", "ny")):
+            raise ValueError(
+                f"kpec option element_size_m = {opts['element_size_m']!r} together with nx or ny: expected either "
+                "the element size or the element counts"
+            )
         if normal_force_N is not None and (not math.isfinite(normal_force_N) or normal_force_N <= 0):
             raise ValueError(f"normal_force_N = {normal_force_N!r}: expected None or a finite number > 0")
         g_mod, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
         h_min = _minimum_gap(geometry)
 
-        def solve_at(delta: float) -> KpecSolution:
-            x, y = _overlap_grid(geometry, h_min + delta, h_min, int(opts["nx"]), int(opts["ny"]), float(margin))
+        def solve_at(pen: float):
+            """KPEC with the gap shifted so that its sampled minimum is -pen; (x, y, h, p, contact, kernel out)."""
+            x, y = _grid(geometry, h_min + pen, h_min, opts)
             xx, yy = np.meshgrid(x, y)
-            return kpec_pressure(geometry.gap_m(xx, yy), x, y, delta, shear_modulus_Pa=g_mod, poisson_ratio=nu)
+            h = np.ascontiguousarray(geometry.gap_m(xx, yy), dtype=float) - (pen + h_min)
+            h = np.where(np.isfinite(h), h, 1.0)  # off the surfaces: far from contact
+            p = np.zeros(h.shape)
+            contact = np.zeros(h.shape, dtype=np.bool_)
+            out = self._normal(h, x, y, g_mod, nu, p, contact)
+            return x, y, h, p, contact, out
 
         iterations = 0
         if normal_force_N is None:
-            delta = -h_min
-            if delta <= 0:
-                return _no_contact(self.name, geometry, creepage, start, f"approach {delta!r} m <= 0: no contact")
-            sol = solve_at(delta)
+            pen = -h_min
+            if pen <= 0:
+                return _no_contact(self.name, geometry, creepage, start, f"approach {pen!r} m <= 0: no contact")
+            x, y, h, p, contact, out = solve_at(pen)
         else:
-            delta = _hertz_start_delta(geometry, normal_force_N, g_mod / (1 - nu))
-            sol = solve_at(delta)
+            pen = _hertz_start_delta(geometry, normal_force_N, g_mod / (1 - nu))
+            x, y, h, p, contact, out = solve_at(pen)
             prev = None
-            for iterations in range(1, 40):  # noqa: B007
-                if abs(sol.normal_force_N / normal_force_N - 1.0) < 1e-10:
+            for iterations in range(1, int(opts["max_iterations"]) + 1):  # noqa: B007
+                force = _force(p, x, y)
+                if force > 0 and abs(force / normal_force_N - 1.0) < 1e-10:
                     break
                 slope = 1.5
-                if prev is not None and prev[1] != sol.normal_force_N and prev[0] != delta:
-                    slope = math.log(sol.normal_force_N / prev[1]) / math.log(delta / prev[0])
-                    slope = min(max(slope, 0.5), 3.0)
-                prev = (delta, sol.normal_force_N)
-                delta *= (normal_force_N / sol.normal_force_N) ** (1.0 / slope)
-                sol = solve_at(delta)
-        converged = normal_force_N is None or abs(sol.normal_force_N / normal_force_N - 1.0) < 1e-8
-        coef = kalker_coefficients(sol.semi_axis_long_m / sol.semi_axis_lat_m, nu)
-        l1, l2, l3 = effective_flexibilities(
-            sol.semi_axis_long_m,
-            sol.semi_axis_lat_m,
-            sol.normal_force_N,
-            creepage.longitudinal,
-            creepage.lateral,
-            creepage.spin_1_per_m,
-            shear_modulus_Pa=g_mod,
-            friction_coefficient=mu,
-            coefficients=coef,
-            flexibility="three",
+                if prev is not None and force > 0 and prev[1] > 0 and prev[1] != force and prev[0] != pen:
+                    slope = min(max(math.log(force / prev[1]) / math.log(pen / prev[0]), 0.5), 3.0)
+                prev = (pen, force)
+                pen *= (normal_force_N / force) ** (1.0 / slope) if force > 0 else 2.0
+                x, y, h, p, contact, out = solve_at(pen)
+        force = _force(p, x, y)
+        if not contact.any():
+            return _no_contact(self.name, geometry, creepage, start, "KPEC found no element in contact")
+        converged = normal_force_N is None or abs(force / normal_force_N - 1.0) < 1e-8
+        message = f"{self.name.upper()} + {'FaStrip' if opts['tangential'] == 'fastrip' else 'FASTSIM'} per strip"
+        if not converged:
+            message = f"force control did not converge in {iterations} steps: F_N = {force!r} N"
+        dx, dy = x[1] - x[0], y[1] - y[0]
+        fn_kpec, p_max, curv_a, curv_b, y_mid, a_eq, b_eq, penetration = out
+        l1, l2, l3, a_fl, b_fl = simplified_flexibilities(
+            contact, dx, dy, fn_kpec, g_mod, nu, mu, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m
         )
-        tx = np.zeros(sol.pressure_Pa.shape)
-        ty = np.zeros(sol.pressure_Pa.shape)
-        slip = np.zeros(sol.pressure_Pa.shape, dtype=np.bool_)
-        fx, fy, mz = _fastsim_rows(
-            sol.pressure_Pa, sol.x_m, sol.y_m, mu, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m,
-            float(l1), float(l2), float(l3), tx, ty, slip,
-        )  # fmt: skip
-        dx = sol.x_m[1] - sol.x_m[0]
-        dy = sol.y_m[1] - sol.y_m[0]
-        area = dx * dy
-        contact = sol.pressure_Pa > 0
+        tx, ty = np.zeros(p.shape), np.zeros(p.shape)
+        slip = np.zeros(p.shape, dtype=np.bool_)
+        xi, eta, phi = creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m
+        if opts["tangential"] == "fastrip":
+            from rigid_dynamics.contact.fastrip import strip_creepages
+
+            xi_s, eta_s, phi_s, p0, *_ = strip_creepages(
+                a_fl, b_fl, fn_kpec, xi, eta, phi, shear_modulus_Pa=g_mod, poisson_ratio=nu, friction_coefficient=mu
+            )
+            fx, fy, mz = fastrip_strips(
+                p, contact, x, y, mu, nu, a_fl, p0, xi_s, eta_s, phi_s, xi, eta, phi, l1, l2, l3, tx, ty, slip
+            )
+        else:
+            fx, fy, mz = fastsim_strips(p, contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
+        edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
         fields = ContactFields(
-            x_m=sol.x_m,
-            y_m=sol.y_m,
-            pressure_Pa=sol.pressure_Pa,
-            traction_long_Pa=tx,
-            traction_lat_Pa=ty,
-            in_contact=contact,
-            in_slip=slip,
+            x_m=x, y_m=y, pressure_Pa=p, traction_long_Pa=tx, traction_lat_Pa=ty, in_contact=contact, in_slip=slip
         )
         return ContactResult(
             method=self.name,
             success=bool(converged),
             status="ok" if converged else "not-converged",
-            message="KPEC + FASTSIM" if converged else f"force control did not converge in {iterations} steps",
-            normal_force_N=sol.normal_force_N,
-            creep_force_long_N=float(fx * area),
-            creep_force_lat_N=float(fy * area),
-            spin_moment_Nm=float(mz * area),
-            max_pressure_Pa=float(sol.pressure_Pa.max()),
-            semi_axis_long_m=sol.semi_axis_long_m if geometry.is_elliptic else None,
-            semi_axis_lat_m=sol.semi_axis_lat_m if geometry.is_elliptic else None,
-            contact_area_m2=sol.contact_area_m2,
-            approach_m=float(geometry.approach_m + (sol.approach_m + h_min)),
+            message=message,
+            normal_force_N=force,
+            creep_force_long_N=float(fx),
+            creep_force_lat_N=float(fy),
+            spin_moment_Nm=float(mz),
+            max_pressure_Pa=float(p.max()),
+            semi_axis_long_m=_finite(a_eq, a_fl) if geometry.is_elliptic else None,
+            semi_axis_lat_m=_finite(b_eq, b_fl) if geometry.is_elliptic else None,
+            contact_area_m2=float(contact.sum() * dx * dy),
+            approach_m=float(geometry.approach_m + (penetration + h_min)),
             creepage=creepage,
             fields=fields,
             iterations=int(iterations),
             wall_time_s=time.perf_counter() - start,
             extra={
-                "nx": int(opts["nx"]),
-                "ny": int(opts["ny"]),
-                "equivalent_ellipse_m": [sol.semi_axis_long_m, sol.semi_axis_lat_m],
-                "equivalent_curvatures_1_per_m": [sol.curvature_long_1_per_m, sol.curvature_lat_1_per_m],
-                "penetration_m": sol.approach_m,
+                "nx": int(x.size),
+                "ny": int(y.size),
+                "element_size_m": [float(dx), float(dy)],
+                "equivalent_ellipse_m": [_finite(a_eq), _finite(b_eq)],
+                "equivalent_curvatures_1_per_m": [_finite(curv_a), _finite(curv_b)],
+                "ellipse_centre_lat_m": _finite(y_mid),
+                "penetration_m": float(penetration),
+                "flexibilities_m_per_Pa": [float(l1), float(l2), float(l3)],
+                "flexibility_ellipse_m": [float(a_fl), float(b_fl)],
+                "contact_touches_potential_area_edge": edge,
+                "method_error": "not estimated (approximate method; benchmarks/results/kpec.md)",
             },
         )
+
+    @staticmethod
+    def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
+        """The normal kernel: (F_N for the flexibilities, p_max, A, B, y_m, a, b, penetration) (kpec.py)."""
+        from rigid_dynamics.contact.kpec import kpec_pressure
+
+        return kpec_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact)
+
+
+class AnalynModel(KpecModel):
+    """CONTACT's modified ANALYN normal method (B = 6) + FASTSIM per strip: the registered model ``analyn``.
+
+    As :class:`KpecModel` with :func:`~rigid_dynamics.contact.kpec.analyn_pressure` for the normal problem (no
+    equivalent ellipse: ``extra`` reports NaN for its fields).
+    """
+
+    name = "analyn"
+    description = "CONTACT's ANALYN semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
+
+    @staticmethod
+    def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
+        from rigid_dynamics.contact.kpec import analyn_pressure
+
+        force = analyn_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact)
+        nan = math.nan
+        return force, float(pressure.max()), nan, nan, nan, nan, nan, float(-h.min())
+
+
+def _finite(value, fallback=None):
+    """float(value), or ``fallback`` when it is not finite (ANALYN has no equivalent ellipse)."""
+    return float(value) if math.isfinite(value) else fallback
+
+
+def _force(p, x, y) -> float:
+    return float(p.sum() * (x[1] - x[0]) * (y[1] - y[0]))
+
+
+def _grid(geometry, level, h_min, opts):
+    """Element centres (x, y) of the grid (module docstring) for the rigid overlap {h <= level}."""
+    und = geometry.undeformed
+    size = opts["element_size_m"]
+    if und is not None and und.potential_area_m is not None:
+        x0, x1, y0, y1 = und.potential_area_m
+        x_lim, y_lim = (float(x0), float(x1)), (float(y0), float(y1))
+    else:
+        x, y = _overlap_grid(geometry, level, h_min, 2, 2, float(opts["margin"]))
+        hx, hy = x[1] - x[0], y[1] - y[0]
+        x_lim, y_lim = (x[0] - 0.5 * hx, x[1] + 0.5 * hx), (y[0] - 0.5 * hy, y[1] + 0.5 * hy)
+    if size is None:
+        nx, ny = int(opts["nx"]), int(opts["ny"])
+    else:
+        from rigid_dynamics.contact.bem.model import _whole_elements
+
+        x_lim, nx = _whole_elements(x_lim, float(size))
+        y_lim, ny = _whole_elements(y_lim, float(size))
+        if nx * ny > MAX_ELEMENTS:
+            raise ValueError(
+                f"kpec option element_size_m = {size!r} gives {nx} x {ny} elements over the potential contact area: "
+                f"expected at most {MAX_ELEMENTS} (a larger element size)"
+            )
+    dx = (x_lim[1] - x_lim[0]) / nx
+    dy = (y_lim[1] - y_lim[0]) / ny
+    return x_lim[0] + dx * (np.arange(nx) + 0.5), y_lim[0] + dy * (np.arange(ny) + 0.5)
 
 
 def _minimum_gap(geometry) -> float:

@@ -44,6 +44,7 @@ Kalker and CONTACT define them (option ``rolling_speed``, see ``_creepage``).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Mapping
@@ -451,7 +452,24 @@ class _Evaluator:
 
     def __init__(self, case, material, model, track, opts):
         self.case, self.material, self.model, self.track, self.opts = case, material, model, track, opts
+        # a model that estimates its grid error (bem) does so for the final patches only (final_patches)
+        self.estimates = hasattr(model, "with_grid_error")
+        self.inner = {**(opts["model"] or {}), "estimate_grid_error": False} if self.estimates else opts["model"]
         self.count = 0
+
+    def final_patches(self, patches: list) -> list:
+        """The equilibrium's patches with the model's grid-error estimate (bem; the numbers are unchanged)."""
+        if not self.estimates:
+            return patches
+        return [
+            dataclasses.replace(
+                p,
+                result=self.model.with_grid_error(
+                    p.geometry, p.creepage, self.material, p.result, options=self.opts["model"]
+                ),
+            )
+            for p in patches
+        ]
 
     def geometry(self, pose: WheelsetPose, side: str):
         """(list of (geometry, combination, deepest rail point)), smallest gap (vertical or normal), m."""
@@ -498,9 +516,7 @@ class _Evaluator:
             creepage = _creepage(
                 self.case, pose, material_point, geometry.frame[:, 2], omega, self.opts["rolling_speed"]
             )
-            result = self.model.solve(
-                geometry, creepage, self.material, normal_force_N=None, options=self.opts["model"]
-            )
+            result = self.model.solve(geometry, creepage, self.material, normal_force_N=None, options=self.inner)
             if not result.success:
                 failed.append(f"{side} patch {k}: {result.message}")
             patches.append(PatchSolution(side, geometry, creepage, result, how, tuple(deepest)))
@@ -720,7 +736,7 @@ def solve_wheelset_case(
             False, status, messages.get(status, status), time.perf_counter() - started, math.nan, math.nan, [], {},
             iterations, "per-wheel" if per_wheel else "equilibrium", omega, mode,
         )  # fmt: skip
-    patches = [p for side in sides for p in states[side].patches]
+    patches = evaluator.final_patches([p for side in sides for p in states[side].patches])
     failed = [f for side in sides for f in states[side].failed]
     message = messages.get(status, status)
     if failed:

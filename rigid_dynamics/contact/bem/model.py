@@ -27,6 +27,7 @@ the combined modulus G/(1 - nu)::
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Mapping
@@ -47,6 +48,16 @@ OPTIONS = declare(
     Option("ny", int, 40, "elements along y (lateral)", minimum=1, maximum=4096),
     Option("element_size_m", float, None, "square elements of this side instead of nx, ny (CONTACT's DX = DS), m",
            minimum=0.0, maximum=0.1, exclusive_minimum=True, allow_none=True),
+    Option("dx_m", float, None, "element size along x instead of nx (CONTACT's DX), m", minimum=0.0, maximum=0.1,
+           exclusive_minimum=True, allow_none=True),
+    Option("dy_m", float, None, "element size along y instead of ny (CONTACT's DY; None: dx_m), m", minimum=0.0,
+           maximum=0.1, exclusive_minimum=True, allow_none=True),
+    Option("grid_tolerance", float, 0.02, "accepted estimated relative grid error of forces, max pressure and area",
+           minimum=0.0, exclusive_minimum=True),
+    Option("max_refinements", int, 2, "halvings of the default grid's elements while the estimate exceeds "
+           "grid_tolerance", minimum=0, maximum=5),
+    Option("estimate_grid_error", bool, True, "estimate the grid error (false: for the inner solves of an "
+           "iteration whose final patches are estimated by with_grid_error)"),
     Option("margin", float, 1.15, "potential contact area in Hertz semi-axes", minimum=1.0),
     Option("tolerance", float, 1e-6, "relative tolerance of NORM and TANG", minimum=0.0, exclusive_minimum=True),
     Option("max_iterations", int, 500, "NORM CG iterations and TANG Newton steps, each", minimum=1),
@@ -72,6 +83,21 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   ``nx``, ``ny``: the counts follow from the potential area, widened to whole elements whose centres lie at
   integer multiples of the size from the contact plane's origin (the patch's reference point), as CONTACT's grid
   (not together with ``nx`` or ``ny``; at most ``MAX_ELEMENTS`` elements);
+* ``dx_m``, ``dy_m`` (float > 0 or None): rectangular elements of these sides (CONTACT's DX and DY; ``dy_m``
+  None: ``dx_m``) instead of ``nx``, ``ny``, placed as for ``element_size_m`` (not together with it, nor with
+  ``nx``, ``ny``);
+* ``grid_tolerance`` (float > 0, default 0.02) and ``max_refinements`` (int >= 0, default 2): every solution
+  carries an estimate of its discretisation error (``extra["grid_error"]``, :func:`grid_error_estimate`) from two
+  companion solutions over the same potential area with elements twice and four times as large. When neither
+  ``nx``/``ny`` nor an element size is given, the grid starts at the default counts and its elements are halved
+  (counts doubled, the finer solution taking the place of the fine one and the two coarser companions reused)
+  while the largest relative estimate exceeds ``grid_tolerance``, at most ``max_refinements`` times. A grid the
+  caller names is solved as named. A solution whose estimate still exceeds ``grid_tolerance``, or whose grid is
+  too coarse for the estimate (fewer than 6 elements along x or y), ends with status ``"warning"`` (``success``
+  True, the numbers are the solution's) and a message naming the estimate and the tolerance;
+* ``estimate_grid_error`` (bool, default True): False skips the companions and the refinement (the result says
+  it is not estimated); for an iterative caller, which then estimates its final patches with
+  :meth:`BemModel.with_grid_error` (the wheelset case does);
 * a patch whose ``undeformed.potential_area_m`` is given (the wheelset case's CONTACT-style patches: a rectangle
   holding the whole rigid overlap) is solved on that area, without the margin rule and its enlargements;
 * ``margin`` (>= 1): margin m of the potential area (module docstring);
@@ -112,6 +138,10 @@ PROBLEMS = ("rolling", "shift", "transient")
 ROLLING_SLIP_POINTS = {"centre": 0.0, "midpoint": 0.5}
 """Offset of the rigid slip from the element centre, in elements along x (option ``rolling_slip_point``)."""
 
+MIN_COMPANION_ELEMENTS = 3
+"""Fewest elements along x or y of a coarse companion grid of the error estimate (a coarser one says nothing of
+the fine grid: it is left out, and without the companion twice as coarse the error is not estimated)."""
+
 MAX_ELEMENTS = 4_000_000
 """Largest grid ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
 
@@ -132,7 +162,6 @@ def hertz_ellipse(
         (a_x, b_y, p0, F_N, approach): semi-axes along x and y (m), maximum pressure (Pa),
         normal force (N), approach (m).
     """
-    from scipy.optimize import brentq
     from scipy.special import ellipe, ellipk
 
     if (normal_force_N is None) == (approach_m is None):
@@ -156,7 +185,17 @@ def hertz_ellipse(
         k, e = ellipk(e2), ellipe(e2)
         return (e / (1.0 - e2) - k) / (k - e) - ratio
 
-    e2 = brentq(mismatch, 1e-12, 1.0 - 1e-15, xtol=1e-15, rtol=1e-14)
+    # the ratio grows monotonically with e^2 from 1 to infinity: bisection to the last bit (no scipy.optimize,
+    # whose import costs a small command a fifth of its start-up)
+    low, high = 1e-12, 1.0 - 1e-15
+    while True:
+        e2 = 0.5 * (low + high)
+        if not low < e2 < high:
+            break
+        if mismatch(e2) < 0.0:
+            low = e2
+        else:
+            high = e2
     k, e = float(ellipk(e2)), float(ellipe(e2))
     if normal_force_N is not None:
         a = (3.0 * normal_force_N * (k - e) / (2.0 * math.pi * combined_modulus_Pa * small * e2)) ** (1.0 / 3.0)
@@ -178,13 +217,27 @@ def _options(options: Mapping | None) -> dict:
     options = options or {}
     size = opts["element_size_m"]
     if size is not None:
-        both = [k for k in ("nx", "ny") if k in options]
+        both = [k for k in ("nx", "ny", "dx_m", "dy_m") if k in options]
         if both:
             raise ValueError(
                 f"option element_size_m = {size!r} together with {' and '.join(both)}: expected either the element "
                 "size or the element counts"
             )
-    if opts["extrapolate"] and opts["element_size_m"] is None and (opts["nx"] % 2 or opts["ny"] % 2 or opts["nx"] < 4):
+    if opts["dy_m"] is not None and opts["dx_m"] is None:
+        raise ValueError(f"option dy_m = {opts['dy_m']!r} without dx_m: expected dx_m as well (or element_size_m)")
+    if opts["dx_m"] is not None:
+        both = [k for k in ("nx", "ny") if k in options]
+        if both:
+            raise ValueError(
+                f"option dx_m = {opts['dx_m']!r} together with {' and '.join(both)}: expected either the element "
+                "sizes or the element counts"
+            )
+        size = opts["dx_m"], opts["dy_m"] if opts["dy_m"] is not None else opts["dx_m"]
+    elif size is not None:
+        size = size, size
+    opts["element_sizes_m"] = size
+    opts["grid_named"] = any(k in options for k in ("nx", "ny", "element_size_m", "dx_m", "dy_m"))
+    if opts["extrapolate"] and size is None and (opts["nx"] % 2 or opts["ny"] % 2 or opts["nx"] < 4):
         raise ValueError(
             f"option extrapolate = true with nx = {opts['nx']!r}, ny = {opts['ny']!r}: expected even element counts "
             "(nx >= 4), so that 2 x 2 elements merge into the coarse grid"
@@ -241,14 +294,92 @@ class BemModel:
         """
         start = time.perf_counter()
         opts = _options(options)
-        result = self._solve(geometry, creepage, material, normal_force_N, opts, None, start)
-        if not opts["extrapolate"] or result.status == "no-contact":
+        fine = self._solve(geometry, creepage, material, normal_force_N, opts, None, start)
+        if fine.status == "no-contact" or not fine.success:
+            return fine
+        if not opts["estimate_grid_error"]:
+            if opts["extrapolate"]:
+                fine = self._extrapolated(geometry, creepage, material, normal_force_N, opts, fine, start)
+            return _without_grid_error(fine, "estimate_grid_error = false", time.perf_counter() - start)
+        return self._estimate(geometry, creepage, material, normal_force_N, opts, fine, start, refine=True)
+
+    def with_grid_error(
+        self,
+        geometry: ContactGeometry,
+        creepage: Creepage,
+        material: Material,
+        result: ContactResult,
+        *,
+        normal_force_N: float | None = None,
+        options: Mapping | None = None,
+    ) -> ContactResult:
+        """``result`` (this model's, solved with ``estimate_grid_error = false`` and the same arguments) with its
+        grid-error estimate, status and message as :meth:`solve` gives them, without refining its grid (an
+        iterative caller such as the wheelset case estimates only its final patches; the numbers stay the ones its
+        equilibrium holds). An extrapolated result is returned as it is (not estimated).
+        """
+        start = time.perf_counter()
+        opts = _options(options)
+        if result.status == "no-contact" or not result.success or opts["extrapolate"]:
             return result
-        ex = result.extra
-        x0, x1, y0, y1 = ex["potential_area_m"]
-        coarse_opts = dict(opts, nx=ex["nx"] // 2, ny=max(ex["ny"] // 2, 1), element_size_m=None, extrapolate=False)
+        out = self._estimate(geometry, creepage, material, normal_force_N, opts, result, start, refine=False)
+        return dataclasses.replace(out, wall_time_s=result.wall_time_s + time.perf_counter() - start)
+
+    def _extrapolated(self, geometry, creepage, material, normal_force_N, opts, fine, start) -> ContactResult:
+        """Richardson extrapolation of ``fine`` with the merged grid (option ``extrapolate``)."""
+        x0, x1, y0, y1 = fine.extra["potential_area_m"]
+        coarse_opts = dict(opts, nx=fine.extra["nx"] // 2, ny=max(fine.extra["ny"] // 2, 1), element_sizes_m=None,
+                           extrapolate=False)  # fmt: skip
         coarse = self._solve(geometry, creepage, material, normal_force_N, coarse_opts, ((x0, x1), (y0, y1)), start)
-        return _richardson(result, coarse, time.perf_counter() - start)
+        return _richardson(fine, coarse, time.perf_counter() - start)
+
+    def _estimate(self, geometry, creepage, material, normal_force_N, opts, fine, start, refine) -> ContactResult:
+        """The grid-error estimate of ``fine`` from its companions, refining the default grid (``refine`` and no
+        grid named) while it exceeds ``grid_tolerance``; see :data:`DEFAULT_OPTIONS`.
+        """
+        x0, x1, y0, y1 = fine.extra["potential_area_m"]
+        area = ((x0, x1), (y0, y1))
+
+        first_nx = fine.extra["nx"]
+
+        def on_grid(nx: int, ny: int) -> ContactResult:
+            grid_opts = dict(opts, nx=nx, ny=ny, element_sizes_m=None, extrapolate=False)
+            if opts["transient_steps"] is not None:  # roll the same distance on every grid
+                grid_opts["transient_steps"] = max(1, round(opts["transient_steps"] * nx / first_nx))
+            return self._solve(geometry, creepage, material, normal_force_N, grid_opts, area, start)
+
+        def coarser(result: ContactResult, factor: int) -> ContactResult | None:
+            nx, ny = round(result.extra["nx"] / factor), round(result.extra["ny"] / factor)
+            if min(nx, ny) < MIN_COMPANION_ELEMENTS:
+                return None
+            return on_grid(nx, ny)
+
+        tolerance = float(opts["grid_tolerance"])
+        levels = [fine, coarser(fine, 2), coarser(fine, 4)]
+        estimate = grid_error_estimate(levels, material.friction_coefficient)
+        refinements = 0
+        while (
+            refine
+            and not opts["grid_named"]
+            and refinements < opts["max_refinements"]
+            and (estimate is None or estimate["largest_relative"] > tolerance)
+            and 4 * fine.extra["nx"] * fine.extra["ny"] <= MAX_ELEMENTS
+        ):
+            finer = on_grid(2 * fine.extra["nx"], 2 * fine.extra["ny"])
+            if not finer.success:
+                break
+            levels = [finer, levels[0], levels[1]]
+            fine = finer
+            refinements += 1
+            estimate = grid_error_estimate(levels, material.friction_coefficient)
+        result = fine
+        if opts["extrapolate"]:  # the companion twice as coarse is the merged grid (unless it was too small)
+            result = (
+                _richardson(fine, levels[1], time.perf_counter() - start)
+                if levels[1] is not None
+                else self._extrapolated(geometry, creepage, material, normal_force_N, opts, fine, start)
+            )
+        return _with_grid_error(result, estimate, tolerance, refinements, time.perf_counter() - start)
 
     def _solve(self, geometry, creepage, material, normal_force_N, opts, fixed_area, start) -> ContactResult:
         """:meth:`solve` on one grid; ``fixed_area`` ((x0, x1), (y0, y1)) imposes the potential area (m)."""
@@ -307,18 +438,19 @@ class BemModel:
             xs, ys = np.asarray(geometry.undeformed.x_m), np.asarray(geometry.undeformed.y_m)
             field_box = (float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
         grown = 0
-        size = opts["element_size_m"]
+        size = opts["element_sizes_m"]
         if fixed_area is not None:
             x_lim, y_lim = fixed_area
             size = None
         even = bool(opts["extrapolate"])
         while True:
             if size is not None:
-                x_lim, nx = _whole_elements(x_lim, float(size), even)
-                y_lim, ny = _whole_elements(y_lim, float(size), even)
+                x_lim, nx = _whole_elements(x_lim, float(size[0]), even)
+                y_lim, ny = _whole_elements(y_lim, float(size[1]), even)
                 if nx * ny > MAX_ELEMENTS:
+                    name = "element_size_m" if opts["element_size_m"] is not None else "dx_m"
                     raise ValueError(
-                        f"option element_size_m = {size!r} gives {nx} x {ny} elements over the potential contact "
+                        f"option {name} = {opts[name]!r} gives {nx} x {ny} elements over the potential contact "
                         f"area: expected at most {MAX_ELEMENTS} (a larger element size)"
                     )
             dx = (x_lim[1] - x_lim[0]) / nx
@@ -416,7 +548,12 @@ class BemModel:
         )
         semi_long = semi_lat = None
         if geometry.is_elliptic:
-            semi_long, semi_lat = _elliptic_semi_axes(x, y, p, contact, dx, dy)
+            semi_long, semi_lat, fitted = _elliptic_semi_axes(x, y, p, contact, dx, dy)
+        # a quadric patch's area from the fitted ellipse (converges smoothly, within 0.4 % of Hertz from 10 x 10
+        # elements); the element count jumps by several % as the edge crosses element centres. A sampled field's
+        # pressure need not be elliptic: its area is the element count, as CONTACT's.
+        quadric = semi_long is not None and fitted and geometry.undeformed is None
+        contact_area = math.pi * semi_long * semi_lat if quadric else contact.sum() * area
         success = bool(norm.converged and tang.converged)
         if success:
             status, message = "ok", "NORM and TANG converged"
@@ -443,7 +580,7 @@ class BemModel:
             max_pressure_Pa=float(p.max()),
             semi_axis_long_m=semi_long,
             semi_axis_lat_m=semi_lat,
-            contact_area_m2=float(contact.sum() * area),
+            contact_area_m2=float(contact_area),
             approach_m=float(geometry.approach_m + norm.approach_shift_m),
             creepage=creepage,
             fields=fields,
@@ -530,8 +667,6 @@ def _richardson(fine: ContactResult, coarse: ContactResult, wall_time_s: float) 
     F = 2 F_h - F_2h; the fine grid's estimated error F_h - F = F_2h - F_h is reported per quantity. The
     normal solution, the fields and the other outputs are the fine grid's.
     """
-    import dataclasses
-
     names = ("creep_force_long_N", "creep_force_lat_N", "spin_moment_Nm")
     values = {k: 2.0 * getattr(fine, k) - getattr(coarse, k) for k in names}
     success = bool(fine.success and coarse.success)
@@ -561,7 +696,143 @@ def _richardson(fine: ContactResult, coarse: ContactResult, wall_time_s: float) 
     )
 
 
-def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
+GRID_ERROR_QUANTITIES = (
+    ("normal_force_N", "normal force"),
+    ("creep_force_N", "creep force"),
+    ("max_pressure_Pa", "max pressure"),
+    ("contact_area_m2", "contact area"),
+)
+"""The quantities whose relative grid-error estimate is held against ``grid_tolerance`` (key, words)."""
+
+
+def _smooth_error(fine: float, coarse: float, coarsest: float | None) -> float:
+    """Estimated error of ``fine`` from the values on elements 1, 2 and 4 times as large (first order assumed).
+
+    Differences d1 = v_h - v_2h, d2 = v_2h - v_4h. Monotone and contracting at an observed order between 0 and 3
+    (d1 d2 > 0, |d1| < |d2| <= 8 |d1|): |d1|, the Richardson error of a first-order method (steady rolling's
+    upwind slip and the element-count area are first order; for the second-order normal problem this
+    overestimates by about 3; observed orders above 1 on coarse grids were measured to be pre-asymptotic on the
+    large-spin case, whose order tends to 1.0: benchmarks/results/bem_rolling_coarse.md). Otherwise (oscillating
+    differences, or a d1 that is small by chance beside a large d2, as on coarse grids where the contact's edge
+    jumps between elements) the bound max(|d1|, |d2|/2); without v_4h, |d1|.
+    """
+    d1 = fine - coarse
+    if coarsest is None:
+        return abs(d1)
+    d2 = coarse - coarsest
+    if d1 * d2 > 0 and abs(d1) < abs(d2) <= 8.0 * abs(d1):
+        return abs(d1)
+    return max(abs(d1), abs(d2) / 2.0)
+
+
+def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
+    """Discretisation-error estimate of ``levels[0]`` from companions on coarser grids over the same area.
+
+    Args:
+        levels: [fine, coarse, coarsest] ContactResults with elements 1, 2 and 4 times as large (the last may be
+            None; the coarse one None means no estimate).
+        friction_coefficient: mu, for the floor of the creep-force scale.
+
+    Returns:
+        None when the coarse companion is missing or failed; else a dict with the absolute estimates
+        ``normal_force_N``, ``creep_force_N`` (|(e_x, e_y)| of the two creep-force components),
+        ``spin_moment_Nm``, ``max_pressure_Pa``, ``contact_area_m2``; ``relative`` (each against the fine value;
+        the creep force against max(|F_t|, 0.01 mu F_N), the scale of ``wheelrail bench``), ``largest_relative``
+        (over :data:`GRID_ERROR_QUANTITIES`) and ``grids`` [[nx, ny], ...]. Each quantity by :func:`_smooth_error`
+        (measured against Hertz and the converged creep forces of the named cases:
+        ``benchmarks/results/bem_grid_error.md``).
+    """
+    fine, coarse, coarsest = levels
+    if coarse is None or not coarse.success or coarse.status == "no-contact":
+        return None
+    if coarsest is not None and (not coarsest.success or coarsest.status == "no-contact"):
+        coarsest = None
+
+    def values(name):
+        return [None if r is None else getattr(r, name) for r in (fine, coarse, coarsest)]
+
+    def smooth(name):
+        v = values(name)
+        return _smooth_error(v[0], v[1], v[2])
+
+    creep = (
+        math.hypot(smooth("creep_force_long_N"), smooth("creep_force_lat_N"))
+        if fine.creep_force_long_N is not None
+        else 0.0
+    )
+    absolute = {
+        "normal_force_N": smooth("normal_force_N"),
+        "creep_force_N": creep,
+        "spin_moment_Nm": smooth("spin_moment_Nm") if fine.spin_moment_Nm is not None else 0.0,
+        "max_pressure_Pa": smooth("max_pressure_Pa"),
+        "contact_area_m2": smooth("contact_area_m2"),
+    }
+    creep_scale = max(
+        math.hypot(fine.creep_force_long_N or 0.0, fine.creep_force_lat_N or 0.0),
+        0.01 * friction_coefficient * fine.normal_force_N,
+    )
+    scales = {
+        "normal_force_N": fine.normal_force_N,
+        "creep_force_N": creep_scale,
+        "max_pressure_Pa": fine.max_pressure_Pa,
+        "contact_area_m2": fine.contact_area_m2,
+    }
+    relative = {k: (absolute[k] / scales[k] if scales[k] > 0 else math.inf) for k, _ in GRID_ERROR_QUANTITIES}
+    return {
+        **absolute,
+        "relative": relative,
+        "largest_relative": max(relative.values()),
+        "grids": [[r.extra["nx"], r.extra["ny"]] for r in (fine, coarse, coarsest) if r is not None],
+    }
+
+
+def _without_grid_error(result: ContactResult, reason: str, wall_time_s: float) -> ContactResult:
+    """``result`` marked as not estimated (``extra["grid_error"]["estimated"]`` False, the reason in the message)."""
+    extra = dict(result.extra)
+    extra["grid_error"] = {"estimated": False, "reason": reason}
+    extra["grid_error_estimate"] = None
+    message = f"{result.message}; grid error not estimated ({reason})"
+    return dataclasses.replace(result, message=message, extra=extra, wall_time_s=wall_time_s)
+
+
+def _with_grid_error(result: ContactResult, estimate, tolerance: float, refinements: int, wall_time_s: float):
+    """``result`` with ``extra["grid_error"]`` (and ``grid_error_estimate``, the largest relative estimate) and,
+    when the estimate is missing or above ``tolerance``, status "warning" with the reason in the message.
+    """
+    extra = dict(result.extra)
+    nx, ny = extra["nx"], extra["ny"]
+    status, message = result.status, result.message
+    if estimate is None:
+        extra["grid_error"] = {"tolerance": tolerance, "refinements": refinements, "estimated": False}
+        extra["grid_error_estimate"] = None
+        if status == "ok":
+            status = "warning"
+        message += (
+            f"; the grid error is not estimated: {nx} x {ny} elements are too few for a companion grid twice as "
+            f"coarse (or it failed); expected at least {2 * MIN_COMPANION_ELEMENTS} elements along x and y"
+        )
+    else:
+        extra["grid_error"] = {**estimate, "tolerance": tolerance, "refinements": refinements, "estimated": True}
+        extra["grid_error_estimate"] = estimate["largest_relative"]
+        worst = [
+            f"{words} {estimate['relative'][k]:.2%}"
+            for k, words in GRID_ERROR_QUANTITIES
+            if estimate["relative"][k] > tolerance
+        ]
+        if worst:
+            if status == "ok":
+                status = "warning"
+            message += (
+                f"; estimated grid error above grid_tolerance {tolerance:g} at {nx} x {ny} elements: "
+                + ", ".join(worst)
+                + " (a finer grid: smaller dx_m/element_size_m, larger nx/ny, or more max_refinements)"
+            )
+        else:
+            message += f"; estimated grid error {estimate['largest_relative']:.2%} <= {tolerance:g} at {nx} x {ny}"
+    return dataclasses.replace(result, status=status, message=message, extra=extra, wall_time_s=wall_time_s)
+
+
+def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float, bool]:
     """Semi-axes (along x, y) of an elliptic patch from a least-squares fit of the pressure field.
 
     For Hertzian pressure p^2 = p0^2 (1 - (x - xc)^2/a^2 - (y - yc)^2/b^2) (Johnson 1985, eq 4.22), so
@@ -573,12 +844,12 @@ def _elliptic_semi_axes(x, y, pressure, contact, dx, dy) -> tuple[float, float]:
     jj, ii = np.nonzero(contact)
     extents = (float(0.5 * (x[ii].max() - x[ii].min() + dx)), float(0.5 * (y[jj].max() - y[jj].min() + dy)))
     if len(ii) < 6:
-        return extents
+        return (*extents, False)
     weights = pressure[jj, ii]
     xc = float(np.sum(weights * x[ii]) / np.sum(weights))
     yc = float(np.sum(weights * y[jj]) / np.sum(weights))
     design = np.stack([np.ones(len(ii)), (x[ii] - xc) ** 2, (y[jj] - yc) ** 2], axis=1)
     c0, c1, c2 = np.linalg.lstsq(design, weights**2, rcond=None)[0]
     if not (c0 > 0 and c1 < 0 and c2 < 0):
-        return extents
-    return float(np.sqrt(-c0 / c1)), float(np.sqrt(-c0 / c2))
+        return (*extents, False)
+    return float(np.sqrt(-c0 / c1)), float(np.sqrt(-c0 / c2)), True

@@ -1,0 +1,225 @@
+"""The BEM's grid-error estimate against the actual error, and the cost of meeting ``grid_tolerance`` by default.
+
+Part 1, the named quadric cases (``comparisons/cases``): the model ``bem`` at its defaults (grid refined from
+40 x 40 until the estimate meets ``grid_tolerance`` = 2 %) and on the former default 40 x 40 grid (named, not
+refined): final grid, largest relative estimate, the creep-force / max-pressure / area estimates and actual errors
+against independent references (max pressure and area: Hertz's closed form, the normal problem of these
+quasi-identical quadric cases being Hertz's; creep forces: the case's reference, the BEM limits of 40/80/160
+elements with their uncertainty of 0.3-1.2 %; the large-spin case also against its converged F_y/(mu F_N) = -0.6254 from
+benchmarks/results/bem_rolling_coarse.md and CONTACT's -0.6215 quoted in issue 27), wall time (best of 3).
+
+Part 2, Manchester A-2.2 (kinematics "deck", right wheel) at CONTACT's 0.2 mm elements (option element_size_m):
+our estimate against the actual difference to CONTACT's finest run of the same step (benchmarks/results/
+contact_grid.md: 0.025 mm for the flange, 0.05 mm for the tread and the flange root).
+
+Run: ``.venv/bin/python benchmarks/bench_bem_grid_error.py`` -> benchmarks/results/bem_grid_error.json and .md.
+"""
+
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import json  # noqa: E402
+import math  # noqa: E402
+import platform  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+import tomllib  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from rigid_dynamics.contact.bem.model import BemModel, hertz_ellipse  # noqa: E402
+from rigid_dynamics.contact.types import ContactGeometry, Creepage  # noqa: E402
+from rigid_dynamics.files import write_text  # noqa: E402
+from rigid_dynamics.materials import Material  # noqa: E402
+
+CASES = (
+    "hertz-ab-1",
+    "hertz-ab-0.1",
+    "hertz-ab-10",
+    "creep-long-small",
+    "creep-long-mid",
+    "creep-long-saturated",
+    "creep-lat-spin",
+    "creep-spin-only",
+    "large-spin",
+)
+LARGE_SPIN = {"converged": -0.6254, "CONTACT": -0.6215}
+# contact_grid.md: CONTACT's step (our a22_case(step - 1)) -> (case, DX mm, FN, FX, FS, PMAX MPa, area mm2)
+CONTACT_FINEST = {
+    6: ("a22-tread", 0.05, 9787.0, -456.2, -2900.0, 730.6, 20.24),
+    11: ("a22-flange-root", 0.05, 9619.0, -762.5, -2738.0, 1572.0, 14.96),
+    17: ("a22-flange", 0.025, 12730.0, -2073.0, -3194.0, 2597.0, 7.428),
+}
+
+
+def _case(name):
+    folder = ROOT / "comparisons" / "cases" / name
+    case = tomllib.loads((folder / "case.toml").read_text())
+    ref = tomllib.loads((folder / "reference.toml").read_text())["reference"]
+    m, g, k = case["material"], case["geometry"], case["kinematics"]
+    material = Material(m["shear_modulus_Pa"], m["poisson_ratio"], m["friction_coefficient"])
+    geometry = ContactGeometry.quadric(g["radius_long_m"], g["radius_lat_m"])
+    creepage = Creepage(k["creepage_long"], k["creepage_lat"], k["spin_creepage_1_per_m"], k["rolling_speed_m_per_s"])
+    return geometry, creepage, material, case["loading"]["normal_force_N"], ref
+
+
+def _timed(fn, repeats=3):
+    best, result = math.inf, None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = fn()
+        best = min(best, time.perf_counter() - start)
+    return result, best
+
+
+def _quadric_row(name, options):
+    geometry, creepage, material, force, ref = _case(name)
+    e_star = material.shear_modulus_Pa / (1 - material.poisson_ratio)
+    curvatures = (geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m)
+    a, b, p0, *_ = hertz_ellipse(*curvatures, e_star, normal_force_N=force)  # the normal problem is Hertz's
+    res, wall = _timed(lambda: BemModel().solve(geometry, creepage, material, normal_force_N=force, options=options))
+    mu_fn = material.friction_coefficient * force
+    ref_fx, ref_fy = ref.get("creep_force_long_N", 0.0), ref.get("creep_force_lat_N", 0.0)
+    scale = max(math.hypot(ref_fx, ref_fy), 0.01 * mu_fn)
+    grid = res.extra["grid_error"]
+    row = {
+        "case": name,
+        "options": options,
+        "status": res.status,
+        "grid": f"{res.extra['nx']}x{res.extra['ny']}",
+        "refinements": grid["refinements"],
+        "wall_s": wall,
+        "estimate_largest": grid.get("largest_relative"),
+        "estimate": grid.get("relative"),
+        "error": {
+            "creep_force_N": math.hypot(res.creep_force_long_N - ref_fx, res.creep_force_lat_N - ref_fy) / scale,
+            "max_pressure_Pa": abs(res.max_pressure_Pa / p0 - 1),
+            "contact_area_m2": abs(res.contact_area_m2 / (math.pi * a * b) - 1),
+        },
+    }
+    if name == "large-spin":
+        ratio = res.creep_force_lat_N / mu_fn
+        row["fy_over_mu_fn"] = ratio
+        row["error_vs"] = {k: abs(ratio / v - 1) for k, v in LARGE_SPIN.items()}
+    return row
+
+
+def _a22_rows():
+    from comparisons.manchester import MATERIAL, a22_case
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    rows = []
+    for step, (name, dx_mm, fn, fx, fs, pmax, area) in CONTACT_FINEST.items():
+        options = {"model": {"element_size_m": 0.2e-3}, "sides": ("right",)}
+        sol, wall = _timed(
+            lambda step=step, options=options: solve_wheelset_case(
+                a22_case(step - 1, "deck"), MATERIAL, "bem", options
+            ),
+            repeats=1,
+        )
+        (patch,) = [p.result for p in sol.patches if p.side == "right"]
+        grid = patch.extra["grid_error"]
+        mu_fn = MATERIAL.friction_coefficient * fn
+        # forces on the rail in CONTACT's table; ours act on the wheel: compare magnitudes of the tangential force
+        ft_ours, ft_contact = math.hypot(patch.creep_force_long_N, patch.creep_force_lat_N), math.hypot(fx, fs)
+        rows.append({
+            "step": step,
+            "case": name,
+            "contact_finest_dx_mm": dx_mm,
+            "status": patch.status,
+            "grid": f"{patch.extra['nx']}x{patch.extra['ny']}",
+            "wall_s": wall,
+            "estimate": grid.get("relative"),
+            "difference_to_contact_finest": {
+                "normal_force_N": abs(patch.normal_force_N / fn - 1),
+                "creep_force_N": abs(ft_ours - ft_contact) / max(ft_contact, 0.01 * mu_fn),
+                "max_pressure_Pa": abs(patch.max_pressure_Pa / (pmax * 1e6) - 1),
+                "contact_area_m2": abs(patch.contact_area_m2 / (area * 1e-6) - 1),
+            },
+        })  # fmt: skip
+    return rows
+
+
+def _pct(value):
+    return "-" if value is None else f"{100 * value:.2f} %"
+
+
+def main():
+    quadric = []
+    for name in CASES:
+        quadric.append(_quadric_row(name, {}))
+        quadric.append(_quadric_row(name, {"nx": 40, "ny": 40}))
+    a22 = _a22_rows()
+    machine = {
+        "platform": platform.platform(),
+        "cpu_count": os.cpu_count(),
+        "python": platform.python_version(),
+        "load_average_at_end": [round(v, 2) for v in os.getloadavg()],
+        "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
+    }
+    out = ROOT / "benchmarks" / "results"
+    write_text(out / "bem_grid_error.json", json.dumps({"machine": machine, "quadric": quadric, "a22": a22}, indent=2))
+    lines = [
+        "# The BEM's grid-error estimate and the cost of the default grid (benchmarks/bench_bem_grid_error.py)",
+        "",
+        __doc__.split("\n\n")[1].replace("\n", " "),
+        "",
+        f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs, one thread, Python {machine['python']}; "
+        f"load average at end {machine['load_average_at_end']} (shared machine); {machine['date_utc']} UTC. "
+        "Each cell: estimate / actual error. Wall time best of 3 (NORM + TANG on the grid and its companions).",
+        "",
+        "| case | options | status | grid | creep force est. / err. | max pressure est. / err. | area est. / err. | "
+        "wall ms |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in quadric:
+        est = r["estimate"] or {}
+        cells = [
+            r["case"],
+            "default" if not r["options"] else "nx = ny = 40",
+            r["status"],
+            f"{r['grid']} ({r['refinements']} ref.)",
+        ]
+        for key in ("creep_force_N", "max_pressure_Pa", "contact_area_m2"):
+            cells.append(f"{_pct(est.get(key))} / {_pct(r['error'][key])}")
+        cells.append(f"{1e3 * r['wall_s']:.0f}")
+        lines.append("| " + " | ".join(cells) + " |")
+    spin = [r for r in quadric if r["case"] == "large-spin"]
+    lines += [""] + [
+        f"Large-spin F_y/(mu F_N) with {'the defaults' if not r['options'] else '40 x 40'}: {r['fy_over_mu_fn']:.4f}, "
+        f"{_pct(r['error_vs']['converged'])} from the converged -0.6254, {_pct(r['error_vs']['CONTACT'])} from "
+        "CONTACT's -0.6215."
+        for r in spin
+    ]
+    default_ms = sum(r["wall_s"] for r in quadric if not r["options"])
+    fixed_ms = sum(r["wall_s"] for r in quadric if r["options"])
+    lines += [
+        "",
+        f"Cost: the nine cases at the defaults take {1e3 * default_ms:.0f} ms in all against {1e3 * fixed_ms:.0f} ms "
+        f"on the 40 x 40 grid with its companions ({default_ms / fixed_ms:.1f}x).",
+        "",
+        "## Manchester A-2.2 at CONTACT's 0.2 mm elements (right wheel, deck kinematics)",
+        "",
+        "Each cell: our estimate / our difference to CONTACT's finest run of the step (the two codes agree within "
+        "0.5 % at equal elements except the flange root's max pressure, 3 %: contact_grid.md).",
+        "",
+        "| step | case | status | grid | normal force | creep force | max pressure | area | wall s |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in a22:
+        est, diff = r["estimate"] or {}, r["difference_to_contact_finest"]
+        cells = [str(r["step"]), r["case"], r["status"], r["grid"]]
+        for key in ("normal_force_N", "creep_force_N", "max_pressure_Pa", "contact_area_m2"):
+            cells.append(f"{_pct(est.get(key))} / {_pct(diff[key])}")
+        cells.append(f"{r['wall_s']:.2f}")
+        lines.append("| " + " | ".join(cells) + " |")
+    write_text(out / "bem_grid_error.md", "\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
