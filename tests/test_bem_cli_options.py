@@ -83,13 +83,13 @@ def test_transient_problem_through_the_cli(tmp_path, capsys):
 
 
 def test_printed_verdict_agrees_with_the_exit_status(capsys):
-    """A BEM grid coarser than its tolerance: the printed table says WARNING (not ok) with the patch's message, the
+    """A BEM grid coarser than its tolerance: the printed table says warning (not ok) with the patch's message, the
     exit status is 1, and the JSON's patch status is "warning"."""
     import json
 
     code = main(["contact", "hertz-quadric", "--method", "bem", "--set", "solver.nx=20", "--set", "solver.ny=20"])
     out = capsys.readouterr().out
-    assert code == 1 and out.startswith("method bem: WARNING - ") and "single: warning" in out, out
+    assert code == 1 and out.startswith("method bem: warning - ") and "single: warning" in out, out
     code = main(["contact", "hertz-quadric", "--method", "bem", "--set", "solver.nx=20", "--set", "solver.ny=20",
                  "--json"])  # fmt: skip
     data = json.loads(capsys.readouterr().out)
