@@ -148,3 +148,29 @@ def test_one_case_namespace_for_every_command(capsys, tmp_path):
     assert named.source == "none" and named.reference == {} and named.case_path.name == "hertz-quadric.toml"
     argv = ["bench", "--quick", "--cases", "hertz-quadric", "--models", "hertz", "--out", str(tmp_path / "b")]
     assert main(argv) == 0
+
+
+def test_help_shows_defaults_and_examples_and_the_stability_sweep_name(capsys):
+    """Every command's --help gives its options' defaults and examples; the stability sweep is called what it does
+    (`stability`; `stress` stays as an alias)."""
+    for command in ("run", "contact", "bench", "compare", "demo", "stability", "stress", "sweep", "critical-speed"):
+        with pytest.raises(SystemExit) as stop:
+            main([command, "--help"])
+        assert stop.value.code == 0
+        text = capsys.readouterr().out
+        assert "examples:" in text and "wheelrail " in text.split("examples:")[1], command
+    with pytest.raises(SystemExit):
+        main(["contact", "--help"])
+    assert "(default: auto)" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    assert "stability (stress)" in capsys.readouterr().out
+
+
+def test_models_before_the_case_do_not_swallow_it(tmp_path, capsys):
+    """`compare --models hertz fastsim CASE`: argparse hands CASE to --models; the trailing non-model is the case."""
+    out = tmp_path / "c"
+    assert main(["compare", "--models", "hertz", "fastsim", "hertz-quadric", "--out", str(out)]) == 0
+    assert (out / "report.md").exists() and "hertz-quadric" in (out / "report.md").read_text()
+    assert main(["compare", "--models", "hertz", "fastsim"]) == 2
+    assert "the case is missing" in capsys.readouterr().err

@@ -307,7 +307,7 @@ def cmd_stress(args) -> int:
     scene = load_scene(source)
     from comparisons.stress import ENERGY_SUSPECT_RELATIVE, run_stress_sweep
 
-    with output_folder(args.out, f"stress-{source.stem}") as out_dir:
+    with output_folder(args.out, f"stability-{source.stem}") as out_dir:
         copy_input(source, out_dir, "scene.toml")
         update, close = _progress_bar(False, f"stress {source.stem}")
         try:
@@ -549,9 +549,12 @@ def _add_manchester(sub) -> None:
 
 
 def _add_stress(sub) -> None:
-    stress = sub.add_parser("stress", help="numerical-stability stress sweep")
+    stress = sub.add_parser(
+        "stability", aliases=["stress"], help="numerical-stability sweep of a scene (steps, stiffness, tolerances; "
+        "alias: stress)",
+    )  # fmt: skip
     stress.add_argument("scene", nargs="?", help="embedded scene name or TOML file (default: hunting-conical)")
-    stress.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/stress-<scene>-<time>)")
+    stress.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/stability-<scene>-<time>)")
     stress.add_argument("--quick", action="store_true", help="a small sweep")
     stress.add_argument(
         "--workers",
@@ -581,6 +584,42 @@ def register(add) -> None:
     COMMANDS.append(add)
 
 
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """``--help`` with each option's default (where it has one and its help does not already say it) and the
+    command's examples kept as written.
+    """
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if (
+            "default" in text
+            or default in (None, False, argparse.SUPPRESS)
+            or not action.option_strings
+            or isinstance(default, list)
+        ):
+            return text
+        return f"{text} (default: {default})"
+
+
+EXAMPLES = {
+    "run": ["wheelrail run polygonal-wheel --out out/poly", 'wheelrail run curve-flange --set contact_model="bem"',
+            "wheelrail run wheel-flat --set speed_m_per_s=20 --no-plots"],
+    "contact": ["wheelrail contact hertz-quadric --method fastsim --json",
+                "wheelrail contact manchester-a22 --method bem --plot --out out/a22",
+                "wheelrail contact large-spin --method bem --set solver.grid_tolerance=0.01"],
+    "conicity": ["wheelrail conicity", "wheelrail conicity --wheel worn_high_mileage.prw --rail site_b_hr.prr"],
+    "manchester": ["wheelrail manchester --method bem --out out/a22"],
+    "stability": ["wheelrail stability polygonal-wheel --quick", "wheelrail stability curve --workers 2"],
+    "bench": ["wheelrail bench --quick", "wheelrail bench --cases a22-flange large-spin --models fastsim bem"],
+    "compare": ["wheelrail compare a22-flange", "wheelrail compare large-spin --models hertz fastsim bem"],
+    "demo": ["wheelrail demo", "wheelrail demo curve-flange --models hertz fastsim bem"],
+    "sweep": ["wheelrail sweep study.toml --workers 2 --out out/study"],
+    "critical-speed": ["wheelrail critical-speed hunting-conical", "wheelrail critical-speed curve --high 60"],
+}  # fmt: skip
+"""Command -> example command lines shown by ``wheelrail COMMAND --help``."""
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``wheelrail: error: ...`` and exit status 2 (no usage block)."""
 
@@ -594,7 +633,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     from wheelrail import __version__
 
-    parser = _Parser(prog="wheelrail", description=__doc__.splitlines()[0])
+    parser = _Parser(
+        prog="wheelrail",
+        description="Railway wheelset dynamics and wheel-rail contact with a verified ladder of contact models.",
+        epilog="start with:\n  wheelrail demo\n  wheelrail contact hertz-quadric --method fastsim\n"
+        "  wheelrail run polygonal-wheel\n`wheelrail COMMAND --help` gives each command's options, defaults and "
+        "examples.",
+        formatter_class=_HelpFormatter,
+    )
     parser.add_argument("--version", action="version", version=f"wheelrail {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
@@ -603,6 +649,11 @@ def build_parser() -> argparse.ArgumentParser:
     for target in COMMAND_MODULES:
         module_name, function = target.split(":")
         getattr(importlib.import_module(module_name), function)(sub)
+    for name, command in sub.choices.items():  # defaults and examples in every command's --help
+        command.formatter_class = _HelpFormatter
+        examples = EXAMPLES.get(name) or EXAMPLES.get(command.prog.removeprefix("wheelrail ").strip(), [])
+        if examples and command.epilog is None:
+            command.epilog = "examples:\n" + "\n".join(f"  {line}" for line in examples)
     return parser
 
 

@@ -25,6 +25,21 @@ DEMO_TOLERANCE = 0.1
 7-12 minutes here (0.04 s took 8.9-14.5 s in-process) instead of about half a minute (README, demo)."""
 
 
+def _positional_after_models(args, name: str, allowed, default: str | None = None) -> None:
+    """``--models a b CASE``: argparse gives CASE to ``--models`` (nargs "+"); a trailing name that is not a model,
+    with the positional ``name`` missing, is that positional (the order a user naturally writes).
+    """
+    models = list(args.models or ())
+    if getattr(args, name) is None and models and models[-1] not in allowed:
+        setattr(args, name, models.pop())
+        args.models = models or None
+    if getattr(args, name) is None:
+        if default is not None:
+            setattr(args, name, default)
+            return
+        raise ConfigError(f"{args.command}: the {name} is missing: expected {args.command} {name.upper()} [options]")
+
+
 def _check_models(models, allowed) -> list[str]:
     models = list(models or allowed)
     for name in models:
@@ -81,6 +96,7 @@ def cmd_compare(args) -> int:
     from wheelrail.named_cases import load_named_case
     from wheelrail.output import copy_input, output_folder
 
+    _positional_after_models(args, "case", COMPARE_MODELS)
     models = _check_models(args.models, COMPARE_MODELS)
     named = load_named_case(args.case)
     # locked (one compare per folder at a time); an earlier compare's report and compare.json are removed first
@@ -99,6 +115,7 @@ def cmd_demo(args) -> int:
     from wheelrail.output import output_folder
     from wheelrail.scenes import load_scene, resolve_scene_path
 
+    _positional_after_models(args, "scene", COMPARE_MODELS, default="polygonal-wheel")
     models = _check_models(args.models, COMPARE_MODELS)
     from dataclasses import replace
 
@@ -265,13 +282,13 @@ def register(sub) -> None:
     bench.set_defaults(func=cmd_bench)
 
     compare = sub.add_parser("compare", help="one case through Hertz, FASTSIM, BEM and FEA side by side")
-    compare.add_argument("case", help="named case (see `wheelrail bench --list`) or case folder")
+    compare.add_argument("case", nargs="?", help="named case (see `wheelrail cases`) or case folder")
     compare.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
     compare.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/compare-<case>-<time>)")
     compare.set_defaults(func=cmd_compare)
 
     demo = sub.add_parser("demo", help="the default demo: a run, the contact at its peak through every rung, report")
-    demo.add_argument("scene", nargs="?", default="polygonal-wheel", help="scene with the 3-D contact search")
+    demo.add_argument("scene", nargs="?", help="scene with the 3-D contact search (default: polygonal-wheel)")
     demo.add_argument("--out", type=out_path, help="output folder (default: wheelrail-out/demo-<scene>-<time>)")
     demo.add_argument("--models", nargs="+", metavar="NAME", help="models (default: hertz fastsim bem fea)")
     demo.add_argument(
