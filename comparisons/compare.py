@@ -78,7 +78,7 @@ def _resolution(model, options, main) -> str:
     return ""
 
 
-def _solve_models(named, models, options):
+def _solve_models(named, models, options, progress=None):
     from comparisons.bench import case_errors, side_values, solve_contact_case, warm_up
 
     out = {}
@@ -100,6 +100,8 @@ def _solve_models(named, models, options):
             "main": _main_patch(patches, named.side),
         }
         entry["resolution"] = _resolution(model, options.get(model, {}), entry["main"])
+        if progress is not None:
+            progress(f"{model} solved in {entry['wall_time_s']:.2g} s ({entry['status']})")
         if success:
             entry["values"] = side_values(patches, named.side)
             entry["errors"], entry["error"] = case_errors(named, entry["values"])
@@ -449,15 +451,21 @@ def _pct(value):
     return "-" if value is None else f"{100 * value:.2g} %"
 
 
-def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options=None) -> dict:
-    """Solve, draw and write report.md / report.html / compare.json into ``out_dir`` (see the module docstring)."""
+def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options=None, progress=None) -> dict:
+    """Solve, draw and write report.md / report.html / compare.json into ``out_dir`` (see the module docstring).
+
+    ``progress``, when given, is called with one line of text after each step (a rung solved, the stresses, the
+    pictures), so that a run of tens of seconds is not silent.
+    """
     from comparisons.contact_plots import plot_contact_fields
     from comparisons.files import write_json_atomic, write_text_atomic
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     options = {**DEFAULT_OPTIONS, **(options or {})}
-    solved = _solve_models(named, [m for m in models if m != "fea"] + (["bem"] if "bem" not in models else []), options)
+    solved = _solve_models(
+        named, [m for m in models if m != "fea"] + (["bem"] if "bem" not in models else []), options, progress
+    )
     pictures, notes = {}, []
     bem = solved.get("bem", {})
     bem_main = bem.get("main") if bem.get("status") == "ok" else None
@@ -474,6 +482,8 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
         entries.append((model, _hertz_fields(result) if result.fields is None else result.fields))
     cuts, sources, fea_result = None, [], None
     if bem_main is not None and bem_main[3].fields is not None:
+        if progress is not None:
+            progress("subsurface stresses" + (" and FEA (minutes on a fine mesh)" if "fea" in models else ""))
         cuts, sources, fea_result = subsurface(named, bem_main, fea_options, with_fea="fea" in models)
         if fea_result is not None and fea_result.fields is not None and fea_result.success:
             entries.append(("fea", fea_result.fields))
@@ -482,6 +492,8 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
             notes.append(f"FEA: {cuts['fea_message']}")
     else:
         notes.append(f"BEM did not give a patch on the {named.side} side: no subsurface stresses or difference maps")
+    if progress is not None:
+        progress("maps and report")
     if entries:
         pictures["pressure"] = _plot_pressures(entries, bem_main[3].fields if bem_main else None, out_dir)
     for model in ("fastsim", "bem"):

@@ -75,6 +75,7 @@ def limit_cycle_search(
     bisections: int = 3,
     extensions: int = 2,
     simulate=None,
+    progress=None,
 ) -> dict:
     """Follow the hunting limit cycle down in speed (module docstring).
 
@@ -93,6 +94,7 @@ def limit_cycle_search(
         extensions: a run whose oscillation is still large but decaying slowly (ratio in [0.5, persist_ratio))
             is continued from its last state up to this many times before it counts as decaying.
         simulate: the simulate function (default rigid_dynamics.wheelset.simulate).
+        progress: called with one line of text after each run (speed, amplitude, verdict), or None.
 
     Returns:
         dict: ``success``, ``status`` ("ok", "no-cycle-at-start", "cycle-down-to-low-speed", "run-failed"),
@@ -131,6 +133,11 @@ def limit_cycle_search(
                 "message": result.message,
             }
         )
+        if progress is not None:
+            progress(
+                f"run {len(runs)} at {speed:.4g} m/s: amplitude {amplitude * 1e3:.3g} mm, persistence "
+                f"{persistence:.3g}: {'limit cycle' if cycle else 'decays / none'} ({result.status})"
+            )
         return result, cycle
 
     first = replace(scene, initial=replace(scene.initial, lateral_displacement_m=disturbance_m))

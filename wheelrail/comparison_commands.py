@@ -40,6 +40,15 @@ def _positional_after_models(args, name: str, allowed, default: str | None = Non
         raise ConfigError(f"{args.command}: the {name} is missing: expected {args.command} {name.upper()} [options]")
 
 
+def _say(prefix: str):
+    """A progress callback: one line ``prefix: text`` on stderr."""
+
+    def say(text: str) -> None:
+        print(f"{prefix}: {text}", file=sys.stderr, flush=True)
+
+    return say
+
+
 def _check_models(models, allowed) -> list[str]:
     models = list(models or allowed)
     for name in models:
@@ -102,7 +111,7 @@ def cmd_compare(args) -> int:
     # locked (one compare per folder at a time); an earlier compare's report and compare.json are removed first
     with output_folder(args.out, f"compare-{named.name}", summaries=COMPARE_SUMMARIES) as out_dir:
         copy_input(named.case_path, out_dir, "case.toml")
-        report = run_compare(named, out_dir, models=models)
+        report = run_compare(named, out_dir, models=models, progress=_say("compare"))
     for line in report["headlines"]:
         print(line)
     print(f"report: {Path(out_dir) / 'report.md'} (and report.html)")
@@ -167,7 +176,7 @@ def _demo(scene, source, models, out_dir) -> int:
     )
     named = NamedCase("peak-contact", out_dir, "none (no reference: the BEM is the most exact rung here)", "single",
                       {}, note=note, case=patch)  # fmt: skip
-    compare = run_compare(named, subfolder(out_dir, "compare"), models=models)
+    compare = run_compare(named, subfolder(out_dir, "compare"), models=models, progress=_say("demo 2/3"))
     print("demo 3/3: report")
     models = compare["models"]
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 
 from wheelrail.config import PHYSICAL_RANGES, ConfigError
 
@@ -117,6 +118,7 @@ def cmd_critical_speed(args) -> int:
             speed_steps=args.steps,
             threshold_m=1e-3 * args.threshold_mm,
             simulate=partial(simulate, provider=provider),
+            progress=lambda text: print(f"critical-speed: {text}", file=sys.stderr, flush=True),
         )
         speed = _speed(nonlinear["speed_m_per_s"])
         print(f"{source.stem}: nonlinear critical speed {speed}: {nonlinear['message']}")
