@@ -463,49 +463,60 @@ def _write_outputs(records: list[dict], spec: dict, out: Path) -> list[str]:
     return files
 
 
+def _value_text(name: str, value) -> str:
+    """``name = value`` for a legend, numbers in the label's units (``flat depth [mm] = 0.5``)."""
+    from comparisons.style import label_of
+
+    label, scale = label_of(name)
+    return f"{label} = {value * scale:g}" if isinstance(value, (int, float)) else f"{label} = {value}"
+
+
 def _plot(frame, spec: dict, path: Path):
-    """Each metric against each varied numeric parameter; failed points as red crosses at the bottom."""
+    """Each metric against each varied numeric parameter, labelled as quantities in an engineer's units (mm, MPa;
+    comparisons.style.label_of); points that are not ok (or whose metric is NaN) as crosses at the bottom, named by
+    their status.
+    """
     import numpy as np
 
-    parameters = [
-        p
-        for p in dict.fromkeys(k for point in spec["points"] for k in point)
-        if p in frame.columns and frame[p].dtype.kind in "if" and frame[p].nunique() > 1
-    ]
+    varied = [
+        p for p in dict.fromkeys(k for point in spec["points"] for k in point)
+        if p in frame.columns and frame[p].nunique() > 1
+    ]  # fmt: skip
+    parameters = [p for p in varied if frame[p].dtype.kind in "if"]  # the x axes; every varied key is a curve
     metrics = [m for m in spec["metrics"] if m in frame.columns and frame[m].dtype.kind in "if"]
     if not parameters or not metrics:
         return None
-    import matplotlib
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    from comparisons.style import label_of
     from wheelrail.output import atomic_write
 
-    ok = frame["status"] == "ok"
-    fig, axes = plt.subplots(
-        len(metrics), len(parameters), figsize=(4.2 * len(parameters), 3.2 * len(metrics)), squeeze=False
-    )
+    fig = Figure(figsize=(4.2 * len(parameters), 3.2 * len(metrics)), layout="constrained")
+    axes = fig.subplots(len(metrics), len(parameters), squeeze=False)
     for i, metric in enumerate(metrics):
+        ylabel, yscale = label_of(metric)
+        good = (frame["status"] == "ok") & np.isfinite(frame[metric].astype(float))
         for j, parameter in enumerate(parameters):
             ax = axes[i][j]
-            others = [p for p in parameters if p != parameter]
-            groups = frame[ok].groupby(others) if others else [((), frame[ok])]
+            xlabel, xscale = label_of(parameter)
+            others = [p for p in varied if p != parameter]
+            groups = frame[good].groupby(others) if others else [((), frame[good])]
             for label, group in groups:
                 group = group.sort_values(parameter)
-                text = ", ".join(f"{p}={v:g}" for p, v in zip(others, np.atleast_1d(label), strict=False))
-                ax.plot(group[parameter], group[metric], "o-", ms=4, label=text or None)
-            failed = frame[~ok]
+                text = ", ".join(_value_text(p, v) for p, v in zip(others, np.atleast_1d(label), strict=False))
+                ax.plot(group[parameter] * xscale, group[metric] * yscale, "o-", ms=4, label=text or None)
+            failed = frame[~good]
             if len(failed):
-                floor = frame.loc[ok, metric].min() if ok.any() else 0.0
-                ax.plot(failed[parameter], np.full(len(failed), floor), "rx", ms=8, label="failed")
-            ax.set_xlabel(parameter)
-            ax.set_ylabel(metric)
+                floor = frame.loc[good, metric].min() * yscale if good.any() else 0.0
+                for status, rows in failed.groupby("status"):
+                    name = "ok, no value" if status == "ok" else status
+                    ax.plot(rows[parameter] * xscale, np.full(len(rows), floor), "x", ms=8, label=name)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel)
+            ax.grid(True, alpha=0.3)
             if others or len(failed):
                 ax.legend(fontsize=7)
-    fig.tight_layout()
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
-    plt.close(fig)
     return path
 
 
