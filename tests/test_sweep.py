@@ -22,7 +22,7 @@ description = "two speeds, two frictions, one point over its budget"
 scene = "hunting-conical"
 metrics = ["max_abs_lateral_displacement_m"]
 [set]
-duration_s = 0.02
+duration_s = 0.2  # long enough that a worker is still busy when the first point is recorded
 [grid]
 speed_m_per_s = [10.0, 30.0]
 "material.friction_coefficient" = [0.2, 0.4]
