@@ -125,7 +125,8 @@ def test_bad_input_raises():
 def test_pchip_coefficients_are_scipys():
     """The numpy PCHIP of the creep-coefficient table (kalker.pchip_coefficients, kept so that importing the
     coefficients needs no scipy.interpolate) equals scipy's PchipInterpolator: on the table and on random data with
-    flat and sign-changing stretches."""
+    flat and sign-changing stretches. On the table bit for bit: an adaptive wheel-flat run with wheel lift
+    (tests/test_dynamics_adaptive.py) moved its force error estimate from 0.9 % to 2.5 % on a 3e-15 change."""
     import numpy as np
     from scipy.interpolate import PchipInterpolator
 
@@ -133,7 +134,7 @@ def test_pchip_coefficients_are_scipys():
 
     x = np.log(kalker.KALKER_TABLE.a_over_b)
     y = np.log(kalker.KALKER_TABLE.values.reshape(len(x), 12))
-    np.testing.assert_allclose(kalker._PP_C, PchipInterpolator(x, y, axis=0).c, rtol=1e-13, atol=1e-13)
+    assert np.array_equal(kalker._PP_C, PchipInterpolator(x, y, axis=0).c)  # bit for bit: runs are chaotic
     rng = np.random.default_rng(7)
     for _ in range(100):
         n = int(rng.integers(3, 12))

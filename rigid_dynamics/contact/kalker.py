@@ -146,8 +146,9 @@ def pchip_coefficients(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     d[0] = edge(h[0], h[1], slope[0], slope[1])
     d[-1] = edge(h[-1], h[-2], slope[-1], slope[-2])
     c = np.empty((4, len(x) - 1, y.shape[1]))
-    c[0] = (d[:-1] + d[1:] - 2.0 * slope) / h**2
-    c[1] = (3.0 * slope - 2.0 * d[:-1] - d[1:]) / h
+    t = (d[:-1] + d[1:] - 2.0 * slope) / h  # scipy's order of operations: bit-identical coefficients
+    c[0] = t / h
+    c[1] = (slope - d[:-1]) / h - t
     c[2] = d[:-1]
     c[3] = y[:-1]
     return c
