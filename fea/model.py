@@ -77,6 +77,14 @@ class FeaOptions:
             which the recovered stress tensor is returned in ``extra["stress_points_Pa"]`` (a list of 3 x 3
             tensors, Pa; None where a point lies outside the mesh), or None. Quarter models mirror the point
             into x, y >= 0 and flip the shear components that are odd in x or y.
+        mesh_tolerance: relative discretisation error asked of the max pressure, the contact area and (approach
+            control) the normal force; the mesh is refined (:mod:`fea.refinement`) until the estimate meets it or
+            the next level would exceed ``max_dofs`` (status "mesh-tolerance-not-met"). None: one solve on the
+            given mesh, no error estimate (status "error-not-estimated").
+        max_dofs: budget of the refinement series: the largest number of displacement unknowns of a level.
+        grading: g, the growth of the element size per unit distance away from the patch on the first level
+            (meshing.hertz); every refinement divides it by the refinement ratio, so the far field is refined
+            with the patch (with a fixed grading the approach stagnates: measured on the Hertz case).
     """
 
     quick: bool = False
@@ -97,6 +105,9 @@ class FeaOptions:
     max_elements: int = 2_000_000
     stress_points_m: tuple | None = None
     surface_traction: dict | None = None
+    mesh_tolerance: float | None = 0.02
+    max_dofs: int = 200_000
+    grading: float = 0.4
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -129,6 +140,10 @@ class FeaOptions:
                     raise ValueError(f"surface_traction.{key}: expected finite values of shape {shape}")
             if self.formulation != "rigid":
                 raise ValueError(f"surface_traction with formulation = {self.formulation!r}: expected 'rigid'")
+        if self.mesh_tolerance is not None and not (math.isfinite(self.mesh_tolerance) and self.mesh_tolerance > 0):
+            raise ValueError(f"mesh_tolerance = {self.mesh_tolerance!r}: expected a finite number > 0 or None")
+        if not (math.isfinite(self.grading) and self.grading > 0):
+            raise ValueError(f"grading = {self.grading!r}: expected a finite number > 0")
         if self.stress_points_m is not None:
             pts = np.asarray(self.stress_points_m, dtype=float)
             if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
@@ -179,6 +194,14 @@ OPTIONS = declare_dataclass(
             "help": "tangential tractions on the wheel on a grid (x_m, y_m, traction_long_Pa, traction_lat_Pa), "
             "applied negated to the rail block's contact face"
         },
+        "mesh_tolerance": {
+            "help": "relative discretisation error asked of max pressure, area and force (None: one mesh, no estimate)",
+            "minimum": 0,
+            "exclusive_minimum": True,
+        },
+        "max_dofs": {"help": "budget of the mesh refinement: largest number of unknowns of a level", "minimum": 1},
+        "grading": {"help": "element size growth per unit distance from the patch (first level)", "minimum": 0,
+                    "exclusive_minimum": True},
     },
 )
 """Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``
@@ -228,7 +251,23 @@ class FeaModel:
             raise ValueError(f"normal_force_N = {normal_force_N!r}: expected a finite number > 0 or None")
         if normal_force_N is None and geometry.undeformed is None and geometry.approach_m <= 0:
             return self._empty(geometry, creepage, "no-contact", "approach_m <= 0: the surfaces do not touch", t0)
+        from fea.refinement import solve_to_tolerance
 
+        def solve_level(level_opts):
+            return self._solve_level(geometry, creepage, material, normal_force_N, level_opts, comm, t0)
+
+        return solve_to_tolerance(
+            solve_level,
+            opts,
+            approach_control=normal_force_N is None,
+            block_estimate=opts.formulation != "profiles",
+            t0=t0,
+        )
+
+    def _solve_level(self, geometry, creepage, material, normal_force_N, opts, comm, t0):
+        """One solve on the mesh of ``opts``: (ContactResult with status "ok" or a failure, write()), ``write()``
+        writing the VTU grid and the PNGs of this level when ``opts.output_dir`` is set.
+        """
         import dolfinx_solver  # noqa: F401  (must precede dolfinx/petsc4py/mpi4py)
         from mpi4py import MPI
 
@@ -272,7 +311,8 @@ class FeaModel:
             else:
                 q0 = geometry.approach_m
                 if q0 <= h_offset:
-                    return self._empty(geometry, creepage, "no-contact", "no overlap at the given approach", t0)
+                    empty = self._empty(geometry, creepage, "no-contact", "no overlap at the given approach", t0)
+                    return empty, _nothing
             overlap = finite & (h_grid < q0)
             gx, gy = np.meshgrid(und.x_m, und.y_m)
             dx = float(np.diff(und.x_m).mean()) if len(und.x_m) > 1 else 0.0
@@ -302,6 +342,7 @@ class FeaModel:
             semi_axis_lat_m=semi[1],
             elements_per_semi_axis=opts.n_per_semi_axis,
             domain_factor=opts.block_factor,
+            grading=opts.grading,
             center_m=center,
             symmetry="quarter" if quadric and opts.formulation != "profiles" and not opts.surface_traction else "full",
         )
@@ -384,7 +425,7 @@ class FeaModel:
             "approach_note": "approach of a clamped finite block, smaller than the half-space value",
         }
         if sol.status == "no-contact":
-            return self._empty(geometry, creepage, "no-contact", sol.message, t0, extra=extra)
+            return self._empty(geometry, creepage, "no-contact", sol.message, t0, extra=extra), _nothing
 
         # Pressure field (full patch).
         xy, force, weight = sol.node_xy_m, sol.node_force_N, sol.node_weight_m2
@@ -404,6 +445,13 @@ class FeaModel:
         weighted = sol.node_weight_m2 > 1e-9 * sol.node_weight_m2.max()
         extra["max_nodal_pressure_Pa"] = float((sol.node_force_N[weighted] / sol.node_weight_m2[weighted]).max())
         extra["contact_area_nodal_m2"] = area_nodal
+        extra["max_pressure_definition"] = (
+            f"largest force-weighted average of the nodal pressures within {opts.filter_radius_factor:g} element "
+            "sizes (fea.postprocess.filtered_pressure): the nodal values N_i / w_i scatter by several per cent from "
+            "node to node, the average keeps the force and converges; max_nodal_pressure_Pa is the unfiltered one"
+            if radius > 0
+            else "largest nodal pressure N_i / w_i (filter_radius_factor 0)"
+        )
 
         semi_long = semi_lat = None
         area = area_nodal
@@ -437,22 +485,23 @@ class FeaModel:
                     comm, stress_fn, np.asarray(opts.stress_points_m, float), domain.symmetry == "quarter"
                 )
 
-        if opts.output_dir is not None:
-            from fea.output import write_outputs
+        def write():
+            if opts.output_dir is not None:
+                from fea.output import write_outputs
 
-            extra["files"] = write_outputs(
-                _patch_output_dir(opts.output_dir, geometry),
-                sol,
-                stress_fn,
-                fields,
-                domain,
-                spec,
-                young_body,
-                nu,
-                comm=comm,
-            )
+                extra["files"] = write_outputs(
+                    _patch_output_dir(opts.output_dir, geometry),
+                    sol,
+                    stress_fn,
+                    fields,
+                    domain,
+                    spec,
+                    young_body,
+                    nu,
+                    comm=comm,
+                )
 
-        return ContactResult(
+        result = ContactResult(
             method=self.name,
             success=sol.success,
             status=sol.status,
@@ -470,6 +519,7 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra,
         )
+        return result, write
 
     def _empty(self, geometry, creepage, status, message, t0, extra=None) -> ContactResult:
         return ContactResult(
@@ -485,6 +535,10 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra or {},
         )
+
+
+def _nothing() -> None:
+    """The output writer of a level without contact (nothing to write)."""
 
 
 def _traction_function(traction: Mapping):
