@@ -518,8 +518,11 @@ def warm_up(method: str, material: Material) -> float:
     return time.perf_counter() - start
 
 
-def solve_case(case: ContactCase, method: str) -> CaseSolution:
+def solve_case(case: ContactCase, method: str, progress=None) -> CaseSolution:
     """Solve a validated case with the contact model ``method``.
+
+    ``progress``: optional callable taking one line per wheel evaluation of a wheelset case (see
+    ``solve_wheelset_case``).
 
     The model is imported and its compiled kernels loaded (:func:`warm_up`) before the clock starts, so
     ``wall_time_s`` measures the solve; that preparation is ``setup_s``. For a wheelset case the clock
@@ -552,7 +555,9 @@ def solve_case(case: ContactCase, method: str) -> CaseSolution:
             [("single", case.geometry, case.creepage, result)],
             setup_s=setup_s,
         )
-    solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options)
+    solution = solve_wheelset_case(
+        case.wheelset, case.material, method, options=case.solver_options, progress=progress
+    )
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     extra = {
         k: v
