@@ -60,3 +60,33 @@ def test_without_a_stated_error_the_scatter_defeats_force_tolerance():
     sol = solve_wheelset_case(_case(), STEEL, ScatteredHertz(stated=None), options={"max_iterations": 12})
     assert not sol.success and sol.status == "not-converged"
     assert math.isnan(sol.load_tolerance) or sol.load_tolerance == pytest.approx(1e-6)
+
+
+class CoarseFirst(ScatteredHertz):
+    """A model with ``coarse_options`` (as the FEA): its coarse solves state no error and do not scatter."""
+
+    def __init__(self):
+        super().__init__()
+        self.calls = []
+
+    @staticmethod
+    def coarse_options(options):
+        return {"coarse": True}
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
+        coarse = bool(options and options.get("coarse"))
+        self.calls.append(coarse)
+        if coarse:
+            return self.hertz.solve(geometry, creepage, material, normal_force_N=normal_force_N)
+        return super().solve(geometry, creepage, material, normal_force_N=normal_force_N)
+
+
+def test_a_model_with_coarse_options_is_balanced_on_them_first():
+    model, lines = CoarseFirst(), []
+    sol = solve_wheelset_case(_case(), STEEL, model, progress=lines.append)
+    assert sol.success and sol.status == "ok", sol.message
+    first_full = model.calls.index(False)
+    assert first_full >= 2 and not any(model.calls[first_full:])  # coarse evaluations, then only full ones
+    assert all("(coarse mesh)" in line for line in lines[:first_full])
+    assert "(coarse mesh)" not in lines[-1]
+    assert sol.load_tolerance == pytest.approx(STATED) and sol.equilibrium_residual < STATED

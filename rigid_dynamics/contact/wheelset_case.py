@@ -28,8 +28,9 @@ Kinematics (``roll_rad`` of the case):
 Residuals phi_i = (F_i / W)^(2/3) - 1 (nearly linear in the sink: F ~ q^1.5); the first step scales the sink by
 (W / F)^(2/3), then secant (per wheel) or Broyden's method (both wheels), until |F_i / W - 1| <
 ``force_tolerance``, or the patches' stated relative error of their normal forces when larger (a model with a
-discretisation error, the FEA: see ``_load_tolerance``). The tangential problem is part of every evaluation,
-since its forces carry part of W.
+discretisation error, the FEA: see ``_load_tolerance``). A model with ``coarse_options(options)`` (the FEA: its
+first mesh, without the refinement series) is balanced first with those, then with its own options from there.
+The tangential problem is part of every evaluation, since its forces carry part of W.
 
 Pitch rate: the case's ``pitch_rate_rad_per_s`` (the wheelset's angular velocity about its axle, with CONTACT's
 sign: negative for forward rolling; spin rate phi' = -pitch rate), else option ``spin_rate``:
@@ -73,6 +74,10 @@ DEFAULT_CASE_OPTIONS: dict = {
     # or to the wheelset centre's speed ("centre", eq 41); see _creepage
     "sides": SIDES,  # per-wheel kinematics: the wheels to solve (CONTACT's A-2.2 deck solves the right one)
 }
+COARSE_FORCE_TOLERANCE = 1e-3
+"""The load tolerance of the coarse phase of a model with ``coarse_options`` (the FEA): the full solve's force
+differs from the coarse one by its discretisation error, several per cent on the A-2.2 patches, so balancing the
+coarse load further is wasted (manchester-a22: 14 coarse evaluations to 1e-6, the last 6 of them below 1e-3)."""
 SPIN_RATES = ("zero-axle-moment", "nominal", "mean-rolling-radius")
 PATCH_MODES = ("contact", "search")
 
@@ -441,6 +446,8 @@ class _Evaluator:
     def __init__(self, case, material, model, track, opts, progress=None):
         self.case, self.material, self.model, self.track, self.opts = case, material, model, track, opts
         self.progress = progress
+        self.model_options = opts["model"]
+        self.phase = ""
         self.count = 0
         self.started = time.perf_counter()
 
@@ -490,7 +497,7 @@ class _Evaluator:
                 self.case, pose, material_point, geometry.frame[:, 2], omega, self.opts["rolling_speed"]
             )
             result = self.model.solve(
-                geometry, creepage, self.material, normal_force_N=None, options=self.opts["model"]
+                geometry, creepage, self.material, normal_force_N=None, options=self.model_options
             )
             if not result.success:
                 failed.append(f"{side} patch {k}: {result.message}")
@@ -508,7 +515,7 @@ class _Evaluator:
             target = self.case.wheel_load_N
             load = f"vertical load {state.vertical_load_N:.6g} N" + (f" (target {target:.6g} N)" if target else "")
             self.progress(
-                f"wheel evaluation {self.count}: {side} wheel, {len(patches)} patch(es), {load}, "
+                f"wheel evaluation {self.count}{self.phase}: {side} wheel, {len(patches)} patch(es), {load}, "
                 f"tolerance {_load_tolerance(state, self.opts):.3g}, {time.perf_counter() - self.started:.1f} s"
             )
         return state
@@ -701,7 +708,22 @@ def solve_wheelset_case(
         omega = -float(case.pitch_rate_rad_per_s)
     else:
         omega = case.rolling_speed_m_per_s / case.nominal_radius_m
-    states, warm, iterations, status = solve_pose(omega, None)
+    coarse = getattr(contact_model, "coarse_options", None)
+    coarse = coarse(opts["model"]) if coarse is not None and case.wheel_load_N is not None else None
+    if coarse is not None:
+        # a model whose every solve refines its own mesh (the FEA): the equilibrium first on its coarsest mesh,
+        # then from there with the full solve (usually accepted at once within its stated force error)
+        evaluator.model_options, evaluator.phase = coarse, " (coarse mesh)"
+        tolerance = opts["force_tolerance"]
+        opts["force_tolerance"] = max(tolerance, COARSE_FORCE_TOLERANCE)
+        states, warm, iterations, status = solve_pose(omega, None)
+        evaluator.model_options, evaluator.phase = opts["model"], ""
+        opts["force_tolerance"] = tolerance
+        if states is not None and status == "ok":
+            states, warm, its, status = solve_pose(omega, warm)
+            iterations += its
+    else:
+        states, warm, iterations, status = solve_pose(omega, None)
     if states is not None and status == "ok" and mode == "mean-rolling-radius":
         omega = _spin_rate_estimate(case, list(states.values()), mode)
         states, warm, its, status = solve_pose(omega, warm)
