@@ -22,9 +22,12 @@ Block size. The "rigid" and "two-body" formulations truncate the half-space at a
 D = ``domain_factor`` max(a, b). The approach (load control) and the force (approach control) depend on the
 compliance of the whole block and decay as 1/D (Hertz case, P2: -2.08 %, -1.10 %, -0.62 % at D = 20, 40, 80
 semi-axes, a decay D^-s with s = 0.92 then 0.83): one more solve on the first level's mesh with 2 D estimates the
-truncation error as |Q(2D) - Q(D)| / (1 - 2^-s) with s = 0.75 (``BLOCK_DECAY_ORDER``), added to the mesh error of
-those two quantities. The pressure and the area are
-local: their truncation error (below 0.5 % at D = 20 on the Hertz case) is not estimated separately.
+truncation error as |Q(2D) - Q(D)| / (1 - 2^-s) with s = 0.75 (``BLOCK_DECAY_ORDER``), added to the mesh error.
+The max pressure feels the block less (about +0.5 % at D = 20 on the Hertz case) but enough to exceed a small
+mesh error (the compare test's Hertz circle: 0.37 % true against 0.26 % stated without it), so it gets the same
+estimate. The area's truncation error (about -0.3 % at D = 20) is below the scatter of the area between the two
+blocks' meshes (the estimate then said 2.2 % on the P2 Hertz series whose true area error was 0.3 %): it is not
+estimated, and the area's stated error is its mesh error alone.
 
 Tolerance. The max pressure, the contact area and, under approach control, the normal force are judged (their
 relative error estimate <= ``mesh_tolerance``); the approach, the semi-axes and the largest von Mises stress are
@@ -51,8 +54,8 @@ BLOCK_DECAY_ORDER = 0.75
 of Q(D) is |Q(2D) - Q(D)| / (1 - 2^-s), 2.5 times the difference with s = 0.75 (2 with s = 1)."""
 JUDGED = ("max_pressure", "contact_area", "normal_force")
 """Quantities whose relative error estimate must meet ``mesh_tolerance``."""
-BLOCK_SENSITIVE = ("normal_force", "approach")
-"""Quantities with an estimated block-size (truncation) error."""
+BLOCK_SENSITIVE = ("normal_force", "approach", "max_pressure")
+"""Quantities with an estimated block-size (truncation) error (module docstring)."""
 
 
 def _quantities(result) -> dict[str, float | None]:

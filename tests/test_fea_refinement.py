@@ -43,10 +43,10 @@ def test_two_levels_assume_first_order_and_a_crossing_uses_the_previous_differen
     assert observed > 3 and error == pytest.approx(0.0999 / REFINEMENT_RATIO / (REFINEMENT_RATIO - 1))
 
 
-def test_estimate_adds_the_block_size_error_to_force_and_approach_only():
-    levels = [{"approach": 1.0, "max_pressure": 10.0}, {"approach": 1.01, "max_pressure": 10.1}]
-    out = estimate(levels, {"approach": 1.02, "max_pressure": 10.5})
-    assert out["block_size_relative_error"]["max_pressure"] is None
+def test_estimate_adds_the_block_size_error_to_force_approach_and_pressure_only():
+    levels = [{"approach": 1.0, "contact_area": 10.0}, {"approach": 1.01, "contact_area": 10.1}]
+    out = estimate(levels, {"approach": 1.02, "contact_area": 10.5})
+    assert out["block_size_relative_error"]["contact_area"] is None
     assert out["block_size_relative_error"]["approach"] == pytest.approx(0.02 / (1 - 2**-0.75) / 1.01)
     assert out["relative_error"]["approach"] == pytest.approx(
         out["mesh_relative_error"]["approach"] + out["block_size_relative_error"]["approach"]
