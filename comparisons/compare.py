@@ -6,8 +6,9 @@ What is solved:
   times and errors against the case's reference (as in :mod:`comparisons.bench`);
 * the maps use each model's main patch on the reference side (the patch with the largest normal force). FEA is
   solved on the BEM's main patch geometry with the BEM's normal force (one patch, not the whole wheelset: the
-  same problem for both, and minutes less), frictionless, at its default mesh unless ``fea_options`` say
-  otherwise.
+  same problem for both, and minutes less), frictionless, refined to its default ``mesh_tolerance`` unless
+  ``fea_options`` say otherwise; its numbers carry the error it states, and the report judges FEA against the BEM
+  with both stated errors (comparisons.stated_errors; "not yet stated" where the BEM states none).
 
 Pictures (PNG, matplotlib; one 3-D view with pyvista, off-screen):
 
@@ -34,6 +35,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from comparisons.stated_errors import agreement, stated_errors
 
 COMPARE_MODELS = ("hertz", "fastsim", "bem", "fea")
 DEFAULT_OPTIONS = {"fastsim": {"nx": 40, "ny": 40}, "bem": {"nx": 64, "ny": 64}}
@@ -80,6 +83,7 @@ def _resolution(model, options, main) -> str:
 
 def _solve_models(named, models, options, progress=None):
     from comparisons.bench import case_errors, side_values, solve_contact_case, warm_up
+    from comparisons.stated_errors import side_stated_errors
 
     out = {}
     for model in models:
@@ -105,6 +109,7 @@ def _solve_models(named, models, options, progress=None):
         if success:
             entry["values"] = side_values(patches, named.side)
             entry["errors"], entry["error"] = case_errors(named, entry["values"])
+            entry["stated_errors"] = side_stated_errors([p[3] for p in patches if p[0] == named.side])
         out[model] = entry
     return out
 
@@ -521,7 +526,9 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
             },
             "note": "main BEM patch only, BEM normal force",
             "resolution": _fea_resolution(fea_result),
+            "stated_errors": stated_errors(fea_result),
         }
+        solved["fea"]["agreement_with_bem"] = _fea_bem_agreement(solved["fea"], bem_main)
     from comparisons.rung_differences import explain
 
     differences = explain(solved, getattr(named.case, "material", None), options)
@@ -543,11 +550,17 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
 
 
 def _fea_resolution(result) -> str:
-    """FEA's mesh for the report: element size at the patch and elements per semi-axis."""
+    """FEA's mesh for the report: element size at the patch, cells, and the refinement series that stated the
+    error (levels, elements per semi-axis of the finest).
+    """
     size = result.extra.get("element_size_m")
     mesh = result.extra.get("mesh") or {}
-    cells = mesh.get("cells") or mesh.get("n_cells")
+    cells = mesh.get("element_count") or mesh.get("cells") or mesh.get("n_cells")
     text = f"element size {size * 1e3:.3g} mm at the patch" if size else "mesh not reported"
+    levels = (result.extra.get("discretisation_error") or {}).get("levels") or []
+    if levels:
+        finest = levels[-1]["elements_per_semi_axis"]
+        text += f", finest of {len(levels)} refinement levels ({finest:.3g} per semi-axis)"
     return text + (f", {cells} cells" if cells else "")
 
 
@@ -557,6 +570,28 @@ def _source_file(named) -> str | None:
     if folder is None or not (Path(folder) / "SOURCE.md").is_file():
         return None
     return f"comparisons/cases/{named.name}/SOURCE.md"
+
+
+def _fea_bem_agreement(fea_entry: dict, bem_main) -> dict:
+    """FEA against the BEM's main patch (the same patch and normal force) on max pressure and area, judged with both
+    stated errors (comparisons.stated_errors.agreement; agree None where the BEM states none).
+    """
+    bem_result = bem_main[3]
+    fea_errors = fea_entry.get("stated_errors") or {}
+    bem_errors = stated_errors(bem_result) or {}
+    out = {}
+    for name, attribute in (("max_pressure", "max_pressure_Pa"), ("contact_area", "contact_area_m2")):
+        fea_value, bem_value = fea_entry["values"].get(attribute), getattr(bem_result, attribute)
+        if fea_value is None or bem_value is None:
+            continue
+        out[name] = {
+            "fea": fea_value,
+            "bem": bem_value,
+            "fea_stated": fea_errors.get(name),
+            "bem_stated": bem_errors.get(name),
+            **agreement(fea_value, bem_value, fea_errors.get(name), bem_errors.get(name)),
+        }
+    return out
 
 
 def _report(named, models, solved, sources, cuts, pictures, notes, differences=()) -> dict:
@@ -569,12 +604,12 @@ def _report(named, models, solved, sources, cuts, pictures, notes, differences=(
         + f". Side compared: {named.side}.",
         "",
         "| model | grid / mesh | status | time | N [N] | Fx [N] | Fy [N] | p max [MPa] | area [mm2] | err N | err F | "
-        "err p | err area |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "err p | err area | stated err N / p / area |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         f"| reference | | {named.source} | | {_fmt(ref.get('normal_force_N'))} | "
         f"{_fmt(ref.get('creep_force_long_N'))} | "
         f"{_fmt(ref.get('creep_force_lat_N'))} | {_fmt(ref.get('max_pressure_Pa'), 1e-6)} | "
-        f"{_fmt(ref.get('contact_area_m2'), 1e6)} | | | | |",
+        f"{_fmt(ref.get('contact_area_m2'), 1e6)} | | | | | |",
     ]
     for model in models:
         e = solved.get(model)
@@ -590,9 +625,16 @@ def _report(named, models, solved, sources, cuts, pictures, notes, differences=(
             f"{_fmt(v.get('creep_force_long_N'))} | {_fmt(v.get('creep_force_lat_N'))} | "
             f"{_fmt(v.get('max_pressure_Pa'), 1e-6)} | {_fmt(v.get('contact_area_m2'), 1e6)} | "
             f"{_pct(err.get('err_normal_force'))} | {_pct(err.get('err_creep_force'))} | "
-            f"{_pct(err.get('err_max_pressure'))} | {_pct(err.get('err_area'))} |"
+            f"{_pct(err.get('err_max_pressure'))} | {_pct(err.get('err_area'))} | {_stated_cell(model, e)} |"
         )
-    lines += ["", "Times: whole case (a wheelset case includes search and equilibrium); FEA: one patch.", ""]
+    lines += [
+        "",
+        "Times: whole case (a wheelset case includes search and equilibrium); FEA: one patch. `stated err`: the "
+        "relative discretisation error a model states for its own normal force, max pressure and area (the FEA's from "
+        "its refinement series, fea.refinement; `not stated` where a model states none).",
+        "",
+    ]
+    lines += _agreement_lines(solved.get("fea", {}).get("agreement_with_bem"))
     if differences:
         lines += [
             "## Where the rungs differ from the BEM",
@@ -660,6 +702,40 @@ def _report(named, models, solved, sources, cuts, pictures, notes, differences=(
         lines += ["## Notes", ""] + [f"- {n}" for n in notes] + [""]
     markdown = "\n".join(lines) + "\n"
     return {"markdown": markdown, "html": _html(markdown, named.name), "headlines": headlines}
+
+
+def _stated_cell(model: str, entry: dict) -> str:
+    if model == "hertz":
+        return "exact (closed form)"
+    errors = entry.get("stated_errors")
+    if errors is None:
+        return "not stated" if entry.get("status") == "ok" else "-"
+    return " / ".join(_pct(errors.get(n)) for n in ("normal_force", "max_pressure", "contact_area"))
+
+
+def _agreement_lines(agreement_: dict | None) -> list[str]:
+    """The report's paragraph on FEA against BEM, judged with both stated errors."""
+    if not agreement_:
+        return []
+    lines = ["## FEA against BEM (same patch, same normal force)", ""]
+    for name, a in agreement_.items():
+        label = name.replace("_", " ")
+        scale = 1e-6 if name == "max_pressure" else 1e6
+        unit = "MPa" if name == "max_pressure" else "mm2"
+        head = (f"- {label}: FEA {_fmt(a['fea'], scale)} {unit}, BEM {_fmt(a['bem'], scale)} {unit}, "
+                f"{_pct(a['difference'])} apart; ")  # fmt: skip
+        if a["agree"] is None:
+            fea = "not stated" if a["fea_stated"] is None else _pct(a["fea_stated"])
+            bem = "the BEM's error is not yet stated" if a["bem_stated"] is None else f"BEM {_pct(a['bem_stated'])}"
+            lines.append(head + f"FEA's stated error {fea}, {bem}: no verdict.")
+        elif a["agree"]:
+            lines.append(head + f"they agree within the stated errors (FEA {_pct(a['fea_stated'])} + BEM "
+                         f"{_pct(a['bem_stated'])}).")  # fmt: skip
+        else:
+            lines.append(head + f"more than the stated errors allow (FEA {_pct(a['fea_stated'])} + BEM "
+                         f"{_pct(a['bem_stated'])}): one of the two errors is understated, or the two solve "
+                         "different problems (the FEA's finite block against the half-space).")  # fmt: skip
+    return lines + [""]
 
 
 def _html(markdown: str, title: str) -> str:

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from comparisons.stated_errors import stated_errors
 from rigid_dynamics.files import save_figure, write_text
 from rigid_dynamics.materials import STEEL, Material
 
@@ -191,6 +192,7 @@ def _numbers(result) -> dict:
         "contact_area_m2": result.contact_area_m2,
         "semi_axes_m": [result.semi_axis_long_m, result.semi_axis_lat_m],
         "wall_time_s": result.wall_time_s,
+        "stated_errors": stated_errors(result),
     }
 
 
@@ -235,11 +237,12 @@ def _markdown(summary: dict) -> str:
         "D_p = sum|p_fea - p_bem| / sum p_bem on the BEM grid; D_A = A_fea/A_bem - 1; "
         "D_O = outline mismatch area / A_bem.",
         "",
-        "FEA = rigid-indenter block on the sampled gap; FEA-prof = two elastic bodies from the real profiles.",
+        "FEA = rigid-indenter block on the sampled gap; FEA-prof = two elastic bodies from the real profiles. "
+        "`stated err`: the relative discretisation errors each FEA states (fea.refinement; `not stated` on one mesh).",
         "",
         "| patch | N / kN | p_max Hertz / BEM / FEA / FEA-prof (MPa) | area Hertz / BEM / FEA / FEA-prof (mm^2) "
-        "| D_p FEA / prof | D_A FEA / prof | D_O FEA / prof |",
-        "|---|---|---|---|---|---|---|",
+        "| D_p FEA / prof | D_A FEA / prof | D_O FEA / prof | FEA / prof stated err p, area |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for p in summary["patches"]:
 
@@ -259,9 +262,20 @@ def _markdown(summary: dict) -> str:
             f"{g('pressure_difference_force_weighted', '.3f')} / "
             f"{g('profiles_pressure_difference_force_weighted', '.3f')} | "
             f"{g('contact_area_difference', '+.3f')} / {g('profiles_contact_area_difference', '+.3f')} | "
-            f"{g('outline_mismatch', '.3f')} / {g('profiles_outline_mismatch', '.3f')} |"
+            f"{g('outline_mismatch', '.3f')} / {g('profiles_outline_mismatch', '.3f')} | "
+            f"{_stated(p['fea'])} / {_stated(p['fea_profiles'])} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def _stated(numbers: dict) -> str:
+    """The FEA's stated relative errors of max pressure and area, or "not stated" (mesh_tolerance None)."""
+    errors = numbers.get("stated_errors")
+    if not errors:
+        return "not stated"
+    return ", ".join(
+        "-" if errors.get(k) is None else f"{100 * errors[k]:.2g} %" for k in ("max_pressure", "contact_area")
+    )
 
 
 def main(argv=None) -> int:

@@ -18,6 +18,8 @@ sqrt(((s1-s2)^2 + (s2-s3)^2 + (s3-s1)^2)/2), maximum shear (Tresca) (s1 - s3)/2.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -180,3 +182,36 @@ def axis_maximum(depth: np.ndarray, value: np.ndarray) -> tuple[float, float]:
             if d[k - 1] <= z <= d[k + 1]:
                 return float(np.polyval(coef, z)), float(z)
     return float(v[k]), float(d[k])
+
+
+def peak_pressure(
+    xy: np.ndarray, pressure: np.ndarray, usable: np.ndarray, guess_m: np.ndarray, radius_m: float
+) -> float | None:
+    """Peak of a quadratic surface fitted to the squared nodal pressures around ``guess_m``, Pa (None: no fit).
+
+    p^2 = c0 + c1 x + c2 y + c3 x^2 + c4 x y + c5 y^2 (x, y from the guess) by least squares over the usable nodes
+    within ``radius_m``; its stationary point, when the fit is a cap (negative definite) and the point lies within
+    the radius, gives the peak sqrt(p^2). Hertz's p^2 is exactly such a quadric (Johnson 1985, eq 3.63), so the fit
+    has no bias there; on a smooth non-Hertzian top the bias is O(r^4) in the fit radius r. Against the largest
+    patch average (:func:`filtered_pressure`): the average of a hill is below its top by p0 r^2 / (4 a^2) and the
+    largest of many noisy averages is biased upwards; the fit averages the nodal scatter over every node within r.
+
+    Args:
+        xy: (n, 2) node positions, m. pressure: (n,) nodal pressures N_i / w_i, Pa. usable: (n,) bool (in contact,
+        with a lumped weight). guess_m: (2,) the location of the largest patch average, m. radius_m: fit radius, m.
+    """
+    d = xy - np.asarray(guess_m, float)
+    near = usable & (np.hypot(d[:, 0], d[:, 1]) <= radius_m)
+    if near.sum() < 12:
+        return None
+    x, y, p2 = d[near, 0] / radius_m, d[near, 1] / radius_m, pressure[near] ** 2
+    matrix = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
+    c, *_ = np.linalg.lstsq(matrix, p2, rcond=None)
+    hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+    if not np.all(np.linalg.eigvalsh(hessian) < 0):
+        return None
+    top = np.linalg.solve(hessian, -c[1:3])
+    if np.hypot(*top) > 1.0:
+        return None
+    value = float(c[0] + c[1:3] @ top + 0.5 * top @ hessian @ top)
+    return math.sqrt(value) if value > 0 else None

@@ -49,6 +49,20 @@ def test_compare_hertz_circle_report_and_subsurface_check(tmp_path, monkeypatch)
     assert fea["max_orthogonal_shear_Pa"] == pytest.approx(bem["max_orthogonal_shear_Pa"], rel=0.1)
     html = (out / "report.html").read_text()
     assert "<table>" in html and 'src="subsurface.png"' in html
+    # the FEA's numbers carry their stated error, and they hold against the closed form (p0 and area of Hertz)
+    fea_entry = summary["models"]["fea"]
+    stated = fea_entry["stated_errors"]
+    assert fea_entry["status"] == "ok" and stated["max_pressure"] <= 0.02 and stated["contact_area"] <= 0.02
+    assert abs(fea_entry["values"]["max_pressure_Pa"] / p0 - 1) <= stated["max_pressure"]
+    area = named.reference["contact_area_m2"]
+    assert abs(fea_entry["values"]["contact_area_m2"] / area - 1) <= stated["contact_area"]
+    judged = fea_entry["agreement_with_bem"]["max_pressure"]
+    report = (out / "report.md").read_text()
+    assert "## FEA against BEM" in report
+    if judged["bem_stated"] is None:
+        assert judged["agree"] is None and "the BEM's error is not yet stated" in report
+    else:
+        assert judged["agree"] is True
 
 
 @pytest.mark.fea

@@ -554,8 +554,11 @@ def warm_up(method: str, material: Material) -> float:
     return time.perf_counter() - start
 
 
-def solve_case(case: ContactCase | str | Path, method: str) -> CaseSolution:
+def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> CaseSolution:
     """Solve a validated case (or a case's name or file, read by :func:`load_case`) with the model ``method``.
+
+    ``progress``: optional callable taking one line per wheel evaluation of a wheelset case (see
+    ``solve_wheelset_case``).
 
     The model is imported and its compiled kernels loaded (:func:`warm_up`) before the clock starts, so
     ``wall_time_s`` measures the solve; that preparation is ``setup_s``. For a wheelset case the clock
@@ -591,7 +594,9 @@ def solve_case(case: ContactCase | str | Path, method: str) -> CaseSolution:
         )
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case  # only a wheelset case needs the search
 
-    solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options)
+    solution = solve_wheelset_case(
+        case.wheelset, case.material, method, options=case.solver_options, progress=progress
+    )
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     extra = {
         k: v

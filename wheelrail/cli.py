@@ -136,7 +136,7 @@ def cmd_contact(args) -> int:
             raise refused
         if args.method == "fea" and out_dir is not None:
             case = _with_fea_output(case, out_dir)
-        solution = solve_case(case, args.method)
+        solution = solve_case(case, args.method, progress=_progress_line if args.method == "fea" else None)
         record = solution_record(solution)
         if overrides:
             record["overrides"] = overrides
@@ -155,6 +155,12 @@ def cmd_contact(args) -> int:
         if out_dir is not None:
             _print(f"output written to {out_dir}")
     return EXIT_OK if record["status"] == "ok" else EXIT_FAILED
+
+
+def _progress_line(text: str) -> None:
+    """One line of progress on stderr (rank 0 only): a slow model (the FEA) reports each wheel evaluation."""
+    if _mpi_rank() == 0:
+        print(f"wheelrail: {text}", file=sys.stderr, flush=True)
 
 
 def _mpi_broadcast(value):

@@ -182,7 +182,9 @@ def _demo(scene, source, models, out_dir) -> int:
 
     def p0(model):
         value = models.get(model, {}).get("values", {}).get("max_pressure_Pa")
-        return "-" if value is None else f"{value / 1e6:.0f}"
+        stated = (models.get(model, {}).get("stated_errors") or {}).get("max_pressure")
+        text = "-" if value is None else f"{value / 1e6:.0f}"
+        return text if value is None or stated is None else f"{text} +- {100 * stated:.2g} %"
 
     def grid(model):
         text = models.get(model, {}).get("resolution", "")

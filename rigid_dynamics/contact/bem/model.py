@@ -814,6 +814,18 @@ def _with_grid_error(result: ContactResult, estimate, tolerance: float, refineme
     else:
         extra["grid_error"] = {**estimate, "tolerance": tolerance, "refinements": refinements, "estimated": True}
         extra["grid_error_estimate"] = estimate["largest_relative"]
+        relative = estimate["relative"]
+        # the layout every rung that states its error uses (comparisons.stated_errors; the FEA's fea.refinement)
+        extra["discretisation_error"] = {
+            "method": "companion grids with elements 2x and 4x as large (grid_error_estimate)",
+            "relative_error": {
+                "normal_force": relative["normal_force_N"],
+                "max_pressure": relative["max_pressure_Pa"],
+                "contact_area": relative["contact_area_m2"],
+                "creep_force_long": relative["creep_force_N"],
+                "creep_force_lat": relative["creep_force_N"],
+            },
+        }
         worst = [
             f"{words} {estimate['relative'][k]:.2%}"
             for k, words in GRID_ERROR_QUANTITIES
