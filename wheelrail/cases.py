@@ -594,9 +594,7 @@ def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> Ca
         )
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case  # only a wheelset case needs the search
 
-    solution = solve_wheelset_case(
-        case.wheelset, case.material, method, options=case.solver_options, progress=progress
-    )
+    solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options, progress=progress)
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     extra = {
         k: v
