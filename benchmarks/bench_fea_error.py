@@ -56,8 +56,10 @@ def hertz_series(options: dict) -> dict:
         "message": r.message,
         "wall_time_s": time.perf_counter() - start,
         "levels": [
-            {**{k: lv[k] for k in ("elements_per_semi_axis", "dofs", "wall_time_s")},
-             **{f"true_{k}": lv[k] / v - 1.0 for k, v in exact.items()}}
+            {
+                **{k: lv[k] for k in ("elements_per_semi_axis", "dofs", "wall_time_s")},
+                **{f"true_{k}": lv[k] / v - 1.0 for k, v in exact.items()},
+            }
             for lv in _levels(r)
         ],  # fmt: skip
         "stated": {k: info["relative_error"].get(k) for k in exact},
@@ -129,11 +131,16 @@ def markdown(data: dict) -> str:
                 f"{lv['normal_force']:.0f} | {lv['max_pressure'] / 1e6:.0f} | {lv['contact_area'] * 1e6:.2f} |"
             )
         b = p["bem"]
-        lines += ["", f"BEM (40 x 40, the equilibrium's): N {b['normal_force_N']:.0f} N, p max "
-                  f"{b['max_pressure_Pa'] / 1e6:.0f} MPa, area {b['contact_area_m2'] * 1e6:.2f} mm2. Stated FEA "
-                  "errors: " + ", ".join(f"{k} {_pct(v)}" for k, v in (p["stated"] or {}).items() if v is not None)
-                  + "; of which block size: "
-                  + ", ".join(f"{k} {_pct(v)}" for k, v in (p["block_size"] or {}).items() if v is not None), ""]
+        lines += [
+            "",
+            f"BEM (40 x 40, the equilibrium's): N {b['normal_force_N']:.0f} N, p max "
+            f"{b['max_pressure_Pa'] / 1e6:.0f} MPa, area {b['contact_area_m2'] * 1e6:.2f} mm2. Stated FEA "
+            "errors: "
+            + ", ".join(f"{k} {_pct(v)}" for k, v in (p["stated"] or {}).items() if v is not None)
+            + "; of which block size: "
+            + ", ".join(f"{k} {_pct(v)}" for k, v in (p["block_size"] or {}).items() if v is not None),
+            "",
+        ]
     return "\n".join(lines) + "\n"
 
 

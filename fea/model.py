@@ -200,8 +200,11 @@ OPTIONS = declare_dataclass(
             "exclusive_minimum": True,
         },
         "max_dofs": {"help": "budget of the mesh refinement: largest number of unknowns of a level", "minimum": 1},
-        "grading": {"help": "element size growth per unit distance from the patch (first level)", "minimum": 0,
-                    "exclusive_minimum": True},
+        "grading": {
+            "help": "element size growth per unit distance from the patch (first level)",
+            "minimum": 0,
+            "exclusive_minimum": True,
+        },
     },
 )
 """Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``

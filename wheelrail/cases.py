@@ -555,9 +555,7 @@ def solve_case(case: ContactCase, method: str, progress=None) -> CaseSolution:
             [("single", case.geometry, case.creepage, result)],
             setup_s=setup_s,
         )
-    solution = solve_wheelset_case(
-        case.wheelset, case.material, method, options=case.solver_options, progress=progress
-    )
+    solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options, progress=progress)
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     extra = {
         k: v

@@ -852,9 +852,7 @@ def _solve_whole(evaluator, track, case, omega, q_ref, warm, opts):
         if not all(states[side].patches for side in SIDES):
             return False
         if target is not None:
-            return all(
-                abs(states[s].vertical_load_N / target - 1.0) < _load_tolerance(states[s], opts) for s in SIDES
-            )
+            return all(abs(states[s].vertical_load_N / target - 1.0) < _load_tolerance(states[s], opts) for s in SIDES)
         return all(abs(states[s].max_approach_m - case.approach_m) < opts["approach_tolerance_m"] for s in SIDES)
 
     previous = None
