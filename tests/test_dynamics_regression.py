@@ -46,7 +46,7 @@ BLOCKS = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12))
 """Blocks of like states (positions, angles, velocities, angular rates) compared at the block's largest magnitude."""
 
 
-def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None):
+def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None, method=None):
     from rigid_dynamics.wheelset import DynamicsScene
     from wheelrail.config import build_dataclass
 
@@ -60,6 +60,8 @@ def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None):
     if rk4_step_s is not None:
         integrator = replace(scene.integrator, method="RK4", fixed_step_s=rk4_step_s, output_step_s=2 * rk4_step_s)
         scene = replace(scene, integrator=integrator)
+    if method is not None:
+        scene = replace(scene, integrator=replace(scene.integrator, method=method))
     return scene
 
 
@@ -78,6 +80,12 @@ for _model in ("fastsim", "vermeulen-johnson", "linear"):
             ("hunting-conical", 0.3, "tables", _model, 5e-4),
             _compiled,
         )
+# written by commit f3b48bb (before issue 25): the compiled embedded pairs on tables and on the search with the beam
+# track, auto's choice per patch in the loop, and the curve's track-following frame
+CASES["polygonal-wheel-tables-fastsim-DP54"] = (("polygonal-wheel", 0.05, "tables", None, None, "DP54"), None)
+CASES["wheel-flat-BS32"] = (("wheel-flat", 0.005, None, None, None, "BS32"), None)
+CASES["polygonal-wheel-tables-auto-compiled"] = (("polygonal-wheel", 0.05, "tables", "auto"), None)
+CASES["curve-default"] = (("curve", 0.05), None)
 
 
 def _run(name):
