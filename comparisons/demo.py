@@ -48,7 +48,7 @@ def peak_patch_case(result, skip_s: float | None = None) -> PatchCase:
     """
     from rigid_dynamics.contact.registry import get_model
     from rigid_dynamics.contact.types import ContactGeometry, Creepage
-    from rigid_dynamics.wheelset.equations import WheelsetModel
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider
 
     scene = result.scene

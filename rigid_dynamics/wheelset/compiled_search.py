@@ -35,6 +35,7 @@ A side without contact gets SearchProvider's placeholder in slot 0 (q = -smalles
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -46,9 +47,20 @@ from rigid_dynamics.contact._search_kernels import (
     refine_point,
     wheel_irregularity,
 )
+from rigid_dynamics.wheelset.layout import (
+    G_APPROACH,
+    G_CONTACT_ANGLE,
+    G_CURVATURE_LAT,
+    G_CURVATURE_LONG,
+    G_LEVER,
+    G_NORMAL,
+    G_ROLLING_RADIUS,
+    G_WHEEL_LATERAL,
+    N_GEO,
+)
 from rigid_dynamics.wheelset.providers.surfaces import MIN_LATERAL_CURVATURE_1_PER_M
+from rigid_dynamics.wheelset.state import ROLL, SPIN, YAW, X, Y, Z
 
-N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
 MAX_START = 8  # starts refined per side and evaluation
 MAX_MEMORY = 4  # candidates kept per side for the next evaluation
 ABSENT_GAP_M = 0.01  # providers.ABSENT_GAP_M
@@ -60,6 +72,24 @@ COS_STEEPEST = math.cos(math.radians(75.0))
     S_SCAN, S_GAP, S_NEWTON, S_ITER, S_TOL, S_RADIUS, S_MEMR, S_TRACK, S_AHALF, S_APTS,
 ) = range(21)  # fmt: skip
 SP_LEN = 21
+
+
+class SearchArgs(NamedTuple):
+    """The search mode's record: the per-side parameters ``sp`` (2, SP_LEN), the profile tables and irregularity
+    rows of the four surfaces (wheel left, rail left, wheel right, rail right), the memory of the previous
+    evaluation (``mem``, ``n_mem``: warm starts, carried between calls) and scratch (``cand``, ``order``, ``vb``,
+    ``rot``).
+    """
+
+    sp: np.ndarray
+    tabs: tuple
+    irrs: tuple
+    mem: np.ndarray
+    n_mem: np.ndarray
+    cand: np.ndarray
+    order: np.ndarray
+    vb: np.ndarray
+    rot: np.ndarray
 
 
 @njit(cache=True, _nrt=False)
@@ -129,10 +159,12 @@ def _rot(rot, v, out):
 
 
 @njit(cache=True, _nrt=False)
-def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr, rail_map, right, vb, g):
-    """Geometry of the patch at the refined minimum (alpha, y_d) with distance h into g (N_GEO): search._patch's
-    point, normal and principal relative curvatures, on the tabulated surfaces. vb: scratch (12, 3).
+def patch_geometry(alpha, y_d, h, rot, centre, surfaces, vb, g):
+    """Geometry of the patch at the refined minimum (alpha, y_d) with distance h into g (layout.GEOMETRY_FIELDS):
+    search._patch's point, normal and principal relative curvatures, on the tabulated surfaces ``surfaces`` =
+    (wheel, rail, wheel irregularities, rail irregularities, rail map, right side). vb: scratch (12, 3).
     """
+    wheel, rail, wheel_irr, rail_irr, rail_map, right = surfaces
     r, r_y, r_yy = _table(y_d, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
     v, r_a, r_aa = wheel_irregularity(alpha, wheel_irr)
     r += v
@@ -191,16 +223,17 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
         big_a, big_b = mean + half, mean - half
     else:
         big_a, big_b = mean - half, mean + half
-    g[0] = -h
-    g[1], g[2], g[3] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1], 0.5 * (p[2] + qz) - centre[2]
-    g[4], g[5], g[6] = n[0], n[1], n[2]
+    g[G_APPROACH] = -h
+    g[G_LEVER], g[G_LEVER + 1] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1]
+    g[G_LEVER + 2] = 0.5 * (p[2] + qz) - centre[2]
+    g[G_NORMAL], g[G_NORMAL + 1], g[G_NORMAL + 2] = n[0], n[1], n[2]
     # B floored as the profile section floors it (SearchProvider too): on the conformal arcs of a flange root and a
     # gauge corner of equal radius (S1002 / UIC60: 13 mm) the surface curvatures cancel and B is round-off
-    g[7], g[8] = max(big_a, 1e-6), max(big_b, MIN_LATERAL_CURVATURE_1_PER_M)
-    g[9] = r
-    g[10] = y_d
+    g[G_CURVATURE_LONG], g[G_CURVATURE_LAT] = max(big_a, 1e-6), max(big_b, MIN_LATERAL_CURVATURE_1_PER_M)
+    g[G_ROLLING_RADIUS] = r
+    g[G_WHEEL_LATERAL] = y_d
     tilt = -n[1] if right else n[1]
-    g[11] = math.atan2(tilt, -n[2])
+    g[G_CONTACT_ANGLE] = math.atan2(tilt, -n[2])
 
 
 @njit(cache=True, _nrt=False)
@@ -245,15 +278,17 @@ def _track(a, yd, memory, args, radius, limit, y_range):
 
 
 @njit(cache=True, _nrt=False)
-def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg):
+def search_side(s, centre, spin, search, full, cg):
     """Candidates and patches of side s (0 left, 1 right) into cg rows 2 s, 2 s + 1; updates the memory
     mem[s] (MAX_MEMORY, 7: angle from the lowest point alpha - (pi/2 - phi), y_d, h, h_aa, h_yy, h_ay, merged) /
     n_mem[s]: the angle is kept relative to the lowest point, so that a warm start follows the wheel's rotation;
     the Hessian is the last refinement's; merged candidates (one interpenetration region with a deeper one) are
     kept as warm starts of the next scan, not tracked. cand: scratch (2 MAX_START, 8: alpha, y_d, h, mark,
     Hessian, merged; the second half holds the lateral scan's minima),
-    order: scratch (MAX_START,) int. Returns the number of starts that did not converge.
+    order: scratch (MAX_START,) int (all in the record ``search``, :class:`SearchArgs`). Returns the number of
+    starts that did not converge.
     """
+    sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = search
     # (built here, not returned from a helper: these functions run without NRT reference counting, so no array may
     # be handed back to a caller that counts references)
     wheel = (sp[s, S_WLOW], sp[s, S_WSTEP], tabs[2 * s][0], tabs[2 * s][1], tabs[2 * s][2])
@@ -428,67 +463,54 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
     for i in range(min(n_kept, 2)):
         k = order[i]
         if cand[k, 2] < 0:
-            patch_geometry(
-                cand[k, 0],
-                cand[k, 1],
-                cand[k, 2],
-                rot,
-                centre,
-                wheel,
-                rail,
-                wheel_irr,
-                rail_irr,
-                rail_map,
-                right,
-                vb,
-                cg[c0 + n_patch],
-            )
+            surfaces = (wheel, rail, wheel_irr, rail_irr, rail_map, right)
+            patch_geometry(cand[k, 0], cand[k, 1], cand[k, 2], rot, centre, surfaces, vb, cg[c0 + n_patch])
             n_patch += 1
-    if n_patch == 2 and cg[c1, 11] < cg[c0, 11]:
+    if n_patch == 2 and cg[c1, G_CONTACT_ANGLE] < cg[c0, G_CONTACT_ANGLE]:
         for f in range(N_GEO):
             cg[c0, f], cg[c1, f] = cg[c1, f], cg[c0, f]
     if n_patch == 0:
         gap = cand[order[0], 2] if n_kept > 0 else ABSENT_GAP_M
         sign = sp[s, S_SIGN]
         g = cg[c0]
-        g[0] = -gap
-        g[1], g[2], g[3] = 0.0, sign * 0.75, radius
-        g[4], g[5], g[6] = 0.0, 0.0, -1.0
-        g[7], g[8], g[9] = 0.5 / radius, 0.5 / 0.3, radius
-        g[10], g[11] = sign * 0.75, 0.0
+        g[G_APPROACH] = -gap
+        g[G_LEVER], g[G_LEVER + 1], g[G_LEVER + 2] = 0.0, sign * 0.75, radius
+        g[G_NORMAL], g[G_NORMAL + 1], g[G_NORMAL + 2] = 0.0, 0.0, -1.0
+        g[G_CURVATURE_LONG], g[G_CURVATURE_LAT], g[G_ROLLING_RADIUS] = 0.5 / radius, 0.5 / 0.3, radius
+        g[G_WHEEL_LATERAL], g[G_CONTACT_ANGLE] = sign * 0.75, 0.0
     if n_patch < 2:
-        cg[c1, 0] = math.nan
+        cg[c1, G_APPROACH] = math.nan
     return failed
 
 
 @njit(cache=True, _nrt=False)
-def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg):
-    """Both sides' patches at the state y into cg (4, N_GEO). Returns the number of unconverged refinements."""
-    rotation(y[3], y[4], y[5], rot)
-    failed = 0
-    for s in range(2):
-        failed += search_side(s, y[0:3], rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
-    return failed
-
-
-@njit(cache=True, _nrt=False)
-def search_geometry_on_track(
-    y, rail_left_m, rail_right_m, lateral_left_m, lateral_right_m, sp, tabs, irrs, mem, n_mem, full, cand, order,
-    vb, rot, cg, centre
-):  # fmt: skip
-    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels (left, right)
-    and moved laterally by its lateral displacements (left, right; 0 without the lateral track): each side is
-    searched at the wheelset centre raised by its rail's deflection and moved by minus its lateral displacement
-    (centre: a scratch 3-vector), and the levers (contact point - centre) are those of that pose (a rigid shift of
-    the rail).
+def search_geometry(y, search, full, cg):
+    """Both sides' patches at the state y into cg (4, N_GEO) by the search of the record ``search``
+    (:class:`SearchArgs`; ``full``: with the lateral scan). Returns the number of unconverged refinements.
     """
-    rotation(y[3], y[4], y[5], rot)
+    rotation(y[YAW], y[ROLL], y[SPIN], search.rot)
     failed = 0
     for s in range(2):
-        centre[0] = y[0]
-        centre[1] = y[1] - (lateral_left_m if s == 0 else lateral_right_m)
-        centre[2] = y[2] - (rail_left_m if s == 0 else rail_right_m)
-        failed += search_side(s, centre, rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
+        failed += search_side(s, y[X : Z + 1], y[SPIN], search, full, cg)
+    return failed
+
+
+@njit(cache=True, _nrt=False)
+def search_geometry_on_track(y, rails, search, full, cg, centre):
+    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels and moved
+    laterally by its lateral displacements (``rails`` = (deflection left, right, lateral left, right), m; lateral 0
+    without the lateral track): each side is searched at the wheelset centre raised by its rail's deflection and
+    moved by minus its lateral displacement (centre: a scratch 3-vector), and the levers (contact point - centre)
+    are those of that pose (a rigid shift of the rail).
+    """
+    rail_left_m, rail_right_m, lateral_left_m, lateral_right_m = rails
+    rotation(y[YAW], y[ROLL], y[SPIN], search.rot)
+    failed = 0
+    for s in range(2):
+        centre[0] = y[X]
+        centre[1] = y[Y] - (lateral_left_m if s == 0 else lateral_right_m)
+        centre[2] = y[Z] - (rail_left_m if s == 0 else rail_right_m)
+        failed += search_side(s, centre, y[SPIN], search, full, cg)
     return failed
 
 
@@ -564,6 +586,18 @@ def pack_search(provider, options=None):
         irrs.append(np.ascontiguousarray(wheel.irregularity_rows, float).reshape(-1, 7))
         irrs.append(np.ascontiguousarray(rail.irregularity_rows, float).reshape(-1, 7))
     return sp, tuple(tabs), tuple(irrs)
+
+
+def search_args(provider, options=None) -> SearchArgs:
+    """The :class:`SearchArgs` of a SearchProvider (:func:`pack_search` and a fresh :func:`workspace`)."""
+    return SearchArgs(*pack_search(provider, options), *workspace())
+
+
+def no_search_args() -> SearchArgs:
+    """A :class:`SearchArgs` of the right types for the modes that do not search (never read)."""
+    tab = np.zeros((3, 2))
+    irr = np.zeros((0, 7))
+    return SearchArgs(np.zeros((2, SP_LEN)), (tab, tab, tab, tab), (irr, irr, irr, irr), *workspace())
 
 
 def workspace():
