@@ -16,8 +16,8 @@ spin; velocities; angular rates) against the largest magnitude in the block over
 (the vertical velocity of hunting-conical stays below 7e-6 m/s at 20 m/s) is compared at the scale of its block,
 not at its own.
 
-The compiled cases are bit-identical. The Python right-hand side (equations.WheelsetModel.derivative) now ends in
-the compiled equations of motion, suspension and track (compiled._assemble: J^-1 by the rotation instead of
+The compiled cases are bit-identical. The Python right-hand side (wheelset_model.WheelsetModel.derivative) now ends in
+the compiled equations of motion, suspension and track (compiled_motion._assemble: J^-1 by the rotation instead of
 np.linalg.solve, scalar sums) and takes its creepages from the compiled kernel, so its states move by rounding:
 measured at most 3e-14 of the block on the RK4 table cases, 7e-13 on polygonal-wheel (Python search) and 9.6e-11
 (angular rates) on hunting-conical with RK45, whose adaptive steps (rtol 1e-6) carry the rounding further: that case

@@ -64,7 +64,7 @@ def _two_dof_closed_form_hz(m1, m2, k1, k2):
 
 
 def test_track_eigenfrequencies_against_the_closed_form():
-    """The model's track right-hand side (equations.WheelsetModel._track_derivative), linearised by finite
+    """The model's track right-hand side (wheelset_model.WheelsetModel._track_derivative), linearised by finite
     differences without damping, against the 2-DOF closed form; then with the unsprung mass of half the wheelset
     on the rail (rigid contact): the P2 resonance, which Jenkins' data put at sqrt(Kt/(Mu+Mt))/2pi = 57 Hz and which
     is commonly quoted at 50-100 Hz for ballasted track (Iwnicki, Handbook, P2 force)."""

@@ -33,8 +33,10 @@ from rigid_dynamics.wheelset.layout import (
     AUTO_FEATURE_NAMES,
     AUTO_FEATURES,
     AUTO_LEVEL,
+    AUTO_LINEAR,
     AUTO_RUNG,
     AUTO_RUNG_NAMES,
+    AUTO_VERMEULEN_JOHNSON,
     N_FIELDS,
 )
 
@@ -194,10 +196,10 @@ def _creep_law(par, code, dummy, patch, xi, eta, spin):
 @njit(cache=True, _nrt=False)
 def _auto_threshold(par, rung, f):
     """Auto's threshold of feature f (layout.AUTO_FEATURE_NAMES) for rung (layout.AUTO_LINEAR, ...)."""
-    if rung == 0:
+    if rung == AUTO_LINEAR:
         v = (par.auto_linear_saturation, par.auto_linear_spin_share, par.auto_linear_ellipticity_residual,
              par.auto_linear_curvature_change, par.auto_linear_second_patch_nearness)  # fmt: skip
-    elif rung == 1:
+    elif rung == AUTO_VERMEULEN_JOHNSON:
         v = (par.auto_vermeulen_johnson_saturation, par.auto_vermeulen_johnson_spin_share,
              par.auto_vermeulen_johnson_ellipticity_residual, par.auto_vermeulen_johnson_curvature_change,
              par.auto_vermeulen_johnson_second_patch_nearness)  # fmt: skip

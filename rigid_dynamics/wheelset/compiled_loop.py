@@ -1,8 +1,10 @@
-"""Error-controlled integration in the compiled loop: embedded Runge-Kutta pairs with step-size control, dense
-output at the output times and contact onset/loss located within the step.
+"""The compiled loops: embedded Runge-Kutta pairs with step-size control, dense output at the output times and
+contact onset/loss located within the step (:func:`embedded_run`), and the fixed-step RK4 (:func:`rk4_run`). Both
+take records (:class:`Tableau`, :class:`StepControl`, :class:`Outputs`, :class:`Carried`, :class:`EventLog`,
+compiled_records.PackedRun) and return an :class:`Outcome`; drivers.py calls them in chunks.
 
-The right-hand side is compiled._rhs, called exactly as compiled.rk4_run calls it (tables mode 0 or the compiled
-3-D search mode 1; the lateral scan ``full`` at each step's first stage, which for these FSAL pairs is the previous
+The right-hand side is compiled_rhs._rhs, called exactly as rk4_run below calls it (tables or the compiled
+3-D search; the lateral scan ``full`` at each step's first stage, which for these FSAL pairs is the previous
 step's last stage, and at the recorded samples). Two pairs (Butcher tableaux below, module constants with their
 sources; tests/test_dynamics_adaptive.py checks their order conditions and observed orders):
 
@@ -27,9 +29,9 @@ accepted; the next step is h (0.9 norm^(-0.7/k) norm_prev^(0.4/k)), a PI control
 Wanner II, IV.2), k = the order of the error estimate + 1, the factor within [0.2, 10] (not above 1 right after a
 rejection). A rejected step is retried with h max(0.2, 0.9 norm^(-1/k)). A stage whose right-hand side fails
 (status not 0, or a non-finite state) is retried at a quarter of the step, except a contact model that failed
-behind the callback (status 5, compiled._external: not a matter of the step), which ends the run. A step below
-``h_min`` ends the run with status 6 (UNDERFLOW, drivers: "step-size-underflow"), with the status of the last
-failure kept for the message.
+behind the callback (layout.CALLBACK_FAILED, compiled_rhs._external: not a matter of the step), which ends the
+run. A step below ``h_min`` ends the run with layout.UNDERFLOW ("step-size-underflow"), with the status of the
+last failure kept for the message.
 
 A step that would end a little past an output time (by less than one stage's share of it) is shortened to end
 there, so that the sample needs no right-hand side of its own.
@@ -46,8 +48,8 @@ The search memory (compiled_search: the warm starts of the contact points) is sa
 restored when the step is rejected, and after every evaluation off the step's path (output samples, event
 location), so that an accepted step sees the memory of the previous step's end, as in rk4_run.
 
-Status codes: those of compiled.rk4_run (0 ok, 1 blow-up, 2 force anomaly, 3 derailed, 4 creepages undefined) and
-5 step-size underflow.
+Status codes: layout.STATUS (0 ok, 1 blow-up, 2 force anomaly, 3 derailed, 4 creepages undefined, 5 callback
+failed, 6 step-size underflow).
 """
 
 from __future__ import annotations
@@ -126,6 +128,10 @@ class Outputs(NamedTuple):
     states: np.ndarray
     recs: np.ndarray
     errs: np.ndarray
+
+
+ERROR_NORM, STARTED = range(2)
+"""Entries of Carried.control: the controller's previous error norm; 1 once kst[0], mask0 and gap0 hold t0's."""
 
 
 class Carried(NamedTuple):
@@ -310,19 +316,19 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     fmax, ymax = par.max_force_N, par.max_lateral_m
     t = t0
     evals, accepted, rejected, located, last_fail = 0, 0, 0, 0, 0
-    if carry[1] == 0.0:
+    if carry[STARTED] == 0.0:
         st = _rhs(t, y, run, ws, True, True, kst[0])
         evals += 1
         if st != 0:
             return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
         _contact_mask(rec, ncand, mask0, gap0)
-        carry[1] = 1.0
+        carry[STARTED] = 1.0
         if n_ev[0] == 0 and ev_t.shape[0] > 0:
             ev_t[0] = t
             for c in range(ncand):
                 ev_mask[0, c] = mask0[c]
             n_ev[0] = 1
-    err_prev = carry[0]
+    err_prev = carry[ERROR_NORM]
     tiny = 1e-12 * max(1.0, abs(t_end))
     after_reject = False
     h_event = np.nan  # the controller's step before a step was cut short to end at a switch
@@ -530,7 +536,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         factor = 0.9 * norm ** (-0.7 / k_order) * err_prev ** (0.4 / k_order)
         factor = min(max(factor, 0.2), 1.0 if after_reject else 10.0)
         err_prev = norm
-        carry[0] = err_prev
+        carry[ERROR_NORM] = err_prev
         h *= factor
         if h_event == h_event:
             # the step was cut short to end at a located switch, not by its error: resume the controller's step

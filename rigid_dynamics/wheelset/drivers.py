@@ -1,6 +1,6 @@
 """The integrators over the right-hand side: scipy's adaptive ``OdeSolver`` methods stepped one step at a time
-(:func:`run_adaptive`, with the Jacobian of :func:`state_jacobian` for Radau and BDF), the fixed-step RK4 on the
-Python right-hand side (:func:`run_rk4`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
+(:func:`run_scipy`, with the Jacobian of :func:`state_jacobian` for Radau and BDF, and the fixed-step RK4 as one more
+``OdeSolver``, :func:`_rk4_class`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
 DP54/BS32 with step-size control of compiled_loop.py, :func:`run_embedded`), with the force error estimate and its
 check (:func:`force_error_check`). Run statuses of the compiled codes: layout.STATUS.
 """
@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from functools import cache
 
 import numpy as np
 
@@ -49,7 +50,7 @@ def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, se
     full-run peaks are not converged.
 
     The estimate is the contact-force difference between RK4 and its embedded third-order solution over the step
-    ending at each recorded sample (compiled.rk4_run, :func:`run_rk4`). On the embedded scenes it separates the
+    ending at each recorded sample (compiled_loop.rk4_run, :func:`run_scipy`). On the embedded scenes it separates the
     steps whose force results move by more than a few per cent of the static load from those that do not, where the
     contact-passage time against the step misses the creep-force bias of polygonal-wheel at 1 ms and step doubling
     underestimates it (benchmarks/results/step_sensitivity.md).
@@ -171,26 +172,122 @@ def state_jacobian(fun: Callable) -> Callable:
     return jac
 
 
-def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
+@cache
+def _rk4_class():
+    """:class:`RK4` (scipy imported only when a Python-side run needs it)."""
+    from scipy.integrate import DenseOutput, OdeSolver
+
+    class RK4Dense(DenseOutput):
+        """Cubic Hermite between the step's ends (derivatives k1 at the start and k4, the last stage, at the end)."""
+
+        def __init__(self, t_old, t, y_old, y, k1, k4):
+            super().__init__(t_old, t)
+            self.y_old, self.y, self.k1, self.k4 = y_old, y, k1, k4
+
+        def _call_impl(self, t):
+            h = self.t - self.t_old
+            s = (np.asarray(t) - self.t_old) / h
+            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+            return h00 * self.y_old + h10 * h * self.k1 + h01 * self.y + h11 * h * self.k4
+
+    class RK4(OdeSolver):
+        """The classical Runge-Kutta method of order 4 with a fixed step as a scipy ``OdeSolver``: the Python
+        right-hand side's RK4 runs through the same driver as scipy's methods (:func:`run_scipy`).
+
+        The step is ``step`` shortened to divide the interval into whole steps; t after n steps is t0 + n h. The
+        embedded third-order solution of the same stages and the derivative at the step's end, k5 = f(t + h, y4)
+        (the next step's k1), y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) (Hairer, Norsett & Wanner, Solving ODEs I,
+        2nd ed., II.4), is :meth:`third_order`: the force error estimate's second state. Dense output: cubic Hermite
+        between the step's ends with k1 and k4.
+        """
+
+        def __init__(self, fun, t0, y0, t_bound, step, vectorized=False, **extraneous):
+            super().__init__(fun, t0, y0, t_bound, vectorized)
+            self.n_steps = max(1, int(math.ceil((t_bound - t0) / step - 1e-9)))
+            self.h = (t_bound - t0) / self.n_steps
+            self.t_start = t0
+            self.steps_done = 0
+            self.k_next = None  # f at the current state once evaluated: the next step's k1
+            self.stages = None
+            self.y_old = None
+
+        def _step_impl(self):
+            h, t, y = self.h, self.t, self.y
+            k1 = self.k_next if self.k_next is not None else self.fun(t, y)
+            k2 = self.fun(t + 0.5 * h, y + 0.5 * h * k1)
+            k3 = self.fun(t + 0.5 * h, y + 0.5 * h * k2)
+            k4 = self.fun(t + h, y + h * k3)
+            self.y_old, self.stages, self.k_next = y, (k1, k2, k3, k4), None
+            self.steps_done += 1
+            self.y = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            self.t = self.t_start + self.steps_done * h
+            if self.steps_done == self.n_steps:
+                self.t_bound = self.t  # n h may round past or short of the interval's end: this is the end
+            return True, None
+
+        def derivative_at_end(self):
+            """The derivative f at the current state (evaluated once: it is the next step's k1)."""
+            if self.k_next is None:
+                self.k_next = self.fun(self.t, self.y)
+            return self.k_next
+
+        def third_order(self):
+            """The embedded third-order solution of the last step (one right-hand side: the next step's k1)."""
+            k1, k2, k3, _ = self.stages
+            k5 = self.derivative_at_end()
+            return self.y_old + self.h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k5 / 6.0)
+
+        def _dense_output_impl(self):
+            return RK4Dense(self.t_old, self.t, self.y_old, self.y, self.stages[0], self.stages[3])
+
+    return RK4
+
+
+def _force_error(model, solver) -> float:
+    """The force error estimate of the last RK4 step: the largest difference of the per-wheel contact forces at the
+    propagated state and at the embedded third-order one (inf when one cannot be evaluated), N.
+    """
+    y3 = solver.third_order()
+    try:
+        error = float(np.max(np.abs(contact_force_sums(model, solver.y) - contact_force_sums(model, y3))))
+    except (ContactFailure, ValueError, ArithmeticError):
+        error = math.inf
+    return math.inf if math.isnan(error) else error  # NaN: forces not computable at one of the two states
+
+
+def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
+    """The Python right-hand side ``fun`` stepped one step at a time by a scipy ``OdeSolver``: RK45, DOP853, Radau
+    (with :func:`state_jacobian`), BDF, LSODA, DP54 / BS32 off the compiled loop (scipy's RK45 / RK23), and RK4
+    (:class:`RK4`, fixed step). The samples at ``out_times`` come from the step's dense output (the step's end
+    itself when a sample falls on it).
+
+    RK4 also estimates its force error (as compiled_loop.rk4_run): every :func:`steps_between_checks` steps and at
+    a sample on the step's end, the contact forces at the propagated and at the embedded third-order state
+    (:func:`_force_error`, two extra contact evaluations); a sample on the step's end carries the estimate of that
+    step, other samples the largest of the checks since the previous sample. Samples are recorded (and checked for
+    anomalies) before the estimate is evaluated.
+    """
     from scipy import integrate
 
     from rigid_dynamics.wheelset.compiled_loop import SCIPY_EQUIVALENT
 
-    # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located contact switches
-    cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
+    fixed = settings.method == "RK4"
+    if fixed:
+        cls = _rk4_class()
+    else:  # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located switches
+        cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
     options = {"jac": state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
+    if fixed:
+        options = {"step": settings.fixed_step_s}
+    atol = tolerances(settings, model.scene)
     solver = cls(
-        fun,
-        0.0,
-        y0,
-        duration,
-        rtol=settings.relative_tolerance,
-        atol=tolerances(settings, scene),
-        max_step=settings.max_step_s,
-        **options,
+        fun, 0.0, y0, duration, rtol=settings.relative_tolerance, atol=atol, max_step=settings.max_step_s, **options
     )
+    check_every = steps_between_checks(settings, solver.h) if fixed else 0
     steps = 0
     next_out = 1
+    pending = math.nan
     while solver.status == "running":
         t_before = solver.t
         try:
@@ -213,16 +310,27 @@ def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene
             exc = Stop("blow-up", f"non-finite state at t = {solver.t:.6g} s", solver.t, solver.y)
             exc.steps = steps
             raise exc
-        if next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
-            dense = solver.dense_output()
-            while next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
-                t_out = out_times[next_out]
-                try:
-                    recorder.record(t_out, dense(t_out) if t_out < solver.t else solver.y)
-                except Stop as stop:
-                    stop.steps = steps
-                    raise
-                next_out += 1
+        at_end = False
+        try:
+            if next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12 * max(1.0, duration):
+                dense = solver.dense_output()
+                h = solver.t - solver.t_old
+                while next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12 * max(1.0, duration):
+                    t_out = out_times[next_out]
+                    at_end = abs((t_out - solver.t_old) / h - 1.0) < 1e-9
+                    recorder.record(t_out, solver.y if at_end else dense(t_out), math.nan if at_end else pending)
+                    if not at_end:
+                        pending = math.nan
+                    next_out += 1
+            if fixed and (steps % check_every == 0 or at_end):
+                error = _force_error(model, solver)
+                pending = error if math.isnan(pending) else max(pending, error)
+        except Stop as stop:
+            stop.steps = steps
+            raise
+        if at_end and fixed:
+            recorder.set_last_error(pending)
+            pending = math.nan
         report(solver.t)
     return steps
 
@@ -322,77 +430,6 @@ def steps_between_checks(settings, step_s: float) -> int:
     """Steps between force error checks: every output step, at most FORCE_CHECK_INTERVAL_S apart."""
     out_every = max(1, int(round(settings.output_step_s / step_s)))
     return max(1, min(out_every, int(round(FORCE_CHECK_INTERVAL_S / step_s))))
-
-
-def run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
-    """Classical RK4 with a fixed step on the Python right-hand side ``fun``, output by cubic Hermite interpolation.
-
-    Force error estimate (as compiled.rk4_run): every :func:`steps_between_checks` steps the step is also advanced
-    by the embedded third-order formula, y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) with k5 = f(t + h, y4) (the next
-    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept (two extra contact
-    evaluations per check). An output sample at the step's end carries the estimate of that step, other samples
-    the largest of the checks since the previous sample. The samples are recorded (and checked for anomalies)
-    before the estimate is evaluated; a third-order state whose contact cannot be evaluated gives an infinite one.
-    """
-    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
-    h = duration / n_steps
-    check_every = steps_between_checks(settings, h)
-    y = y0.copy()
-    t = 0.0
-    next_out = 1
-    k1 = None
-    pending = math.nan
-    for i in range(n_steps):
-        try:
-            k1 = fun(t, y) if k1 is None else k1
-            k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
-            k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
-            k4 = fun(t + h, y + h * k3)
-        except Stop as stop:
-            stop.steps = i
-            raise
-        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        t_new = (i + 1) * h
-        at_end = False
-        while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
-            t_out = out_times[next_out]
-            # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
-            s = (t_out - t) / h
-            if abs(s - 1.0) < 1e-9:
-                y_out, at_end = y_new, True
-            else:
-                h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-                h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-                y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
-            try:
-                recorder.record(t_out, y_out, math.nan if at_end else pending)
-            except Stop as stop:
-                stop.steps = i + 1
-                raise
-            if not at_end:
-                pending = math.nan
-            next_out += 1
-        k_next = None
-        if (i + 1) % check_every == 0 or at_end:
-            try:
-                k_next = fun(t_new, y_new)
-            except Stop as stop:
-                stop.steps = i + 1
-                raise
-            y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
-            try:
-                error = float(np.max(np.abs(contact_force_sums(model, y_new) - contact_force_sums(model, y3))))
-            except (ContactFailure, ValueError, ArithmeticError):
-                error = math.inf
-            if math.isnan(error):  # forces not computable at one of the two states
-                error = math.inf
-            pending = error if math.isnan(pending) else max(pending, error)
-        if at_end:
-            recorder.set_last_error(pending)
-            pending = math.nan
-        y, t, k1 = y_new, t_new, k_next
-        report(t)
-    return n_steps
 
 
 def step_control(settings, scene, max_steps: int):

@@ -41,7 +41,7 @@ class SimulationResult:
         states: the 12 states (STATE_NAMES) at the output times, shape (n, 12).
         patches: PATCH_FIELDS -> array (n, 2 sides [left, right], 2 slots [tread, flange/second]);
             NaN where a candidate does not exist or is not in contact (normal_force_N is 0 there); with
-            contact_model "auto" also AUTO_PATCH_FIELDS (equations.py: the rung chosen per patch and why).
+            contact_model "auto" also AUTO_PATCH_FIELDS (layout.py: the rung chosen per patch and why).
         contact_force_N: sum of the contact forces on each wheel, main frame, shape (n, 2, 3).
         kinetic_energy_J, potential_energy_J: T and V_g = -m g z at the output times, (n,); with the elastic track
             they include the track masses' kinetic energy and the pad and ballast springs' energy.

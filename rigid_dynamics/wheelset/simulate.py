@@ -51,7 +51,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_adaptive, run_compiled, run_rk4
+from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_compiled, run_scipy
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import ConicalProvider, TableProvider
@@ -250,10 +250,8 @@ def simulate(
         next_out = 1
         if use_compiled:
             steps = run_compiled(model, full0, duration, settings, recorder, report, start)
-        elif settings.method == "RK4":
-            steps = run_rk4(fun, full0, duration, settings, out_times, recorder, report, model)
         else:
-            steps = run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
+            steps = run_scipy(fun, full0, duration, settings, out_times, recorder, report, model)
         message = f"reached t = {duration:g} s"
         stats = getattr(model, "adaptive_stats", None)
         if use_compiled and embedded and stats:

@@ -1,6 +1,6 @@
 """Contact-geometry tables over lateral shift and roll for ideal geometry (:class:`TableProvider`), with the
 running-direction irregularities added per pose; evaluated by the compiled look-up of the dynamics
-(compiled._table_geometry), also for inspection.
+(compiled_tables._table_geometry), also for inspection.
 """
 
 from __future__ import annotations
