@@ -98,39 +98,35 @@ def tables_for(shear_modulus_Pa: float, poisson_ratio: float) -> TabulatedHertzK
     return TabulatedHertzKalker(Material(shear_modulus_Pa, poisson_ratio, 0.0))
 
 
+HERTZ_P, HERTZ_K, HERTZ_D = range(3)
+"""Rows of HertzKalkerTables.hertz: the inverted axial function p = (b/a)^2 and Kalker's elliptic K(p), D(p)."""
+KALKER_C11, KALKER_C22, KALKER_C23, KALKER_C33 = range(4)
+"""Rows of HertzKalkerTables.kalker: Kalker's creep coefficients."""
+
+
 class HertzKalkerTables(NamedTuple):
-    """:class:`TabulatedHertzKalker` as the compiled code reads it: the inverted axial function p and
-    Kalker's K, D on a uniform grid of ln(max(A, B)/min(A, B)); C11, C22, C23, C33 on a uniform grid of ln(a/b).
+    """:class:`TabulatedHertzKalker` as the compiled code reads it: ``hertz`` (rows :data:`HERTZ_P`, ...) on a
+    uniform grid of ln(max(A, B)/min(A, B)) from ``log_ratio_start`` by ``log_ratio_step``; ``kalker`` (rows
+    :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b). Two arrays: the record is passed per patch.
     """
 
     log_ratio_start: float
     log_ratio_step: float
-    p: np.ndarray
-    k: np.ndarray
-    d: np.ndarray
+    hertz: np.ndarray
     log_ab_start: float
     log_ab_step: float
-    c11: np.ndarray
-    c22: np.ndarray
-    c23: np.ndarray
-    c33: np.ndarray
+    kalker: np.ndarray
 
 
 def hertz_kalker_tables(tables) -> HertzKalkerTables:
     """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`."""
-    c = np.ascontiguousarray(tables.c)
     return HertzKalkerTables(
         float(tables.log_r[0]),
         float(tables.log_r[1] - tables.log_r[0]),
-        np.ascontiguousarray(tables.p),
-        np.ascontiguousarray(tables.k),
-        np.ascontiguousarray(tables.d),
+        np.ascontiguousarray(np.stack([tables.p, tables.k, tables.d])),
         float(tables.log_ab[0]),
         float(tables.log_ab[1] - tables.log_ab[0]),
-        c[0].copy(),
-        c[1].copy(),
-        c[2].copy(),
-        c[3].copy(),
+        np.ascontiguousarray(tables.c),
     )
 
 
@@ -152,19 +148,21 @@ def _hertz_kalker(par, tables, q, ca, cb):
     (N, a, b, C11, C22, C23, C33).
     """
     amin, amax = min(ca, cb), max(ca, cb)
-    i, w = _uniform(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, tables.p.shape[0])
-    pp = tables.p[i] * (1 - w) + tables.p[i + 1] * w
-    kk_ = tables.k[i] * (1 - w) + tables.k[i + 1] * w
-    dd = tables.d[i] * (1 - w) + tables.d[i + 1] * w
+    hz = tables.hertz
+    i, w = _uniform(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, hz.shape[1])
+    pp = hz[HERTZ_P, i] * (1 - w) + hz[HERTZ_P, i + 1] * w
+    kk_ = hz[HERTZ_K, i] * (1 - w) + hz[HERTZ_K, i + 1] * w
+    dd = hz[HERTZ_D, i] * (1 - w) + hz[HERTZ_D, i + 1] * w
     major = math.sqrt(q * dd / (kk_ * amin))
     normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
     minor = major * math.sqrt(pp)
     sa, sb = (major, minor) if ca <= cb else (minor, major)
-    i, w = _uniform(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, tables.c11.shape[0])
-    c11 = tables.c11[i] * (1 - w) + tables.c11[i + 1] * w
-    c22 = tables.c22[i] * (1 - w) + tables.c22[i + 1] * w
-    c23 = tables.c23[i] * (1 - w) + tables.c23[i + 1] * w
-    c33 = tables.c33[i] * (1 - w) + tables.c33[i + 1] * w
+    kk = tables.kalker
+    i, w = _uniform(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    c11 = kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w
+    c22 = kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w
+    c23 = kk[KALKER_C23, i] * (1 - w) + kk[KALKER_C23, i + 1] * w
+    c33 = kk[KALKER_C33, i] * (1 - w) + kk[KALKER_C33, i + 1] * w
     return normal, sa, sb, c11, c22, c23, c33
 
 

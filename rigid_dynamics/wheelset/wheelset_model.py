@@ -378,7 +378,9 @@ class WheelsetModel:
         compiled_rhs.use_callback(self.callback)
         if run.mode == GEOMETRY_GIVEN:
             self._given_geometry(full)
-            return int(compiled_rhs.rhs_given(float(t), full, run, self._cg, out, self._rec, record))
+            return int(
+                compiled_rhs.rhs_given(float(t), full, run.par, run.tables, run.sides, self._cg, out, self._rec, record)
+            )
         if record:
             return int(compiled_rhs.contact_once(float(t), full, run, out, self._rec, self._cg))
         return int(compiled_rhs.rhs_once(float(t), full, run, out, self._rec))
