@@ -35,7 +35,7 @@ from numba import njit, objmode
 from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK, _law
 from rigid_dynamics.wheelset.compiled_motion import _assemble, _patch_creepages, _rotation
 from rigid_dynamics.wheelset.compiled_search import search_geometry, search_geometry_on_track
-from rigid_dynamics.wheelset.compiled_tables import TableScratch, _table_geometry, table_scratch
+from rigid_dynamics.wheelset.compiled_tables import _table_geometry, table_scratch
 from rigid_dynamics.wheelset.layout import (
     APPROACH,
     CALLBACK_FAILED,
@@ -164,13 +164,13 @@ def _external(t, y, c, side, g, creep, frame):
 
 
 @njit(cache=True, _nrt=False)
-def _forces(t, y, par, tables, sides, cg, ws, record, out):
+def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, record, out):
     """d/dt of the full state into ``out`` from the candidate geometry cg (ncand, layout.N_GEO) (a candidate with
-    q = NaN is absent: recorded as NaN); fills the patch record ws.rec (ncand + 2, layout.N_FIELDS) and the side
-    forces when ``record``. Returns the status (layout.STATUS). (par, tables, sides: the run's, passed apart: a
-    record argument is passed field by field, and this runs for every right-hand side.)
+    q = NaN is absent: recorded as NaN); fills the patch record rec (ncand + 2, layout.N_FIELDS) and the side
+    forces when ``record``; sc: the scratch rows (layout.SCRATCH_ROWS, 3); dummy: FASTSIM's empty field array.
+    Returns the status (layout.STATUS). (The run's and the workspace's arrays are passed apart, not as their
+    records: a record argument is passed field by field, and this runs for every right-hand side.)
     """
-    rec, sc = ws.rec, ws.scratch
     n, lever, vel, ex, ey = sc[S_NORMAL], sc[S_LEVER], sc[S_POINT_VELOCITY], sc[S_EX], sc[S_EY]
     fc, mc = sc[S_PATCH_FORCE], sc[S_PATCH_MOMENT]
     force, moment, side_force = sc[S_TOTAL_FORCE], sc[S_TOTAL_MOMENT], sc[S_SIDE_FORCE : S_SIDE_FORCE + 2]
@@ -226,9 +226,7 @@ def _forces(t, y, par, tables, sides, cg, ws, record, out):
             if st != 0:
                 return CALLBACK_FAILED
         else:
-            normal, sa, sb, tx, ty, mz, to_callback = _law(
-                par, tables, ws.dummy, q, ca, cb, xi, eta, spin, rec, c, record
-            )
+            normal, sa, sb, tx, ty, mz, to_callback = _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
             if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
                 normal, tx, ty, mz, sa, sb, st = _external(t, y, c, side, g, (speed, xi, eta, spin), (ex, ey))
                 if st != 0:
@@ -278,7 +276,7 @@ def _rhs(t, y, run, ws, record, full, out):
     scan; mode layout.GEOMETRY_GIVEN: ws.cg as the caller filled it), then :func:`_forces`. Returns the status.
     """
     _geometry(y, run, ws, full)
-    return _forces(t, y, run.par, run.tables, run.sides, ws.cg, ws, record, out)
+    return _forces(t, y, run.par, run.tables, run.sides, ws.cg, ws.rec, ws.scratch, ws.dummy, record, out)
 
 
 @njit(cache=True, _nrt=False)
@@ -349,9 +347,7 @@ def rhs_given(t, y, par, tables, sides, cg, out, rec, record):
     parameter record, Hertz/Kalker tables and sides only: called from Python per right-hand side, where every
     array of a record costs its unboxing.)
     """
-    no_tables = TableScratch(np.empty((0, 0)), np.empty(0), np.empty((3, 0)))
-    ws = Workspace(no_tables, rec, cg, np.zeros((N_SCRATCH, 3)), np.zeros((1, 1)))
-    return _forces(t, y, par, tables, sides, cg, ws, record, out)
+    return _forces(t, y, par, tables, sides, cg, rec, np.zeros((N_SCRATCH, 3)), np.zeros((1, 1)), record, out)
 
 
 @njit(cache=True, _nrt=False)
