@@ -1,5 +1,5 @@
 """Real-time factor against force error: fixed-step RK4 and the error-controlled embedded pairs (DP54, BS32) of the
-compiled loop (rigid_dynamics/wheelset/compiled_adaptive.py) on the four embedded scenes.
+compiled loop (rigid_dynamics/wheelset/compiled_loop.py) on the four embedded scenes.
 
 Per scene, a converged reference (RK4 at a fine step; a second reference, DP54 at rtol 1e-7 and atol 1e-10, says
 how well it is converged), then RK4 at several steps and DP54 / BS32 at several tolerances. Force error of a run,

@@ -211,10 +211,10 @@ def main() -> int:
         "bounds per patch, on the cases measured). Neither run is exact: these are auto's departures from "
         "always-BEM (default BEM grid), not errors against a reference; the two runs' states also drift apart.",
         "",
-        "Both runs take the same path: one compiled right-hand side (rigid_dynamics/wheelset/compiled.py) with "
+        "Both runs take the same path: one compiled right-hand side (rigid_dynamics/wheelset/compiled_rhs.py) with "
         "the contact geometry compiled (tables, 3-D search) or given by the provider (conical), auto's choice per "
         "patch and step in the compiled code, linear / Vermeulen-Johnson / FASTSIM inline and BEM through the one "
-        "callback (compiled._external); driver: the compiled RK4 loop for RK4 scenes, scipy's RK45 calling the "
+        "callback (compiled_rhs._external); driver: the compiled RK4 loop for RK4 scenes, scipy's RK45 calling the "
         "same function for hunting-conical.",
         "",
     ]

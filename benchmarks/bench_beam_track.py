@@ -1,7 +1,7 @@
 """The discretely supported beam track (``[track_dynamics] model = "beam"``): its checks, a second method for it, and
 the wheel-flat impact against speed on it beside the lumped and the rigid track.
 
-1. Track checks from the beam's matrices (rigid_dynamics.wheelset.track.TrackSystem), UIC60 on 0.6 m seats:
+1. Track checks from the beam's matrices (rigid_dynamics.wheelset.track_matrices.TrackSystem), UIC60 on 0.6 m seats:
    static point stiffness, pinned-pinned frequency against the closed forms, P2 resonance of half the wheelset
    against Jenkins et al. (1974).
 2. Second method: comparisons/wheelflat_fe_beam.py, the vertical half-wheelset on an Euler-Bernoulli rail of
@@ -51,7 +51,8 @@ from comparisons.wheelflat_fe_beam import fe_track_from_scene, simulate_passage_
 from comparisons.wheelflat_vertical import from_scene  # noqa: E402
 from rigid_dynamics.files import write_text  # noqa: E402
 from rigid_dynamics.wheelset import DynamicsScene, Irregularities, TrackDynamics, simulate  # noqa: E402
-from rigid_dynamics.wheelset.track import TrackSystem, beam_layout, travel_m  # noqa: E402
+from rigid_dynamics.wheelset.track import beam_layout, travel_m  # noqa: E402
+from rigid_dynamics.wheelset.track_matrices import TrackSystem  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results"
 JENKINS_KT, JENKINS_MT = 150.0e6, 245.0

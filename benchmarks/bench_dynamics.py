@@ -10,8 +10,8 @@ classical RK4 with a 0.5 ms step as in the scene file unless the case name gives
   first-order rigid-body correction (providers/search.py);
 * ``search-ideal``: the 3-D search without the polygon;
 * ``tables-ideal``, ``tables-polygon``: contact-geometry tables over lateral shift and roll (ideal geometry; with
-  the polygon by the running-direction section of compiled._irregularity), the Python right-hand side;
-* ``*-compiled-*``: the same tables in the compiled RK4 loop (rigid_dynamics.wheelset.compiled; FASTSIM by the
+  the polygon by the running-direction section of compiled_tables._irregularity), the Python right-hand side;
+* ``*-compiled-*``: the same tables in the compiled RK4 loop (rigid_dynamics.wheelset.compiled_loop; FASTSIM by the
   contact package's strip kernel, the polygon evaluated in the loop), 2 s simulated; ``-vj``: Vermeulen-Johnson,
   ``-fastsim15x10``: FASTSIM on 15 x 10 elements (creep forces within 1 % of a 200 x 200 grid,
   benchmarks/results/fastsim_grid.md) instead of 20 x 20 (0.5 %);
@@ -82,7 +82,7 @@ Notes.
 * The Python paths, for reference: the search at every RHS (search) costs ~3.5 ms per call (search-reuse halves
   the searches by the first-order rigid-body update between close stages), the Python table RHS 0.35-0.6 ms.
   tables-polygon-compiled treats the polygon by a running-direction section of the table candidates
-  (compiled._irregularity) instead of the 3-D search (22x / 38x).
+  (compiled_tables._irregularity) instead of the 3-D search (22x / 38x).
 * Compiled table path: ~1 us per RHS with Vermeulen-Johnson, ~2.5 us with FASTSIM 20 x 20 (the strip kernel
   ~0.8 us per patch), ~1.6 us with 15 x 10. It equals the Python path to ~1e-14 (tests/test_dynamics_compiled.py).
 """

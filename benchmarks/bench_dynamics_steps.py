@@ -105,26 +105,28 @@ def passage_steps(scene, step_s):
 def doubling_estimate(scene, result, samples=100):
     """Step doubling at up to ``samples`` settled recorded states (compiled right-hand side; None when the scene
     does not run compiled)."""
-    from rigid_dynamics.wheelset import compiled
-    from rigid_dynamics.wheelset.equations import WheelsetModel
+    from rigid_dynamics.wheelset.compiled_rhs import rhs_once
+    from rigid_dynamics.wheelset.layout import N_FIELDS, NORMAL_FORCE
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     if not result.compiled:
         return None
     provider = build_provider(scene)
     law = get_contact_model(scene.contact_model)
     model = WheelsetModel(scene, provider, law, model_options(law.name, scene))
-    par, hz, kk, sides, _, mode, targs, sargs = model.packed
-    par["frame_x0_m"] = result.states[0, 0]
-    rec = np.zeros((len(sides) + 2, compiled.N_FIELDS))
+    run = model.packed
+    sides = run.sides
+    run.par["frame_x0_m"] = result.states[0, 0]
+    rec = np.zeros((len(sides) + 2, N_FIELDS))
     h = scene.integrator.fixed_step_s
 
     def rhs(t, y):
         out = np.zeros(len(y))
-        compiled.rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec)
+        rhs_once(t, y, run, out, rec)
         forces = np.zeros((2, 3))
         for c in range(len(sides)):
-            if rec[c, 0] > 0:
+            if rec[c, NORMAL_FORCE] > 0:
                 forces[sides[c]] += rec[c, :3]
         return out, forces
 

@@ -1,6 +1,6 @@
 """FASTSIM strip grid: time per call of the compiled kernel and the error of coarse grids.
 
-The wheelset RK4 loop (rigid_dynamics/wheelset/compiled.py) calls the strip kernel
+The wheelset RK4 loop (rigid_dynamics/wheelset/compiled_rhs.py) calls the strip kernel
 ``rigid_dynamics.contact.fastsim._fastsim_one`` for every patch at every right-hand-side evaluation, so its
 cost and its grid (nx elements per strip, ny strips) set the simulation speed. This script measures:
 

@@ -48,8 +48,8 @@ def peak_patch_case(result, skip_s: float | None = None) -> PatchCase:
     """
     from rigid_dynamics.contact.registry import get_model
     from rigid_dynamics.contact.types import ContactGeometry, Creepage
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     scene = result.scene
     normal = np.nan_to_num(np.asarray(result.patches["normal_force_N"], float), nan=-np.inf)

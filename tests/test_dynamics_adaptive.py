@@ -1,4 +1,4 @@
-"""Error-controlled integration in the compiled loop (rigid_dynamics/wheelset/compiled_adaptive.py): the embedded
+"""Error-controlled integration in the compiled loop (rigid_dynamics/wheelset/compiled_loop.py): the embedded
 pairs DP54 (Dormand-Prince 5(4)) and BS32 (Bogacki-Shampine 3(2)) with step-size control, dense output and located
 contact switches.
 
@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 from hardening_helpers import assert_bad_scene
 
-from rigid_dynamics.wheelset import build_provider, compiled_adaptive, simulate
-from rigid_dynamics.wheelset.compiled_adaptive import BS32_A, BS32_B_HAT, DP54_A, DP54_B_HAT, DP54_P, PAIRS
+from rigid_dynamics.wheelset import build_provider, compiled_loop, simulate
+from rigid_dynamics.wheelset.compiled_loop import BS32_A, BS32_B_HAT, DP54_A, DP54_B_HAT, DP54_P, PAIRS
 from rigid_dynamics.wheelset.parameters import IntegratorSettings
 from wheelrail.scenes import load_scene
 
@@ -89,7 +89,7 @@ def test_tableaux_satisfy_the_order_conditions():
     assert "b.c^2 = 1/3" in _order_conditions(BS32_A, BS32_B_HAT, 3)  # order 2 only
     for j in range(7):
         assert sum(Fraction(v) for v in DP54_P[j]) == (Fraction(DP54_A[-1][j]) if j < 6 else 0)
-    for name, ((a, c, e, p), _, _) in PAIRS.items():
+    for name, ((a, c, e, p, _), _) in PAIRS.items():
         assert np.allclose(a.sum(axis=1), c) and abs(e.sum()) < 1e-15, name
         assert np.allclose(p.sum(axis=1), np.append(a[-1, :-1], 0.0)), name  # y(theta = 1) = y_new
 
@@ -281,9 +281,9 @@ def test_loose_tolerance_is_flagged():
 
 
 def test_step_size_underflow_is_a_named_status(monkeypatch):
-    """A step below compiled_adaptive.MIN_STEP_S ends the run as "step-size-underflow" with the time and the
+    """A step below compiled_loop.MIN_STEP_S ends the run as "step-size-underflow" with the time and the
     tolerances in the message (here the floor raised to 1 ms, above the steps the wheel-flat impact needs)."""
-    monkeypatch.setattr(compiled_adaptive, "MIN_STEP_S", 1e-3)
+    monkeypatch.setattr(compiled_loop, "MIN_STEP_S", 1e-3)
     scene = replace(_wheel_flat_lumped(), duration_s=0.05)
     result = simulate(_adaptive(scene))
     assert result.status == "step-size-underflow", result.message

@@ -23,7 +23,8 @@ import numpy as np
 import pytest
 
 from rigid_dynamics.wheelset import DynamicsScene, IntegratorSettings, TrackDynamics, simulate
-from rigid_dynamics.wheelset.track import TrackSystem, beam_layout
+from rigid_dynamics.wheelset.track import beam_layout
+from rigid_dynamics.wheelset.track_matrices import TrackSystem
 
 JENKINS_KT_N_PER_M = 150.0e6
 JENKINS_MT_KG = 245.0
@@ -162,9 +163,9 @@ def test_beam_size_follows_the_run_and_the_cutoff():
 def test_compiled_beam_rates_equal_the_matrices():
     """Regression (two implementations of the same equations): compiled track_rates (recurrence for the mode
     shapes, loops over seats) against TrackSystem.rates (M^-1 (b F - C v - K q)) at a random state."""
-    from rigid_dynamics.wheelset.compiled import track_rates
-    from rigid_dynamics.wheelset.equations import WheelsetModel
+    from rigid_dynamics.wheelset.compiled_motion import track_rates
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     for theory in ("euler-bernoulli", "timoshenko"):
         scene = DynamicsScene(track_dynamics=_beam(rail_theory=theory), contact_provider="conical", duration_s=0.2)
@@ -224,10 +225,10 @@ def test_structured_jacobian_equals_the_difference_quotients(lateral):
     the beam's columns from its linear equations and the rail under the wheels; the lateral track's 4 columns by
     differences) against central differences in every state, at the rest state of a short run on the beam; and the
     RK4 step limit from both."""
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
     from rigid_dynamics.wheelset.stability import jacobian, rk4_stable_step
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     scene = _scene(
         duration_s=0.001, track_dynamics=_beam(cutoff_frequency_Hz=2000.0, end_margin_m=1.2, lateral_model=lateral)
@@ -259,9 +260,9 @@ def test_largest_eigenvalues_give_the_step_limit_of_the_full_spectrum():
     eigenvalues (stability._largest_eigenvalues); on the wheel-flat scene's beam (Timoshenko, 5 kHz) it equals the
     limit from every eigenvalue (numpy) to 1e-6."""
     from rigid_dynamics.wheelset import stability
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     scene = _scene(duration_s=0.05)
     law = get_contact_model(scene.contact_model)

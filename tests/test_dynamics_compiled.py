@@ -1,4 +1,4 @@
-"""The one right-hand side (rigid_dynamics.wheelset.compiled) in its compiled RK4 loop, against references.
+"""The one right-hand side (rigid_dynamics.wheelset.compiled_rhs) in its compiled RK4 loop, against references.
 
 Independent references: Klingel's kinematic wavelength 2 pi sqrt(r0 e0 / lambda) on the compiled tables; the
 energy balance d(T + V_g)/dt = P_contact + P_exterior (the work integrals are integrated with the states, so the
@@ -99,9 +99,11 @@ def test_energy_balance_in_the_compiled_loop(model, irregularity):
 
 
 class ExternalLinear(LinearModel):
-    """The registry's linear model as a user model: not compiled, so it runs through the callback boundary."""
+    """The registry's linear model as a user model that declares no compiled law (``compiled_law = None``), so it
+    runs through the callback boundary (a subclass that keeps its parent's law would run the compiled one)."""
 
     name = "external-linear"
+    compiled_law = None
 
 
 def test_callback_boundary_gives_the_registry_model_solution():
@@ -122,6 +124,7 @@ def test_callback_boundary_gives_the_registry_model_solution():
 
 class Failing(LinearModel):
     name = "failing"
+    compiled_law = None  # its own solve: through the callback
 
     def solve(self, *args, **kwargs):
         raise RuntimeError("no answer")
@@ -129,6 +132,7 @@ class Failing(LinearModel):
 
 class FailingLater(LinearModel):
     name = "failing-later"
+    compiled_law = None  # its own solve: through the callback
 
     def solve(self, geometry, creepage, material, **kwargs):
         if FailingLater.armed:

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from rigid_dynamics.kinematics import wheelset_rotation
-from rigid_dynamics.wheelset import compiled
+from rigid_dynamics.wheelset import compiled_records
 from rigid_dynamics.wheelset import compiled_search as cs
-from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, simulate
+from rigid_dynamics.wheelset.simulate import build_provider, simulate
 from wheelrail.scenes import load_scene, resolve_scene_path
 
 
@@ -40,18 +40,17 @@ def _poses(n, seed):
 
 def _compare_geometry(provider, poses, *, full=True, moved=None, point_atol=1e-8, normal_atol=2e-6):
     """Patches of SearchProvider and of the compiled search at each pose; returns the number of patches compared."""
-    sp, tabs, irrs = cs.pack_search(provider, provider.options)
-    mem, n_mem, cand, order, vb, rot = cs.workspace()
+    search = cs.search_args(provider, provider.options)
     cg = np.zeros((4, cs.N_GEO))
     compared = 0
     for pose in poses:
         state = np.zeros(14)
         state[:6] = pose
-        n_mem[:] = 0
-        cs.search_geometry(state, sp, tabs, irrs, mem, n_mem, True, cand, order, vb, rot, cg)
+        search.n_mem[:] = 0
+        cs.search_geometry(state, search, True, cg)
         if moved is not None:  # track from this pose to a nearby one without the scan
             state[:6] = np.asarray(pose) + moved
-            cs.search_geometry(state, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg)
+            cs.search_geometry(state, search, full, cg)
         ref = provider.patches(state[:3], state[3], state[4], state[5])
         for side in (0, 1):
             rows = [c for c in (2 * side, 2 * side + 1) if not np.isnan(cg[c, 0]) and cg[c, 0] > 0]
@@ -88,7 +87,7 @@ def test_rotation_is_the_kinematics_rotation():
 
 def test_polygonal_wheel_patches_equal_the_python_search(polygon_scene):
     provider = build_provider(polygon_scene)
-    assert compiled.supported(polygon_scene, provider, get_contact_model("fastsim"))
+    assert compiled_records.supported(polygon_scene, provider)
     compared = _compare_geometry(provider, _poses(40, 1))
     print(f"{compared} patches compared")
     assert compared >= 40

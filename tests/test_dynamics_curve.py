@@ -15,7 +15,7 @@ spin), Kalker's linear creep forces f_ij = G (ab)^k C_ij with the semi-axes from
 and the steady balance: the forces on the wheelset equal m times the centripetal acceleration, the moments equal
 Omega x (J omega_a) (steady precession: the gyroscopic couple J_a (V/r0)(V/R) of the spin with the curve's yaw
 rate), with gravity along the true vertical of the canted track and the carried mass's quasi-static load at the
-axle (the model of compiled._assemble_curve: the axle load is axle_load/g times g minus the centripetal
+axle (the model of compiled_motion._assemble_curve: the axle load is axle_load/g times g minus the centripetal
 acceleration). The unknowns (y, psi, spin rate, the two normal loads, roll and centre height) are solved by
 Newton's method (scipy.optimize.fsolve). Hertz (contact.hertz) and Kalker's table (contact.kalker)
 are the project's own, verified elsewhere (tests/test_hertz.py, tests/test_kalker.py).

@@ -16,7 +16,6 @@ import pytest
 
 from rigid_dynamics.contact.types import ContactResult
 from rigid_dynamics.wheelset.drivers import state_jacobian
-from rigid_dynamics.wheelset.equations import WheelsetModel
 from rigid_dynamics.wheelset.linear import creep_coefficients, linear_model_for_scene
 from rigid_dynamics.wheelset.parameters import (
     DynamicsScene,
@@ -36,6 +35,7 @@ from rigid_dynamics.wheelset.simulate import (
     save_timeseries,
     simulate,
 )
+from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
 BASE = DynamicsScene(
     track=TrackGeometry(rail_head_radius_m=0.05),

@@ -1,8 +1,8 @@
 """The lateral track (``[track_dynamics] lateral_model = "lumped"``): verification.
 
 * Its defaults against the Winkler beam they are reduced from (closed form, Timoshenko's 2 k_f / beta) and against
-  a second method: the discretely supported beam of :class:`track.TrackSystem` written with the rail's lateral
-  bending stiffness and the fastenings' lateral springs on rigid sleepers, whose static point stiffness (between
+  a second method: the discretely supported beam of :class:`track_matrices.TrackSystem` written with the rail's
+  lateral bending stiffness and the fastenings' lateral springs on rigid sleepers, whose static point stiffness (between
   two rail seats and over one) brackets the lumped model's.
 * Steady curving on the elastic track (lumped vertical and lateral) against the independent quasi-static curving
   solution of tests/test_dynamics_curve.py with each rail at rest on its springs under its wheel's force (w = F_z /
@@ -26,9 +26,9 @@ from rigid_dynamics.wheelset.simulate import simulate
 from rigid_dynamics.wheelset.track import (
     UIC60_LATERAL_SEAT,
     TrackDynamics,
-    TrackSystem,
     lumped_lateral_equivalent,
 )
+from rigid_dynamics.wheelset.track_matrices import TrackSystem
 
 LATERAL = TrackDynamics(model="lumped", lateral_model="lumped")
 
@@ -110,9 +110,9 @@ def test_steady_curving_on_the_elastic_track_against_the_quasi_static_solution(c
 def test_lateral_track_rates_equal_the_matrices():
     """Regression (self-consistency): the compiled track rates (lumped and beam, with the lateral track) equal
     TrackSystem.rates."""
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model
     from rigid_dynamics.wheelset.state import N_RIGID
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     for model in ("lumped", "beam"):
         scene = replace(curve_scene(), track_dynamics=replace(LATERAL, model=model), duration_s=0.05)
@@ -139,9 +139,9 @@ def test_bad_lateral_input():
 def test_lateral_track_frequency_closed_form():
     """The free lateral rail (no wheel): m_y u'' + c_y u' + k_y u = 0, eigenvalues of the track's own rates
     against the closed form -zeta w0 +- w0 sqrt(zeta^2 - 1)."""
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model
     from rigid_dynamics.wheelset.state import N_RIGID
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     scene = replace(curve_scene(), track_dynamics=LATERAL, duration_s=0.05)
     wm = WheelsetModel(scene, build_provider(scene), get_contact_model("linear"))

@@ -16,8 +16,8 @@ spin; velocities; angular rates) against the largest magnitude in the block over
 (the vertical velocity of hunting-conical stays below 7e-6 m/s at 20 m/s) is compared at the scale of its block,
 not at its own.
 
-The compiled cases are bit-identical. The Python right-hand side (equations.WheelsetModel.derivative) now ends in
-the compiled equations of motion, suspension and track (compiled._assemble: J^-1 by the rotation instead of
+The compiled cases are bit-identical. The Python right-hand side (wheelset_model.WheelsetModel.derivative) now ends in
+the compiled equations of motion, suspension and track (compiled_motion._assemble: J^-1 by the rotation instead of
 np.linalg.solve, scalar sums) and takes its creepages from the compiled kernel, so its states move by rounding:
 measured at most 3e-14 of the block on the RK4 table cases, 7e-13 on polygonal-wheel (Python search) and 9.6e-11
 (angular rates) on hunting-conical with RK45, whose adaptive steps (rtol 1e-6) carry the rounding further: that case
@@ -46,7 +46,7 @@ BLOCKS = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12))
 """Blocks of like states (positions, angles, velocities, angular rates) compared at the block's largest magnitude."""
 
 
-def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None):
+def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None, method=None):
     from rigid_dynamics.wheelset import DynamicsScene
     from wheelrail.config import build_dataclass
 
@@ -60,6 +60,8 @@ def _scene(name, duration_s, provider=None, model=None, rk4_step_s=None):
     if rk4_step_s is not None:
         integrator = replace(scene.integrator, method="RK4", fixed_step_s=rk4_step_s, output_step_s=2 * rk4_step_s)
         scene = replace(scene, integrator=integrator)
+    if method is not None:
+        scene = replace(scene, integrator=replace(scene.integrator, method=method))
     return scene
 
 
@@ -78,6 +80,12 @@ for _model in ("fastsim", "vermeulen-johnson", "linear"):
             ("hunting-conical", 0.3, "tables", _model, 5e-4),
             _compiled,
         )
+# written by commit f3b48bb (before issue 25): the compiled embedded pairs on tables and on the search with the beam
+# track, auto's choice per patch in the loop, and the curve's track-following frame
+CASES["polygonal-wheel-tables-fastsim-DP54"] = (("polygonal-wheel", 0.05, "tables", None, None, "DP54"), None)
+CASES["wheel-flat-BS32"] = (("wheel-flat", 0.005, None, None, None, "BS32"), None)
+CASES["polygonal-wheel-tables-auto-compiled"] = (("polygonal-wheel", 0.05, "tables", "auto"), None)
+CASES["curve-default"] = (("curve", 0.05), None)
 
 
 def _run(name):

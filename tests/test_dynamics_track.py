@@ -64,12 +64,12 @@ def _two_dof_closed_form_hz(m1, m2, k1, k2):
 
 
 def test_track_eigenfrequencies_against_the_closed_form():
-    """The model's track right-hand side (equations.WheelsetModel._track_derivative), linearised by finite
+    """The model's track right-hand side (wheelset_model.WheelsetModel._track_derivative), linearised by finite
     differences without damping, against the 2-DOF closed form; then with the unsprung mass of half the wheelset
     on the rail (rigid contact): the P2 resonance, which Jenkins' data put at sqrt(Kt/(Mu+Mt))/2pi = 57 Hz and which
     is commonly quoted at 50-100 Hz for ballasted track (Iwnicki, Handbook, P2 force)."""
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     track = replace(TrackDynamics(model="lumped"), pad_damping_N_s_per_m=0.0, ballast_damping_N_s_per_m=0.0)
     scene = DynamicsScene(track_dynamics=track, contact_provider="conical")
@@ -340,9 +340,10 @@ def test_track_states_reach_the_table_and_the_npz(tmp_path):
 
 def test_dipped_joint_geometry():
     """N_irr of the dipped joint: about alpha L deep at the joint, slopes +alpha before and -alpha after it (z down),
-    level far away; the compiled formula (compiled._dip) gives the same numbers."""
-    from rigid_dynamics.wheelset import compiled
+    level far away; the compiled formula (compiled_tables._dip) gives the same numbers."""
+    from rigid_dynamics.wheelset import compiled_tables
     from rigid_dynamics.wheelset.irregular import rail_irregularity
+    from rigid_dynamics.wheelset.layout import new_parameters
 
     irr = Irregularities(joint_dip_angle_rad=0.01, joint_position_m=5.0, joint_ramp_length_m=3.0)
     alpha = 0.005
@@ -354,11 +355,13 @@ def test_dipped_joint_geometry():
     assert abs(value[3]) < 1.5e-4 and abs(value[4]) < 1.5e-4  # alpha e^2 / (2 |u|) far away
     assert abs(first[3]) < 1e-5 and abs(first[4]) < 1e-5
     assert second[0] == pytest.approx(-alpha / irr.joint_rounding_m, rel=1e-3)  # concave bottom, 1/(0.5 m) < 1/r0
-    par = compiled.new_parameters()
+    par = new_parameters()
     par["dip_angle_rad"], par["dip_position_m"], par["dip_ramp_length_m"] = 0.01, 5.0, 3.0
     par["dip_entry_rounding_m"], par["dip_rounding_m"] = irr.joint_entry_rounding_m, irr.joint_rounding_m
     for k, x in enumerate((5.0, 4.8, 5.2, -20.0, 30.0)):
-        np.testing.assert_allclose(compiled._dip(par, x), (value[k], first[k], second[k]), rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(
+            compiled_tables._dip(par, x), (value[k], first[k], second[k]), rtol=1e-12, atol=1e-15
+        )
 
 
 @pytest.mark.parametrize("method", ["RK45", "Radau"])

@@ -92,12 +92,11 @@ def _kernel_args(provider, pose):
 
 
 def _compiled_patches(provider, pose):
-    sp, tabs, irrs = cs.pack_search(provider, provider.options)
-    mem, n_mem, cand, order, vb, rot = cs.workspace()
+    search = cs.search_args(provider, provider.options)
     cg = np.zeros((4, cs.N_GEO))
     state = np.zeros(14)
     state[:6] = pose
-    failed = cs.search_geometry(state, sp, tabs, irrs, mem, n_mem, True, cand, order, vb, rot, cg)
+    failed = cs.search_geometry(state, search, True, cg)
     return cg, failed
 
 

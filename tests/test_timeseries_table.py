@@ -7,7 +7,7 @@ every column equals its slice of the (n, 2, 2) / (n, 12) arrays, CSV and Parquet
 import numpy as np
 import pytest
 
-from rigid_dynamics.wheelset.equations import PATCH_FIELDS
+from rigid_dynamics.wheelset.layout import PATCH_FIELDS
 from rigid_dynamics.wheelset.state import STATE_NAMES
 from rigid_dynamics.wheelset.table import result_columns, timeseries_columns, write_table
 from wheelrail.cli import main

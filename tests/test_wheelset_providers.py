@@ -17,9 +17,9 @@ from rigid_dynamics.contact.registry import get_model
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.kinematics import angular_velocity, wheelset_rotation
 from rigid_dynamics.materials import STEEL
-from rigid_dynamics.wheelset.equations import _creepages, rotation_and_rates
 from rigid_dynamics.wheelset.parameters import Irregularities, TrackGeometry, WheelsetParameters
 from rigid_dynamics.wheelset.providers import ConicalProvider, ProfileSectionProvider, TableProvider
+from rigid_dynamics.wheelset.wheelset_model import _creepages, rotation_and_rates
 
 R0, E0, LAM = 0.46, 0.75, 0.05
 
@@ -141,27 +141,24 @@ def test_creepages_match_contact_creepage_module():
 
 def _compiled_law(name):
     """The parameter record and tables of the compiled right-hand side for the registry model ``name`` on STEEL."""
-    from rigid_dynamics.wheelset import compiled
-    from rigid_dynamics.wheelset.equations import _tables_for
+    from rigid_dynamics.wheelset.compiled_laws import hertz_kalker_tables, tables_for
+    from rigid_dynamics.wheelset.compiled_records import law_code
+    from rigid_dynamics.wheelset.layout import new_parameters
 
-    tables = _tables_for(STEEL.shear_modulus_Pa, STEEL.poisson_ratio)
-    par = compiled.new_parameters()
+    tables = tables_for(STEEL.shear_modulus_Pa, STEEL.poisson_ratio)
+    par = new_parameters()
     par["shear_modulus_Pa"], par["contact_modulus_Pa"] = STEEL.shear_modulus_Pa, tables.e_star
     par["friction_coefficient"] = STEEL.friction_coefficient
-    par["model_code"] = compiled.model_code(get_model(name))
+    par["model_code"] = law_code(get_model(name))
     par["fastsim_nx"], par["fastsim_ny"] = 20, 20
-    hz = np.vstack([np.zeros(len(tables.log_r)), tables.p, tables.k, tables.d])
-    hz[0, 0], hz[0, 1] = tables.log_r[0], tables.log_r[1] - tables.log_r[0]
-    kk = np.vstack([np.zeros(len(tables.log_ab)), tables.c])
-    kk[0, 0], kk[0, 1] = tables.log_ab[0], tables.log_ab[1] - tables.log_ab[0]
-    return par, hz, kk
+    return par, hertz_kalker_tables(tables)
 
 
 @pytest.mark.parametrize("name", ["hertz", "linear", "vermeulen-johnson", "fastsim"])
 def test_compiled_laws_equal_model_solve(name):
-    """The compiled laws of the dynamics (tabulated Hertz/C_ij + kernels, compiled._law) equal the registry's models
-    (contact.models: the exact Hertz solver and Kalker's coefficients) to the tables' interpolation accuracy."""
-    from rigid_dynamics.wheelset import compiled
+    """The compiled laws of the dynamics (tabulated Hertz/C_ij + kernels, compiled_laws._law) equal the registry's
+    models (contact.models: the exact Hertz solver and Kalker's coefficients) to the tables' interpolation accuracy."""
+    from rigid_dynamics.wheelset.compiled_laws import patch_forces
 
     rng = np.random.default_rng(11)
     n = 6
@@ -169,22 +166,39 @@ def test_compiled_laws_equal_model_solve(name):
     curv_b = rng.uniform(0.5, 30.0, n)
     approach = rng.uniform(2e-5, 2e-4, n)
     xi, eta, spin = rng.normal(0, 2e-3, n), rng.normal(0, 2e-3, n), rng.normal(0, 0.3, n)
-    par, hz, kk = _compiled_law(name)
+    par, tables = _compiled_law(name)
     model = get_model(name)
     for k in range(n):
         res = model.solve(
             ContactGeometry(curv_a[k], curv_b[k], approach[k]), Creepage(xi[k], eta[k], spin[k], 20.0), STEEL
         )
-        got = compiled.patch_forces(par, hz, kk, approach[k], curv_a[k], curv_b[k], xi[k], eta[k], spin[k])
-        assert got[6] == 0
+        got = patch_forces(par, tables, approach[k], curv_a[k], curv_b[k], xi[k], eta[k], spin[k])
+        assert not got[6]
         want = [res.normal_force_N, res.creep_force_long_N, res.creep_force_lat_N, res.spin_moment_Nm or 0.0,
                 res.semi_axis_long_m, res.semi_axis_lat_m]  # fmt: skip
         scale = [res.normal_force_N] * 4 + [res.semi_axis_long_m, res.semi_axis_lat_m]
         np.testing.assert_allclose(np.array(got[:6]) / scale, np.array(want) / scale, rtol=0, atol=2e-7)
 
 
-def test_models_without_compiled_law_go_through_the_callback():
-    from rigid_dynamics.wheelset import compiled
+def test_models_declare_their_compiled_law():
+    """A model declares the law the loop compiles in its place; bem, fea-like and user models (no declaration) go
+    through the callback; a user's subclass of a compiled law keeps it (the module of its class does not matter)."""
+    from rigid_dynamics.contact.models import FastsimModel
+    from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_CODES, LAW_FASTSIM
+    from rigid_dynamics.wheelset.compiled_records import law_code
 
-    assert compiled.model_code(get_model("bem")) == compiled.CALLBACK_CODE
-    assert compiled.model_code(get_model("auto")) == compiled.AUTO_CODE
+    assert law_code(get_model("bem")) == LAW_CALLBACK
+    assert law_code(get_model("fastrip")) == LAW_CALLBACK
+    assert law_code(get_model("auto")) == LAW_AUTO
+    for name in ("hertz", "linear", "vermeulen-johnson", "fastsim"):
+        assert law_code(get_model(name)) == LAW_CODES[name]
+
+    class MyFastsim(FastsimModel):
+        name = "my-fastsim"
+
+    class MyLaw(FastsimModel):
+        name = "my-law"
+        compiled_law = None  # a subclass that changes the law says so
+
+    assert law_code(MyFastsim()) == LAW_FASTSIM
+    assert law_code(MyLaw()) == LAW_CALLBACK

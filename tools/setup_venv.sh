@@ -8,7 +8,7 @@ if [ ! -x .venv/bin/python ]; then
     "$py" -m venv .venv
 fi
 .venv/bin/python -m pip install --quiet --disable-pip-version-check --upgrade pip
-.venv/bin/python -m pip install --quiet --disable-pip-version-check -e ".[dev]"
+.venv/bin/python -m pip install --quiet --disable-pip-version-check -e ".[all,dev]"
 # numba compiles the dynamics and contact kernels on first use and caches them on disk: do it once here, with
 # progress, so that the first `wheelrail run` does not wait silently for a minute or more
 echo "setup: compiling the numba kernels once (about 2 minutes on a 2-core machine)" >&2

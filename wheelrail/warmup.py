@@ -41,7 +41,7 @@ def warm_up_all(stream=sys.stderr) -> dict[str, float]:
             print(f"setup: warning: scene {name} not compiled ({type(exc).__name__}: {exc})", file=stream, flush=True)
         timings[f"scene {name}"] = time.perf_counter() - start
         if "adaptive" not in timings:
-            # the embedded pairs' loop (compiled_adaptive.embedded_run): one compilation serves DP54 and BS32 on
+            # the embedded pairs' loop (compiled_loop.embedded_run): one compilation serves DP54 and BS32 on
             # tables and on the 3-D search (the same argument types)
             print(
                 "setup: compiling the error-controlled (DP54/BS32) loop (up to two minutes) ...",

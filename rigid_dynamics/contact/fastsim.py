@@ -292,38 +292,74 @@ def kalker_flexibilities(a, b, shear_modulus_Pa, coefficients: CreepCoefficients
     return l1, l2, l3
 
 
+FLEXIBILITY_CODES = {"three": 0, "single": 1, "three-unblended": 2}
+"""The flexibility variants as the compiled kernels take them (:func:`flexibilities_one`)."""
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def flexibilities_one(a, b, normal_force_N, xi, eta, phi, shear_modulus_Pa, friction_coefficient, c, flexibility):
+    """Flexibilities (L1, L2, L3) of one patch by the variant ``flexibility`` (:data:`FLEXIBILITY_CODES`; module
+    docstring), c = (C11, C22, C23): the one implementation (the batch :func:`effective_flexibilities` and the
+    compiled dynamics loop call it).
+    """
+    c11, c22, c23 = c
+    g = shear_modulus_Pa
+    l1 = 8.0 * a / (3.0 * c11 * g)
+    l2 = 8.0 * a / (3.0 * c22 * g)
+    l3 = math.pi * a * math.sqrt(a / b) / (4.0 * c23 * g)
+    if flexibility == 2:  # three-unblended
+        return l1, l2, l3
+    ab = a * b
+    if flexibility == 1:  # single
+        num = l1 * abs(xi) + l2 * abs(eta) + l3 * abs(phi) * math.sqrt(ab)
+        den = math.sqrt(xi**2 + eta**2 + ab * phi**2)
+        single = num / den if den > 0 else l1
+        return single, single, single
+    # "three": blending of Vollebregt & Voltr (2023)
+    cc = 3.0 * math.pi * a / 32.0
+    cp2 = (cc * phi) ** 2
+    num = xi**2 + eta**2 + cp2
+    den = xi**2 / l1 + eta**2 / l2 + cp2 / l3
+    l_comb = num / den if den > 0 else l1
+    force = friction_coefficient * normal_force_N
+    ch2 = (force / (g * ab * c11)) ** 2 + (force / (g * ab * c22)) ** 2 + (force / (g * ab**1.5 * c23)) ** 2
+    f_crp = math.sqrt((xi**2 + eta**2 + phi**2) / ch2) if ch2 > 0 else np.inf
+    w = min(max(f_crp / 3.0, 0.0), 1.0)
+    return (1 - w) * l1 + w * l_comb, (1 - w) * l2 + w * l_comb, (1 - w) * l3 + w * l_comb
+
+
+@njit(cache=True)
+def _flexibilities_many(a, b, normal_force_N, creep, shear_modulus_Pa, friction_coefficient, c, flexibility, out):
+    """:func:`flexibilities_one` over flat arrays; creep = (xi, eta, phi), c = (C11, C22, C23) arrays; out (3, n)."""
+    xi, eta, phi = creep
+    c11, c22, c23 = c
+    for k in range(a.shape[0]):
+        out[0, k], out[1, k], out[2, k] = flexibilities_one(
+            a[k], b[k], normal_force_N[k], xi[k], eta[k], phi[k], shear_modulus_Pa, friction_coefficient[k],
+            (c11[k], c22[k], c23[k]), flexibility,
+        )  # fmt: skip
+
+
 def effective_flexibilities(
     a, b, normal_force_N, xi, eta, phi, *, shear_modulus_Pa, friction_coefficient, coefficients, flexibility
 ):
-    """Flexibilities (L1, L2, L3) actually used for each patch by the chosen variant (module docstring)."""
+    """Flexibilities (L1, L2, L3) actually used for each patch by the chosen variant (module docstring;
+    :func:`flexibilities_one` per patch).
+    """
     if flexibility not in FLEXIBILITIES:
         raise ValueError(f"flexibility = {flexibility!r}: expected one of {', '.join(FLEXIBILITIES)}")
-    l1, l2, l3 = kalker_flexibilities(a, b, shear_modulus_Pa, coefficients)
-    if flexibility == "three-unblended":
-        return l1, l2, l3
-    ab = a * b
-    if flexibility == "single":
-        num = l1 * np.abs(xi) + l2 * np.abs(eta) + l3 * np.abs(phi) * np.sqrt(ab)
-        den = np.sqrt(xi**2 + eta**2 + ab * phi**2)
-        single = np.where(den > 0, num / np.where(den > 0, den, 1.0), l1)
-        return single, single, single
-    # "three": blending of Vollebregt & Voltr (2023)
-    c = 3.0 * math.pi * a / 32.0
-    cp2 = (c * phi) ** 2
-    num = xi**2 + eta**2 + cp2
-    den = xi**2 / l1 + eta**2 / l2 + cp2 / l3
-    l_comb = np.where(den > 0, num / np.where(den > 0, den, 1.0), l1)
-    force = friction_coefficient * normal_force_N
-    g = shear_modulus_Pa
-    ch2 = (
-        (force / (g * ab * coefficients.c11)) ** 2
-        + (force / (g * ab * coefficients.c22)) ** 2
-        + (force / (g * ab**1.5 * coefficients.c23)) ** 2
-    )
-    with np.errstate(divide="ignore", invalid="ignore"):
-        f_crp = np.where(ch2 > 0, np.sqrt((xi**2 + eta**2 + phi**2) / ch2), np.inf)
-    w = np.clip(f_crp / 3.0, 0.0, 1.0)
-    return (1 - w) * l1 + w * l_comb, (1 - w) * l2 + w * l_comb, (1 - w) * l3 + w * l_comb
+    values = (a, b, normal_force_N, xi, eta, phi, friction_coefficient, coefficients.c11, coefficients.c22)
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (*values, coefficients.c23)))
+    shape = arrays[0].shape
+    flat = [np.ascontiguousarray(v).ravel() for v in arrays]
+    out = np.empty((3, flat[0].size))
+    _flexibilities_many(
+        flat[0], flat[1], flat[2], (flat[3], flat[4], flat[5]), float(shear_modulus_Pa), flat[6],
+        (flat[7], flat[8], flat[9]), FLEXIBILITY_CODES[flexibility], out,
+    )  # fmt: skip
+    if not shape:
+        return float(out[0, 0]), float(out[1, 0]), float(out[2, 0])
+    return out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape)
 
 
 @dataclass(frozen=True, eq=False)

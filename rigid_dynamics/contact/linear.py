@@ -14,9 +14,33 @@ as the open-source CONTACT program). Valid for small creepages only: no saturati
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def linear_one(shear_modulus_Pa, a, b, c11, c22, c23, c33, xi, eta, phi):
+    """(Fx, Fy, Mz) of the linear theory (eq 50-52) for one patch: the one implementation (the batch
+    :func:`linear_creep_forces` and the compiled dynamics loop call it).
+    """
+    ab = a * b
+    g_ab = shear_modulus_Pa * ab
+    g_ab15 = g_ab * math.sqrt(ab)
+    return -g_ab * c11 * xi, -g_ab * c22 * eta - g_ab15 * c23 * phi, g_ab15 * c23 * eta - g_ab * ab * c33 * phi
+
+
+@njit(cache=True)
+def _linear_many(shear_modulus_Pa, a, b, c, xi, eta, phi, out):
+    """:func:`linear_one` over flat arrays; c = (C11, C22, C23, C33) arrays; out (3, n)."""
+    c11, c22, c23, c33 = c
+    for k in range(a.shape[0]):
+        out[0, k], out[1, k], out[2, k] = linear_one(
+            shear_modulus_Pa, a[k], b[k], c11[k], c22[k], c23[k], c33[k], xi[k], eta[k], phi[k]
+        )
 
 
 def linear_creep_forces(
@@ -51,10 +75,10 @@ def linear_creep_forces(
     if not (np.all(a > 0) and np.all(b > 0)):
         raise ValueError("semi-axes: expected semi_axis_long_m > 0 and semi_axis_lat_m > 0")
     c = coefficients if coefficients is not None else kalker_coefficients(a / b, poisson_ratio)
-    ab = a * b
-    g_ab = shear_modulus_Pa * ab
-    g_ab15 = g_ab * np.sqrt(ab)
-    fx = -g_ab * c.c11 * xi
-    fy = -g_ab * c.c22 * eta - g_ab15 * c.c23 * phi
-    mz = g_ab15 * c.c23 * eta - g_ab * ab * c.c33 * phi
-    return fx, fy, mz
+    flat = [np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float).ravel() for v in (a, b, xi, eta, phi)]
+    coef = tuple(
+        np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float).ravel() for v in (c.c11, c.c22, c.c23, c.c33)
+    )
+    out = np.empty((3, flat[0].size))
+    _linear_many(float(shear_modulus_Pa), flat[0], flat[1], coef, flat[2], flat[3], flat[4], out)
+    return out[0].reshape(a.shape), out[1].reshape(a.shape), out[2].reshape(a.shape)

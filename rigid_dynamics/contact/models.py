@@ -171,10 +171,15 @@ class HertzianModel:
     implements ``tangential(hertz, creepage, material, opts) -> (forces, extra)``: ``forces`` the keyword
     fields of :class:`~.types.ContactResult` it sets (creep forces, spin moment, fields), ``extra`` what it
     adds to ``result.extra``. Forces act on the wheel, contact frame.
+
+    ``compiled_law``: the law the compiled dynamics loop runs in place of :meth:`solve` (a name of
+    wheelset.layout.LAW_CODES: the same law on the same Hertz patch), None for a model the loop hands each patch to
+    through its callback. A subclass keeps its parent's law; a subclass that changes the tangential law sets None.
     """
 
     name = ""
     description = ""
+    compiled_law: str | None = None
     OPTIONS: dict = declare()
     SATURATING: bool | None = None
 
@@ -207,6 +212,7 @@ class HertzModel(HertzianModel):
     """Hertz normal contact only (seed eq 32-38); creep forces and spin moment 0.0."""
 
     name = "hertz"
+    compiled_law = "hertz"
     description = "Hertz normal contact only; creep forces 0"
 
     def tangential(self, hertz, creepage, material, opts):
@@ -230,6 +236,7 @@ class LinearModel(HertzianModel):
     """Hertz + Kalker's linear theory (full adhesion; seed eq 50-52)."""
 
     name = "linear"
+    compiled_law = "linear"
     description = "Hertz + Kalker's linear theory (full adhesion)"
     SATURATING = False
 
@@ -242,6 +249,7 @@ class VermeulenJohnsonModel(HertzianModel):
     """Hertz + linear theory saturated by Vermeulen-Johnson's cubic law (seed eq 53-58, cube)."""
 
     name = "vermeulen-johnson"
+    compiled_law = "vermeulen-johnson"
     description = "Hertz + Vermeulen-Johnson saturation (no spin)"
     SATURATING = True
 
@@ -271,6 +279,7 @@ class FastsimModel(HertzianModel):
     """
 
     name = "fastsim"
+    compiled_law = "fastsim"
     description = "Hertz + Kalker's FASTSIM (simplified theory)"
     SATURATING = True
     OPTIONS: dict = declare(
@@ -385,6 +394,7 @@ class AutoModel:
     """
 
     name = "auto"
+    compiled_law = "auto"
     description = "cheapest model meeting the tolerance for the patch"
     OPTIONS: dict = declare(
         Option("tolerance", float, 0.05, "accepted relative creep-force error", minimum=0, exclusive_minimum=True),

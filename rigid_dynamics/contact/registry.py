@@ -27,7 +27,12 @@ from rigid_dynamics.materials import Material
 
 @runtime_checkable
 class ContactModel(Protocol):
-    """What every contact model provides."""
+    """What every contact model provides.
+
+    A model may also declare ``compiled_law``: the name of the law the compiled dynamics loop runs in its place
+    (wheelset.layout.LAW_CODES; the registry's hertz, linear, vermeulen-johnson, fastsim and auto do); a model
+    without it (bem, fea, user models) gets each patch of the loop through the callback.
+    """
 
     name: str
     description: str

@@ -16,7 +16,31 @@ its linear contribution to Ty. No spin moment is produced.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def saturate_one(tx, ty, limit):
+    """(T_bar_x, T_bar_y) of linear forces (tx, ty) under the limit f N (eq 53-58) for one patch: the one
+    implementation (the batch :func:`vermeulen_johnson_saturation` and the compiled dynamics loop call it).
+    """
+    tt = math.hypot(tx, ty)
+    if tt > 0.0:
+        wprime = tt / (3.0 * limit) if limit > 0 else np.inf
+        one = max(1.0 - wprime, 0.0)
+        scale = limit * (1.0 - one**3) / tt
+        return tx * scale, ty * scale
+    return tx, ty
+
+
+@njit(cache=True)
+def _saturate_many(tx, ty, limit, out):
+    """:func:`saturate_one` over flat arrays into out (2, n)."""
+    for k in range(tx.shape[0]):
+        out[0, k], out[1, k] = saturate_one(tx[k], ty[k], limit[k])
 
 
 def vermeulen_johnson_saturation(
@@ -41,11 +65,7 @@ def vermeulen_johnson_saturation(
     )
     if np.any(n < 0) or np.any(f < 0):
         raise ValueError("normal_force_N and friction_coefficient: expected values >= 0")
-    t = np.hypot(tx, ty)
-    limit = f * n
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w = np.where(limit > 0, t / (3.0 * limit), np.inf)
-        one_minus = np.clip(1.0 - w, 0.0, None)
-        t_bar = limit * (1.0 - one_minus**3)
-        scale = np.where(t > 0, t_bar / t, 0.0)
-    return tx * scale, ty * scale
+    shape = tx.shape
+    out = np.empty((2, tx.size))
+    _saturate_many(*(np.ascontiguousarray(v, dtype=float).ravel() for v in (tx, ty, f * n)), out)
+    return out[0].reshape(shape), out[1].reshape(shape)

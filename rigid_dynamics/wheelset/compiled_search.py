@@ -35,6 +35,7 @@ A side without contact gets SearchProvider's placeholder in slot 0 (q = -smalles
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -46,9 +47,20 @@ from rigid_dynamics.contact._search_kernels import (
     refine_point,
     wheel_irregularity,
 )
+from rigid_dynamics.wheelset.layout import (
+    G_APPROACH,
+    G_CONTACT_ANGLE,
+    G_CURVATURE_LAT,
+    G_CURVATURE_LONG,
+    G_LEVER,
+    G_NORMAL,
+    G_ROLLING_RADIUS,
+    G_WHEEL_LATERAL,
+    N_GEO,
+)
 from rigid_dynamics.wheelset.providers.surfaces import MIN_LATERAL_CURVATURE_1_PER_M
+from rigid_dynamics.wheelset.state import ROLL, SPIN, YAW, X, Y, Z
 
-N_GEO = 12  # q, lever (3), normal (3), A, B, rolling radius, wheel lateral y_d, contact angle
 MAX_START = 8  # starts refined per side and evaluation
 MAX_MEMORY = 4  # candidates kept per side for the next evaluation
 ABSENT_GAP_M = 0.01  # providers.ABSENT_GAP_M
@@ -60,6 +72,37 @@ COS_STEEPEST = math.cos(math.radians(75.0))
     S_SCAN, S_GAP, S_NEWTON, S_ITER, S_TOL, S_RADIUS, S_MEMR, S_TRACK, S_AHALF, S_APTS,
 ) = range(21)  # fmt: skip
 SP_LEN = 21
+
+# columns of the candidates' scratch ``cand`` (2 MAX_START, 8): angle alpha, wheel lateral y_d, distance h, mark (the
+# lateral scan's gap, then the memory entry a start came from, then -1 when taken), the Hessian of h (h_aa, h_yy,
+# h_ay), merged (1: one interpenetration region with a deeper candidate)
+C_ALPHA, C_YD, C_H, C_MARK, C_H_AA, C_H_YY, C_H_AY, C_MERGED = range(8)
+# columns of the memory ``mem`` (2 sides, MAX_MEMORY, 7): the angle from the lowest point, y_d, h, the Hessian
+# (h_aa, h_yy, h_ay), merged
+M_ANGLE, M_YD, M_H, M_H_AA, M_H_YY, M_H_AY, M_MERGED = range(7)
+# rows of the vector scratch ``vb`` (12, 3) of patch_geometry: the wheel point, its tangents along alpha and y_d, the
+# second derivatives (aa, ay, yy; rows 1-5 reused for the rail's), the normal, the rolling-direction basis e1, e2,
+# and a local vector
+V_POINT, V_T_ALPHA, V_T_Y, V_X_AA, V_X_AY, V_X_YY, V_NORMAL, V_E1, V_E2 = range(9)
+V_LOCAL = 11
+
+
+class SearchArgs(NamedTuple):
+    """The search mode's record: the per-side parameters ``sp`` (2, SP_LEN), the profile tables and irregularity
+    rows of the four surfaces (wheel left, rail left, wheel right, rail right), the memory of the previous
+    evaluation (``mem``, ``n_mem``: warm starts, carried between calls) and scratch (``cand``, ``order``, ``vb``,
+    ``rot``).
+    """
+
+    sp: np.ndarray
+    tabs: tuple
+    irrs: tuple
+    mem: np.ndarray
+    n_mem: np.ndarray
+    cand: np.ndarray
+    order: np.ndarray
+    vb: np.ndarray
+    rot: np.ndarray
 
 
 @njit(cache=True, _nrt=False)
@@ -88,7 +131,7 @@ def _vertical_gap(cos_a, sin_a, r_irr, y_d, rot, centre, wheel, rail, rail_range
     """N(p_x, p_y) - p_z of the wheel point (alpha, y_d) (cos, sin of alpha and R_irr(alpha) given); +inf where
     the wheel or the rail is not defined.
     """
-    r = _table(y_d, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])[0]
+    r = _table(y_d, *wheel)[0]
     if not math.isfinite(r):
         return math.inf
     r += r_irr
@@ -97,7 +140,7 @@ def _vertical_gap(cos_a, sin_a, r_irr, y_d, rot, centre, wheel, rail, rail_range
     if not (py >= rail_range[0] and py <= rail_range[1]):
         return math.inf
     pz = rot[2, 0] * x0 + rot[2, 1] * y_d + rot[2, 2] * x2 + centre[2]
-    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0]
+    big_n = _table(py, *rail)[0]
     if rail_irr.shape[0] > 0:
         px = rot[0, 0] * x0 + rot[0, 1] * y_d + rot[0, 2] * x2 + centre[0]
         big_n += rail_irregularity(px, py, rail_irr, rail_map[0], rail_map[1])[0]
@@ -129,16 +172,18 @@ def _rot(rot, v, out):
 
 
 @njit(cache=True, _nrt=False)
-def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr, rail_map, right, vb, g):
-    """Geometry of the patch at the refined minimum (alpha, y_d) with distance h into g (N_GEO): search._patch's
-    point, normal and principal relative curvatures, on the tabulated surfaces. vb: scratch (12, 3).
+def patch_geometry(alpha, y_d, h, rot, centre, surfaces, vb, g):
+    """Geometry of the patch at the refined minimum (alpha, y_d) with distance h into g (layout.GEOMETRY_FIELDS):
+    search._patch's point, normal and principal relative curvatures, on the tabulated surfaces ``surfaces`` =
+    (wheel, rail, wheel irregularities, rail irregularities, rail map, right side). vb: scratch (12, 3).
     """
-    r, r_y, r_yy = _table(y_d, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
+    wheel, rail, wheel_irr, rail_irr, rail_map, right = surfaces
+    r, r_y, r_yy = _table(y_d, *wheel)
     v, r_a, r_aa = wheel_irregularity(alpha, wheel_irr)
     r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
-    loc = vb[11]
-    p, t_a, t_y, x_aa, x_ay, x_yy = vb[0], vb[1], vb[2], vb[3], vb[4], vb[5]
+    loc = vb[V_LOCAL]
+    p, t_a, t_y, x_aa, x_ay, x_yy = vb[V_POINT], vb[V_T_ALPHA], vb[V_T_Y], vb[V_X_AA], vb[V_X_AY], vb[V_X_YY]
     loc[0], loc[1], loc[2] = r * ca, y_d, r * sa
     _rot(rot, loc, p)
     loc[0], loc[1], loc[2] = r_a * ca - r * sa, 0.0, r_a * sa + r * ca
@@ -153,7 +198,7 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
     _rot(rot, loc, x_yy)
     for i in range(3):
         p[i] += centre[i]
-    n, e1, e2 = vb[6], vb[7], vb[8]
+    n, e1, e2 = vb[V_NORMAL], vb[V_E1], vb[V_E2]
     # n = -(t_y x t_a)/|.|: from the rail into the wheel
     n[0] = -(t_y[1] * t_a[2] - t_y[2] * t_a[1])
     n[1] = -(t_y[2] * t_a[0] - t_y[0] * t_a[2])
@@ -172,11 +217,11 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
     e2[1] = n[2] * e1[0] - n[0] * e1[2]
     e2[2] = n[0] * e1[1] - n[1] * e1[0]
     w11, w12, w22 = _tensor(t_a, t_y, x_aa, x_ay, x_yy, n, e1, e2)
-    big_n, n_y, n_yy = _table(qy, rail[0], rail[1], rail[2], rail[3], rail[4])
+    big_n, n_y, n_yy = _table(qy, *rail)
     _, n_x, vy, n_xx, n_xy, vyy = rail_irregularity(qx, qy, rail_irr, rail_map[0], rail_map[1])
     n_y += vy
     n_yy += vyy
-    du, dv, duu, duv, dvv = vb[1], vb[2], vb[3], vb[4], vb[5]  # reused for the rail
+    du, dv, duu, duv, dvv = vb[V_T_ALPHA], vb[V_T_Y], vb[V_X_AA], vb[V_X_AY], vb[V_X_YY]  # reused for the rail
     du[0], du[1], du[2] = 1.0, 0.0, n_x
     dv[0], dv[1], dv[2] = 0.0, 1.0, n_y
     duu[0], duu[1], duu[2] = 0.0, 0.0, n_xx
@@ -191,16 +236,17 @@ def patch_geometry(alpha, y_d, h, rot, centre, wheel, rail, wheel_irr, rail_irr,
         big_a, big_b = mean + half, mean - half
     else:
         big_a, big_b = mean - half, mean + half
-    g[0] = -h
-    g[1], g[2], g[3] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1], 0.5 * (p[2] + qz) - centre[2]
-    g[4], g[5], g[6] = n[0], n[1], n[2]
+    g[G_APPROACH] = -h
+    g[G_LEVER], g[G_LEVER + 1] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1]
+    g[G_LEVER + 2] = 0.5 * (p[2] + qz) - centre[2]
+    g[G_NORMAL], g[G_NORMAL + 1], g[G_NORMAL + 2] = n[0], n[1], n[2]
     # B floored as the profile section floors it (SearchProvider too): on the conformal arcs of a flange root and a
     # gauge corner of equal radius (S1002 / UIC60: 13 mm) the surface curvatures cancel and B is round-off
-    g[7], g[8] = max(big_a, 1e-6), max(big_b, MIN_LATERAL_CURVATURE_1_PER_M)
-    g[9] = r
-    g[10] = y_d
+    g[G_CURVATURE_LONG], g[G_CURVATURE_LAT] = max(big_a, 1e-6), max(big_b, MIN_LATERAL_CURVATURE_1_PER_M)
+    g[G_ROLLING_RADIUS] = r
+    g[G_WHEEL_LATERAL] = y_d
     tilt = -n[1] if right else n[1]
-    g[11] = math.atan2(tilt, -n[2])
+    g[G_CONTACT_ANGLE] = math.atan2(tilt, -n[2])
 
 
 @njit(cache=True, _nrt=False)
@@ -209,14 +255,14 @@ def _keep_lowest(cand, first, n, alpha, y_d, gap):
     highest gap when full). Returns the new n.
     """
     if n < MAX_START:
-        cand[first + n, 0], cand[first + n, 1], cand[first + n, 3] = alpha, y_d, gap
+        cand[first + n, C_ALPHA], cand[first + n, C_YD], cand[first + n, C_MARK] = alpha, y_d, gap
         return n + 1
     worst = first
     for j in range(first + 1, first + MAX_START):
-        if cand[j, 3] > cand[worst, 3]:
+        if cand[j, C_MARK] > cand[worst, C_MARK]:
             worst = j
-    if gap < cand[worst, 3]:
-        cand[worst, 0], cand[worst, 1], cand[worst, 3] = alpha, y_d, gap
+    if gap < cand[worst, C_MARK]:
+        cand[worst, C_ALPHA], cand[worst, C_YD], cand[worst, C_MARK] = alpha, y_d, gap
     return n
 
 
@@ -228,9 +274,9 @@ def _track(a, yd, memory, args, radius, limit, y_range):
     """
     d = 1.0e-5
     da = d / radius
-    h_aa, h_yy, h_ay = memory[3], memory[4], memory[5]
+    h_aa, h_yy, h_ay = memory[M_H_AA], memory[M_H_YY], memory[M_H_AY]
     det = h_aa * h_yy - h_ay * h_ay
-    h0 = distance(a, yd, *args, memory[2])
+    h0 = distance(a, yd, *args, memory[M_H])
     if not (math.isfinite(h0) and h_aa > 0 and det > 0):
         return a, yd, h0, False
     g_a = (distance(a + da, yd, *args, h0) - distance(a - da, yd, *args, h0)) / (2 * d)
@@ -245,15 +291,17 @@ def _track(a, yd, memory, args, radius, limit, y_range):
 
 
 @njit(cache=True, _nrt=False)
-def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg):
+def search_side(s, centre, spin, search, full, cg):
     """Candidates and patches of side s (0 left, 1 right) into cg rows 2 s, 2 s + 1; updates the memory
     mem[s] (MAX_MEMORY, 7: angle from the lowest point alpha - (pi/2 - phi), y_d, h, h_aa, h_yy, h_ay, merged) /
     n_mem[s]: the angle is kept relative to the lowest point, so that a warm start follows the wheel's rotation;
     the Hessian is the last refinement's; merged candidates (one interpenetration region with a deeper one) are
     kept as warm starts of the next scan, not tracked. cand: scratch (2 MAX_START, 8: alpha, y_d, h, mark,
     Hessian, merged; the second half holds the lateral scan's minima),
-    order: scratch (MAX_START,) int. Returns the number of starts that did not converge.
+    order: scratch (MAX_START,) int (all in the record ``search``, :class:`SearchArgs`). Returns the number of
+    starts that did not converge.
     """
+    sp, tabs, irrs, mem, n_mem, cand, order, vb, rot = search
     # (built here, not returned from a helper: these functions run without NRT reference counting, so no array may
     # be handed back to a caller that counts references)
     wheel = (sp[s, S_WLOW], sp[s, S_WSTEP], tabs[2 * s][0], tabs[2 * s][1], tabs[2 * s][2])
@@ -306,14 +354,14 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
         for i in range(n_h):
             new = True
             for j in range(MAX_START, MAX_START + n_vertical):
-                if abs(cand[j, 1] - cand[i, 1]) <= 1.5 * step:
+                if abs(cand[j, C_YD] - cand[i, C_YD]) <= 1.5 * step:
                     new = False
             if new:
-                n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, cand[i, 1], cand[i, 3])
+                n_y = _keep_lowest(cand, MAX_START, n_y, alpha_mid, cand[i, C_YD], cand[i, C_MARK])
         # at each lateral minimum, the minima over the angle (search_side's alpha grid: e.g. both edges of a flat)
         n_a, half = int(sp[s, S_APTS]), sp[s, S_AHALF]
         for j in range(MAX_START, MAX_START + n_y):
-            y_s = cand[j, 1]
+            y_s = cand[j, C_YD]
             g_prev2, g_prev = math.inf, math.inf
             for i in range(n_a + 1):
                 if i < n_a:
@@ -333,78 +381,88 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
         for j in range(n_start):
             best, dist = -1, sp[s, S_MEMR]
             for m in range(n_mem[s]):
-                d = max(abs(mem[s, m, 1] - cand[j, 1]), radius * abs(alpha_mid + mem[s, m, 0] - cand[j, 0]))
+                d = max(
+                    abs(mem[s, m, M_YD] - cand[j, C_YD]),
+                    radius * abs(alpha_mid + mem[s, m, M_ANGLE] - cand[j, C_ALPHA]),
+                )
                 if d < dist:
                     best, dist = m, d
-            cand[j, 3] = best
+            cand[j, C_MARK] = best
     else:
         for m in range(n_mem[s]):
-            cand[n_start, 3] = m
+            cand[n_start, C_MARK] = m
             n_start += 1
     failed = 0
     for j in range(n_start):
-        m = int(cand[j, 3])
-        cand[j, 7] = 0.0
-        if not full and mem[s, m, 6] > 0:
+        m = int(cand[j, C_MARK])
+        cand[j, C_MERGED] = 0.0
+        if not full and mem[s, m, M_MERGED] > 0:
             # merged into a deeper candidate's region at the last scan: carried to the next scan as a warm start
             for f in range(6):
                 cand[j, f if f < 3 else f + 1] = mem[s, m, f]
-            cand[j, 0] += alpha_mid
-            cand[j, 3], cand[j, 7] = -1.0, 1.0  # not a candidate of this evaluation
+            cand[j, C_ALPHA] += alpha_mid
+            cand[j, C_MARK], cand[j, C_MERGED] = -1.0, 1.0  # not a candidate of this evaluation
             continue
         tracked = False
         if m >= 0:
-            a, yd = alpha_mid + mem[s, m, 0], mem[s, m, 1]
+            a, yd = alpha_mid + mem[s, m, M_ANGLE], mem[s, m, M_YD]
             a, yd, h, tracked = _track(a, yd, mem[s, m], args, radius, sp[s, S_TRACK], y_range)
             if tracked:
-                cand[j, 4], cand[j, 5], cand[j, 6] = mem[s, m, 3], mem[s, m, 4], mem[s, m, 5]
+                cand[j, C_H_AA], cand[j, C_H_YY], cand[j, C_H_AY] = (
+                    mem[s, m, M_H_AA],
+                    mem[s, m, M_H_YY],
+                    mem[s, m, M_H_AY],
+                )
         else:
-            a, yd = cand[j, 0], cand[j, 1]
+            a, yd = cand[j, C_ALPHA], cand[j, C_YD]
         if not tracked:
             a, yd, ok, hs, h_aa, h_yy, h_ay = refine_point(
                 a, yd, *args, radius, int(sp[s, S_ITER]), sp[s, S_TOL], False
             )
             h = distance(a, yd, *args, hs)
-            cand[j, 4], cand[j, 5], cand[j, 6] = h_aa, h_yy, h_ay
+            cand[j, C_H_AA], cand[j, C_H_YY], cand[j, C_H_AY] = h_aa, h_yy, h_ay
             if not ok:
                 failed += 1
-        cand[j, 0], cand[j, 1], cand[j, 2] = a, yd, h
-        cand[j, 3] = 0.0  # not taken yet (the deduplication marks taken starts with -1)
+        cand[j, C_ALPHA], cand[j, C_YD], cand[j, C_H] = a, yd, h
+        cand[j, C_MARK] = 0.0  # not taken yet (the deduplication marks taken starts with -1)
     # deduplicate, deepest first (search_side): the same point, or one interpenetration region
     n_kept = 0
     for _ in range(n_start):
         best = -1
         for j in range(n_start):
-            if math.isfinite(cand[j, 2]) and cand[j, 3] != -1.0 and (best < 0 or cand[j, 2] < cand[best, 2]):
+            if math.isfinite(cand[j, C_H]) and cand[j, C_MARK] != -1.0 and (best < 0 or cand[j, C_H] < cand[best, C_H]):
                 best = j
         if best < 0:
             break
-        cand[best, 3] = -1.0  # taken
+        cand[best, C_MARK] = -1.0  # taken
         duplicate = False
         for i in range(n_kept):
             k = order[i]
-            if abs(cand[best, 1] - cand[k, 1]) < 1e-6 and abs(cand[best, 0] - cand[k, 0]) * radius < 1e-6:
+            if (
+                abs(cand[best, C_YD] - cand[k, C_YD]) < 1e-6
+                and abs(cand[best, C_ALPHA] - cand[k, C_ALPHA]) * radius < 1e-6
+            ):
                 duplicate = True
                 break
-            if full and cand[best, 2] < 0:  # (tracked candidates were separate regions at the last scan)
+            if full and cand[best, C_H] < 0:  # (tracked candidates were separate regions at the last scan)
                 # one interpenetration region when every wheel point of the joining segment (25 points, the middle
                 # first: the likeliest to show a gap) lies inside the rail: its vertical gap, which has the sign of
                 # its distance h along the normal, is negative (search_side tests h itself)
                 inside = True
                 for q in range(-1, 25):
                     t = 0.5 if q < 0 else q / 24.0
-                    a_t = cand[k, 0] + t * (cand[best, 0] - cand[k, 0])
+                    a_t = cand[k, C_ALPHA] + t * (cand[best, C_ALPHA] - cand[k, C_ALPHA])
                     gap = _vertical_gap(
                         math.cos(a_t), math.sin(a_t), wheel_irregularity(a_t, wheel_irr)[0],
-                        cand[k, 1] + t * (cand[best, 1] - cand[k, 1]), rot, centre, wheel, rail, rail_range, rail_irr,
-                        rail_map,
+                        cand[k, C_YD] + t * (cand[best, C_YD] - cand[k, C_YD]), rot, centre, wheel, rail, rail_range,
+                        rail_irr, rail_map,
                     )  # fmt: skip
                     if not gap < 0:
                         inside = False
                         break
                 if inside:
                     duplicate = True
-                    cand[best, 7] = 1.0  # merged: kept in the memory as a warm start only
+                    cand[best, C_MERGED] = 1.0  # merged: kept in the memory as a warm start only
                     break
         if not duplicate:
             order[n_kept] = best
@@ -413,13 +471,17 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
     n_mem[s] = 0
     for i in range(n_kept + n_start):
         k = order[i] if i < n_kept else i - n_kept
-        if i >= n_kept and cand[k, 7] != 1.0:
+        if i >= n_kept and cand[k, C_MERGED] != 1.0:
             continue
-        if cand[k, 2] < sp[s, S_GAP] and n_mem[s] < MAX_MEMORY:
-            mem[s, n_mem[s], 0], mem[s, n_mem[s], 1] = cand[k, 0] - alpha_mid, cand[k, 1]
-            mem[s, n_mem[s], 2] = cand[k, 2]
-            mem[s, n_mem[s], 3], mem[s, n_mem[s], 4], mem[s, n_mem[s], 5] = cand[k, 4], cand[k, 5], cand[k, 6]
-            mem[s, n_mem[s], 6] = cand[k, 7]
+        if cand[k, C_H] < sp[s, S_GAP] and n_mem[s] < MAX_MEMORY:
+            mem[s, n_mem[s], M_ANGLE], mem[s, n_mem[s], M_YD] = cand[k, C_ALPHA] - alpha_mid, cand[k, C_YD]
+            mem[s, n_mem[s], M_H] = cand[k, C_H]
+            mem[s, n_mem[s], M_H_AA], mem[s, n_mem[s], M_H_YY], mem[s, n_mem[s], M_H_AY] = (
+                cand[k, C_H_AA],
+                cand[k, C_H_YY],
+                cand[k, C_H_AY],
+            )
+            mem[s, n_mem[s], M_MERGED] = cand[k, C_MERGED]
             n_mem[s] += 1
     # patches: the two deepest (order is by depth), then by contact angle
     right = s == 1
@@ -427,68 +489,55 @@ def search_side(s, centre, rot, spin, sp, tabs, irrs, mem, n_mem, full, cand, or
     n_patch = 0
     for i in range(min(n_kept, 2)):
         k = order[i]
-        if cand[k, 2] < 0:
-            patch_geometry(
-                cand[k, 0],
-                cand[k, 1],
-                cand[k, 2],
-                rot,
-                centre,
-                wheel,
-                rail,
-                wheel_irr,
-                rail_irr,
-                rail_map,
-                right,
-                vb,
-                cg[c0 + n_patch],
-            )
+        if cand[k, C_H] < 0:
+            surfaces = (wheel, rail, wheel_irr, rail_irr, rail_map, right)
+            patch_geometry(cand[k, C_ALPHA], cand[k, C_YD], cand[k, C_H], rot, centre, surfaces, vb, cg[c0 + n_patch])
             n_patch += 1
-    if n_patch == 2 and cg[c1, 11] < cg[c0, 11]:
+    if n_patch == 2 and cg[c1, G_CONTACT_ANGLE] < cg[c0, G_CONTACT_ANGLE]:
         for f in range(N_GEO):
             cg[c0, f], cg[c1, f] = cg[c1, f], cg[c0, f]
     if n_patch == 0:
         gap = cand[order[0], 2] if n_kept > 0 else ABSENT_GAP_M
         sign = sp[s, S_SIGN]
         g = cg[c0]
-        g[0] = -gap
-        g[1], g[2], g[3] = 0.0, sign * 0.75, radius
-        g[4], g[5], g[6] = 0.0, 0.0, -1.0
-        g[7], g[8], g[9] = 0.5 / radius, 0.5 / 0.3, radius
-        g[10], g[11] = sign * 0.75, 0.0
+        g[G_APPROACH] = -gap
+        g[G_LEVER], g[G_LEVER + 1], g[G_LEVER + 2] = 0.0, sign * 0.75, radius
+        g[G_NORMAL], g[G_NORMAL + 1], g[G_NORMAL + 2] = 0.0, 0.0, -1.0
+        g[G_CURVATURE_LONG], g[G_CURVATURE_LAT], g[G_ROLLING_RADIUS] = 0.5 / radius, 0.5 / 0.3, radius
+        g[G_WHEEL_LATERAL], g[G_CONTACT_ANGLE] = sign * 0.75, 0.0
     if n_patch < 2:
-        cg[c1, 0] = math.nan
+        cg[c1, G_APPROACH] = math.nan
     return failed
 
 
 @njit(cache=True, _nrt=False)
-def search_geometry(y, sp, tabs, irrs, mem, n_mem, full, cand, order, vb, rot, cg):
-    """Both sides' patches at the state y into cg (4, N_GEO). Returns the number of unconverged refinements."""
-    rotation(y[3], y[4], y[5], rot)
-    failed = 0
-    for s in range(2):
-        failed += search_side(s, y[0:3], rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
-    return failed
-
-
-@njit(cache=True, _nrt=False)
-def search_geometry_on_track(
-    y, rail_left_m, rail_right_m, lateral_left_m, lateral_right_m, sp, tabs, irrs, mem, n_mem, full, cand, order,
-    vb, rot, cg, centre
-):  # fmt: skip
-    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels (left, right)
-    and moved laterally by its lateral displacements (left, right; 0 without the lateral track): each side is
-    searched at the wheelset centre raised by its rail's deflection and moved by minus its lateral displacement
-    (centre: a scratch 3-vector), and the levers (contact point - centre) are those of that pose (a rigid shift of
-    the rail).
+def search_geometry(y, search, full, cg):
+    """Both sides' patches at the state y into cg (4, N_GEO) by the search of the record ``search``
+    (:class:`SearchArgs`; ``full``: with the lateral scan). Returns the number of unconverged refinements.
     """
-    rotation(y[3], y[4], y[5], rot)
+    rotation(y[YAW], y[ROLL], y[SPIN], search.rot)
     failed = 0
     for s in range(2):
-        centre[0] = y[0]
-        centre[1] = y[1] - (lateral_left_m if s == 0 else lateral_right_m)
-        centre[2] = y[2] - (rail_left_m if s == 0 else rail_right_m)
-        failed += search_side(s, centre, rot, y[5], sp, tabs, irrs, mem, n_mem, full, cand, order, vb, cg)
+        failed += search_side(s, y[X : Z + 1], y[SPIN], search, full, cg)
+    return failed
+
+
+@njit(cache=True, _nrt=False)
+def search_geometry_on_track(y, rails, search, full, cg, centre):
+    """search_geometry with the rails lowered by the elastic track's rail deflections under the wheels and moved
+    laterally by its lateral displacements (``rails`` = (deflection left, right, lateral left, right), m; lateral 0
+    without the lateral track): each side is searched at the wheelset centre raised by its rail's deflection and
+    moved by minus its lateral displacement (centre: a scratch 3-vector), and the levers (contact point - centre)
+    are those of that pose (a rigid shift of the rail).
+    """
+    rail_left_m, rail_right_m, lateral_left_m, lateral_right_m = rails
+    rotation(y[YAW], y[ROLL], y[SPIN], search.rot)
+    failed = 0
+    for s in range(2):
+        centre[0] = y[X]
+        centre[1] = y[Y] - (lateral_left_m if s == 0 else lateral_right_m)
+        centre[2] = y[Z] - (rail_left_m if s == 0 else rail_right_m)
+        failed += search_side(s, centre, y[SPIN], search, full, cg)
     return failed
 
 
@@ -564,6 +613,18 @@ def pack_search(provider, options=None):
         irrs.append(np.ascontiguousarray(wheel.irregularity_rows, float).reshape(-1, 7))
         irrs.append(np.ascontiguousarray(rail.irregularity_rows, float).reshape(-1, 7))
     return sp, tuple(tabs), tuple(irrs)
+
+
+def search_args(provider, options=None) -> SearchArgs:
+    """The :class:`SearchArgs` of a SearchProvider (:func:`pack_search` and a fresh :func:`workspace`)."""
+    return SearchArgs(*pack_search(provider, options), *workspace())
+
+
+def no_search_args() -> SearchArgs:
+    """A :class:`SearchArgs` of the right types for the modes that do not search (never read)."""
+    tab = np.zeros((3, 2))
+    irr = np.zeros((0, 7))
+    return SearchArgs(np.zeros((2, SP_LEN)), (tab, tab, tab, tab), (irr, irr, irr, irr), *workspace())
 
 
 def workspace():

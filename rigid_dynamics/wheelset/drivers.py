@@ -1,8 +1,8 @@
 """The integrators over the right-hand side: scipy's adaptive ``OdeSolver`` methods stepped one step at a time
-(:func:`run_adaptive`, with the Jacobian of :func:`state_jacobian` for Radau and BDF), the fixed-step RK4 on the
-Python right-hand side (:func:`run_rk4`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
-DP54/BS32 with step-size control of compiled_adaptive.py), with the force error estimate and its check
-(:func:`force_error_check`).
+(:func:`run_scipy`, with the Jacobian of :func:`state_jacobian` for Radau and BDF, and the fixed-step RK4 as one more
+``OdeSolver``, :func:`_rk4_class`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
+DP54/BS32 with step-size control of compiled_loop.py, :func:`run_embedded`), with the force error estimate and its
+check (:func:`force_error_check`). Run statuses of the compiled codes: layout.STATUS.
 """
 
 from __future__ import annotations
@@ -10,11 +10,20 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from functools import cache
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import AUTO_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS, ContactFailure
-from rigid_dynamics.wheelset.equilibrium import COMPILED_STATUS, contact_force_sums
+from rigid_dynamics.wheelset.equilibrium import contact_force_sums
+from rigid_dynamics.wheelset.layout import (
+    AUTO_PATCH_FIELDS,
+    CALLBACK_FAILED,
+    MAX_SLOTS,
+    N_FIELDS,
+    PATCH_FIELDS,
+    UNDERFLOW,
+    status_name,
+)
 from rigid_dynamics.wheelset.recorder import Stop
 from rigid_dynamics.wheelset.state import (
     N_MECHANICAL,
@@ -29,6 +38,7 @@ from rigid_dynamics.wheelset.state import (
     track_positions,
     track_velocities,
 )
+from rigid_dynamics.wheelset.wheelset_model import ContactFailure
 
 ADAPTIVE_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -40,7 +50,7 @@ def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, se
     full-run peaks are not converged.
 
     The estimate is the contact-force difference between RK4 and its embedded third-order solution over the step
-    ending at each recorded sample (compiled.rk4_run, :func:`run_rk4`). On the embedded scenes it separates the
+    ending at each recorded sample (compiled_loop.rk4_run, :func:`run_scipy`). On the embedded scenes it separates the
     steps whose force results move by more than a few per cent of the static load from those that do not, where the
     contact-passage time against the step misses the creep-force bias of polygonal-wheel at 1 ms and step doubling
     underestimates it (benchmarks/results/step_sensitivity.md).
@@ -54,7 +64,7 @@ def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, se
     tol = settings.force_tolerance
     if settings.method == "RK4":
         advice, failed = f"reduce fixed_step_s = {settings.fixed_step_s:g} s", "the third-order state failed"
-    else:  # the embedded pairs of compiled_adaptive.py
+    else:  # the embedded pairs of compiled_loop.py
         advice = (
             f"tighten relative_tolerance = {settings.relative_tolerance:g} / absolute_tolerance = "
             f"{settings.absolute_tolerance:g}"
@@ -162,26 +172,122 @@ def state_jacobian(fun: Callable) -> Callable:
     return jac
 
 
-def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene) -> int:
+@cache
+def _rk4_class():
+    """:class:`RK4` (scipy imported only when a Python-side run needs it)."""
+    from scipy.integrate import DenseOutput, OdeSolver
+
+    class RK4Dense(DenseOutput):
+        """Cubic Hermite between the step's ends (derivatives k1 at the start and k4, the last stage, at the end)."""
+
+        def __init__(self, t_old, t, y_old, y, k1, k4):
+            super().__init__(t_old, t)
+            self.y_old, self.y, self.k1, self.k4 = y_old, y, k1, k4
+
+        def _call_impl(self, t):
+            h = self.t - self.t_old
+            s = (np.asarray(t) - self.t_old) / h
+            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+            return h00 * self.y_old + h10 * h * self.k1 + h01 * self.y + h11 * h * self.k4
+
+    class RK4(OdeSolver):
+        """The classical Runge-Kutta method of order 4 with a fixed step as a scipy ``OdeSolver``: the Python
+        right-hand side's RK4 runs through the same driver as scipy's methods (:func:`run_scipy`).
+
+        The step is ``step`` shortened to divide the interval into whole steps; t after n steps is t0 + n h. The
+        embedded third-order solution of the same stages and the derivative at the step's end, k5 = f(t + h, y4)
+        (the next step's k1), y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) (Hairer, Norsett & Wanner, Solving ODEs I,
+        2nd ed., II.4), is :meth:`third_order`: the force error estimate's second state. Dense output: cubic Hermite
+        between the step's ends with k1 and k4.
+        """
+
+        def __init__(self, fun, t0, y0, t_bound, step, vectorized=False, **extraneous):
+            super().__init__(fun, t0, y0, t_bound, vectorized)
+            self.n_steps = max(1, int(math.ceil((t_bound - t0) / step - 1e-9)))
+            self.h = (t_bound - t0) / self.n_steps
+            self.t_start = t0
+            self.steps_done = 0
+            self.k_next = None  # f at the current state once evaluated: the next step's k1
+            self.stages = None
+            self.y_old = None
+
+        def _step_impl(self):
+            h, t, y = self.h, self.t, self.y
+            k1 = self.k_next if self.k_next is not None else self.fun(t, y)
+            k2 = self.fun(t + 0.5 * h, y + 0.5 * h * k1)
+            k3 = self.fun(t + 0.5 * h, y + 0.5 * h * k2)
+            k4 = self.fun(t + h, y + h * k3)
+            self.y_old, self.stages, self.k_next = y, (k1, k2, k3, k4), None
+            self.steps_done += 1
+            self.y = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            self.t = self.t_start + self.steps_done * h
+            if self.steps_done == self.n_steps:
+                self.t_bound = self.t  # n h may round past or short of the interval's end: this is the end
+            return True, None
+
+        def derivative_at_end(self):
+            """The derivative f at the current state (evaluated once: it is the next step's k1)."""
+            if self.k_next is None:
+                self.k_next = self.fun(self.t, self.y)
+            return self.k_next
+
+        def third_order(self):
+            """The embedded third-order solution of the last step (one right-hand side: the next step's k1)."""
+            k1, k2, k3, _ = self.stages
+            k5 = self.derivative_at_end()
+            return self.y_old + self.h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k5 / 6.0)
+
+        def _dense_output_impl(self):
+            return RK4Dense(self.t_old, self.t, self.y_old, self.y, self.stages[0], self.stages[3])
+
+    return RK4
+
+
+def _force_error(model, solver) -> float:
+    """The force error estimate of the last RK4 step: the largest difference of the per-wheel contact forces at the
+    propagated state and at the embedded third-order one (inf when one cannot be evaluated), N.
+    """
+    y3 = solver.third_order()
+    try:
+        error = float(np.max(np.abs(contact_force_sums(model, solver.y) - contact_force_sums(model, y3))))
+    except (ContactFailure, ValueError, ArithmeticError):
+        error = math.inf
+    return math.inf if math.isnan(error) else error  # NaN: forces not computable at one of the two states
+
+
+def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
+    """The Python right-hand side ``fun`` stepped one step at a time by a scipy ``OdeSolver``: RK45, DOP853, Radau
+    (with :func:`state_jacobian`), BDF, LSODA, DP54 / BS32 off the compiled loop (scipy's RK45 / RK23), and RK4
+    (:class:`RK4`, fixed step). The samples at ``out_times`` come from the step's dense output (the step's end
+    itself when a sample falls on it).
+
+    RK4 also estimates its force error (as compiled_loop.rk4_run): every :func:`steps_between_checks` steps and at
+    a sample on the step's end, the contact forces at the propagated and at the embedded third-order state
+    (:func:`_force_error`, two extra contact evaluations); a sample on the step's end carries the estimate of that
+    step, other samples the largest of the checks since the previous sample. Samples are recorded (and checked for
+    anomalies) before the estimate is evaluated.
+    """
     from scipy import integrate
 
-    from rigid_dynamics.wheelset.compiled_adaptive import SCIPY_EQUIVALENT
+    from rigid_dynamics.wheelset.compiled_loop import SCIPY_EQUIVALENT
 
-    # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located contact switches
-    cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
+    fixed = settings.method == "RK4"
+    if fixed:
+        cls = _rk4_class()
+    else:  # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located switches
+        cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
     options = {"jac": state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
+    if fixed:
+        options = {"step": settings.fixed_step_s}
+    atol = tolerances(settings, model.scene)
     solver = cls(
-        fun,
-        0.0,
-        y0,
-        duration,
-        rtol=settings.relative_tolerance,
-        atol=tolerances(settings, scene),
-        max_step=settings.max_step_s,
-        **options,
+        fun, 0.0, y0, duration, rtol=settings.relative_tolerance, atol=atol, max_step=settings.max_step_s, **options
     )
+    check_every = steps_between_checks(settings, solver.h) if fixed else 0
     steps = 0
     next_out = 1
+    pending = math.nan
     while solver.status == "running":
         t_before = solver.t
         try:
@@ -204,22 +310,33 @@ def run_adaptive(fun, y0, duration, settings, out_times, recorder, report, scene
             exc = Stop("blow-up", f"non-finite state at t = {solver.t:.6g} s", solver.t, solver.y)
             exc.steps = steps
             raise exc
-        if next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
-            dense = solver.dense_output()
-            while next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12:
-                t_out = out_times[next_out]
-                try:
-                    recorder.record(t_out, dense(t_out) if t_out < solver.t else solver.y)
-                except Stop as stop:
-                    stop.steps = steps
-                    raise
-                next_out += 1
+        at_end = False
+        try:
+            if next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12 * max(1.0, duration):
+                dense = solver.dense_output()
+                h = solver.t - solver.t_old
+                while next_out < len(out_times) and out_times[next_out] <= solver.t + 1e-12 * max(1.0, duration):
+                    t_out = out_times[next_out]
+                    at_end = abs((t_out - solver.t_old) / h - 1.0) < 1e-9
+                    recorder.record(t_out, solver.y if at_end else dense(t_out), math.nan if at_end else pending)
+                    if not at_end:
+                        pending = math.nan
+                    next_out += 1
+            if fixed and (steps % check_every == 0 or at_end):
+                error = _force_error(model, solver)
+                pending = error if math.isnan(pending) else max(pending, error)
+        except Stop as stop:
+            stop.steps = steps
+            raise
+        if at_end and fixed:
+            recorder.set_last_error(pending)
+            pending = math.nan
         report(solver.t)
     return steps
 
 
 def patch_tables(model, block, sides, slots) -> dict:
-    """The compiled loops' records of a block of output samples (n, candidates + 2, compiled.N_FIELDS) as the
+    """The compiled loops' records of a block of output samples (n, candidates + 2, layout.N_FIELDS) as the
     recorder's per-patch tables: field -> (n, 2 sides, MAX_SLOTS), NaN where no candidate sits (PATCH_FIELDS, and
     AUTO_PATCH_FIELDS for ``auto``).
     """
@@ -232,66 +349,74 @@ def patch_tables(model, block, sides, slots) -> dict:
     return tables
 
 
-def run_compiled(model, packed, y0, duration, settings, recorder, report, start) -> int:
-    """RK4 in the compiled loop (compiled.rk4_run), in chunks so that wall time and progress are watched; the
-    embedded pairs with step-size control (``method`` "DP54" or "BS32") in compiled_adaptive.run_embedded.
+def _stop_from_status(model, status, t_end, y_end, method, steps, why=""):
+    """The :class:`Stop` of a compiled loop that ended with a status other than ok (layout.STATUS)."""
+    name = status_name(status)
+    if status == CALLBACK_FAILED and model.callback is not None:
+        why = f": {model.callback.message}"
+    message = f"compiled {method} stopped ({name}) at t = {t_end:.6g} s{why}"
+    stop = Stop(name, message, float(t_end), np.array(y_end[:12]))
+    stop.steps = steps
+    return stop
+
+
+def _watch(model, settings, start, t, y, steps):
+    """Raise "budget-exceeded" when the run's right-hand-side budget or wall time is spent."""
+    if model.rhs_evaluations >= settings.max_rhs_evaluations:
+        stop = Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
+    elif time.perf_counter() - start > settings.max_wall_time_s:
+        stop = Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
+    else:
+        return
+    stop.steps = steps
+    raise stop
+
+
+def _append_samples(model, recorder, outputs, k_out, k_new, times):
+    """The compiled loop's samples k_out..k_new-1 (at ``times``) to the recorder."""
+    ncand = len(model.packed.sides)
+    block = outputs.recs[k_out:k_new]
+    tables = patch_tables(model, block, model.packed.sides, model.packed.slots)
+    recorder.append_many(
+        times, outputs.states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy(), outputs.errs[k_out:k_new]
+    )
+
+
+def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
+    """RK4 in the compiled loop (compiled_loop.rk4_run), in chunks so that wall time and progress are watched; the
+    embedded pairs with step-size control (``method`` "DP54" or "BS32") in :func:`run_embedded`.
     """
-    from rigid_dynamics.wheelset import compiled, compiled_adaptive
+    from rigid_dynamics.wheelset.compiled_loop import PAIRS, Outputs, rk4_run
+    from rigid_dynamics.wheelset.compiled_rhs import use_callback
 
-    if settings.method in compiled_adaptive.PAIRS:
-        return compiled_adaptive.run_embedded(model, packed, y0, duration, settings, recorder, report, start)
-
-    par, hz, kk, sides, slots, mode, targs, sargs = packed
-    compiled.use_callback(model.callback)
+    if settings.method in PAIRS:
+        return run_embedded(model, y0, duration, settings, recorder, report, start)
+    run = model.packed
+    use_callback(model.callback)
     n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
     h = duration / n_steps
     out_every = max(1, int(round(settings.output_step_s / h)))
     check_every = steps_between_checks(settings, h)
     n_out = n_steps // out_every
-    ncand = len(sides)
-    states = np.zeros((n_out, len(y0)))
-    recs = np.zeros((n_out, ncand + 2, compiled.N_FIELDS))
-    errs = np.full(n_out, np.nan)
+    ncand = len(run.sides)
+    outputs = Outputs(
+        np.zeros(0), np.zeros((n_out, len(y0))), np.zeros((n_out, ncand + 2, N_FIELDS)), np.full(n_out, np.nan)
+    )
     y, t, done, k_out = y0.copy(), 0.0, 0, 0
     chunk = max(out_every, (2000 // out_every) * out_every)
     while done < n_steps:
         todo = min(chunk, n_steps - done)
-        status, did, k_new, t_end, y_end, evals = compiled.rk4_run(
-            y, t, h, todo, out_every, check_every, par, hz, kk, sides, mode, targs, sargs, states, recs, errs, k_out
-        )
-        model.rhs_evaluations += int(evals)
-        if k_new > k_out:
-            block = recs[k_out:k_new]
-            tables = patch_tables(model, block, sides, slots)
-            times = (done // out_every + np.arange(1, k_new - k_out + 1)) * out_every * h
-            recorder.append_many(
-                times, states[k_out:k_new], tables, block[:, ncand : ncand + 2, :3].copy(), errs[k_out:k_new]
-            )
-        k_out = k_new
-        if status != 0:
-            why = (
-                f": {model.callback.message}"
-                if status == compiled.CALLBACK_FAILED and model.callback is not None
-                else ""
-            )
-            stop = Stop(
-                COMPILED_STATUS[int(status)],
-                f"compiled RK4 stopped ({COMPILED_STATUS[int(status)]}) at t = {t_end:.6g} s{why}",
-                float(t_end),
-                np.array(y_end[:12]),
-            )
-            stop.steps = done + int(did)
-            raise stop
+        outcome = rk4_run(y, t, h, (todo, out_every, check_every), run, outputs, k_out)
+        model.rhs_evaluations += outcome.evaluations
+        if outcome.k_out > k_out:
+            times = (done // out_every + np.arange(1, outcome.k_out - k_out + 1)) * out_every * h
+            _append_samples(model, recorder, outputs, k_out, outcome.k_out, times)
+        k_out = outcome.k_out
+        if outcome.status != 0:
+            raise _stop_from_status(model, outcome.status, outcome.t, outcome.y, "RK4", done + outcome.accepted)
         done += todo
-        y, t = y_end, t_end
-        if model.rhs_evaluations >= settings.max_rhs_evaluations:
-            stop = Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
-            stop.steps = done
-            raise stop
-        if time.perf_counter() - start > settings.max_wall_time_s:
-            stop = Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
-            stop.steps = done
-            raise stop
+        y, t = outcome.y, outcome.t
+        _watch(model, settings, start, t, y, done)
         report(t)
     return n_steps
 
@@ -307,72 +432,156 @@ def steps_between_checks(settings, step_s: float) -> int:
     return max(1, min(out_every, int(round(FORCE_CHECK_INTERVAL_S / step_s))))
 
 
-def run_rk4(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
-    """Classical RK4 with a fixed step on the Python right-hand side ``fun``, output by cubic Hermite interpolation.
-
-    Force error estimate (as compiled.rk4_run): every :func:`steps_between_checks` steps the step is also advanced
-    by the embedded third-order formula, y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) with k5 = f(t + h, y4) (the next
-    step's k1), and the largest difference of the per-wheel contact forces at y4 and y3 is kept (two extra contact
-    evaluations per check). An output sample at the step's end carries the estimate of that step, other samples
-    the largest of the checks since the previous sample. The samples are recorded (and checked for anomalies)
-    before the estimate is evaluated; a third-order state whose contact cannot be evaluated gives an infinite one.
+def step_control(settings, scene, max_steps: int):
+    """The compiled_loop.StepControl of an embedded pair's run: atol per state (:func:`tolerances`) and its
+    weights (positions by atol alone: their values carry offsets, x and the spin angle grow along the track, z is
+    about r0; the rates by atol + rtol |y|; the work integrals, diagnostics, not controlled).
     """
-    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
-    h = duration / n_steps
-    check_every = steps_between_checks(settings, h)
-    y = y0.copy()
-    t = 0.0
-    next_out = 1
-    k1 = None
-    pending = math.nan
-    for i in range(n_steps):
+    from rigid_dynamics.wheelset.compiled_loop import EVENT_TIME_TOLERANCE_S, MIN_STEP_S, StepControl
+    from rigid_dynamics.wheelset.state import track_positions
+
+    atol = tolerances(settings, scene)
+    weight = np.full(len(atol), 2.0)  # 2: atol + rtol |y|
+    weight[POSITIONS] = 1.0  # 1: atol alone
+    weight[track_positions(len(atol))] = 1.0  # (absent on the rigid track)
+    weight[WORK] = 0.0  # diagnostics, not in the right-hand side
+    return StepControl(
+        settings.relative_tolerance, atol, weight, MIN_STEP_S, settings.max_step_s, EVENT_TIME_TOLERANCE_S, max_steps
+    )
+
+
+def initial_step(rhs, y0, control, k_order) -> float:
+    """The starting step of Hairer, Norsett & Wanner I, II.4 (algorithm of "Starting step size"), from two
+    right-hand sides ``rhs(t, y)``, under the compiled_loop.StepControl ``control``.
+    """
+    sc = control.atol + control.rtol * np.abs(y0)
+    on = control.weight > 0
+
+    def rms(v):
+        return float(np.sqrt(np.mean((v[on] / sc[on]) ** 2)))
+
+    f0 = rhs(0.0, y0)
+    d0, d1 = rms(y0), rms(f0)
+    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    h0 = min(h0, control.h_max)
+    f1 = rhs(h0, y0 + h0 * f0)
+    d2 = rms(f1 - f0) / h0
+    big = max(d1, d2)
+    h1 = max(1e-6, h0 * 1e-3) if big <= 1e-15 else (0.01 / big) ** (1.0 / k_order)
+    step = min(100.0 * h0, h1, control.h_max)
+    return step if np.isfinite(step) and step > 0 else 1e-6
+
+
+def side_events(events, sides):
+    """("wheel-lift" | "contact-restored", side, time_s) from the compiled loop's event log
+    (compiled_loop.EventLog): a side is in contact while any of its candidates is.
+    """
+    from rigid_dynamics.wheelset.providers import SIDES
+
+    n = int(events.count[0])
+    found = []
+    if n == 0:
+        return found
+    touching = [bool(np.any(events.masks[0][sides == s])) for s in range(2)]
+    for k in range(1, n):
+        for s in range(2):
+            now = bool(np.any(events.masks[k][sides == s]))
+            if now != touching[s]:
+                found.append(("contact-restored" if now else "wheel-lift", SIDES[s], float(events.times[k])))
+                touching[s] = now
+    return found
+
+
+def run_embedded(model, y0, duration, settings, recorder, report, start) -> int:
+    """An embedded pair with step-size control in the compiled loop (compiled_loop.embedded_run), in calls of
+    compiled_loop.STEPS_PER_CALL accepted steps so that wall time, budget and progress are watched. Records the
+    samples at the output times (multiples of output_step_s, and the end); the wheel-lift and contact-restored
+    events are the located switches (their times within compiled_loop.EVENT_TIME_TOLERANCE_S), not the samples'.
+    Sets ``model.adaptive_stats``. Returns the accepted steps.
+    """
+    from rigid_dynamics.wheelset.compiled_loop import (
+        MAX_EVENTS,
+        MIN_STEP_S,
+        PAIRS,
+        STEPS_PER_CALL,
+        Carried,
+        EventLog,
+        Outputs,
+        embedded_run,
+    )
+    from rigid_dynamics.wheelset.compiled_rhs import rhs_once, use_callback
+
+    scene, run = model.scene, model.packed
+    use_callback(model.callback)
+    tableau, _ = PAIRS[settings.method]
+    control = step_control(settings, scene, STEPS_PER_CALL)
+    ncand = len(run.sides)
+    n_out = int(math.floor(duration / settings.output_step_s + 1e-9))
+    out_times = settings.output_step_s * np.arange(1, n_out + 1)
+    if len(out_times) == 0 or out_times[-1] < duration - 1e-12:
+        out_times = np.append(out_times, duration)
+    outputs = Outputs(
+        out_times,
+        np.zeros((len(out_times), len(y0))),
+        np.zeros((len(out_times), ncand + 2, N_FIELDS)),
+        np.full(len(out_times), np.nan),
+    )
+    rec = np.zeros((ncand + 2, N_FIELDS))
+
+    def rhs(t, y):
+        out = np.zeros(len(y))
+        status = rhs_once(t, y, run, out, rec)
+        return out if status == 0 else np.full(len(y), np.nan)
+
+    h = initial_step(rhs, y0, control, tableau.k_order)
+    model.rhs_evaluations += 2
+    carried = Carried(np.array([1e-4, 0.0]), np.zeros((len(tableau.a), len(y0))), np.zeros(ncand, np.int64),
+                      np.zeros(ncand))  # fmt: skip
+    events = EventLog(np.zeros(MAX_EVENTS), np.zeros((MAX_EVENTS, ncand), np.int64), np.zeros(1, np.int64))
+    stats = {"accepted_steps": 0, "rejected_steps": 0, "located_switches": 0}
+    model.adaptive_stats = stats
+    y, t, k_out = y0.copy(), 0.0, 0
+
+    def events_to_recorder():
+        kept = [ev for ev in recorder.events if ev[0] not in ("wheel-lift", "contact-restored")]
+        recorder.events[:] = sorted(kept + side_events(events, run.sides), key=lambda ev: ev[2])
+
+    while True:
+        outcome = embedded_run(y, t, duration, h, tableau, control, run, outputs, k_out, carried, events)
+        model.rhs_evaluations += outcome.evaluations
+        stats["accepted_steps"] += outcome.accepted
+        stats["rejected_steps"] += outcome.rejected
+        stats["located_switches"] += outcome.located
         try:
-            k1 = fun(t, y) if k1 is None else k1
-            k2 = fun(t + 0.5 * h, y + 0.5 * h * k1)
-            k3 = fun(t + 0.5 * h, y + 0.5 * h * k2)
-            k4 = fun(t + h, y + h * k3)
+            if outcome.k_out > k_out:
+                _append_samples(model, recorder, outputs, k_out, outcome.k_out, out_times[k_out : outcome.k_out])
         except Stop as stop:
-            stop.steps = i
+            events_to_recorder()
+            stop.steps = stats["accepted_steps"]
             raise
-        y_new = y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        t_new = (i + 1) * h
-        at_end = False
-        while next_out < len(out_times) and out_times[next_out] <= t_new + 1e-12 * max(1.0, duration):
-            t_out = out_times[next_out]
-            # cubic Hermite between the step ends (derivatives k1 and f(t_new) approximated by k4)
-            s = (t_out - t) / h
-            if abs(s - 1.0) < 1e-9:
-                y_out, at_end = y_new, True
-            else:
-                h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-                h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-                y_out = h00 * y + h10 * h * k1 + h01 * y_new + h11 * h * k4
-            try:
-                recorder.record(t_out, y_out, math.nan if at_end else pending)
-            except Stop as stop:
-                stop.steps = i + 1
-                raise
-            if not at_end:
-                pending = math.nan
-            next_out += 1
-        k_next = None
-        if (i + 1) % check_every == 0 or at_end:
-            try:
-                k_next = fun(t_new, y_new)
-            except Stop as stop:
-                stop.steps = i + 1
-                raise
-            y3 = y + h * (k1 / 6.0 + k2 / 3.0 + k3 / 3.0 + k_next / 6.0)
-            try:
-                error = float(np.max(np.abs(contact_force_sums(model, y_new) - contact_force_sums(model, y3))))
-            except (ContactFailure, ValueError, ArithmeticError):
-                error = math.inf
-            if math.isnan(error):  # forces not computable at one of the two states
-                error = math.inf
-            pending = error if math.isnan(pending) else max(pending, error)
-        if at_end:
-            recorder.set_last_error(pending)
-            pending = math.nan
-        y, t, k1 = y_new, t_new, k_next
+        k_out = outcome.k_out
+        if outcome.status != 0:
+            events_to_recorder()
+            why = ""
+            if outcome.status == UNDERFLOW:
+                last = outcome.last_failure
+                why = (
+                    f": the step fell below {MIN_STEP_S:g} s"
+                    + (f" after a failed stage ({status_name(last)})" if last else "")
+                    + f" (relative_tolerance = {control.rtol:g}, absolute_tolerance = {settings.absolute_tolerance:g})"
+                )
+            raise _stop_from_status(
+                model, outcome.status, outcome.t, outcome.y, settings.method, stats["accepted_steps"], why
+            )
+        y, t, h = outcome.y, outcome.t, outcome.h
+        if t >= duration - 1e-12 * max(1.0, duration):
+            break
+        try:
+            _watch(model, settings, start, t, y, stats["accepted_steps"])
+        except Stop:
+            events_to_recorder()
+            raise
         report(t)
-    return n_steps
+    events_to_recorder()
+    report(t)
+    return stats["accepted_steps"]

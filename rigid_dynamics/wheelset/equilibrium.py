@@ -7,12 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import MAX_SLOTS, ContactFailure, WheelsetModel
+from rigid_dynamics.wheelset.layout import MAX_SLOTS
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.state import TRACK
-
-COMPILED_STATUS = {1: "blow-up", 2: "force-anomaly", 3: "derailed", 4: "contact-failed", 5: "contact-failed"}
-"""Status codes of the compiled loop (compiled.rk4_run) -> run statuses."""
+from rigid_dynamics.wheelset.wheelset_model import ContactFailure, WheelsetModel
 
 
 def initial_state(scene: DynamicsScene) -> np.ndarray:
@@ -101,7 +99,7 @@ def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deep
 def _rail_forces(model: WheelsetModel, state: np.ndarray, derivative) -> np.ndarray:
     """Vertical contact force on each rail (left, right; then the lateral ones with the lateral track) at a 12-state
     on ``track_rest``, N, from the track acceleration the right-hand side gives (at rest b F = M q'' + K q:
-    track.TrackSystem.rail_forces_at_rest).
+    track_matrices.TrackSystem.rail_forces_at_rest).
     """
     d = derivative(0.0, model.full_state(state))
     return model.track_system.rail_forces_at_rest(model.track_rest, d[TRACK])

@@ -195,9 +195,9 @@ def creep_coefficients(scene: DynamicsScene, contact_model=None, provider=None) 
     from dataclasses import replace
 
     from rigid_dynamics.contact.types import ContactGeometry, Creepage
-    from rigid_dynamics.wheelset.equations import WheelsetModel
     from rigid_dynamics.wheelset.parameters import InitialConditions
     from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, initial_state
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     centred = replace(scene, initial=InitialConditions())
     provider = provider if provider is not None else build_provider(centred)

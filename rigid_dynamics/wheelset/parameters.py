@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass, field, fields
 
 from rigid_dynamics.materials import STEEL, Material
+from rigid_dynamics.wheelset.fields import check_finite
 from rigid_dynamics.wheelset.track import TrackDynamics
 
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
@@ -23,24 +24,6 @@ INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4", "DP54", "BS32")
 """scipy.integrate.solve_ivp methods plus the fixed-step classical Runge-Kutta method ``RK4``."""
 
 IRREGULARITY_SIDES = ("both", "left", "right")
-
-
-def _check_finite(obj, *, positive=(), nonnegative=()) -> None:
-    """Check that all float/int fields are finite, and the named ones > 0 or >= 0."""
-    for f in fields(obj):
-        value = getattr(obj, f.name)
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            continue
-        if not math.isfinite(value):
-            raise ValueError(f"{f.name} = {value!r}: expected a finite number")
-    for name in positive:
-        value = getattr(obj, name)
-        if not value > 0:
-            raise ValueError(f"{name} = {value!r}: expected a number > 0")
-    for name in nonnegative:
-        value = getattr(obj, name)
-        if not value >= 0:
-            raise ValueError(f"{name} = {value!r}: expected a number >= 0")
 
 
 @dataclass(frozen=True)
@@ -71,7 +54,7 @@ class WheelsetParameters:
     suspension_half_spacing_m: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_finite(self, positive=[f.name for f in fields(self)])
+        check_finite(self, positive=[f.name for f in fields(self)])
 
 
 @dataclass(frozen=True)
@@ -101,7 +84,7 @@ class SuspensionParameters:
     yaw_damping_N_m_s_per_rad: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_finite(self, nonnegative=[f.name for f in fields(self)])
+        check_finite(self, nonnegative=[f.name for f in fields(self)])
 
     @property
     def is_damped(self) -> bool:
@@ -123,7 +106,7 @@ class LoadParameters:
     traction_torque_N_m: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_finite(self, nonnegative=["axle_load_N"])
+        check_finite(self, nonnegative=["axle_load_N"])
 
 
 @dataclass(frozen=True)
@@ -180,7 +163,7 @@ class TrackGeometry:
     cant_reference_width_m: float = 1.5
 
     def __post_init__(self) -> None:
-        _check_finite(
+        check_finite(
             self,
             positive=[
                 "rail_head_radius_m",
@@ -312,7 +295,7 @@ class Harmonic:
     phase_rad: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_finite(self, nonnegative=["amplitude_m"])
+        check_finite(self, nonnegative=["amplitude_m"])
         if isinstance(self.order, bool) or not isinstance(self.order, int) or self.order < 1:
             raise ValueError(f"order = {self.order!r}: expected an integer >= 1")
 
@@ -370,7 +353,7 @@ class Irregularities:
     joint_entry_rounding_m: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_finite(
+        check_finite(
             self,
             positive=["joint_ramp_length_m", "joint_rounding_m", "joint_entry_rounding_m"],
             nonnegative=[
@@ -416,7 +399,7 @@ class IntegratorSettings:
     Attributes:
         method: one of RK45, DOP853, Radau, BDF, LSODA (scipy.integrate), RK4 (fixed step), or DP54 / BS32 (the
             embedded pairs Dormand-Prince 5(4) / Bogacki-Shampine 3(2) with step-size control in the compiled loop,
-            compiled_adaptive.py; scipy's RK45 / RK23 where the scene does not run compiled).
+            compiled_loop.py; scipy's RK45 / RK23 where the scene does not run compiled).
         relative_tolerance, absolute_tolerance: error tolerances of the adaptive methods.
         fixed_step_s: step of RK4, s.
         max_step_s: largest step of the adaptive methods, s.
@@ -429,7 +412,7 @@ class IntegratorSettings:
         stop_at_wheel_lift: end the run (status "wheel-lift") when a wheel loses contact.
         force_tolerance: RK4 and the compiled DP54/BS32: the largest accepted force error estimate of a step (the
             per-wheel normal, longitudinal and lateral creep force of RK4 against its embedded third-order solution,
-            drivers.py; of a pair's solution against its embedded lower-order one, compiled_adaptive.py),
+            drivers.py; of a pair's solution against its embedded lower-order one, compiled_loop.py),
             relative to the static wheel load, over the samples after the scene's settling distance (the start-up
             before it is reported apart); a run that finishes above it ends with status "warning". The default
             0.02 passes the embedded scenes at their own steps and flags the coarser steps at which their force
@@ -455,7 +438,7 @@ class IntegratorSettings:
     lift_half_step_check: bool = True
 
     def __post_init__(self) -> None:
-        _check_finite(
+        check_finite(
             self,
             positive=[
                 "force_tolerance",
@@ -502,7 +485,7 @@ class InitialConditions:
     free_rolling: bool = True
 
     def __post_init__(self) -> None:
-        _check_finite(self)
+        check_finite(self)
         if abs(self.yaw_rad) > 0.2:
             raise ValueError(f"yaw_rad = {self.yaw_rad!r}: expected |value| <= 0.2")
 
@@ -552,7 +535,7 @@ class DynamicsScene:
     initial: InitialConditions = field(default_factory=InitialConditions)
 
     def __post_init__(self) -> None:
-        _check_finite(
+        check_finite(
             self, positive=["speed_m_per_s", "duration_s", "contact_tolerance"], nonnegative=["settling_distance_m"]
         )
         if self.contact_provider not in CONTACT_PROVIDERS:

@@ -9,10 +9,11 @@ import math
 
 import numpy as np
 
-from rigid_dynamics.wheelset.equations import AUTO_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS, WheelsetModel
+from rigid_dynamics.wheelset.layout import AUTO_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES
 from rigid_dynamics.wheelset.state import TRACK
+from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
 NUMERICAL_ERRORS = (ValueError, ArithmeticError, np.linalg.LinAlgError)
 """Exceptions that the static equilibrium or the integration can raise from below for numerical trouble: turned
@@ -246,7 +247,7 @@ class Recorder:
         )
 
     def _summary(self, full_states: np.ndarray) -> np.ndarray:
-        """What the run records of the track at full states (n, n_state): track.TrackSystem.summary."""
+        """What the run records of the track at full states (n, n_state): track_matrices.TrackSystem.summary."""
         system = self.model.track_system
         xi = full_states[:, 0] - self.model.frame_x0 + system.start_position_m()
         return system.summary(full_states[:, TRACK], xi)

@@ -41,7 +41,7 @@ class SimulationResult:
         states: the 12 states (STATE_NAMES) at the output times, shape (n, 12).
         patches: PATCH_FIELDS -> array (n, 2 sides [left, right], 2 slots [tread, flange/second]);
             NaN where a candidate does not exist or is not in contact (normal_force_N is 0 there); with
-            contact_model "auto" also AUTO_PATCH_FIELDS (equations.py: the rung chosen per patch and why).
+            contact_model "auto" also AUTO_PATCH_FIELDS (layout.py: the rung chosen per patch and why).
         contact_force_N: sum of the contact forces on each wheel, main frame, shape (n, 2, 3).
         kinetic_energy_J, potential_energy_J: T and V_g = -m g z at the output times, (n,); with the elastic track
             they include the track masses' kinetic energy and the pad and ballast springs' energy.
@@ -50,8 +50,8 @@ class SimulationResult:
             that on wheel and rail together and the exterior work includes the track dampers'.
         track_states: what the run records of the elastic track at the output times, named by
             ``track_state_names`` (z down): the lumped track's 8 states (state.TRACK_STATE_NAMES), or the beam's
-            rail deflection and velocity under each wheel (track.BEAM_SUMMARY_NAMES); with the lateral track its
-            states too (state.LATERAL_STATE_NAMES); None for the rigid track.
+            rail deflection and velocity under each wheel (track_matrices.BEAM_SUMMARY_NAMES); with the lateral track
+            its states too (state.LATERAL_STATE_NAMES); None for the rigid track.
         track_state_names: the names of ``track_states``' columns.
         track_full_states: every state of the elastic track at the output times (n, k) (the beam's modes and rail
             seats: track.BeamLayout); None for the rigid track.
@@ -60,7 +60,7 @@ class SimulationResult:
             recording), s; loading the compiled code from numba's cache (once per process, ~0.1 s) is not counted.
         failure_time_s, failure_state: where the run ended abnormally (None when it did not).
         provider, contact_model, method: what was used; compiled: whether the compiled loop ran it (RK4, or DP54/BS32:
-            compiled_adaptive.py).
+            compiled_loop.py).
         force_error_estimate: RK4 runs: per output sample, the estimated error of one step in the per-wheel contact
             forces (normal, longitudinal and lateral creep force) divided by the static wheel load, (n,); NaN where
             no step ends at the sample (t = 0, interpolated samples); compiled DP54/BS32 runs: per output sample,

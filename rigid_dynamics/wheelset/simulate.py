@@ -13,7 +13,7 @@ and after every step the state is checked. The implicit Radau and BDF get the Ja
 ``state_jacobian`` (exact kinematic rows, fixed finite-difference steps) instead of scipy's own.
 ``RK4`` is the classical fourth-order Runge-Kutta method with a fixed step (Butcher 1987 tableau:
 c = (0, 1/2, 1/2, 1), b = (1/6, 1/3, 1/3, 1/6)). ``DP54`` and ``BS32`` are the embedded pairs Dormand-Prince 5(4)
-and Bogacki-Shampine 3(2) with step-size control inside the compiled loop (compiled_adaptive.py: PI controller,
+and Bogacki-Shampine 3(2) with step-size control inside the compiled loop (compiled_loop.py: PI controller,
 dense output at the output times, contact onset and loss located within the step and reported as the events'
 times); a scene the compiled loop cannot run takes scipy's RK45 / RK23 (the same pairs) on the Python path.
 
@@ -26,7 +26,7 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 * ``"contact-failed"``: a contact model failed or the creepages became undefined (rolling speed 0);
 * ``"solver-failed"``: the adaptive solver could not continue (step size too small), or a numerical exception
   was raised below the driver (:data:`NUMERICAL_ERRORS`, e.g. the curvature code for a huge stiffness with RK4);
-* ``"step-size-underflow"``: DP54/BS32 in the compiled loop needed a step below compiled_adaptive.MIN_STEP_S;
+* ``"step-size-underflow"``: DP54/BS32 in the compiled loop needed a step below compiled_loop.MIN_STEP_S;
 * ``"budget-exceeded"``: more than ``max_rhs_evaluations`` evaluations or ``max_wall_time_s``;
 * ``"wheel-lift"``: a wheel lost contact and ``stop_at_wheel_lift`` is set;
 * ``"invalid-initial-state"``: no static equilibrium was found for the initial state (also when its search
@@ -52,8 +52,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_adaptive, run_compiled, run_rk4
-from rigid_dynamics.wheelset.equations import ContactFailure, WheelsetModel
+from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_compiled, run_scipy
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import ConicalProvider, TableProvider
@@ -66,6 +65,7 @@ from rigid_dynamics.wheelset.results import (
     timeseries_arrays,
 )
 from rigid_dynamics.wheelset.stability import NUMERICAL_LOOKING, judge_fixed_step, rk4_stable_step
+from rigid_dynamics.wheelset.wheelset_model import ContactFailure, WheelsetModel
 
 __all__ = [
     "ADAPTIVE_METHODS",
@@ -158,7 +158,7 @@ def simulate(
         provider: optional provider instance overriding the scene's ``contact_provider`` (e.g. a
             prebuilt TableProvider reused across runs).
         contact_model: optional model instance or registered name overriding ``scene.contact_model``.
-        compiled: use the compiled RK4 loop (rigid_dynamics.wheelset.compiled) when it supports the run
+        compiled: use the compiled loop (rigid_dynamics.wheelset.compiled_loop) when it supports the run
             (None: whenever it does; False: never; True: required, ValueError if unsupported).
 
     Raises:
@@ -166,12 +166,12 @@ def simulate(
     """
     provider = provider if provider is not None else build_provider(scene)
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
-    from rigid_dynamics.wheelset import compiled as _compiled
-    from rigid_dynamics.wheelset import compiled_adaptive as _adaptive
+    from rigid_dynamics.wheelset.compiled_loop import PAIRS
+    from rigid_dynamics.wheelset.compiled_records import geometry_mode, load, supported
+    from rigid_dynamics.wheelset.layout import GEOMETRY_SEARCH
 
-    embedded = scene.integrator.method in _adaptive.PAIRS
-    supported = _adaptive.supported if embedded else _compiled.supported
-    can_compile = supported(scene, provider, model_obj)
+    embedded = scene.integrator.method in PAIRS
+    can_compile = supported(scene, provider)
     if compiled and not can_compile:
         raise ValueError(
             "compiled = True: the compiled loop needs method RK4, DP54 or BS32 and a TableProvider or a "
@@ -181,15 +181,14 @@ def simulate(
     options = model_options(getattr(model_obj, "name", ""), scene)
     # the compiled 3-D search tracks its contact points between RK4 stages: outside the compiled loop (and for the
     # finite-difference Jacobian of the stability check) the contact package's search gives the geometry
-    search_in_python = _compiled.geometry_mode(provider) == 1
+    search_in_python = geometry_mode(provider) == GEOMETRY_SEARCH
     model = WheelsetModel(scene, provider, model_obj, options, python_geometry=search_in_python and not use_compiled)
     settings = scene.integrator
     duration = scene.duration_s
     packed = model.packed
     if use_compiled:
-        _compiled.load(packed)  # the compiled code (from numba's cache) is loaded before the clock starts
-        if embedded:
-            _adaptive.load(packed, settings, scene)
+        # the compiled code (from numba's cache) is loaded before the clock starts
+        load(packed, PAIRS[settings.method][0] if embedded else None)
     start = time.perf_counter()
     recorder = Recorder(model, scene)
     status, message, fail_t, fail_state = "ok", "", None, None
@@ -200,7 +199,7 @@ def simulate(
     except NUMERICAL_ERRORS as exc:  # e.g. a tiny shear modulus: the wheel sinks until the curvatures turn negative
         state0, ok, why = initial_state(scene), False, f"{type(exc).__name__}: {exc}"
     model.frame_x0 = float(state0[0])
-    packed[0]["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
+    packed.par["frame_x0_m"] = model.frame_x0  # the suspension frame starts where the wheelset does
     model.rhs_evaluations = 0
     full0 = model.full_state(state0)
     last_fraction = [-1.0]
@@ -251,11 +250,9 @@ def simulate(
         recorder.record(0.0, full0)
         next_out = 1
         if use_compiled:
-            steps = run_compiled(model, packed, full0, duration, settings, recorder, report, start)
-        elif settings.method == "RK4":
-            steps = run_rk4(fun, full0, duration, settings, out_times, recorder, report, model)
+            steps = run_compiled(model, full0, duration, settings, recorder, report, start)
         else:
-            steps = run_adaptive(fun, full0, duration, settings, out_times, recorder, report, scene)
+            steps = run_scipy(fun, full0, duration, settings, out_times, recorder, report, model)
         message = f"reached t = {duration:g} s"
         stats = getattr(model, "adaptive_stats", None)
         if use_compiled and embedded and stats:

@@ -114,7 +114,7 @@ def rk4_stable_step(
 ) -> StepLimit:
     """The RK4 stability limit of ``y' = fun(y)`` linearised at ``y`` (module docstring). ``jac(fun, y)``: the
     Jacobian if not :func:`jacobian` (e.g. one that uses the structure of the state,
-    equations.WheelsetModel.state_jacobian).
+    wheelset_model.WheelsetModel.state_jacobian).
     """
     eigenvalues = _largest_eigenvalues((jac or jacobian)(fun, y))
     best = StepLimit(math.inf, 0.0, 1.0, 0j)

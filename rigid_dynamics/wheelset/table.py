@@ -7,7 +7,7 @@ Columns (units in the names, SI):
   position of the centre of mass and Euler angles in the track frame);
 * per wheel ``left`` / ``right`` and contact slot ``tread`` (first patch) / ``second`` (flange or second point):
   ``<side>_<slot>_<quantity>`` for every recorded patch quantity
-  (:data:`~rigid_dynamics.wheelset.equations.PATCH_FIELDS`, forces on the wheel in the patch's contact frame),
+  (:data:`~rigid_dynamics.wheelset.layout.PATCH_FIELDS`, forces on the wheel in the patch's contact frame),
   e.g. ``left_tread_normal_force_N``; NaN where the slot is not in contact;
 * ``<side>_wheel_contact_force_<x|y|z>_N``: sum of the contact forces on that wheel, track frame
   (x along the track, y to the right, z down);

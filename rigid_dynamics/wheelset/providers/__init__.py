@@ -18,7 +18,7 @@ wheel lift can be detected). Providers here:
 * :class:`ProfileSectionProvider` — a 2-D profile section of real profiles, the section sampled by the tables.
 
 Files: patches.py (PatchSet, the protocol, SIDES), conical.py, tables.py (both add the running-direction
-irregularities by the compiled section of the dynamics, compiled._irregularity), surfaces.py (wheel and rail
+irregularities by the compiled section of the dynamics, compiled_tables._irregularity), surfaces.py (wheel and rail
 surfaces from the scene), profile_section.py, search.py.
 """
 

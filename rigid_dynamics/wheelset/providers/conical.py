@@ -109,28 +109,29 @@ class ConicalProvider:
         return patches
 
     def _add_irregularities(self, patches: PatchSet, spin_rad: float) -> None:
-        """The running-direction irregularities by the compiled section of the dynamics (compiled._irregularity:
+        """The running-direction irregularities by the compiled section of the dynamics (compiled_tables._irregularity:
         the wheel point at beta from the lowest point, the extra overlap maximised over beta, projected on the normal;
         the normal tilted by N_irr'; A from the polar curvature of r(beta), floored for a concave flat).
         """
-        from rigid_dynamics.wheelset import compiled
+        from rigid_dynamics.wheelset import layout as lay
+        from rigid_dynamics.wheelset.compiled_tables import irregular_candidates, irregularity_parameters
 
         if getattr(self, "_par", None) is None:
-            self._par = compiled.new_parameters()
-            compiled.irregularity_parameters(self._par, self.irregularities, self._irr_sides, self.r0)
+            self._par = lay.new_parameters()
+            irregularity_parameters(self._par, self.irregularities, self._irr_sides, self.r0)
         n = len(patches)
-        work = np.zeros((9, n))
-        work[0] = patches.approach_m
-        work[4], work[5] = patches.normal[:, 1], patches.normal[:, 2]
-        work[6], work[8] = patches.curvature_long_1_per_m, patches.rolling_radius_m
-        geo = np.empty((n, 8))
+        work = np.zeros((lay.N_TABLE_ROWS, n))
+        work[lay.T_APPROACH] = patches.approach_m
+        work[lay.T_NORMAL_Y], work[lay.T_NORMAL_Z] = patches.normal[:, 1], patches.normal[:, 2]
+        work[lay.T_CURVATURE_LONG] = patches.curvature_long_1_per_m
+        work[lay.T_ROLLING_RADIUS] = patches.rolling_radius_m
+        geo = np.empty((n, lay.N_SECTION))
         sides = np.asarray(patches.side, np.int64)
-        compiled.irregular_candidates(
-            self._par, work, sides, np.ascontiguousarray(patches.point_m[:, 0]), spin_rad, geo
-        )
-        for k in np.flatnonzero(~np.isnan(geo[:, 0])):
-            patches.approach_m[k] = geo[k, 0]
-            patches.point_m[k, 0] += geo[k, 1]
-            patches.point_m[k, 2] += geo[k, 2]
-            patches.normal[k] = geo[k, 3:6]
-            patches.rolling_radius_m[k], patches.curvature_long_1_per_m[k] = geo[k, 6], geo[k, 7]
+        irregular_candidates(self._par, work, sides, np.ascontiguousarray(patches.point_m[:, 0]), spin_rad, geo)
+        for k in np.flatnonzero(~np.isnan(geo[:, lay.I_APPROACH])):
+            patches.approach_m[k] = geo[k, lay.I_APPROACH]
+            patches.point_m[k, 0] += geo[k, lay.I_OFFSET_X]
+            patches.point_m[k, 2] += geo[k, lay.I_OFFSET_Z]
+            patches.normal[k] = geo[k, lay.I_NORMAL_X : lay.I_NORMAL_Z + 1]
+            patches.rolling_radius_m[k] = geo[k, lay.I_ROLLING_RADIUS]
+            patches.curvature_long_1_per_m[k] = geo[k, lay.I_CURVATURE_LONG]

@@ -63,6 +63,22 @@ class SearchProvider:
         self.r0 = wheelset.nominal_radius_m
         self.searches = 0
 
+    def compiled_geometry(self) -> int:
+        """How the compiled right-hand side gets this provider's geometry: its own 3-D search
+        (layout.GEOMETRY_SEARCH, compiled_search.py) when every surface is tabulated (ideal profiles with polygon,
+        flats or corrugation), else from this provider's :meth:`patches` (layout.GEOMETRY_GIVEN: measured grids,
+        harmonics).
+        """
+        from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
+        from rigid_dynamics.wheelset.layout import GEOMETRY_GIVEN, GEOMETRY_SEARCH
+
+        fast = getattr(self.surfaces, "fast", None)
+        if fast is not None and all(
+            isinstance(w, TabulatedWheel) and isinstance(r, TabulatedRail) for w, r in fast.values()
+        ):
+            return GEOMETRY_SEARCH
+        return GEOMETRY_GIVEN
+
     def patches(self, centre_m, yaw_rad, roll_rad, spin_rad=0.0) -> PatchSet:
         key = np.array([*np.asarray(centre_m, float)[:3], yaw_rad, roll_rad, spin_rad], float)
         if self._last is not None:

@@ -1,6 +1,6 @@
 """Contact-geometry tables over lateral shift and roll for ideal geometry (:class:`TableProvider`), with the
 running-direction irregularities added per pose; evaluated by the compiled look-up of the dynamics
-(compiled._table_geometry), also for inspection.
+(compiled_tables._table_geometry), also for inspection.
 """
 
 from __future__ import annotations
@@ -92,43 +92,49 @@ class TableProvider:
         if self.irregularities is not None:
             self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
 
-    def _compiled(self):
-        """(par, grid) of the compiled look-up (compiled.table_candidates), built once."""
-        if getattr(self, "_packed", None) is None:
-            from rigid_dynamics.wheelset import compiled
+    def compiled_geometry(self) -> int:
+        """The compiled right-hand side evaluates these tables itself (layout.GEOMETRY_TABLES; compiled_tables.py)."""
+        from rigid_dynamics.wheelset.layout import GEOMETRY_TABLES
 
-            par = compiled.new_parameters()
+        return GEOMETRY_TABLES
+
+    def _compiled(self):
+        """(par, geometry) of the compiled look-up (compiled_tables.table_candidates), built once."""
+        if getattr(self, "_packed", None) is None:
+            from rigid_dynamics.wheelset.compiled_tables import irregularity_parameters, table_geometry
+            from rigid_dynamics.wheelset.layout import new_parameters
+
+            par = new_parameters()
             par["z_ref_m"], par["nominal_radius_m"] = self.z_ref, self.r0
             if self.irregularities is not None:
-                compiled.irregularity_parameters(par, self.irregularities, self._irr_sides, self.r0)
-            yg, rg = self.y_grid, self.roll_grid
-            grid = np.array([yg[0], yg[1] - yg[0], len(yg), rg[0], rg[1] - rg[0], len(rg)], float)
-            self._packed = (par, grid, np.ascontiguousarray(self.table), np.asarray(self.slot, np.int64))
+                irregularity_parameters(par, self.irregularities, self._irr_sides, self.r0)
+            self._packed = (par, table_geometry(self))
         return self._packed
 
     def patches(self, centre_m, yaw_rad, roll_rad, spin_rad=0.0) -> PatchSet:
-        """The candidates at a pose by the compiled look-up of the dynamics (compiled._table_geometry: bilinear in
-        (theta, y), q = q_ref + (z - z_ref) dq/dz, a merged second candidate dropped, the running-direction
-        irregularities added by compiled._irregularity).
+        """The candidates at a pose by the compiled look-up of the dynamics (compiled_tables._table_geometry:
+        bilinear in (theta, y), q = q_ref + (z - z_ref) dq/dz, a merged second candidate dropped, the
+        running-direction irregularities added by compiled_tables._irregularity).
         """
-        from rigid_dynamics.wheelset import compiled
+        from rigid_dynamics.wheelset import layout as lay
+        from rigid_dynamics.wheelset.compiled_tables import table_candidates
 
-        par, grid, table, slots = self._compiled()
+        par, geometry = self._compiled()
         sides = np.asarray(self.side, np.int64)
         y = np.zeros(14)
         y[0:3] = np.asarray(centre_m, float)[:3]
         y[3], y[4], y[5] = yaw_rad, roll_rad, spin_rad
-        cg = np.empty((len(sides), compiled.N_GEO))
-        compiled.table_candidates(y, par, table, grid, slots, sides, cg)
+        cg = np.empty((len(sides), lay.N_GEO))
+        table_candidates(y, par, geometry, sides, cg)
         return PatchSet(
             side=self.side,
             slot=self.slot,
-            point_m=y[0:3] + cg[:, 1:4],
-            normal=cg[:, 4:7].copy(),
-            curvature_long_1_per_m=cg[:, 7].copy(),
-            curvature_lat_1_per_m=cg[:, 8].copy(),
-            approach_m=cg[:, 0].copy(),
-            rolling_radius_m=cg[:, 9].copy(),
-            contact_angle_rad=cg[:, 11].copy(),
-            wheel_lateral_m=cg[:, 10].copy(),
+            point_m=y[0:3] + cg[:, lay.G_LEVER : lay.G_LEVER + 3],
+            normal=cg[:, lay.G_NORMAL : lay.G_NORMAL + 3].copy(),
+            curvature_long_1_per_m=cg[:, lay.G_CURVATURE_LONG].copy(),
+            curvature_lat_1_per_m=cg[:, lay.G_CURVATURE_LAT].copy(),
+            approach_m=cg[:, lay.G_APPROACH].copy(),
+            rolling_radius_m=cg[:, lay.G_ROLLING_RADIUS].copy(),
+            contact_angle_rad=cg[:, lay.G_CONTACT_ANGLE].copy(),
+            wheel_lateral_m=cg[:, lay.G_WHEEL_LATERAL].copy(),
         )

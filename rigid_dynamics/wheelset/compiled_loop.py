@@ -1,8 +1,10 @@
-"""Error-controlled integration in the compiled loop: embedded Runge-Kutta pairs with step-size control, dense
-output at the output times and contact onset/loss located within the step.
+"""The compiled loops: embedded Runge-Kutta pairs with step-size control, dense output at the output times and
+contact onset/loss located within the step (:func:`embedded_run`), and the fixed-step RK4 (:func:`rk4_run`). Both
+take records (:class:`Tableau`, :class:`StepControl`, :class:`Outputs`, :class:`Carried`, :class:`EventLog`,
+compiled_records.PackedRun) and return an :class:`Outcome`; drivers.py calls them in chunks.
 
-The right-hand side is compiled._rhs, called exactly as compiled.rk4_run calls it (tables mode 0 or the compiled
-3-D search mode 1; the lateral scan ``full`` at each step's first stage, which for these FSAL pairs is the previous
+The right-hand side is compiled_rhs._rhs, called exactly as rk4_run below calls it (tables or the compiled
+3-D search; the lateral scan ``full`` at each step's first stage, which for these FSAL pairs is the previous
 step's last stage, and at the recorded samples). Two pairs (Butcher tableaux below, module constants with their
 sources; tests/test_dynamics_adaptive.py checks their order conditions and observed orders):
 
@@ -27,9 +29,9 @@ accepted; the next step is h (0.9 norm^(-0.7/k) norm_prev^(0.4/k)), a PI control
 Wanner II, IV.2), k = the order of the error estimate + 1, the factor within [0.2, 10] (not above 1 right after a
 rejection). A rejected step is retried with h max(0.2, 0.9 norm^(-1/k)). A stage whose right-hand side fails
 (status not 0, or a non-finite state) is retried at a quarter of the step, except a contact model that failed
-behind the callback (status 5, compiled._external: not a matter of the step), which ends the run. A step below
-``h_min`` ends the run with status 6 (UNDERFLOW, drivers: "step-size-underflow"), with the status of the last
-failure kept for the message.
+behind the callback (layout.CALLBACK_FAILED, compiled_rhs._external: not a matter of the step), which ends the
+run. A step below ``h_min`` ends the run with layout.UNDERFLOW ("step-size-underflow"), with the status of the
+last failure kept for the message.
 
 A step that would end a little past an output time (by less than one stage's share of it) is shortened to end
 there, so that the sample needs no right-hand side of its own.
@@ -46,27 +48,32 @@ The search memory (compiled_search: the warm starts of the contact points) is sa
 restored when the step is rejected, and after every evaluation off the step's path (output samples, event
 location), so that an accepted step sees the memory of the previous step's end, as in rk4_run.
 
-Status codes: those of compiled.rk4_run (0 ok, 1 blow-up, 2 force anomaly, 3 derailed, 4 creepages undefined) and
-5 step-size underflow.
+Status codes: layout.STATUS (0 ok, 1 blow-up, 2 force anomaly, 3 derailed, 4 creepages undefined, 5 callback
+failed, 6 step-size underflow).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from fractions import Fraction as F
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.wheelset.compiled import (
+from rigid_dynamics.wheelset.compiled_rhs import _rhs, force_difference, side_forces, workspace
+from rigid_dynamics.wheelset.layout import (
+    APPROACH,
+    BLOW_UP,
     CALLBACK_FAILED,
+    DERAILED,
+    FORCE_ANOMALY,
     N_FIELDS,
-    _force_difference,
-    _rhs,
-    _side_forces,
-    _workspace,
+    NORMAL_FORCE,
+    OK,
+    UNDERFLOW,
 )
+from rigid_dynamics.wheelset.state import Y
 
 MIN_STEP_S = 1e-10
 """Smallest step of an error-controlled run, s: below it the run ends with status "step-size-underflow" (a contact
@@ -82,13 +89,106 @@ MAX_EVENTS = 100_000
 STEPS_PER_CALL = 2000
 """Accepted steps per call of the compiled loop (between calls the driver checks wall time and budget)."""
 
-UNDERFLOW = 6
+
+class Tableau(NamedTuple):
+    """An explicit Runge-Kutta method as the compiled loop takes it (:func:`_tableau`): A (s, s) whose last row is
+    the propagated weights b, the nodes c, the error weights e = b - b_hat, the dense output P (s, 4), and k = the
+    order of the error estimate + 1 (the controller's exponent).
+    """
+
+    a: np.ndarray
+    c: np.ndarray
+    e: np.ndarray
+    p: np.ndarray
+    k_order: float
 
 
-def _tableau(a_rows, b_hat, p_rows=None):
-    """(A (s, s), c (s), e (s), P (s, 4)) of an FSAL pair from its rows of A (the last row is b), the embedded
-    weights b_hat and the dense-output matrix P (coefficients of theta, theta^2, theta^3, theta^4; None: cubic
-    Hermite between the step's ends, exact in Fractions).
+class StepControl(NamedTuple):
+    """Step-size control of :func:`embedded_run`: rtol, atol per state, the weight per state (0 not controlled,
+    1 atol alone, 2 atol + rtol |y|), the smallest and largest step, the event location's time tolerance (s) and the
+    accepted steps per call.
+    """
+
+    rtol: float
+    atol: np.ndarray
+    weight: np.ndarray
+    h_min: float
+    h_max: float
+    event_tol: float
+    max_steps: int
+
+
+class Outputs(NamedTuple):
+    """Where a compiled loop records its samples: the output times (embedded pairs; RK4 records every
+    ``out_every`` steps), the states, the patch records (samples, candidates + 2, layout.N_FIELDS) and the force
+    error estimates (N).
+    """
+
+    times: np.ndarray
+    states: np.ndarray
+    recs: np.ndarray
+    errs: np.ndarray
+
+
+ERROR_NORM, STARTED = range(2)
+"""Entries of Carried.control: the controller's previous error norm; 1 once kst[0], mask0 and gap0 hold t0's."""
+
+
+class Carried(NamedTuple):
+    """What :func:`embedded_run` carries between calls: ``control`` = (the controller's previous error norm, 1 when
+    ``kst[0]``, ``mask0`` and ``gap0`` hold f(t0, y), the contact set and the approaches at t0), the stages ``kst``
+    (s, states).
+    """
+
+    control: np.ndarray
+    kst: np.ndarray
+    mask0: np.ndarray
+    gap0: np.ndarray
+
+
+class EventLog(NamedTuple):
+    """The located contact switches: times, the contact set after each (per candidate), and count[0] entries (entry
+    0 is the set at the start).
+    """
+
+    times: np.ndarray
+    masks: np.ndarray
+    count: np.ndarray
+
+
+class Outcome(NamedTuple):
+    """What a call of a compiled loop returns: status (layout.STATUS), t, y, the next step h, accepted and rejected
+    steps, the next output index, right-hand-side evaluations, located switches and the status of the last failed
+    stage.
+    """
+
+    status: int
+    t: float
+    y: np.ndarray
+    h: float
+    accepted: int
+    rejected: int
+    k_out: int
+    evaluations: int
+    located: int
+    last_failure: int
+
+
+@njit(cache=True)
+def _outcome(status, t, y, h, accepted, rejected, k_out, evaluations, located, last_failure):
+    """An :class:`Outcome` of one type for every return of the loops (with reference counting: it hands ``y`` back
+    to a caller that counts references).
+    """
+    return Outcome(
+        int(status), float(t), y, float(h), int(accepted), int(rejected), int(k_out), int(evaluations), int(located),
+        int(last_failure),
+    )  # fmt: skip
+
+
+def _tableau(a_rows, b_hat, k_order, p_rows=None):
+    """The :class:`Tableau` of an FSAL pair from its rows of A (the last row is b), the embedded weights b_hat, k (the
+    order of the error estimate + 1) and the dense-output matrix P (coefficients of theta, theta^2, theta^3,
+    theta^4; None: cubic Hermite between the step's ends, exact in Fractions).
     """
     s = len(a_rows)
     a = [[F(0)] * s for _ in range(s)]
@@ -105,11 +205,12 @@ def _tableau(a_rows, b_hat, p_rows=None):
         p_rows[0] = [p_rows[0][0] + 1, p_rows[0][1] - 2, p_rows[0][2] + 1, 0]
         p_rows[s - 1] = [p_rows[s - 1][0], p_rows[s - 1][1] - 1, p_rows[s - 1][2] + 1, 0]
     as_float = np.array([[float(v) for v in row] for row in a])
-    return (
+    return Tableau(
         as_float,
         np.array([float(v) for v in c]),
         np.array([float(v) for v in e]),
         np.array([[float(F(v)) for v in row] for row in p_rows]),
+        float(k_order),
     )
 
 
@@ -143,9 +244,9 @@ BS32_B_HAT = (F(7, 24), F(1, 4), F(1, 3), F(1, 8))
 """Bogacki-Shampine 3(2): the embedded 2nd-order weights."""
 
 PAIRS = {
-    # name: (tableau, k = order of the error estimate + 1, new right-hand sides per step)
-    "DP54": (_tableau(DP54_A, DP54_B_HAT, DP54_P), 5.0, 6),
-    "BS32": (_tableau(BS32_A, BS32_B_HAT), 3.0, 3),
+    # name: (tableau, new right-hand sides per step)
+    "DP54": (_tableau(DP54_A, DP54_B_HAT, 5, DP54_P), 6),
+    "BS32": (_tableau(BS32_A, BS32_B_HAT, 3), 3),
 }
 """The embedded pairs by the scene's ``[integrator] method``."""
 
@@ -176,29 +277,29 @@ def _dense(y, h, kst, p, theta, out):
 def _contact_mask(rec, ncand, mask, gap):
     """Which candidates are in contact (normal force > 0) and their approach q (NaN: absent), from a record."""
     for c in range(ncand):
-        mask[c] = 1 if rec[c, 0] > 0.0 else 0
-        gap[c] = rec[c, 7]
+        mask[c] = 1 if rec[c, NORMAL_FORCE] > 0.0 else 0
+        gap[c] = rec[c, APPROACH]
 
 
 @njit(cache=True)
-def embedded_run(
-    y, t0, t_end, h, a, cc, e, p, k_order, rtol, atol, weight, h_min, h_max, event_tol, max_steps,
-    par, hz, kk, sides, mode, targs, sargs, out_times, k_out, states, recs, errs, carry, kst, mask0, gap0,
-    ev_t, ev_mask, n_ev,
-):  # fmt: skip
-    """Advance from (t0, y) with the embedded pair (a, cc, e, p) under step-size control until t_end or
-    ``max_steps`` accepted steps; record the samples at out_times[k_out:] (dense output, then a right-hand side
-    with record at the interpolated state) into states/recs. Module docstring for the control and the events.
+def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried, events):
+    """Advance from (t0, y) with the embedded pair ``tableau`` (:class:`Tableau`) under the step-size control
+    ``control`` (:class:`StepControl`) until t_end or ``control.max_steps`` accepted steps; record the samples at
+    outputs.times[k_out:] (dense output, then a right-hand side with record at the interpolated state) into
+    ``outputs``. ``run``: compiled_records.PackedRun. Module docstring for the control and the events.
 
-    Carried between calls (the driver keeps them): ``kst[0]`` = f(t0, y) and ``mask0``/``gap0`` (the contact set
-    and approaches at t0) when carry[1] > 0; carry[0] = the controller's previous error norm; the event log
-    ev_t (times), ev_mask (contact set after each switch, per candidate), n_ev[0] (entries; entry 0 is the set at
-    the start). Returns (status, t, y, h next, accepted steps, rejected steps, next output index, rhs evaluations,
-    located switches, status of the last failed stage).
+    Carried between calls (the driver keeps ``carried``, :class:`Carried`, and ``events``, :class:`EventLog`).
+    Returns an :class:`Outcome`.
     """
+    a, cc, e, p, k_order = tableau
+    rtol, atol, weight, h_min, h_max, event_tol, max_steps = control
+    out_times, states, recs, errs = outputs
+    carry, kst, mask0, gap0 = carried
+    ev_t, ev_mask, n_ev = events
+    par, sides = run.par, run.sides
     ncand = sides.shape[0]
-    ws = _workspace(par, targs[0].shape[0], ncand, np.empty((ncand + 2, N_FIELDS)))
-    rec = ws[1]
+    ws = workspace(run, np.empty((ncand + 2, N_FIELDS)))
+    rec = ws.rec
     nst = y.shape[0]
     ns = a.shape[0]
     y = y.copy()
@@ -209,25 +310,25 @@ def embedded_run(
     gap_lo, gap_hi = np.empty(ncand), np.empty(ncand)
     f4, f3 = np.empty((2, 3)), np.empty((2, 3))
     force_err = np.nan
-    mem, n_mem = sargs[3], sargs[4]
+    mem, n_mem = run.search.mem, run.search.n_mem
     mem_save, n_mem_save = mem.copy(), n_mem.copy()
     mem_end, n_mem_end = mem.copy(), n_mem.copy()
     fmax, ymax = par.max_force_N, par.max_lateral_m
     t = t0
     evals, accepted, rejected, located, last_fail = 0, 0, 0, 0, 0
-    if carry[1] == 0.0:
-        st = _rhs(t, y, par, hz, kk, sides, mode, targs, sargs, ws, True, True, kst[0])
+    if carry[STARTED] == 0.0:
+        st = _rhs(t, y, run, ws, True, True, kst[0])
         evals += 1
         if st != 0:
-            return st, t, y, h, accepted, rejected, k_out, evals, located, st
+            return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
         _contact_mask(rec, ncand, mask0, gap0)
-        carry[1] = 1.0
+        carry[STARTED] = 1.0
         if n_ev[0] == 0 and ev_t.shape[0] > 0:
             ev_t[0] = t
             for c in range(ncand):
                 ev_mask[0, c] = mask0[c]
             n_ev[0] = 1
-    err_prev = carry[0]
+    err_prev = carry[ERROR_NORM]
     tiny = 1e-12 * max(1.0, abs(t_end))
     after_reject = False
     h_event = np.nan  # the controller's step before a step was cut short to end at a switch
@@ -243,7 +344,7 @@ def embedded_run(
         if t + 1.01 * h >= t_end:
             h = t_end - t
         if not h >= h_min:
-            return UNDERFLOW, t, y, h, accepted, rejected, k_out, evals, located, last_fail
+            return _outcome(UNDERFLOW, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
         mem_save[:, :, :] = mem
         n_mem_save[:] = n_mem
         # the stages; the last one is f(t + h, y_new) (FSAL), evaluated with its record and the lateral scan
@@ -256,10 +357,10 @@ def embedded_run(
                         acc += a[s, j] * kst[j, i]
                 ys[i] = y[i] + h * acc
             last = s == ns - 1
-            st = _rhs(t + cc[s] * h, ys, par, hz, kk, sides, mode, targs, sargs, ws, last, last, kst[s])
+            st = _rhs(t + cc[s] * h, ys, run, ws, last, last, kst[s])
             evals += 1
             if st == CALLBACK_FAILED:  # the contact model behind the callback failed: not a matter of the step
-                return st, t, y, h, accepted, rejected, k_out, evals, located, st
+                return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
             if st != 0:
                 failed = st
                 break
@@ -332,7 +433,7 @@ def embedded_run(
                 _dense(y, h, kst, p, theta, ys)
                 mem[:, :, :] = mem_save
                 n_mem[:] = n_mem_save
-                st = _rhs(t + theta * h, ys, par, hz, kk, sides, mode, targs, sargs, ws, True, True, scratch)
+                st = _rhs(t + theta * h, ys, run, ws, True, True, scratch)
                 evals += 1
                 if st != 0:
                     break  # the interpolated state cannot be evaluated: keep the bracket found so far
@@ -371,21 +472,21 @@ def embedded_run(
             _contact_mask(rec_end, ncand, mask1, gap1)
         for i in range(nst):
             if not np.isfinite(y_new[i]):
-                return 1, t, y, h, accepted, rejected, k_out, evals, located, 1
+                return _outcome(BLOW_UP, t, y, h, accepted, rejected, k_out, evals, located, BLOW_UP)
         t_new = t + h
         # force error estimate of a step with output samples (as rk4_run's): the per-wheel contact forces at the
         # propagated solution against those at the embedded lower-order one, y_new - err
         k_first = k_out
         if k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny:
-            _side_forces(rec_end, sides, f4)
+            side_forces(rec_end, sides, f4)
             for i in range(nst):
                 ys[i] = y_new[i] - err[i]
-            st = _rhs(t_new, ys, par, hz, kk, sides, mode, targs, sargs, ws, True, False, scratch)
+            st = _rhs(t_new, ys, run, ws, True, False, scratch)
             evals += 1
             force_err = np.inf
             if st == 0:
-                _side_forces(rec, sides, f3)
-                force_err = _force_difference(f4, f3)
+                side_forces(rec, sides, f3)
+                force_err = force_difference(f4, f3)
             mem[:, :, :] = mem_end
             n_mem[:] = n_mem_end
         # the output samples within (t, t_new]: dense output and a right-hand side with record there
@@ -396,20 +497,22 @@ def embedded_run(
                 recs[k_out, :, :] = rec_end
             else:
                 _dense(y, h, kst, p, theta, ys)
-                st = _rhs(out_times[k_out], ys, par, hz, kk, sides, mode, targs, sargs, ws, True, True, scratch)
+                st = _rhs(out_times[k_out], ys, run, ws, True, True, scratch)
                 evals += 1
                 if st != 0:
-                    return st, t, y, h, accepted, rejected, k_out, evals, located, st
+                    return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
                 states[k_out, :] = ys
                 recs[k_out, :, :] = rec
-            _side_forces(recs[k_out], sides, f4)
+            side_forces(recs[k_out], sides, f4)
             errs[k_out] = force_err if k_out == k_first else np.nan
             k_out += 1
             for sd in range(2):
                 if f4[sd, 0] > fmax:
-                    return 2, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, 2
-            if abs(states[k_out - 1, 1]) > ymax:
-                return 3, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, 3
+                    return _outcome(
+                        FORCE_ANOMALY, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, FORCE_ANOMALY
+                    )
+            if abs(states[k_out - 1, Y]) > ymax:
+                return _outcome(DERAILED, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, DERAILED)
         mem[:, :, :] = mem_end
         n_mem[:] = n_mem_end
         switched = False
@@ -433,217 +536,115 @@ def embedded_run(
         factor = 0.9 * norm ** (-0.7 / k_order) * err_prev ** (0.4 / k_order)
         factor = min(max(factor, 0.2), 1.0 if after_reject else 10.0)
         err_prev = norm
-        carry[0] = err_prev
+        carry[ERROR_NORM] = err_prev
         h *= factor
         if h_event == h_event:
             # the step was cut short to end at a located switch, not by its error: resume the controller's step
             h = max(h, min(h_event, 10.0 * h_event * factor))
             h_event = np.nan
         after_reject = False
-    return 0, t, y, h, accepted, rejected, k_out, evals, located, last_fail
+    return _outcome(OK, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
 
 
-ADAPTIVE_STATUS = {
-    1: "blow-up",
-    2: "force-anomaly",
-    3: "derailed",
-    4: "contact-failed",
-    CALLBACK_FAILED: "contact-failed",
-    UNDERFLOW: "step-size-underflow",
-}
-"""Status codes of :func:`embedded_run` -> run statuses."""
+@njit(cache=True)
+def rk4_run(y, t0, h, steps, run, outputs, out_start):
+    """Advance ``steps`` = (n_steps, out_every, check_every) RK4 steps of size h from (t0, y); record every
+    ``out_every`` steps into ``outputs`` (:class:`Outputs`; its times are not read) from index ``out_start``.
+    ``run``: compiled_records.PackedRun (tables or the 3-D search, whose memory carries over between calls; the
+    lateral scan runs at each step's first stage and at the recorded samples). Returns an :class:`Outcome` (its
+    ``accepted``: the steps done; h, rejected, located and last_failure unused).
 
-
-def supported(scene, provider, model) -> bool:
-    """Whether the compiled loop can run this scene with an embedded pair: its method is one of PAIRS and the
-    compiled RK4 loop supports the provider and model (compiled.supported).
+    Error estimate (into errs, N, per recorded sample): at every recorded sample and every ``check_every`` steps
+    the step that ends there is also advanced by the third-order formula embedded in the classical RK4 stages and
+    the derivative at the step's end, k5 = f(t + h, y4) (which is the next step's k1): y3 = y + h (k1/6 + k2/3 +
+    k3/3 + k5/6), so y4 - y3 = h/6 (k4 - k5) (Hairer, Norsett & Wanner, Solving ODEs I, 2nd ed., section II.4,
+    "embedded formulas" of order 4(3)). The estimate is the largest difference of the per-wheel contact forces
+    (normal, longitudinal and lateral creep force) at y4 and y3: the force error of one step of the third-order
+    formula, an upper estimate of RK4's own (one extra right-hand side per check; two between recorded samples).
+    A sample carries the largest estimate of the checks since the previous sample (inf when the third-order
+    state's right-hand side failed).
     """
-    from rigid_dynamics.wheelset import compiled
-
-    if scene.integrator.method not in PAIRS:
-        return False
-    return compiled.supported(replace(scene, integrator=replace(scene.integrator, method="RK4")), provider, model)
-
-
-def _arguments(packed, settings, scene):
-    """(tableau and control arguments) of embedded_run for a run: (a, c, e, p, k, atol, weight)."""
-    from rigid_dynamics.wheelset.drivers import tolerances
-    from rigid_dynamics.wheelset.state import POSITIONS, WORK, track_positions
-
-    (a, c, e, p), k_order, _ = PAIRS[settings.method]
-    atol = tolerances(settings, scene)
-    weight = np.full(len(atol), 2.0)  # 2: atol + rtol |y|
-    weight[POSITIONS] = 1.0  # 1: atol alone (offsets: x and the spin angle grow along the track, z is ~ r0)
-    weight[track_positions(len(atol))] = 1.0  # (absent on the rigid track)
-    weight[WORK] = 0.0  # diagnostics, not in the right-hand side
-    return a, c, e, p, k_order, atol, weight
-
-
-def load(packed, settings, scene) -> None:
-    """Load (from numba's cache, or compile) embedded_run for the types of ``packed`` (compiled.pack's result):
-    zero steps from the zero state.
-    """
-    par, hz, kk, sides, _, mode, targs, sargs = packed
-    a, c, e, p, k_order, atol, weight = _arguments(packed, settings, scene)
-    y = np.zeros(len(atol))
-    ncand = len(sides)
-    embedded_run(
-        y, 0.0, 0.0, 1e-3, a, c, e, p, k_order, 1e-6, atol, weight, MIN_STEP_S, 1e-3, EVENT_TIME_TOLERANCE_S, 0,
-        par, hz, kk, sides, mode, targs, sargs, np.zeros(0), 0, np.zeros((0, len(y))),
-        np.zeros((0, ncand + 2, N_FIELDS)), np.zeros(0), np.array([1e-4, 1.0]), np.zeros((len(a), len(y))),
-        np.zeros(ncand, np.int64), np.zeros(ncand), np.zeros(0), np.zeros((0, ncand), np.int64),
-        np.zeros(1, np.int64),
-    )  # fmt: skip
-
-
-def initial_step(rhs, y0, atol, rtol, weight, k_order, h_max) -> float:
-    """The starting step of Hairer, Norsett & Wanner I, II.4 (algorithm of "Starting step size"), from two
-    right-hand sides ``rhs(t, y)``.
-    """
-    sc = atol + rtol * np.abs(y0)
-    on = weight > 0
-
-    def rms(v):
-        return float(np.sqrt(np.mean((v[on] / sc[on]) ** 2)))
-
-    f0 = rhs(0.0, y0)
-    d0, d1 = rms(y0), rms(f0)
-    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
-    h0 = min(h0, h_max)
-    f1 = rhs(h0, y0 + h0 * f0)
-    d2 = rms(f1 - f0) / h0
-    big = max(d1, d2)
-    h1 = max(1e-6, h0 * 1e-3) if big <= 1e-15 else (0.01 / big) ** (1.0 / k_order)
-    step = min(100.0 * h0, h1, h_max)
-    return step if np.isfinite(step) and step > 0 else 1e-6
-
-
-def side_events(ev_t, ev_mask, n, sides):
-    """("wheel-lift" | "contact-restored", side, time_s) from the event log: a side is in contact while any of its
-    candidates is.
-    """
-    from rigid_dynamics.wheelset.providers import SIDES
-
-    events = []
-    if n == 0:
-        return events
-    touching = [bool(np.any(ev_mask[0][sides == s])) for s in range(2)]
-    for k in range(1, n):
-        for s in range(2):
-            now = bool(np.any(ev_mask[k][sides == s]))
-            if now != touching[s]:
-                events.append(("contact-restored" if now else "wheel-lift", SIDES[s], float(ev_t[k])))
-                touching[s] = now
-    return events
-
-
-def run_embedded(model, packed, y0, duration, settings, recorder, report, start) -> int:
-    """An embedded pair with step-size control in the compiled loop (:func:`embedded_run`), in calls of
-    STEPS_PER_CALL accepted steps so that wall time, budget and progress are watched. Records the samples at the
-    output times (multiples of output_step_s, and the end); the wheel-lift and contact-restored events are the
-    located switches (their times within EVENT_TIME_TOLERANCE_S), not the samples'. Sets ``model.adaptive_stats``.
-    Returns the accepted steps.
-    """
-    import time
-
-    from rigid_dynamics.wheelset import compiled
-    from rigid_dynamics.wheelset.drivers import patch_tables
-    from rigid_dynamics.wheelset.recorder import Stop
-
-    scene = model.scene
-    par, hz, kk, sides, slots, mode, targs, sargs = packed
-    compiled.use_callback(model.callback)
-    a, c, e, p, k_order, atol, weight = _arguments(packed, settings, scene)
-    rtol = settings.relative_tolerance
-    ncand = len(sides)
-    n_out = int(math.floor(duration / settings.output_step_s + 1e-9))
-    out_times = settings.output_step_s * np.arange(1, n_out + 1)
-    if len(out_times) == 0 or out_times[-1] < duration - 1e-12:
-        out_times = np.append(out_times, duration)
-    states = np.zeros((len(out_times), len(y0)))
-    recs = np.zeros((len(out_times), ncand + 2, compiled.N_FIELDS))
-    errs = np.full(len(out_times), np.nan)
-    rec = np.zeros((ncand + 2, compiled.N_FIELDS))
-
-    def rhs(t, y):
-        out = np.zeros(len(y))
-        status = compiled.rhs_once(t, y, par, hz, kk, sides, mode, targs, sargs, out, rec)
-        return out if status == 0 else np.full(len(y), np.nan)
-
-    h = initial_step(rhs, y0, atol, rtol, weight, k_order, settings.max_step_s)
-    model.rhs_evaluations += 2
-    carry = np.array([1e-4, 0.0])
-    kst = np.zeros((len(a), len(y0)))
-    mask0, gap0 = np.zeros(ncand, np.int64), np.zeros(ncand)
-    ev_t, ev_mask, n_ev = np.zeros(MAX_EVENTS), np.zeros((MAX_EVENTS, ncand), np.int64), np.zeros(1, np.int64)
-    stats = {"accepted_steps": 0, "rejected_steps": 0, "located_switches": 0}
-    model.adaptive_stats = stats
-    y, t, k_out = y0.copy(), 0.0, 0
-
-    def events_to_recorder():
-        kept = [ev for ev in recorder.events if ev[0] not in ("wheel-lift", "contact-restored")]
-        recorder.events[:] = sorted(kept + side_events(ev_t, ev_mask, int(n_ev[0]), sides), key=lambda ev: ev[2])
-
-    while True:
-        status, t_end, y_end, h_next, acc, rej, k_new, evals, located, last_fail = embedded_run(
-            y, t, duration, h, a, c, e, p, k_order, rtol, atol, weight, MIN_STEP_S, settings.max_step_s,
-            EVENT_TIME_TOLERANCE_S, STEPS_PER_CALL, par, hz, kk, sides, mode, targs, sargs, out_times, k_out, states,
-            recs, errs, carry, kst, mask0, gap0, ev_t, ev_mask, n_ev,
-        )  # fmt: skip
-        model.rhs_evaluations += int(evals)
-        stats["accepted_steps"] += int(acc)
-        stats["rejected_steps"] += int(rej)
-        stats["located_switches"] += int(located)
-        if k_new > k_out:
-            block = recs[k_out:k_new]
-            tables = patch_tables(model, block, sides, slots)
-            try:
-                recorder.append_many(
-                    out_times[k_out:k_new],
-                    states[k_out:k_new],
-                    tables,
-                    block[:, ncand : ncand + 2, :3].copy(),
-                    errs[k_out:k_new],
-                )
-            except Stop as stop:
-                events_to_recorder()
-                stop.steps = stats["accepted_steps"]
-                raise
-        k_out = k_new
-        if status != 0:
-            events_to_recorder()
-            name = ADAPTIVE_STATUS[int(status)]
-            why = ""
-            if status == CALLBACK_FAILED and model.callback is not None:
-                why = f": {model.callback.message}"
-            if status == UNDERFLOW:
-                why = (
-                    f": the step fell below {MIN_STEP_S:g} s"
-                    + (f" after a failed stage ({ADAPTIVE_STATUS[int(last_fail)]})" if last_fail else "")
-                    + f" (relative_tolerance = {rtol:g}, absolute_tolerance = {settings.absolute_tolerance:g})"
-                )
-            stop = Stop(
-                name,
-                f"compiled {settings.method} stopped ({name}) at t = {t_end:.6g} s{why}",
-                float(t_end),
-                np.array(y_end[:12]),
-            )
-            stop.steps = stats["accepted_steps"]
-            raise stop
-        y, t, h = y_end, float(t_end), float(h_next)
-        if t >= duration - 1e-12 * max(1.0, duration):
-            break
-        if model.rhs_evaluations >= settings.max_rhs_evaluations:
-            events_to_recorder()
-            stop = Stop("budget-exceeded", f"more than {settings.max_rhs_evaluations} RHS evaluations", t, y[:12])
-            stop.steps = stats["accepted_steps"]
-            raise stop
-        if time.perf_counter() - start > settings.max_wall_time_s:
-            events_to_recorder()
-            stop = Stop("budget-exceeded", f"wall time above {settings.max_wall_time_s} s", t, y[:12])
-            stop.steps = stats["accepted_steps"]
-            raise stop
-        report(t)
-    events_to_recorder()
-    report(t)
-    return stats["accepted_steps"]
+    n_steps, out_every, check_every = steps
+    _, states, recs, errs = outputs
+    par, sides = run.par, run.sides
+    ncand = sides.shape[0]
+    ws = workspace(run, np.empty((ncand + 2, N_FIELDS)))
+    rec = ws.rec
+    nst = y.shape[0]
+    y = y.copy()
+    k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
+    k5, k6 = np.empty(nst), np.empty(nst)
+    ys, y_new = np.empty(nst), np.empty(nst)
+    f4, f3 = np.empty((2, 3)), np.empty((2, 3))
+    pending = np.nan
+    t = t0
+    k_out = out_start
+    evals = 0
+    fmax, ymax = par.max_force_N, par.max_lateral_m
+    have_k1 = False  # k1 of the next step is the recorded sample's derivative (same t and y)
+    for step in range(n_steps):
+        if not have_k1:
+            st = _rhs(t, y, run, ws, False, True, k1)
+            evals += 1
+            if st != 0:
+                return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
+        have_k1 = False
+        for i in range(nst):
+            ys[i] = y[i] + 0.5 * h * k1[i]
+        st = _rhs(t + 0.5 * h, ys, run, ws, False, False, k2)
+        if st != 0:
+            return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
+        for i in range(nst):
+            ys[i] = y[i] + 0.5 * h * k2[i]
+        st = _rhs(t + 0.5 * h, ys, run, ws, False, False, k3)
+        if st != 0:
+            return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
+        for i in range(nst):
+            ys[i] = y[i] + h * k3[i]
+        st = _rhs(t + h, ys, run, ws, False, False, k4)
+        evals += 3
+        if st != 0:
+            return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
+        finite = True
+        for i in range(nst):
+            y_new[i] = y[i] + (h / 6.0) * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            if not np.isfinite(y_new[i]):
+                finite = False
+        if not finite:
+            return _outcome(BLOW_UP, t, y, h, step, 0, k_out, evals, 0, BLOW_UP)
+        y, y_new = y_new, y  # y_new now holds the step's start
+        t = t0 + (step + 1) * h
+        output = (step + 1) % out_every == 0 and k_out < states.shape[0]
+        if output or (step + 1) % check_every == 0:
+            st = _rhs(t, y, run, ws, True, True, k5)
+            evals += 1
+            if st != 0:
+                return _outcome(st, t, y, h, step + 1, 0, k_out, evals, 0, st)
+            if output:
+                states[k_out, :] = y
+                recs[k_out, :, :] = rec
+            side_forces(rec, sides, f4)
+            # the embedded third-order solution and its contact forces
+            for i in range(nst):
+                ys[i] = y_new[i] + h * (k1[i] / 6.0 + k2[i] / 3.0 + k3[i] / 3.0 + k5[i] / 6.0)
+            st = _rhs(t, ys, run, ws, True, False, k6)
+            evals += 1
+            worst = np.inf
+            if st == 0:
+                side_forces(rec, sides, f3)
+                worst = force_difference(f4, f3)
+            if not pending >= worst:  # also when pending is NaN
+                pending = worst
+            for i in range(nst):
+                k1[i] = k5[i]
+            have_k1 = True
+            if output:
+                errs[k_out] = pending
+                pending = np.nan
+                k_out += 1
+                for sd in range(2):
+                    if f4[sd, 0] > fmax:
+                        return _outcome(FORCE_ANOMALY, t, y, h, step + 1, 0, k_out, evals, 0, FORCE_ANOMALY)
+                if abs(y[Y]) > ymax:
+                    return _outcome(DERAILED, t, y, h, step + 1, 0, k_out, evals, 0, DERAILED)
+    return _outcome(OK, t, y, h, n_steps, 0, k_out, evals, 0, OK)

@@ -44,7 +44,7 @@ With the elastic track T adds m_r z_r'^2/2 + m_s z_s'^2/2, the potential adds k_
 
 from __future__ import annotations
 
-import functools
+import contextlib
 import math
 from dataclasses import dataclass
 
@@ -52,47 +52,39 @@ import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
+from rigid_dynamics.wheelset import compiled_rhs
 from rigid_dynamics.wheelset import track as track_model
-from rigid_dynamics.wheelset.compiled import model_parameters, patch_creepages, track_rates
+from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_FASTSIM, tables_for
+from rigid_dynamics.wheelset.compiled_motion import patch_creepages, track_rates
+from rigid_dynamics.wheelset.compiled_records import law_code, model_parameters, pack
+from rigid_dynamics.wheelset.layout import (
+    AUTO_PATCH_FIELDS,
+    CALLBACK_FAILED,
+    CREEP_FORCE_LAT,
+    CREEP_FORCE_LONG,
+    CREEPAGES_UNDEFINED,
+    G_APPROACH,
+    G_CONTACT_ANGLE,
+    G_CURVATURE_LAT,
+    G_CURVATURE_LONG,
+    G_LEVER,
+    G_NORMAL,
+    G_ROLLING_RADIUS,
+    G_WHEEL_LATERAL,
+    GEOMETRY_GIVEN,
+    GEOMETRY_SEARCH,
+    MAX_SLOTS,
+    N_FIELDS,
+    N_GEO,
+    NORMAL_FORCE,
+    PATCH_FIELDS,
+    SPIN_MOMENT,
+    status_name,
+)
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES, ContactProvider
 from rigid_dynamics.wheelset.state import N_RIGID, TRACK, n_states
-
-PATCH_FIELDS = (
-    "normal_force_N",
-    "creep_force_long_N",
-    "creep_force_lat_N",
-    "spin_moment_Nm",
-    "creepage_long",
-    "creepage_lat",
-    "spin_creepage_1_per_m",
-    "approach_m",
-    "contact_point_y_m",
-    "wheel_lateral_m",
-    "rolling_radius_m",
-    "contact_angle_rad",
-    "semi_axis_long_m",
-    "semi_axis_lat_m",
-)
-"""Per-patch quantities recorded in the results, each of shape (n_out, 2 sides, 2 slots)."""
-
-MAX_SLOTS = 2
-
-AUTO_PATCH_FIELDS = (
-    "auto_rung",
-    "auto_level",
-    "auto_deciding_feature",
-    "auto_deciding_threshold",
-    "auto_saturation",
-    "auto_spin_share",
-    "auto_ellipticity_residual",
-    "auto_curvature_change",
-    "auto_second_patch_nearness",
-)
-"""Per-patch record of the ``auto`` model's choice (runs with contact_model "auto" only): ``auto_rung`` the index of
-the chosen rung in rigid_dynamics.contact.auto.AUTO_RUNGS, ``auto_level`` the tolerance level used (NaN: below every
-level), ``auto_deciding_feature`` the index in auto.FEATURES of the feature whose threshold decided (-1: none) and
-that threshold, then the patch's features (rigid_dynamics.contact.auto.patch_features)."""
+from rigid_dynamics.wheelset.track_matrices import TrackSystem
 
 
 class ContactFailure(RuntimeError):
@@ -128,8 +120,8 @@ def _cross_rows(vector, rows):
 
 
 def _creepages(lever, normal, omega, v_c, rail_velocity=None):
-    """Contact frames and creepages of many points (eq 39-49) by the compiled kernel (compiled.patch_creepages, the
-    one used by the compiled right-hand side).
+    """Contact frames and creepages of many points (eq 39-49) by the compiled kernel
+    (compiled_motion.patch_creepages, the one used by the compiled right-hand side).
 
     Returns:
         (frames (n, 3, 3), V (n,), xi, eta, spin (n,)).
@@ -143,51 +135,6 @@ def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     out = np.empty((4, n))
     patch_creepages(lever, normal, np.asarray(omega, float), np.asarray(v_c, float), rail_vy, rail_vz, frames, out)
     return frames, out[0], out[1], out[2], out[3]
-
-
-class TabulatedHertzKalker:
-    """Hertz (approach control) and Kalker's C_ij for many patches by look-up tables, for speed.
-
-    Two smooth functions of one variable are tabulated once, on fine grids, from the project's own
-    solvers and interpolated linearly:
-
-    * the inverted axial function p = (b_minor/a_major)^2 of r = max(A, B)/min(A, B) and Kalker's
-      elliptic functions K(p), D(p) (contact.hertz.ellipse_shape_from_curvature_ratio, elliptic_kdbc),
-      on ``HERTZ_POINTS`` points of ln r in [0, ln 1e4];
-    * C11, C22, C23, C33 (contact.kalker.kalker_coefficients at the material's nu) on ``KALKER_POINTS``
-      points of ln(a/b) in [-ln 50, ln 50].
-
-    The compiled right-hand side (compiled._hertz_kalker) interpolates them: a_major = sqrt(q D / (K min(A, B))),
-    N = 2 pi a_major E* q / (3 K), b_minor = a_major sqrt(p), E* = G/(1 - nu). Relative interpolation error < 1e-7
-    (tests/test_wheelset_providers.py compares with hertz_solve_batch and kalker_coefficients); ratios outside the
-    grids are clamped to their ends.
-    """
-
-    HERTZ_POINTS = 20001
-    KALKER_POINTS = 8001
-
-    def __init__(self, material):
-        from rigid_dynamics.contact.hertz import ellipse_shape_from_curvature_ratio, elliptic_kdbc
-        from rigid_dynamics.contact.kalker import kalker_coefficients
-
-        self.shear = material.shear_modulus_Pa
-        self.nu = material.poisson_ratio
-        self.e_star = self.shear / (1.0 - self.nu)
-        self.log_r = np.linspace(0.0, math.log(1e4), self.HERTZ_POINTS)
-        p, _, _ = ellipse_shape_from_curvature_ratio(np.exp(self.log_r))
-        k, d, _, _ = elliptic_kdbc(p)
-        self.p, self.k, self.d = p, k, d
-        self.log_ab = np.linspace(-math.log(50.0), math.log(50.0), self.KALKER_POINTS)
-        coef = kalker_coefficients(np.exp(self.log_ab), self.nu)
-        self.c = np.stack([coef.c11, coef.c22, coef.c23, coef.c33])
-
-
-@functools.lru_cache(maxsize=8)
-def _tables_for(shear_modulus_Pa: float, poisson_ratio: float) -> TabulatedHertzKalker:
-    """TabulatedHertzKalker per material (built once per process: ~0.5 s)."""
-    from rigid_dynamics.materials import Material
-
-    return TabulatedHertzKalker(Material(shear_modulus_Pa, poisson_ratio, 0.0))
 
 
 @dataclass(eq=False)
@@ -204,8 +151,8 @@ class ContactState:
 
 
 class PatchCallback:
-    """The Python side of the compiled code's one callback boundary (compiled._external): a contact model that is not
-    compiled (bem, fea, user models; BEM for ``auto``) solves one patch from its geometry and creepages.
+    """The Python side of the compiled code's one callback boundary (compiled_rhs._external): a contact model that is
+    not compiled (bem, fea, user models; BEM for ``auto``) solves one patch from its geometry and creepages.
 
     The geometry is the quadric of the compiled candidate (curvatures, approach, contact point and frame, rolling
     radius, contact angle) unless the provider gave a sampled one (``geometries``, candidate index -> ContactGeometry;
@@ -222,21 +169,35 @@ class PatchCallback:
         self.seconds = 0.0
         self.message = ""
 
-    def solve(self, c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, ex, ey, radius, angle, lateral):
+    def solve(self, patch):
+        """N, T_x, T_y, M_z, a, b and a status (0 solved, 1 failed: :attr:`message`) of one patch of the loop
+        (compiled_rhs.CallbackPatch) by the model.
+        """
         import time
 
         start = time.perf_counter()
         self.calls += 1
+        t = patch.t_s
         try:
-            geometry = self.geometries.get(c)
+            geometry = self.geometries.get(patch.candidate)
             if geometry is None:
-                frame = np.array([ex, ey, normal], float).T
+                frame = np.array([patch.e_x, patch.e_y, patch.normal], float).T
                 geometry = ContactGeometry(
-                    curvature_long_1_per_m=float(ca), curvature_lat_1_per_m=float(cb), approach_m=float(q),
-                    side=SIDES[int(side)], point_m=np.array(point, float), frame=frame,
-                    contact_angle_rad=float(angle), rolling_radius_m=float(radius),
-                )  # fmt: skip
-            creepage = Creepage(float(xi), float(eta), float(spin), float(speed))
+                    curvature_long_1_per_m=float(patch.curvature_long_1_per_m),
+                    curvature_lat_1_per_m=float(patch.curvature_lat_1_per_m),
+                    approach_m=float(patch.approach_m),
+                    side=SIDES[int(patch.side)],
+                    point_m=np.array(patch.point_m, float),
+                    frame=frame,
+                    contact_angle_rad=float(patch.contact_angle_rad),
+                    rolling_radius_m=float(patch.rolling_radius_m),
+                )
+            creepage = Creepage(
+                float(patch.creepage_long),
+                float(patch.creepage_lat),
+                float(patch.spin_creepage_1_per_m),
+                float(patch.rolling_speed_m_per_s),
+            )
             result = self.model.solve(geometry, creepage, self.material, options=self.options)
         except Exception as exc:  # noqa: BLE001 (any failure of a user model is reported as the run's status)
             self.message = f"contact model {getattr(self.model, 'name', self.model)!r} raised at t = {t:.6g} s: {exc}"
@@ -259,16 +220,16 @@ class PatchCallback:
 
 class WheelsetModel:
     """State function of a wheelset (module docstring) for one scene, provider and contact model: a thin wrapper of the
-    one compiled right-hand side (compiled.py) for the scipy methods, the Python RK4, the static equilibrium,
-    inspection (:meth:`contact`) and tests; the arguments of the compiled code in ``packed`` (compiled.pack), the
-    callback of a contact model that is not compiled in ``callback`` (:class:`PatchCallback`).
+    one compiled right-hand side (compiled_rhs.py) for the scipy methods, the Python RK4, the static equilibrium,
+    inspection (:meth:`contact`) and tests; the arguments of the compiled code in ``packed`` (compiled_records.pack,
+    a PackedRun), the callback of a contact model that is not compiled in ``callback`` (:class:`PatchCallback`).
 
     Args:
         scene: the scene (parameters, material, speed).
         provider: contact-geometry provider.
         contact_model: an object with the ContactModel protocol (registry.get_model).
         model_options: options handed to the model's solve().
-        python_geometry: the provider's own ``patches`` give the geometry (compiled.geometry_mode 2) even where the
+        python_geometry: the provider's own ``patches`` give the geometry (layout.GEOMETRY_GIVEN) even where the
             compiled code evaluates it (the 3-D search outside the compiled loop: simulate).
     """
 
@@ -301,35 +262,31 @@ class WheelsetModel:
         self.torque = scene.loads.traction_torque_N_m
         self.track = scene.track_dynamics
         self.elastic = self.track.elastic
-        self.track_system = track_model.TrackSystem(self.track, track_model.travel_m(scene)) if self.elastic else None
+        self.track_system = TrackSystem(self.track, track_model.travel_m(scene)) if self.elastic else None
         self.n_state = n_states(self.track_system.n_positions if self.elastic else 0)
         self.track_rest = np.zeros(self.n_state - 14)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
         self.par = model_parameters(self)  # replaced by the packed record below (same fields, contact fields set)
-        from rigid_dynamics.wheelset import compiled
-
-        name = getattr(contact_model, "name", "")
+        code = law_code(contact_model)
         opts = dict(model_options or {})
-        fastsim = opts if name == "fastsim" else dict((opts.get("model_options") or {}).get("fastsim") or {})
-        self.tables = _tables_for(scene.material.shear_modulus_Pa, scene.material.poisson_ratio)
-        self.packed = compiled.pack(
-            self, provider, self.tables, contact_model, fastsim, opts.get("tolerance", 0.05), python_geometry
-        )
-        self.par = self.packed[0]
-        self.mode = int(self.packed[5])
-        code = int(self.par["model_code"])
+        fastsim = opts if code == LAW_FASTSIM else dict((opts.get("model_options") or {}).get("fastsim") or {})
+        self.tables = tables_for(scene.material.shear_modulus_Pa, scene.material.poisson_ratio)
+        tolerance = opts.get("tolerance", 0.05)
+        self.packed = pack(self, provider, self.tables, contact_model, fastsim, tolerance, python_geometry)
+        self.par = self.packed.par
+        self.mode = self.packed.mode
         self.callback = None
-        if code == compiled.CALLBACK_CODE:
+        if code == LAW_CALLBACK:
             self.callback = PatchCallback(contact_model, model_options, scene.material)
-        elif code == compiled.AUTO_CODE:
+        elif code == LAW_AUTO:
             from rigid_dynamics.contact.registry import get_model
 
             bem_options = (opts.get("model_options") or {}).get("bem")
             self.callback = PatchCallback(get_model("bem"), bem_options, scene.material)
-        self.auto = code == compiled.AUTO_CODE
-        ncand = len(self.packed[3])
-        self._rec = np.zeros((ncand + 2, compiled.N_FIELDS))
-        self._cg = np.full((ncand, compiled.N_GEO), np.nan)
+        self.auto = code == LAW_AUTO
+        ncand = len(self.packed.sides)
+        self._rec = np.zeros((ncand + 2, N_FIELDS))
+        self._cg = np.full((ncand, N_GEO), np.nan)
 
     def full_state(self, state: np.ndarray) -> np.ndarray:
         """The full state of a 12-state: work integrals 0 and, with the elastic track, ``track_rest``."""
@@ -340,7 +297,7 @@ class WheelsetModel:
 
     def static_track(self, rail_force_N) -> np.ndarray:
         """Track states at rest under the vertical rail forces (left, right), N, with the wheelset at its start
-        (track.TrackSystem.rest_state).
+        (track_matrices.TrackSystem.rest_state).
         """
         return self.track_system.rest_state(rail_force_N)
 
@@ -411,28 +368,26 @@ class WheelsetModel:
 
     # ----------------------------------------------------------------------------------------------
     def _compiled_rhs(self, t: float, full: np.ndarray, out: np.ndarray, record: bool) -> int:
-        """The compiled right-hand side (compiled.rhs_once / rhs_given) at the full state into ``out``; the
-        candidates into self._rec (and self._cg with ``record``). Returns its status.
+        """The compiled right-hand side (compiled_rhs.rhs_once / rhs_given) at the full state into ``out``; the
+        candidates into self._rec (and self._cg with ``record``). Returns its status (layout.STATUS).
         """
-        from rigid_dynamics.wheelset import compiled
-
-        par, hz, kk, sides, _, mode, targs, sargs = self.packed
+        run = self.packed
         if len(full) != self.n_state or len(out) != self.n_state:  # the compiled code does not check bounds
             raise ValueError(f"full state of length {len(full)}: this run's state has {self.n_state} entries")
-        par["frame_x0_m"] = self.frame_x0
-        compiled.use_callback(self.callback)
-        if mode == 2:
+        run.par["frame_x0_m"] = self.frame_x0
+        compiled_rhs.use_callback(self.callback)
+        if run.mode == GEOMETRY_GIVEN:
             self._given_geometry(full)
-            return int(compiled.rhs_given(float(t), full, par, hz, kk, sides, self._cg, out, self._rec, record))
-        if record:
             return int(
-                compiled.contact_once(float(t), full, par, hz, kk, sides, mode, targs, sargs, out, self._rec, self._cg)
+                compiled_rhs.rhs_given(float(t), full, run.par, run.tables, run.sides, self._cg, out, self._rec, record)
             )
-        return int(compiled.rhs_once(float(t), full, par, hz, kk, sides, mode, targs, sargs, out, self._rec))
+        if record:
+            return int(compiled_rhs.contact_once(float(t), full, run, out, self._rec, self._cg))
+        return int(compiled_rhs.rhs_once(float(t), full, run, out, self._rec))
 
     def _given_geometry(self, full: np.ndarray) -> None:
-        """Mode 2 (compiled.geometry_mode): the provider's candidates into self._cg (side s, slot k at row 2 s + k;
-        rows without a candidate NaN) and their sampled geometries (if any) to the callback.
+        """The geometry given by Python (layout.GEOMETRY_GIVEN): the provider's candidates into self._cg (side s,
+        slot k at row 2 s + k; rows without a candidate NaN) and their sampled geometries (if any) to the callback.
         """
         track = self.rail_under_wheels(full)[0:2] if self.elastic else None
         patches = self.patches_on_track(
@@ -446,23 +401,35 @@ class WheelsetModel:
             if slot >= MAX_SLOTS:
                 raise ContactFailure(f"provider {self.provider.name!r}: more than {MAX_SLOTS} candidates on a side")
             c = 2 * side + slot
-            cg[c, 0] = patches.approach_m[k]
-            cg[c, 1:4] = patches.point_m[k] - full[0:3]
-            cg[c, 4:7] = patches.normal[k]
-            cg[c, 7], cg[c, 8] = patches.curvature_long_1_per_m[k], patches.curvature_lat_1_per_m[k]
-            cg[c, 9], cg[c, 10] = patches.rolling_radius_m[k], patches.wheel_lateral_m[k]
-            cg[c, 11] = patches.contact_angle_rad[k]
+            cg[c, G_APPROACH] = patches.approach_m[k]
+            cg[c, G_LEVER : G_LEVER + 3] = patches.point_m[k] - full[0:3]
+            cg[c, G_NORMAL : G_NORMAL + 3] = patches.normal[k]
+            cg[c, G_CURVATURE_LONG] = patches.curvature_long_1_per_m[k]
+            cg[c, G_CURVATURE_LAT] = patches.curvature_lat_1_per_m[k]
+            cg[c, G_ROLLING_RADIUS], cg[c, G_WHEEL_LATERAL] = patches.rolling_radius_m[k], patches.wheel_lateral_m[k]
+            cg[c, G_CONTACT_ANGLE] = patches.contact_angle_rad[k]
             if patches.geometries is not None:
                 geometries[c] = patches.geometries[k]
         if self.callback is not None:
             self.callback.geometries = geometries
 
+    @contextlib.contextmanager
+    def _search_memory_kept(self, keep: bool):
+        """With ``keep``: the compiled search's warm starts (its only state) restored after the block."""
+        search = self.packed.search
+        memory = [np.copy(search.mem), np.copy(search.n_mem)] if keep and self.mode == GEOMETRY_SEARCH else None
+        try:
+            yield
+        finally:
+            if memory is not None:
+                search.mem[...], search.n_mem[...] = memory
+
     def _failure(self, status: int, t: float) -> ContactFailure:
-        if status == 5 and self.callback is not None:
+        if status == CALLBACK_FAILED and self.callback is not None:
             return ContactFailure(self.callback.message)
-        if status == 4:
+        if status == CREEPAGES_UNDEFINED:
             return ContactFailure(f"rolling speed not > 0 at a contact (t = {t:.6g} s): creepages undefined")
-        return ContactFailure(f"compiled right-hand side: status {status}")
+        return ContactFailure(f"compiled right-hand side: status {status} ({status_name(status)})")
 
     def contact(
         self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None, keep_search_memory=False
@@ -475,29 +442,20 @@ class WheelsetModel:
         ``keep_search_memory``: leave the compiled search's warm starts as they were (a look that must not change the
         run).
         """
-        from rigid_dynamics.wheelset import compiled
-
         full = self.full_state(state)
         if self.elastic and track is not None:
             full[TRACK] = track
         out = np.empty(self.n_state)
-        memory = None
-        if keep_search_memory and self.mode == 1:  # the compiled search's warm starts (its only state) kept
-            memory = [np.copy(a) for a in self.packed[7][3:5]]
-        try:
+        with self._search_memory_kept(keep_search_memory):
             status = self._compiled_rhs(0.0, full, out, True)
-        finally:
-            if memory is not None:
-                for keep, now in zip(memory, self.packed[7][3:5], strict=True):
-                    now[...] = keep
         if status != 0:
             raise self._failure(status, 0.0)
-        sides, slots = self.packed[3], self.packed[4]
-        present = np.flatnonzero(~np.isnan(self._cg[:, 0]))
+        sides, slots = self.packed.sides, self.packed.slots
+        present = np.flatnonzero(~np.isnan(self._cg[:, G_APPROACH]))
         rec, cg = self._rec[present], self._cg[present]
         centre, v_c = full[0:3], full[6:9]
         _, _, omega = rotation_and_rates(*full[3:6], *full[9:12])
-        lever, normal = cg[:, 1:4], cg[:, 4:7]
+        lever, normal = cg[:, G_LEVER : G_LEVER + 3], cg[:, G_NORMAL : G_NORMAL + 3]
         velocity = v_c + _cross_rows(omega, lever)
         rail_velocity = np.zeros((len(present), 3))
         if self.elastic:
@@ -505,8 +463,11 @@ class WheelsetModel:
             rail_velocity[:, 1] = self.rail_lateral_under_wheels(full)[2:4][sides[present]]
         velocity = velocity - rail_velocity
         frames, _, _, _, _ = _creepages(lever, normal, omega, v_c, rail_velocity)
-        active = np.nan_to_num(rec[:, 0], nan=0.0) > 0
-        t_x, t_y, n_f, m_z = (np.where(active, np.nan_to_num(rec[:, k]), 0.0) for k in (1, 2, 0, 3))
+        active = np.nan_to_num(rec[:, NORMAL_FORCE], nan=0.0) > 0
+        t_x, t_y, n_f, m_z = (
+            np.where(active, np.nan_to_num(rec[:, k]), 0.0)
+            for k in (CREEP_FORCE_LONG, CREEP_FORCE_LAT, NORMAL_FORCE, SPIN_MOMENT)
+        )
         force = frames[:, :, 0] * t_x[:, None] + frames[:, :, 1] * t_y[:, None] + frames[:, :, 2] * n_f[:, None]
         moment = frames[:, :, 2] * m_z[:, None]
         force[~active] = 0.0
@@ -516,12 +477,11 @@ class WheelsetModel:
             names = PATCH_FIELDS + (AUTO_PATCH_FIELDS if self.auto else ())
             values = {name: rec[:, f].copy() for f, name in enumerate(names)}
             values["contact_point_y_m"] = centre[1] + lever[:, 1]
-        del compiled
         return ContactState(sides[present], slots[present], force, moment, lever.copy(), velocity, values)
 
     def derivative(self, t: float, state: np.ndarray) -> np.ndarray:
         """d/dt of the full state (12 mechanical + 2 work integrals [+ the track's states, TRACK]) by the compiled
-        right-hand side (compiled._rhs's geometry, compiled laws and callback, compiled._assemble): the one
+        right-hand side (compiled_rhs._rhs's geometry, compiled laws and callback, compiled_motion._assemble): the one
         implementation, also for the scipy methods and the Python RK4.
 
         Raises:
@@ -539,12 +499,12 @@ class WheelsetModel:
         """Per wheel (left, right) the contact force of the last right-hand side, main frame, (2, 3), N: only set
         by a recording call (:meth:`contact`).
         """
-        ncand = len(self.packed[3])
+        ncand = len(self.packed.sides)
         return self._rec[ncand : ncand + 2, :3].copy()
 
     def _track_derivative(self, track, rail_force, out, x_m: float = 0.0) -> float:
-        """d/dt of the track's states into ``out`` under the rail forces (left, right) (compiled.track_rates) with
-        the wheelset at x (the beam: xi = x - x0 + margin); returns the dampers' power.
+        """d/dt of the track's states into ``out`` under the rail forces (left, right) (compiled_motion.track_rates)
+        with the wheelset at x (the beam: xi = x - x0 + margin); returns the dampers' power.
         """
         full = np.zeros(self.n_state)
         full[0] = x_m
@@ -604,8 +564,8 @@ class WheelsetModel:
         return jac
 
     def track_energy_J(self, track) -> tuple:
-        """(kinetic, potential) energy of the elastic track's states (n, k) or (k,), J (track.TrackSystem.energy_J;
-        0, 0 on the rigid track).
+        """(kinetic, potential) energy of the elastic track's states (n, k) or (k,), J
+        (track_matrices.TrackSystem.energy_J; 0, 0 on the rigid track).
         """
         if not self.elastic:
             return 0.0, 0.0
@@ -624,21 +584,16 @@ class WheelsetModel:
 
     def contact_approaches(self, state: np.ndarray, keep_search_memory=False) -> list:
         """Per wheel (left, right) the approaches of its candidates at a 12-state on ``track_rest``, m: the geometry
-        alone (compiled.geometry_once; mode 2 the provider), no contact model.
+        alone (compiled_rhs.geometry_once; the given geometry: the provider), no contact model.
         """
-        from rigid_dynamics.wheelset import compiled
-
         full = self.full_state(state)
-        par, _, _, sides, _, mode, targs, sargs = self.packed
-        if mode == 2:
+        sides = self.packed.sides
+        if self.packed.mode == GEOMETRY_GIVEN:
             self._given_geometry(full)
         else:
-            memory = [np.copy(a) for a in sargs[3:5]] if keep_search_memory and mode == 1 else None
-            compiled.geometry_once(full, par, sides, mode, targs, sargs, self._cg)
-            if memory is not None:
-                for keep, now in zip(memory, sargs[3:5], strict=True):
-                    now[...] = keep
-        q = self._cg[:, 0]
+            with self._search_memory_kept(keep_search_memory):
+                compiled_rhs.geometry_once(full, self.packed, self._cg)
+        q = self._cg[:, G_APPROACH]
         return [q[(sides == i) & ~np.isnan(q)] for i in (0, 1)]
 
     def deepest_approach(self, state: np.ndarray) -> list:

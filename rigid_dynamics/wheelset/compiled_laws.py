@@ -1,0 +1,325 @@
+"""The contact laws of the compiled right-hand side (numba): Hertz and Kalker's C_ij by tables, the creep laws, and
+``auto``'s choice per patch.
+
+* Hertz and Kalker (:func:`_hertz_kalker`): from the tables of :class:`TabulatedHertzKalker` (the record
+  :class:`HertzKalkerTables`), the approach q and the relative curvatures A, B give N, the semi-axes and C11, C22,
+  C23, C33.
+* The creep laws (:func:`_creep_law`, the codes :data:`LAW_CODES` of the names that the contact models declare as
+  their ``compiled_law``, contact/models.py): ``hertz`` (no creep force), ``linear`` (Kalker's linear theory, eq 50-52,
+  contact.linear.linear_one), ``vermeulen-johnson`` (eq 53-58 with the cube, contact.vermeulen_johnson.saturate_one
+  on the linear forces) and ``fastsim`` (contact.fastsim._fastsim_one with the flexibilities of
+  contact.fastsim.flexibilities_one; options nx, ny, traction_bound, flexibility).
+* ``auto`` (:func:`_auto_choice`): the measured thresholds of contact/data/auto_thresholds.json in the parameter
+  record; a patch auto gives to BEM goes through the callback (compiled_rhs._external).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from rigid_dynamics.contact.fastsim import _fastsim_one, flexibilities_one
+from rigid_dynamics.contact.linear import linear_one
+from rigid_dynamics.contact.vermeulen_johnson import saturate_one
+from rigid_dynamics.wheelset.layout import (
+    AUTO_BEM,
+    AUTO_DECIDING_FEATURE,
+    AUTO_DECIDING_THRESHOLD,
+    AUTO_FASTSIM,
+    AUTO_FEATURE_NAMES,
+    AUTO_FEATURES,
+    AUTO_LEVEL,
+    AUTO_LINEAR,
+    AUTO_RUNG,
+    AUTO_RUNG_NAMES,
+    AUTO_VERMEULEN_JOHNSON,
+    N_FIELDS,
+)
+
+LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO = range(6)
+LAW_CODES = {
+    "hertz": LAW_HERTZ,
+    "linear": LAW_LINEAR,
+    "vermeulen-johnson": LAW_VERMEULEN_JOHNSON,
+    "fastsim": LAW_FASTSIM,
+    "auto": LAW_AUTO,
+}
+"""The laws compiled into the loop, by the name a contact model declares (contact.models.HertzianModel.compiled_law);
+LAW_CALLBACK: every patch through the callback (bem, fea, user models); LAW_AUTO: auto's rung chosen per patch
+(linear, Vermeulen-Johnson and FASTSIM inline, BEM through the callback)."""
+
+
+class TabulatedHertzKalker:
+    """Hertz (approach control) and Kalker's C_ij for many patches by look-up tables, for speed.
+
+    Two smooth functions of one variable are tabulated once, on fine grids, from the project's own
+    solvers and interpolated linearly:
+
+    * the inverted axial function p = (b_minor/a_major)^2 of r = max(A, B)/min(A, B) and Kalker's
+      elliptic functions K(p), D(p) (contact.hertz.ellipse_shape_from_curvature_ratio, elliptic_kdbc),
+      on ``HERTZ_POINTS`` points of ln r in [0, ln 1e4];
+    * C11, C22, C23, C33 (contact.kalker.kalker_coefficients at the material's nu) on ``KALKER_POINTS``
+      points of ln(a/b) in [-ln 50, ln 50].
+
+    The compiled right-hand side (compiled_laws._hertz_kalker) interpolates them: a_major = sqrt(q D / (K min(A, B))),
+    N = 2 pi a_major E* q / (3 K), b_minor = a_major sqrt(p), E* = G/(1 - nu). Relative interpolation error < 1e-7
+    (tests/test_wheelset_providers.py compares with hertz_solve_batch and kalker_coefficients); ratios outside the
+    grids are clamped to their ends.
+    """
+
+    HERTZ_POINTS = 20001
+    KALKER_POINTS = 8001
+
+    def __init__(self, material):
+        from rigid_dynamics.contact.hertz import ellipse_shape_from_curvature_ratio, elliptic_kdbc
+        from rigid_dynamics.contact.kalker import kalker_coefficients
+
+        self.shear = material.shear_modulus_Pa
+        self.nu = material.poisson_ratio
+        self.e_star = self.shear / (1.0 - self.nu)
+        self.log_r = np.linspace(0.0, math.log(1e4), self.HERTZ_POINTS)
+        p, _, _ = ellipse_shape_from_curvature_ratio(np.exp(self.log_r))
+        k, d, _, _ = elliptic_kdbc(p)
+        self.p, self.k, self.d = p, k, d
+        self.log_ab = np.linspace(-math.log(50.0), math.log(50.0), self.KALKER_POINTS)
+        coef = kalker_coefficients(np.exp(self.log_ab), self.nu)
+        self.c = np.stack([coef.c11, coef.c22, coef.c23, coef.c33])
+
+
+@lru_cache(maxsize=8)
+def tables_for(shear_modulus_Pa: float, poisson_ratio: float) -> TabulatedHertzKalker:
+    """TabulatedHertzKalker per material (built once per process: ~0.5 s)."""
+    from rigid_dynamics.materials import Material
+
+    return TabulatedHertzKalker(Material(shear_modulus_Pa, poisson_ratio, 0.0))
+
+
+HERTZ_P, HERTZ_K, HERTZ_D = range(3)
+"""Rows of HertzKalkerTables.hertz: the inverted axial function p = (b/a)^2 and Kalker's elliptic K(p), D(p)."""
+KALKER_C11, KALKER_C22, KALKER_C23, KALKER_C33 = range(4)
+"""Rows of HertzKalkerTables.kalker: Kalker's creep coefficients."""
+
+
+class HertzKalkerTables(NamedTuple):
+    """:class:`TabulatedHertzKalker` as the compiled code reads it: ``hertz`` (rows :data:`HERTZ_P`, ...) on a
+    uniform grid of ln(max(A, B)/min(A, B)) from ``log_ratio_start`` by ``log_ratio_step``; ``kalker`` (rows
+    :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b). Two arrays: the record is passed per patch.
+    """
+
+    log_ratio_start: float
+    log_ratio_step: float
+    hertz: np.ndarray
+    log_ab_start: float
+    log_ab_step: float
+    kalker: np.ndarray
+
+
+def hertz_kalker_tables(tables) -> HertzKalkerTables:
+    """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`."""
+    return HertzKalkerTables(
+        float(tables.log_r[0]),
+        float(tables.log_r[1] - tables.log_r[0]),
+        np.ascontiguousarray(np.stack([tables.p, tables.k, tables.d])),
+        float(tables.log_ab[0]),
+        float(tables.log_ab[1] - tables.log_ab[0]),
+        np.ascontiguousarray(tables.c),
+    )
+
+
+@njit(cache=True, _nrt=False)
+def _uniform(x, x0, step, n):
+    """(cell, weight) of x on the uniform grid x0 + i step, i < n, clamped to its ends."""
+    f = (x - x0) / step
+    if f < 0.0:
+        f = 0.0
+    if f > n - 1.0:
+        f = n - 1.0
+    i = min(int(f), n - 2)
+    return i, f - i
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _hertz_kalker(par, tables, q, ca, cb):
+    """Hertz under approach control (tables of the axial function) and Kalker's C11, C22, C23, C33 (tables of a/b):
+    (N, a, b, C11, C22, C23, C33).
+    """
+    amin, amax = min(ca, cb), max(ca, cb)
+    hz = tables.hertz
+    i, w = _uniform(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, hz.shape[1])
+    pp = hz[HERTZ_P, i] * (1 - w) + hz[HERTZ_P, i + 1] * w
+    kk_ = hz[HERTZ_K, i] * (1 - w) + hz[HERTZ_K, i + 1] * w
+    dd = hz[HERTZ_D, i] * (1 - w) + hz[HERTZ_D, i + 1] * w
+    major = math.sqrt(q * dd / (kk_ * amin))
+    normal = 2.0 * math.pi * major * par.contact_modulus_Pa * q / (3.0 * kk_)
+    minor = major * math.sqrt(pp)
+    sa, sb = (major, minor) if ca <= cb else (minor, major)
+    kk = tables.kalker
+    i, w = _uniform(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    c11 = kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w
+    c22 = kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w
+    c23 = kk[KALKER_C23, i] * (1 - w) + kk[KALKER_C23, i + 1] * w
+    c33 = kk[KALKER_C33, i] * (1 - w) + kk[KALKER_C33, i + 1] * w
+    return normal, sa, sb, c11, c22, c23, c33
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _creep_law(par, code, dummy, patch, xi, eta, spin):
+    """(T_x, T_y, M_z) of the compiled creep law ``code`` (layout.LAW_CODES) on a Hertz patch
+    ``patch`` = (N, a, b, C11, C22, C23, C33) of :func:`_hertz_kalker`.
+    """
+    normal, sa, sb, c11, c22, c23, c33 = patch
+    if code == LAW_HERTZ:
+        return 0.0, 0.0, 0.0
+    if code == LAW_FASTSIM:
+        l1, l2, l3 = flexibilities_one(
+            sa, sb, normal, xi, eta, spin, par.shear_modulus_Pa, par.friction_coefficient, (c11, c22, c23),
+            int(par.flexibility_code),
+        )  # fmt: skip
+        fs = _fastsim_one(
+            sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
+            int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
+        )  # fmt: skip
+        return fs[0], fs[1], fs[2]
+    tx, ty, mz = linear_one(par.shear_modulus_Pa, sa, sb, c11, c22, c23, c33, xi, eta, spin)
+    if code == LAW_VERMEULEN_JOHNSON:
+        tx, ty = saturate_one(tx, ty, par.friction_coefficient * normal)
+        mz = 0.0
+    return tx, ty, mz
+
+
+@njit(cache=True, _nrt=False)
+def _auto_threshold(par, rung, f):
+    """Auto's threshold of feature f (layout.AUTO_FEATURE_NAMES) for rung (layout.AUTO_LINEAR, ...)."""
+    if rung == AUTO_LINEAR:
+        v = (par.auto_linear_saturation, par.auto_linear_spin_share, par.auto_linear_ellipticity_residual,
+             par.auto_linear_curvature_change, par.auto_linear_second_patch_nearness)  # fmt: skip
+    elif rung == AUTO_VERMEULEN_JOHNSON:
+        v = (par.auto_vermeulen_johnson_saturation, par.auto_vermeulen_johnson_spin_share,
+             par.auto_vermeulen_johnson_ellipticity_residual, par.auto_vermeulen_johnson_curvature_change,
+             par.auto_vermeulen_johnson_second_patch_nearness)  # fmt: skip
+    else:
+        v = (par.auto_fastsim_saturation, par.auto_fastsim_spin_share, par.auto_fastsim_ellipticity_residual,
+             par.auto_fastsim_curvature_change, par.auto_fastsim_second_patch_nearness)  # fmt: skip
+    return v[f]
+
+
+@njit(cache=True, _nrt=False)
+def _auto_choice(par, feats):
+    """auto.choose_rung in the loop: (rung as auto.AUTO_RUNGS, deciding feature index or -1, its threshold).
+    The first of linear, Vermeulen-Johnson, FASTSIM (at the run's grid) whose measured box holds every feature;
+    else BEM (layout.AUTO_BEM). The deciding feature: of the last rejected rung the feature furthest beyond its
+    threshold; when the cheapest rung qualified, the feature closest to its threshold.
+    """
+    if math.isnan(par.auto_level):
+        return AUTO_BEM, -1, np.nan
+    last_f, last_t = -1, np.nan
+    for rung in range(AUTO_BEM):
+        if math.isnan(_auto_threshold(par, rung, 0)):
+            continue  # no measured box at this level
+        worst, worst_f = -1.0, -1
+        for f in range(len(AUTO_FEATURE_NAMES)):
+            box = _auto_threshold(par, rung, f)
+            if not feats[f] <= box:
+                ratio = feats[f] / box if box > 0 else np.inf
+                if ratio > worst:
+                    worst, worst_f = ratio, f
+        if worst_f >= 0:
+            last_f, last_t = worst_f, _auto_threshold(par, rung, worst_f)
+            continue
+        if last_f < 0:
+            best, best_f = -1.0, 0
+            for f in range(len(AUTO_FEATURE_NAMES)):
+                box = _auto_threshold(par, rung, f)
+                r = feats[f] / box if box > 0 else (0.0 if feats[f] <= 0 else 1.0)
+                if r > best:
+                    best, best_f = r, f
+            return rung, best_f, _auto_threshold(par, rung, best_f)
+        return rung, last_f, last_t
+    return AUTO_BEM, last_f, last_t
+
+
+@njit(cache=True, _nrt=False)
+def _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record):
+    """The compiled contact law of one patch: (N, a, b, T_x, T_y, M_z, to_callback); to_callback: the patch is for
+    the callback (``auto`` chose BEM, or its FASTSIM broke the friction bound as auto's does in contact.models).
+
+    ``auto`` (par.model_code layout.LAW_AUTO): the features of contact.auto.patch_features that a quadric patch has
+    (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
+    are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
+    rec[c] as layout.AUTO_PATCH_FIELDS.
+    """
+    patch = _hertz_kalker(par, tables, q, ca, cb)
+    normal, sa, sb, c11, c22, c23, c33 = patch
+    code = int(par.model_code)
+    if code != LAW_AUTO:
+        tx, ty, mz = _creep_law(par, code, dummy, patch, xi, eta, spin)
+        return normal, sa, sb, tx, ty, mz, False
+    ab = sa * sb
+    gab = par.shear_modulus_Pa * ab
+    gab15 = gab * math.sqrt(ab)
+    t_lin = math.hypot(-gab * c11 * xi, -gab * c22 * eta - gab15 * c23 * spin)
+    mu_n = par.friction_coefficient * normal
+    feats = (
+        t_lin / (3.0 * mu_n) if mu_n > 0 else np.inf,
+        gab15 * c23 * abs(spin) / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0,
+        0.0,
+        0.0,
+        0.0,
+    )
+    rung, deciding, threshold = _auto_choice(par, feats)
+    to_callback = False
+    tx, ty, mz = 0.0, 0.0, 0.0
+    if rung != AUTO_BEM:
+        tx, ty, mz = _creep_law(par, rung + LAW_LINEAR, dummy, patch, xi, eta, spin)
+        if rung == AUTO_FASTSIM and math.hypot(tx, ty) > (1.0 + par.auto_friction_bound_tolerance) * mu_n:
+            rung, to_callback = AUTO_BEM, True
+    else:
+        to_callback = True
+    if record:
+        rec[c, AUTO_RUNG], rec[c, AUTO_LEVEL], rec[c, AUTO_DECIDING_FEATURE] = rung, par.auto_level, deciding
+        rec[c, AUTO_DECIDING_THRESHOLD] = threshold
+        for f in range(len(AUTO_FEATURE_NAMES)):
+            rec[c, AUTO_FEATURES + f] = feats[f]
+    return normal, sa, sb, tx, ty, mz, to_callback
+
+
+@njit(cache=True)
+def patch_forces(par, tables, q, ca, cb, xi, eta, spin):
+    """One patch through the compiled law of par.model_code (not the callback): (N, T_x, T_y, M_z, a, b,
+    to_callback), for tests and inspection.
+    """
+    rec = np.zeros((1, N_FIELDS))
+    normal, sa, sb, tx, ty, mz, st = _law(par, tables, np.zeros((1, 1)), q, ca, cb, xi, eta, spin, rec, 0, False)
+    return normal, tx, ty, mz, sa, sb, st
+
+
+def auto_parameters(par, tolerance: float, fastsim_grid) -> None:
+    """Auto's thresholds (contact/data/auto_thresholds.json, contact.auto) into the parameter record: the level of
+    ``tolerance`` (contact.auto.level_for; none: NaN, every patch BEM) and per rung (linear, Vermeulen-Johnson,
+    FASTSIM at the run's grid by contact.auto.fastsim_rung) the feature box (NaN: no measured box).
+    """
+    from rigid_dynamics.contact.auto import fastsim_rung, level_for, load_thresholds
+    from rigid_dynamics.contact.models import FRICTION_BOUND_TOLERANCE
+
+    data = load_thresholds()
+    key = level_for(tolerance, data)
+    par["auto_friction_bound_tolerance"] = FRICTION_BOUND_TOLERANCE
+    for rung in AUTO_RUNG_NAMES:
+        for f in AUTO_FEATURE_NAMES:
+            par[f"auto_{rung}_{f}"] = np.nan
+    if key is None:
+        par["auto_level"] = np.nan
+        return
+    par["auto_level"] = float(key)
+    level = data["levels"][key]
+    labels = ("linear", "vermeulen-johnson", fastsim_rung(int(fastsim_grid[0]), int(fastsim_grid[1]), level))
+    for rung, label in zip(AUTO_RUNG_NAMES, labels, strict=True):
+        entry = level.get(label) if label is not None else None
+        box = None if entry is None else entry["thresholds"]
+        if box is not None:
+            for f in AUTO_FEATURE_NAMES:
+                par[f"auto_{rung}_{f}"] = float(box[f])

@@ -1,0 +1,188 @@
+"""The floor plan of the numeric core, checked statically (regression of the code's structure, not physics).
+
+* No import loop inside ``rigid_dynamics``: every ``import`` and ``from ... import`` statement, at module level or
+  inside a function, is an edge (``from pkg import name`` to ``pkg.name`` when that is a module, else to ``pkg``;
+  the implicit import of a package's ``__init__`` by its submodules is not an edge); the graph has no cycle.
+* No function in ``rigid_dynamics/wheelset`` with more than 12 parameters (records instead of positionals), and no
+  file there over 700 lines.
+* The named rows, columns and codes of ``wheelset/layout.py`` follow their tuples of names (the state.py pattern).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "rigid_dynamics"
+MAX_PARAMETERS = 12
+MAX_LINES = 700
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _modules() -> dict[str, Path]:
+    return {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _imports(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """The rigid_dynamics modules that ``name`` imports anywhere in its file."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")
+                anchor = anchor[: len(anchor) - node.level + 1]
+                base = ".".join(anchor + ([base] if base else []))
+            targets = []
+            for alias in node.names:
+                sub = f"{base}.{alias.name}"
+                targets.append(sub if sub in modules else base)
+        else:
+            continue
+        found.update(t for t in targets if t in modules and t != name)
+    return found
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components with more than one module (Tarjan)."""
+    index, low, stack, on_stack, out = {}, {}, [], set(), []
+    counter = [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_loop_in_rigid_dynamics():
+    modules = _modules()
+    graph = {name: _imports(name, path, modules) for name, path in modules.items()}
+    assert _cycles(graph) == []
+
+
+def test_the_loop_detector_finds_a_loop():
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+def _long_signatures(path: Path):
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            a = node.args
+            n = len(a.posonlyargs) + len(a.args) + len(a.kwonlyargs) + (a.vararg is not None) + (a.kwarg is not None)
+            if n > MAX_PARAMETERS:
+                yield f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({n} parameters)"
+
+
+def test_wheelset_functions_take_at_most_12_parameters():
+    found = [hit for path in sorted((PACKAGE / "wheelset").rglob("*.py")) for hit in _long_signatures(path)]
+    assert found == []
+
+
+def test_wheelset_files_at_most_700_lines():
+    long = {
+        str(p.relative_to(ROOT)): n
+        for p in sorted((PACKAGE / "wheelset").rglob("*.py"))
+        if (n := len(p.read_text().splitlines())) > MAX_LINES
+    }
+    assert long == {}
+
+
+def _stem(name: str) -> str:
+    """A field's name without its unit, upper case: the name of its constant."""
+    upper = name.upper()
+    for unit in ("_1_PER_M", "_NM", "_RAD", "_M", "_N"):
+        if upper.endswith(unit):
+            return upper.removesuffix(unit)
+    return upper
+
+
+def test_layout_constants_follow_their_names():
+    from rigid_dynamics.wheelset import compiled_laws, layout
+
+    for k, name in enumerate(layout.PATCH_FIELDS):
+        assert getattr(layout, _stem(name)) == k, name
+    assert layout.N_PATCH == len(layout.PATCH_FIELDS)
+    for k, name in enumerate(layout.AUTO_PATCH_FIELDS[:4]):
+        assert getattr(layout, name.upper()) == layout.N_PATCH + k, name
+    assert layout.AUTO_FEATURES == layout.N_PATCH + 4
+    assert layout.AUTO_PATCH_FIELDS[4:] == tuple(f"auto_{f}" for f in layout.AUTO_FEATURE_NAMES)
+    assert layout.N_FIELDS == len(layout.PATCH_FIELDS) + len(layout.AUTO_PATCH_FIELDS)
+
+    geometry = {
+        "approach_m": "G_APPROACH", "lever_x_m": "G_LEVER", "normal_x": "G_NORMAL",
+        "curvature_long_1_per_m": "G_CURVATURE_LONG", "curvature_lat_1_per_m": "G_CURVATURE_LAT",
+        "rolling_radius_m": "G_ROLLING_RADIUS", "wheel_lateral_m": "G_WHEEL_LATERAL",
+        "contact_angle_rad": "G_CONTACT_ANGLE",
+    }  # fmt: skip
+    for name, const in geometry.items():
+        assert getattr(layout, const) == layout.GEOMETRY_FIELDS.index(name), name
+    for axis, k in (("y", 1), ("z", 2)):
+        assert layout.GEOMETRY_FIELDS.index(f"lever_{axis}_m") == layout.G_LEVER + k
+        assert layout.GEOMETRY_FIELDS.index(f"normal_{axis}") == layout.G_NORMAL + k
+    assert layout.N_GEO == len(layout.GEOMETRY_FIELDS)
+
+    for k, name in enumerate(layout.TABLE_FIELDS):
+        assert getattr(layout, "T_" + _stem(name)) == k, name
+    assert layout.N_TABLE_ROWS == len(layout.TABLE_FIELDS)
+
+    for k, name in enumerate(layout.SECTION_FIELDS):
+        assert getattr(layout, "I_" + _stem(name)) == k, name
+    assert layout.N_SECTION == len(layout.SECTION_FIELDS)
+
+    single = [n for n in layout.SCRATCH_ROWS if not n.startswith(("side_force_", "rotation_row_"))]
+    for name in single:
+        assert getattr(layout, "S_" + name.upper()) == layout.SCRATCH_ROWS.index(name), name
+    assert layout.SCRATCH_ROWS.index("side_force_left") == layout.S_SIDE_FORCE
+    assert layout.SCRATCH_ROWS.index("rotation_row_0") == layout.S_ROTATION
+    assert layout.N_SCRATCH == len(layout.SCRATCH_ROWS)
+
+    for name, code in compiled_laws.LAW_CODES.items():
+        assert getattr(compiled_laws, "LAW_" + name.upper().replace("-", "_")) == code
+    assert len(set(compiled_laws.LAW_CODES.values()) | {compiled_laws.LAW_CALLBACK}) == len(compiled_laws.LAW_CODES) + 1
+    assert sorted(layout.STATUS) == list(range(len(layout.STATUS)))
+    assert layout.status_name(layout.OK) == "ok" and layout.status_name(layout.UNDERFLOW) == "step-size-underflow"
+    assert layout.AUTO_RUNG_NAMES == ("linear", "vermeulen_johnson", "fastsim")
+    assert (layout.AUTO_LINEAR, layout.AUTO_VERMEULEN_JOHNSON, layout.AUTO_FASTSIM) == (0, 1, 2)
+    # auto's rung r runs the law LAW_LINEAR + r (compiled_laws._law)
+    assert compiled_laws.LAW_LINEAR + layout.AUTO_FASTSIM == compiled_laws.LAW_FASTSIM
+
+
+def test_contact_package_auto_rungs_match_the_compiled_order():
+    from rigid_dynamics.contact.auto import AUTO_RUNGS, FEATURES
+    from rigid_dynamics.wheelset import layout
+
+    assert [r.replace("-", "_") for r in AUTO_RUNGS[: len(layout.AUTO_RUNG_NAMES)]] == list(layout.AUTO_RUNG_NAMES)
+    assert tuple(FEATURES) == layout.AUTO_FEATURE_NAMES
