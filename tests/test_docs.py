@@ -101,3 +101,15 @@ def test_the_results_page_has_a_section_per_file():
     sections = [line for line in page.splitlines() if line.startswith("## ")]
     assert len(sections) == len(files)
     assert "](../benchmarks/results/bench/time_vs_error-large-spin.png)" in page
+
+
+def test_the_readme_python_snippet_runs(capsys):
+    """The README's Python block (its five-minute tour) runs as written: what a new user copies first."""
+    import re
+
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert len(blocks) == 1
+    exec(compile(blocks[0], "README.md", "exec"), {"__name__": "readme"})  # noqa: S102
+    out = capsys.readouterr().out
+    assert out.startswith("ok ")
