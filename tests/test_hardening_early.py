@@ -128,7 +128,7 @@ def test_a_value_error_during_the_work_is_a_failure_not_bad_input(capsys, tmp_pa
     (exit 2). Now one line naming the failure, exit 1."""
     import wheelrail.cases
 
-    def broken(case, method):
+    def broken(case, method, progress=None):
         raise ValueError("a check deep inside the solver failed")
 
     monkeypatch.setattr(wheelrail.cases, "solve_case", broken)

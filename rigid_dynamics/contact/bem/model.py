@@ -143,7 +143,22 @@ MIN_COMPANION_ELEMENTS = 3
 the fine grid: it is left out, and without the companion twice as coarse the error is not estimated)."""
 
 MAX_ELEMENTS = 4_000_000
-"""Largest grid ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
+"""Largest grid ``nx`` x ``ny`` or ``element_size_m`` may produce (about 1 GB of FFT work arrays)."""
+SECONDS_PER_ELEMENT = 2.4e-5
+"""Measured solve time per element at 400 x 400 (hertz-quadric with creepage and spin, grid-error companions
+included, one core of the shared 2-core machine, 2026-11-28: 3.8 s); larger grids need more iterations per
+element, so the estimate made from it is a lower bound."""
+
+
+def _grid_budget(nx: int, ny: int, name: str, value) -> None:
+    """Refuse a grid beyond :data:`MAX_ELEMENTS` up front, naming the option, with its memory and time estimate."""
+    if nx * ny > MAX_ELEMENTS:
+        memory_gb = 4 * (2 * nx) * (2 * ny) * 16 / 1e9  # complex FFT work arrays over the doubled grid
+        raise ValueError(
+            f"option {name} = {value!r} gives {nx} x {ny} = {nx * ny} elements: expected at most {MAX_ELEMENTS} "
+            f"(this grid needs about {memory_gb:.1f} GB of FFT work arrays and at least "
+            f"{nx * ny * SECONDS_PER_ELEMENT / 60:.0f} minutes)"
+        )
 
 
 def hertz_ellipse(
@@ -236,6 +251,8 @@ def _options(options: Mapping | None) -> dict:
     elif size is not None:
         size = size, size
     opts["element_sizes_m"] = size
+    if size is None:
+        _grid_budget(opts["nx"], opts["ny"], "nx, ny", (opts["nx"], opts["ny"]))
     opts["grid_named"] = any(k in options for k in ("nx", "ny", "element_size_m", "dx_m", "dy_m"))
     if opts["extrapolate"] and size is None and (opts["nx"] % 2 or opts["ny"] % 2 or opts["nx"] < 4):
         raise ValueError(
@@ -447,12 +464,8 @@ class BemModel:
             if size is not None:
                 x_lim, nx = _whole_elements(x_lim, float(size[0]), even)
                 y_lim, ny = _whole_elements(y_lim, float(size[1]), even)
-                if nx * ny > MAX_ELEMENTS:
-                    name = "element_size_m" if opts["element_size_m"] is not None else "dx_m"
-                    raise ValueError(
-                        f"option {name} = {opts[name]!r} gives {nx} x {ny} elements over the potential contact "
-                        f"area: expected at most {MAX_ELEMENTS} (a larger element size)"
-                    )
+                name = "element_size_m" if opts["element_size_m"] is not None else "dx_m"
+                _grid_budget(nx, ny, name, opts[name])
             dx = (x_lim[1] - x_lim[0]) / nx
             dy = (y_lim[1] - y_lim[0]) / ny
             x = x_lim[0] + dx * (np.arange(nx) + 0.5)
