@@ -61,6 +61,32 @@ def test_fastsim_on_a_coarse_grid_is_a_warning(capsys, tmp_path):
     assert code == 0 and json.loads(out)["patches"][0]["status"] == "ok"  # 20 x 20 meets 5 % here
 
 
+@pytest.mark.parametrize("model", ["bem", "auto"])
+def test_bem_on_a_coarse_grid_or_below_its_tolerance_is_a_warning(capsys, model):
+    """The issue's BEM 2 x 2 (p0 60 % below Hertz) and `auto` at a 0.1 % tolerance (BEM 40 x 40, 1.7 % off a
+    160 x 160 one) ended ok; each now ends warning with exit 1 (the BEM states its grid error, rigid_dynamics.
+    contact.bem.model.grid_error_estimate; tests/test_bem_grid_error.py checks the estimate against Hertz and
+    CONTACT's exact values)."""
+    settings = ["solver.nx=2", "solver.ny=2"] if model == "bem" else ["solver.tolerance=0.001"]
+    argv = ["contact", "large-spin", "--method", model, "--json"]
+    for setting in settings:
+        argv += ["--set", setting]
+    code, out, err = run(capsys, *argv)
+    assert code == 1, err
+    record = json.loads(out)
+    assert record["status"] == "warning" and record["success"] is False
+    assert record["patches"][0]["status"] == "warning"
+
+
+def test_a_huge_bem_grid_is_refused_with_its_estimate(capsys):
+    """BEM 3000 x 3000 (inside nx's declared range) ran for many minutes without a budget; now refused up front,
+    exit 2, with its memory and time estimate."""
+    code, _, err = run(capsys, "contact", "hertz-quadric", "--method", "bem", "--set", "solver.nx=3000",
+                       "--set", "solver.ny=3000")  # fmt: skip
+    assert code == 2 and err.startswith("wheelrail: error: ") and err.count("\n") == 1
+    assert "3000 x 3000 = 9000000 elements: expected at most 4000000" in err and "GB" in err and "minutes" in err
+
+
 @pytest.mark.slow
 def test_scipy_method_at_a_loose_tolerance_is_a_warning():
     """RK45 at rtol 1e-2 on hunting-conical (3 s): energy balance 0.65, peak normal force 240 kN against 89 kN from
