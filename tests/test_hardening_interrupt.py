@@ -49,7 +49,7 @@ def test_ctrl_c_to_the_process_group_ends_quietly_with_130(tmp_path, command):
     try:
         # the two worker processes are up (while the cluster starts, SIGINT is ignored: its workers inherit that)
         assert wait_for(lambda: _workers(proc.pid) >= 2, 240.0), "no workers"
-        wait_for(lambda: False, 5.0)  # the cluster has started and its workers are busy
+        wait_for(lambda: False, 1.0)  # the cluster has started (a quick stress run ends a few s later)
         assert proc.poll() is None, "ended before the interrupt"
         os.killpg(proc.pid, signal.SIGINT)
         _, err = proc.communicate(timeout=120)

@@ -66,7 +66,7 @@ def test_two_compares_into_one_folder_do_not_mix(capsys, tmp_path, monkeypatch):
 
     seen = []
 
-    def stand_in(named, out_dir, models):
+    def stand_in(named, out_dir, models, progress=None):
         seen.append(sorted(p.name for p in out_dir.iterdir()))
         if named.name == "hertz-ab-10":
             raise RuntimeError("the second compare fails half-way")
