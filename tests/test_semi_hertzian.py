@@ -13,12 +13,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from numba import njit
 
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
 from rigid_dynamics.contact.bem.model import hertz_ellipse
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.kalker import kalker_coefficients
-from rigid_dynamics.contact.kpec import equivalent_ellipse, hertz_semi_axes, kpec_pressure
+from rigid_dynamics.contact.kpec import (
+    equivalent_ellipse,
+    fastsim_strips,
+    hertz_semi_axes,
+    kpec_pressure,
+    simplified_flexibilities,
+)
 from rigid_dynamics.contact.registry import ContactModel, get_model
 from rigid_dynamics.contact.semi_hertzian import KpecModel
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
@@ -195,3 +202,24 @@ def test_fastrip_per_strip_against_hertz_fastrip(creepage):
     mu_fn = 0.3 * mine.normal_force_N
     assert abs(mine.creep_force_long_N - ref.creep_force_long_N) < 0.02 * mu_fn
     assert abs(mine.creep_force_lat_N - ref.creep_force_lat_N) < 0.02 * mu_fn
+
+
+@njit(cache=False)
+def _compiled_caller(h, x, y, g, nu, mu, xi, eta, phi, p, contact, tx, ty, slip):
+    """A compiled caller as the dynamics loop will be: the kernels take plain arrays and scalars only."""
+    out = kpec_pressure(h, x, y, g, nu, p, contact)
+    l1, l2, l3, _, _ = simplified_flexibilities(contact, x[1] - x[0], y[1] - y[0], out[0], g, nu, mu, xi, eta, phi)
+    return fastsim_strips(p, contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
+
+
+def test_kernels_compose_in_compiled_code_as_the_rung():
+    """Regression of two paths of ours: the kernels called from a compiled function give the rung's forces."""
+    a, b, *_, approach = _hertz(ContactGeometry.quadric(0.46, 0.3), normal_force_N=1e5)
+    geometry = ContactGeometry.quadric(0.46, 0.3, approach_m=approach)
+    creepage = Creepage(1e-3, 1e-3, 0.5)
+    res = get_model("kpec").solve(geometry, creepage, STEEL, options={"nx": 30, "ny": 30})
+    x, y = res.fields.x_m, res.fields.y_m
+    h = np.ascontiguousarray(geometry.gap_m(*np.meshgrid(x, y)))
+    arrays = [np.zeros(h.shape), np.zeros(h.shape, dtype=bool), np.zeros(h.shape), np.zeros(h.shape)]
+    fx, fy, mz = _compiled_caller(h, x, y, 82e9, 0.28, 0.3, 1e-3, 1e-3, 0.5, *arrays, np.zeros(h.shape, dtype=bool))
+    assert (fx, fy, mz) == pytest.approx((res.creep_force_long_N, res.creep_force_lat_N, res.spin_moment_Nm), 1e-12)

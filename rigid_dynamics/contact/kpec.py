@@ -112,7 +112,6 @@ def equivalent_ellipse(h, x, y, combined_modulus_Pa):
                     r0 = j
                 r1 = j
                 break
-    one_row = r0 >= r1
     if r0 <= 0:
         r0 = min(1, ny - 1)
     im = np.argmin(h[r0])
@@ -122,6 +121,7 @@ def equivalent_ellipse(h, x, y, combined_modulus_Pa):
         y_sta = y[r0] - 0.5 * dy
     if r1 >= ny - 1:
         r1 = max(ny - 2, 0)
+    one_row = r0 >= r1  # after the edge adjustments, as CONTACT
     im = np.argmin(h[r1])
     if r1 + 1 < ny and h[r1 + 1, im] != h[r1, im]:
         y_end = y[r1] + (h_kp - h[r1, im]) * dy / (h[r1 + 1, im] - h[r1, im])
