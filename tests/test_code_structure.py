@@ -123,7 +123,7 @@ def test_wheelset_files_at_most_700_lines():
 def _stem(name: str) -> str:
     """A field's name without its unit, upper case: the name of its constant."""
     upper = name.upper()
-    for unit in ("_1_PER_M", "_NM", "_RAD", "_M", "_N"):
+    for unit in ("_1_PER_M", "_NM", "_RAD", "_M2", "_PA", "_CODE", "_M", "_N"):
         if upper.endswith(unit):
             return upper.removesuffix(unit)
     return upper

@@ -52,11 +52,12 @@ def test_csv_and_parquet_load_in_pandas_and_match_the_npz(run_dir):
             np.testing.assert_array_equal(parquet[f"left_second_{name}"], data[f"patch_{name}"][:, 0, 1])
         np.testing.assert_array_equal(csv["left_wheel_contact_force_z_N"], data["contact_force_N"][:, 0, 2])
         np.testing.assert_array_equal(parquet["work_contact_J"], data["work_contact_J"])
-    # every column name ends in a unit (or is a dimensionless creepage)
+    # every column name ends in a unit or says it is a code (or is a dimensionless creepage or residual)
     for name in csv.columns:
-        assert name.rsplit("_", 1)[-1] in {"s", "m", "rad", "N", "Nm", "J", "per_s", "per_m"} or "creepage" in name, (
-            name
-        )
+        unit = name.rsplit("_", 1)[-1]
+        assert unit in {"s", "m", "m2", "Pa", "rad", "N", "Nm", "J", "per_s", "per_m", "code"} or any(
+            word in name for word in ("creepage", "residual")
+        ), name
 
 
 def test_result_methods_and_bad_suffix(tmp_path):

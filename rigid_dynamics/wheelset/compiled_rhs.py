@@ -15,7 +15,7 @@ Hertz/Kalker tables, the candidates' sides and slots, the geometry mode and its 
 * Creepages and the equations of motion (compiled_motion.py), the contact laws (compiled_laws.py).
 * The callback boundary (:func:`_external`): contact models that are not compiled (bem, fea, user models; BEM when
   ``auto`` chooses it) get each patch (:class:`CallbackPatch`) handed out to one Python dispatcher
-  (wheelset_model.PatchCallback) and give the forces back.
+  (callback.PatchCallback) and give the forces back.
 
 Elastic track: the candidate geometry is evaluated with the wheelset centre raised by that side's rail deflection
 (tables: q = q_ref + (z - z_r - z_ref) dq/dz; search: the side's search at the raised centre), the creepages and
@@ -32,20 +32,24 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, objmode
 
-from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK, _law
+from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_LINEAR, _law
 from rigid_dynamics.wheelset.compiled_motion import _assemble, _patch_creepages, _rotation
 from rigid_dynamics.wheelset.compiled_search import search_geometry, search_geometry_on_track
 from rigid_dynamics.wheelset.compiled_tables import _table_geometry, table_scratch
 from rigid_dynamics.wheelset.layout import (
     APPROACH,
+    AUTO_RUNG,
     CALLBACK_FAILED,
     CONTACT_ANGLE,
+    CONTACT_AREA,
+    CONTACT_LAW,
     CONTACT_POINT_Y,
     CREEP_FORCE_LAT,
     CREEP_FORCE_LONG,
     CREEPAGE_LAT,
     CREEPAGE_LONG,
     CREEPAGES_UNDEFINED,
+    ELLIPTICITY_RESIDUAL,
     G_APPROACH,
     G_CONTACT_ANGLE,
     G_CURVATURE_LAT,
@@ -56,11 +60,14 @@ from rigid_dynamics.wheelset.layout import (
     G_WHEEL_LATERAL,
     GEOMETRY_SEARCH,
     GEOMETRY_TABLES,
+    MAX_PRESSURE,
     N_FIELDS,
     N_GEO,
     N_SCRATCH,
     NORMAL_FORCE,
     OK,
+    PATCH_ELLIPSE,
+    PATCH_GEOMETRY,
     ROLLING_RADIUS,
     S_EX,
     S_EY,
@@ -82,7 +89,7 @@ from rigid_dynamics.wheelset.layout import (
     SPIN_MOMENT,
     WHEEL_LATERAL,
 )
-from rigid_dynamics.wheelset.state import X_VELOCITY, Y_VELOCITY, Z_VELOCITY, X, Y, Z
+from rigid_dynamics.wheelset.state import ROLL, SPIN, X_VELOCITY, Y_VELOCITY, YAW, Z_VELOCITY, X, Y, Z
 from rigid_dynamics.wheelset.track import rail_lateral_under_wheel, rail_under_wheel
 
 
@@ -102,7 +109,9 @@ class Workspace(NamedTuple):
 class CallbackPatch(NamedTuple):
     """One patch handed to the callback (Python side): candidate c of ``side`` at time t_s, its approach and
     relative curvatures, creepages and rolling speed, contact point and contact frame (e_x, e_y, n; main frame),
-    rolling radius, contact angle and the wheel's lateral coordinate of the point.
+    rolling radius, contact angle and the wheel's lateral coordinate of the point, and the wheelset's pose (centre,
+    main frame, m; yaw, roll and spin angle, rad: state.STATE_NAMES' first six) from which the callback can sample
+    the real surfaces' undeformed distance around the patch.
     """
 
     candidate: int
@@ -122,10 +131,34 @@ class CallbackPatch(NamedTuple):
     rolling_radius_m: float
     contact_angle_rad: float
     wheel_lateral_m: float
+    centre_m: tuple
+    yaw_rad: float
+    roll_rad: float
+    spin_rad: float
+
+
+class CallbackOutcome(NamedTuple):
+    """What the callback gives back per patch (callback.PatchCallback.solve): forces on the wheel in the
+    contact frame (N, T_x, T_y: N; M_z: N m), the semi-axes (or the equivalent ellipse's) a, b (m), contact area
+    (m^2), max pressure (Pa), the geometry the model saw (layout.PATCH_ELLIPSE / PATCH_SAMPLED) and its ellipticity
+    residual (NaN for an ellipse), and the status (0 solved, 1 failed: the callback keeps its message).
+    """
+
+    normal_force_N: float
+    creep_force_long_N: float
+    creep_force_lat_N: float
+    spin_moment_Nm: float
+    semi_axis_long_m: float
+    semi_axis_lat_m: float
+    contact_area_m2: float
+    max_pressure_Pa: float
+    patch_geometry: int
+    ellipticity_residual: float
+    status: int
 
 
 _CALLBACK = [None]
-"""The Python object that solves the patches of the non-compiled contact models (wheelset_model.PatchCallback),
+"""The Python object that solves the patches of the non-compiled contact models (callback.PatchCallback),
 set by :func:`use_callback` before a compiled run or right-hand side."""
 
 
@@ -135,7 +168,7 @@ def use_callback(callback) -> None:
 
 
 def _dispatch(patch: CallbackPatch):
-    """The callback boundary's Python side: the patch to the callback in use (wheelset_model.PatchCallback.solve)."""
+    """The callback boundary's Python side: the patch to the callback in use (callback.PatchCallback.solve)."""
     return _CALLBACK[0].solve(patch)
 
 
@@ -143,10 +176,11 @@ def _dispatch(patch: CallbackPatch):
 def _external(t, y, c, side, g, creep, frame):
     """The one callback boundary: candidate c of ``side`` at time t (its geometry row g, layout.GEOMETRY_FIELDS;
     creep = (rolling speed, xi, eta, spin); frame = (e_x, e_y) of the contact frame, main frame) handed to Python
-    (numba objmode) as a :class:`CallbackPatch` and (N, T_x, T_y, M_z, a, b, status) taken back; status != 0: the
-    contact model failed (the callback keeps its message). Overhead measured here: 2.0-2.1 us per objmode call of a
-    trivial Python function; 25 us per patch through wheelset_model.PatchCallback with a model returning constant
-    forces (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes about 20 ms.
+    (numba objmode) as a :class:`CallbackPatch` and a :class:`CallbackOutcome`'s values taken back (N, T_x, T_y,
+    M_z, a, b, area, max pressure, patch geometry code, ellipticity residual, status); status != 0: the contact
+    model failed (the callback keeps its message). Overhead measured here: 2.0-2.1 us per objmode call of a trivial
+    Python function; 25 us per patch through callback.PatchCallback with a model returning constant forces
+    (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes about 20 ms.
     """
     speed, xi, eta, spin = creep
     ex, ey = frame
@@ -155,12 +189,30 @@ def _external(t, y, c, side, g, creep, frame):
     normal = (g[G_NORMAL], g[G_NORMAL + 1], g[G_NORMAL + 2])
     e_x, e_y = (ex[0], ex[1], ex[2]), (ey[0], ey[1], ey[2])
     radius, angle, lateral = g[G_ROLLING_RADIUS], g[G_CONTACT_ANGLE], g[G_WHEEL_LATERAL]
+    centre = (y[X], y[Y], y[Z])
+    yaw, roll, turn = y[YAW], y[ROLL], y[SPIN]
     with objmode(normal_force="float64", tx="float64", ty="float64", mz="float64", sa="float64", sb="float64",
-                 st="int64"):  # fmt: skip
-        normal_force, tx, ty, mz, sa, sb, st = _dispatch(
-            CallbackPatch(c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, e_x, e_y, radius, angle, lateral)
-        )
-    return normal_force, tx, ty, mz, sa, sb, st
+                 area="float64", pmax="float64", geom="int64", resid="float64", st="int64"):  # fmt: skip
+        normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _dispatch(
+            CallbackPatch(
+                c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, e_x, e_y, radius, angle, lateral,
+                centre, yaw, roll, turn,
+            )
+        )  # fmt: skip
+    return normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st
+
+
+@njit(cache=True, _nrt=False)
+def _served_law(par, rec, c, record):
+    """The compiled law that served candidate c (compiled_laws.LAW_CODES): the run's, or for ``auto`` the rung it
+    chose (recorded in rec[c, AUTO_RUNG] when ``record``; NaN otherwise, then LAW_AUTO).
+    """
+    code = int(par.model_code)
+    if code != LAW_AUTO:
+        return code
+    if record and not math.isnan(rec[c, AUTO_RUNG]):
+        return int(rec[c, AUTO_RUNG]) + LAW_LINEAR
+    return LAW_AUTO
 
 
 @njit(cache=True, _nrt=False)
@@ -222,13 +274,24 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, record, out):
         if not speed > 0.0:
             return CREEPAGES_UNDEFINED
         if par.model_code == LAW_CALLBACK:
-            normal, tx, ty, mz, sa, sb, st = _external(t, y, c, side, g, (speed, xi, eta, spin), (ex, ey))
+            normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(
+                t, y, c, side, g, (speed, xi, eta, spin), (ex, ey)
+            )
+            law = LAW_CALLBACK
             if st != 0:
                 return CALLBACK_FAILED
         else:
             normal, sa, sb, tx, ty, mz, to_callback = _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
+            # a compiled law sees the quadric: Hertz's ellipse, its area and max pressure
+            area = math.pi * sa * sb
+            pmax = 1.5 * normal / area if area > 0.0 else math.nan
+            geom, resid = PATCH_ELLIPSE, math.nan
+            law = _served_law(par, rec, c, record)
             if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
-                normal, tx, ty, mz, sa, sb, st = _external(t, y, c, side, g, (speed, xi, eta, spin), (ex, ey))
+                normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(
+                    t, y, c, side, g, (speed, xi, eta, spin), (ex, ey)
+                )
+                law = LAW_CALLBACK
                 if st != 0:
                     return CALLBACK_FAILED
         for k in range(3):
@@ -262,6 +325,11 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, record, out):
             rec[c, SPIN_CREEPAGE] = spin
             rec[c, SEMI_AXIS_LONG] = sa
             rec[c, SEMI_AXIS_LAT] = sb
+            rec[c, CONTACT_AREA] = area
+            rec[c, MAX_PRESSURE] = pmax
+            rec[c, PATCH_GEOMETRY] = geom
+            rec[c, ELLIPTICITY_RESIDUAL] = resid
+            rec[c, CONTACT_LAW] = law
     _assemble(t, y, par, force, moment, p_con, (rail_f0, rail_f1, rail_fy0, rail_fy1), om, rzx, out)
     if record:
         for sd in range(2):

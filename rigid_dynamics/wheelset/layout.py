@@ -44,13 +44,28 @@ PATCH_FIELDS = (
     "contact_angle_rad",
     "semi_axis_long_m",
     "semi_axis_lat_m",
+    "contact_area_m2",
+    "max_pressure_Pa",
+    "patch_geometry_code",
+    "ellipticity_residual",
+    "contact_law_code",
 )
-"""Per-patch quantities recorded in the results, each of shape (n_out, 2 sides, 2 slots)."""
+"""Per-patch quantities recorded in the results, each of shape (n_out, 2 sides, 2 slots). ``patch_geometry_code`` says
+which geometry the contact model saw (:data:`PATCH_ELLIPSE`: the quadric of the curvatures at the contact point;
+:data:`PATCH_SAMPLED`: the undeformed distance sampled from the real surfaces), ``ellipticity_residual`` how far a
+sampled gap departs from that quadric (rigid_dynamics.contact.search.ellipticity_error; NaN for an ellipse) and
+``contact_law_code`` which law served the patch (its code in compiled_laws.LAW_CODES; LAW_CALLBACK for a model solved
+through the callback)."""
 (
     NORMAL_FORCE, CREEP_FORCE_LONG, CREEP_FORCE_LAT, SPIN_MOMENT, CREEPAGE_LONG, CREEPAGE_LAT, SPIN_CREEPAGE,
     APPROACH, CONTACT_POINT_Y, WHEEL_LATERAL, ROLLING_RADIUS, CONTACT_ANGLE, SEMI_AXIS_LONG, SEMI_AXIS_LAT,
-) = range(14)  # fmt: skip
-N_PATCH = 14
+    CONTACT_AREA, MAX_PRESSURE, PATCH_GEOMETRY, ELLIPTICITY_RESIDUAL, CONTACT_LAW,
+) = range(19)  # fmt: skip
+N_PATCH = 19
+
+PATCH_ELLIPSE, PATCH_SAMPLED = range(2)
+"""Codes of the ``patch_geometry_code`` column: the quadric (multi-Hertzian) or the sampled undeformed distance."""
+PATCH_GEOMETRY_NAMES = ("ellipse", "sampled")
 
 AUTO_PATCH_FIELDS = (
     "auto_rung",

@@ -20,6 +20,9 @@ from rigid_dynamics.wheelset.track import TrackDynamics
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
 """Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
 
+PATCH_GEOMETRIES = ("sampled", "ellipse")
+"""What a gap-solving contact model sees per patch in dynamics (DynamicsScene.patch_geometry)."""
+
 INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4", "DP54", "BS32")
 """scipy.integrate.solve_ivp methods plus the fixed-step classical Runge-Kutta method ``RK4``."""
 
@@ -504,6 +507,11 @@ class DynamicsScene:
         contact_provider: "auto" (conical analytic for conical wheels, tables for ideal geometry,
             3-D search with irregularities), "conical", "tables" or "search".
         contact_tolerance: relative force tolerance handed to the "auto" contact model.
+        patch_geometry: what a contact model that solves a gap sees per patch (:data:`PATCH_GEOMETRIES`):
+            "sampled" (default) the undeformed distance sampled from the real surfaces around the patch (the
+            flange's, a flat edge's or a worn pair's non-elliptic patch), "ellipse" the quadric of the relative
+            curvatures at the contact point (multi-Hertzian). The Hertzian laws (hertz, linear,
+            vermeulen-johnson, fastsim) see the quadric either way.
         settling_distance_m: distance travelled from the start after which the summary's peaks are taken (the
             start-up from the initial offset is not a result), m; the full-run peaks are reported beside them.
             The default 10 m covers the start-up of the embedded polygonal-wheel scene from its 1 mm offset (two-point
@@ -528,6 +536,7 @@ class DynamicsScene:
     contact_model: str = "linear"
     contact_provider: str = "auto"
     contact_tolerance: float = 0.05
+    patch_geometry: str = "sampled"
     fastsim_elements_per_strip: int = 20
     fastsim_strips: int = 20
     settling_distance_m: float = 10.0
@@ -544,6 +553,8 @@ class DynamicsScene:
             )
         if not isinstance(self.contact_model, str) or not self.contact_model:
             raise ValueError(f"contact_model = {self.contact_model!r}: expected a registered model name")
+        if self.patch_geometry not in PATCH_GEOMETRIES:
+            raise ValueError(f"patch_geometry = {self.patch_geometry!r}: expected one of {', '.join(PATCH_GEOMETRIES)}")
         for name in ("fastsim_elements_per_strip", "fastsim_strips"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1000:
