@@ -602,6 +602,58 @@ def _fitted_field(sample, half_x: float, half_y: float, margin: float, max_passe
     return field
 
 
+def patch_undeformed_distance(
+    wheel,
+    rail,
+    pose: WheelsetPose,
+    side: str,
+    point_m,
+    frame,
+    wheel_lateral_m: float,
+    approach_m: float,
+    curvatures,
+    options=None,
+) -> UndeformedDistance:
+    """The sampled undeformed distance of one patch at a given pose: the field :func:`search_side` gives its
+    patches (:func:`_fitted_field` of :func:`_sample_field`, the gap of :func:`_gap_at` evaluated exactly at any
+    point), for a patch found elsewhere (e.g. the compiled search of the dynamics loop).
+
+    Args:
+        wheel, rail: the side's surfaces (the search's: fast stand-ins or exact ones).
+        pose: wheelset pose. side: "left" or "right".
+        point_m: the patch's contact point (main frame), m; the plane's origin.
+        frame: (3, 3) columns e_x, e_y, n (n from the rail into the wheel).
+        wheel_lateral_m: y_d of the wheel's contact point, m.
+        approach_m: the patch's rigid approach q, m (> 0 in contact; sizes the first box with ``curvatures``).
+        curvatures: (A, B) of the patch's quadric, 1/m.
+        options: search options (``field_points``, ``field_scale``, ``field_margin``, ``field_min_half_size_m``,
+            ``newton_iterations``; DEFAULT_OPTIONS).
+    """
+    if side not in SIDES:
+        raise ValueError(f"side = {side!r}: expected one of {', '.join(SIDES)}")
+    opts = _merge_options(options)
+    geo = _SideGeometry(wheel, rail, pose, side, tuple(wheel.y_range_m), tuple(rail.y_range_m))
+    centre = np.asarray(point_m, float)
+    frame = np.asarray(frame, float)
+    x_d = geo.rot.T @ (centre - geo.centre)
+    alpha0 = math.atan2(x_d[2], x_d[0])
+    a_use, b_use = (max(float(c), 1e-6) for c in curvatures)
+    scale = 1.6 if opts["field_scale"] is None else opts["field_scale"]
+    q = max(float(approach_m), 0.0)
+    half_x = min(max(scale * math.sqrt(q / a_use), opts["field_min_half_size_m"]), _FIELD_LIMITS_M[0])
+    half_y = min(max(scale * math.sqrt(q / b_use), opts["field_min_half_size_m"]), _FIELD_LIMITS_M[1])
+
+    def sample(x_range, y_range):
+        return _sample_field(
+            geo, alpha0, float(wheel_lateral_m), centre, frame, x_range, y_range, opts["field_points"],
+            opts["newton_iterations"],
+        )  # fmt: skip
+
+    if opts["field_scale"] is None:
+        return _fitted_field(sample, half_x, half_y, opts["field_margin"])
+    return sample((-half_x, half_x), (-half_y, half_y))
+
+
 def search_side(
     wheel, rail, pose: WheelsetPose, side: str, *, wheel_lateral_range_m, rail_lateral_range_m, options=None
 ) -> SideSearch:

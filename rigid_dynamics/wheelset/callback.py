@@ -5,6 +5,9 @@ and answers with a compiled_rhs.CallbackOutcome.
 
 from __future__ import annotations
 
+import math
+import time
+
 import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
@@ -18,12 +21,28 @@ class PatchCallback:
     not compiled (bem, fea, user models; BEM for ``auto``) solves one patch from its geometry and creepages.
 
     The geometry is the quadric of the compiled candidate (curvatures, approach, contact point and frame, rolling
-    radius, contact angle) unless the provider gave a sampled one (``geometries``, candidate index -> ContactGeometry;
-    set per right-hand side by WheelsetModel for providers evaluated in Python). ``calls`` and ``seconds`` count the
-    solves; ``message`` holds the last failure.
+    radius, contact angle), or the provider's (``geometries``, candidate index -> ContactGeometry; set per
+    right-hand side by WheelsetModel for providers evaluated in Python). With ``surfaces`` (a WheelsetTrack, or a
+    callable building it once on first use) a model that solves a gap (bem, fea, models declaring
+    ``solves_undeformed_distance``) gets the undeformed distance sampled from the real surfaces at the pose the
+    patch carries (search.patch_undeformed_distance: the static wheelset search's own sampling, with the box fitted
+    to the rigid overlap, so the element size of a solver that fills the box follows the patch), unless the
+    provider gave one. On an elastic track (``elastic``) the pose is moved along the track's vertical by the rail
+    displacement under the wheel that the candidate's approach implies (one correction: the sampled approach
+    equals the candidate's to second order; the rail's lateral displacement is not sampled separately).
+
+    BEM in the loop (``warm_start``, default True): each candidate (side, slot) keeps a bem.BemWarmStart, the
+    last solve on each grid starting the next one on the same grid; a sampled patch is solved on square elements
+    of a size chosen from a ladder (powers of 2^(1/4)) to give about ``BEM_ELEMENTS``^2 elements over the
+    patch's potential area, kept while the box changes by less than a factor 2, so the grid and its influence
+    numbers repeat from step to step.
+    ``calls`` and ``seconds`` count the solves; ``message`` holds the last failure.
     """
 
-    def __init__(self, model, options, material):
+    warm_start = True
+    """Class default of the BEM warm start (benchmarks/bench_bem_loop_sampled.py switches it off to measure it)."""
+
+    def __init__(self, model, options, material, surfaces=None, elastic=False):
         self.model = model
         self.options = options
         self.material = material
@@ -31,19 +50,42 @@ class PatchCallback:
         self.calls = 0
         self.seconds = 0.0
         self.message = ""
+        self._surfaces = surfaces
+        self.elastic = bool(elastic)
+        self.sample = surfaces is not None and _solves_gap(model)
+        self.bem = getattr(model, "name", "") == "bem"
+        self.warm: dict = {}
+        self.sizes: dict = {}
+        self.sampling_seconds = 0.0
+
+    @property
+    def surfaces(self):
+        """The WheelsetTrack the patches are sampled from (built on first use when given as a callable)."""
+        if callable(self._surfaces) and not hasattr(self._surfaces, "wheels"):
+            self._surfaces = self._surfaces()
+        return self._surfaces
+
+    def warm_counts(self) -> dict:
+        """BEM solves, warm-started solves and NORM + TANG iterations over the run (all candidates)."""
+        totals = {"solves": 0, "warm_solves": 0, "iterations": 0}
+        for warm in self.warm.values():
+            totals["solves"] += warm.solves
+            totals["warm_solves"] += warm.warm_solves
+            totals["iterations"] += warm.iterations
+        return totals
 
     def solve(self, patch):
         """N, T_x, T_y, M_z, a, b and a status (0 solved, 1 failed: :attr:`message`) of one patch of the loop
         (compiled_rhs.CallbackPatch) by the model.
         """
-        import time
-
         start = time.perf_counter()
         self.calls += 1
         t = patch.t_s
         try:
             geometry = self.geometries.get(patch.candidate)
-            if geometry is None:
+            if self.sample and (geometry is None or geometry.undeformed is None):
+                geometry = self._sampled(patch, geometry)
+            elif geometry is None:
                 frame = np.array([patch.e_x, patch.e_y, patch.normal], float).T
                 geometry = ContactGeometry(
                     curvature_long_1_per_m=float(patch.curvature_long_1_per_m),
@@ -61,7 +103,7 @@ class PatchCallback:
                 float(patch.spin_creepage_1_per_m),
                 float(patch.rolling_speed_m_per_s),
             )
-            result = self.model.solve(geometry, creepage, self.material, options=self.options)
+            result = self._solve(patch, geometry, creepage)
         except Exception as exc:  # noqa: BLE001 (any failure of a user model is reported as the run's status)
             self.message = f"contact model {getattr(self.model, 'name', self.model)!r} raised at t = {t:.6g} s: {exc}"
             return _FAILED
@@ -92,6 +134,79 @@ class PatchCallback:
             float(residual),
             0,
         )
+
+    def _sampled(self, patch, given):
+        """The patch's ContactGeometry with the undeformed distance sampled from the real surfaces at its pose."""
+        from dataclasses import replace
+
+        from rigid_dynamics.contact.search import WheelsetPose, patch_undeformed_distance
+
+        start = time.perf_counter()
+        side = SIDES[int(patch.side)]
+        frame = np.array([patch.e_x, patch.e_y, patch.normal], float).T
+        if given is None:
+            given = ContactGeometry(
+                curvature_long_1_per_m=float(patch.curvature_long_1_per_m),
+                curvature_lat_1_per_m=float(patch.curvature_lat_1_per_m),
+                approach_m=float(patch.approach_m), side=side, point_m=np.array(patch.point_m, float), frame=frame,
+                contact_angle_rad=float(patch.contact_angle_rad), rolling_radius_m=float(patch.rolling_radius_m),
+            )  # fmt: skip
+        wheel, rail = self.surfaces.fast[side]
+        centre = np.array(patch.centre_m, float)
+        curvatures = (given.curvature_long_1_per_m, given.curvature_lat_1_per_m)
+        q = float(patch.approach_m)
+
+        def field_at(c):
+            pose = WheelsetPose(*(float(v) for v in c), float(patch.yaw_rad), float(patch.roll_rad),
+                                float(patch.spin_rad))  # fmt: skip
+            return patch_undeformed_distance(
+                wheel, rail, pose, side, given.point_m, given.frame, patch.wheel_lateral_m, q, curvatures
+            )
+
+        field = field_at(centre)
+        if self.elastic:
+            finite = field.distance_m[np.isfinite(field.distance_m)]
+            sampled_q = -float(finite.min()) if finite.size else q
+            vertical = abs(float(given.frame[2, 2]))
+            if vertical > 0.1 and abs(sampled_q - q) > 1e-9:
+                centre[2] -= (sampled_q - q) / vertical  # the rail lowered by w: the wheelset raised by w
+                field = field_at(centre)
+        self.sampling_seconds += time.perf_counter() - start
+        return replace(given, undeformed=field, is_elliptic=False)
+
+    def _solve(self, patch, geometry, creepage):
+        """The model's solve; BEM with its warm start and, on a sampled patch, the element-size ladder."""
+        if not self.bem:
+            return self.model.solve(geometry, creepage, self.material, options=self.options)
+        from rigid_dynamics.contact.bem.model import BemWarmStart
+
+        key = (int(patch.side), int(patch.candidate))
+        warm = self.warm.setdefault(key, BemWarmStart()) if self.warm_start else None
+        options = self.options
+        named = options and any(k in options for k in ("nx", "ny", "element_size_m", "dx_m", "dy_m"))
+        if geometry.undeformed is not None and not named:
+            und = geometry.undeformed
+            extent = math.sqrt(float(np.ptp(und.x_m)) * float(np.ptp(und.y_m)))  # ~BEM_ELEMENTS^2 elements in all
+            size = self.sizes.get(key)
+            wanted = extent / BEM_ELEMENTS
+            if size is None or not (0.5 * wanted <= size <= 2.0 * wanted):
+                size = 2.0 ** (round(4.0 * math.log2(wanted)) / 4.0)
+                self.sizes[key] = size
+            # the fitted box is about twice the overlap's extent: CONTACT-size elements across the contact
+            options = dict(options or {}, element_size_m=0.5 * size)
+        return self.model.solve(geometry, creepage, self.material, options=options, warm_start=warm)
+
+
+BEM_ELEMENTS = 40
+"""Elements of the ladder's size across the sampled box (geometric mean of its sides), before the halving: the box
+is about twice the contact's extent, so about BEM_ELEMENTS^2 elements cover the BEM's potential area."""
+
+
+def _solves_gap(model) -> bool:
+    """Whether a contact model solves an undeformed distance (bem, fea, or declared ``solves_undeformed_distance``)."""
+    from rigid_dynamics.contact.wheelset_case import FIELD_MODELS
+
+    return bool(getattr(model, "solves_undeformed_distance", getattr(model, "name", "") in FIELD_MODELS))
 
 
 _FAILED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_ELLIPSE, np.nan, 1)

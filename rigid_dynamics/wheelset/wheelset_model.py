@@ -150,6 +150,23 @@ class ContactState:
     values: dict | None  # PATCH_FIELDS -> (n,) when recorded
 
 
+def _patch_surfaces(scene: DynamicsScene, provider):
+    """The real surfaces a sampled patch comes from: the provider's WheelsetTrack (SearchProvider), else a callable
+    building the scene's once (profiles and irregularities as the 3-D search's: the tables provider's section
+    surfaces carry no irregularities).
+    """
+    own = getattr(provider, "surfaces", None)
+    if own is not None and hasattr(own, "fast") and hasattr(provider, "searches"):  # SearchProvider
+        return own
+
+    def build():
+        from rigid_dynamics.wheelset.providers.surfaces import build_surfaces
+
+        return build_surfaces(scene.wheelset, scene.track, scene.irregularities)
+
+    return build
+
+
 class WheelsetModel:
     """State function of a wheelset (module docstring) for one scene, provider and contact model: a thin wrapper of the
     one compiled right-hand side (compiled_rhs.py) for the scipy methods, the Python RK4, the static equilibrium,
@@ -208,13 +225,14 @@ class WheelsetModel:
         self.par = self.packed.par
         self.mode = self.packed.mode
         self.callback = None
+        surfaces = _patch_surfaces(scene, provider) if scene.patch_geometry == "sampled" else None
         if code == LAW_CALLBACK:
-            self.callback = PatchCallback(contact_model, model_options, scene.material)
+            self.callback = PatchCallback(contact_model, model_options, scene.material, surfaces, self.elastic)
         elif code == LAW_AUTO:
             from rigid_dynamics.contact.registry import get_model
 
             bem_options = (opts.get("model_options") or {}).get("bem")
-            self.callback = PatchCallback(get_model("bem"), bem_options, scene.material)
+            self.callback = PatchCallback(get_model("bem"), bem_options, scene.material, surfaces, self.elastic)
         self.auto = code == LAW_AUTO
         ncand = len(self.packed.sides)
         self._rec = np.zeros((ncand + 2, N_FIELDS))

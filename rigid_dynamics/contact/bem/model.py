@@ -227,6 +227,37 @@ def hertz_ellipse(
     return b, a, p0, force, approach
 
 
+class BemWarmStart:
+    """The last solution of one patch per grid (element counts and sizes), the initial guess of the next solve of
+    the same patch on the same grid (the dynamics loop: the previous step's solve of the same contact candidate).
+
+    NORM starts from the stored pressure (``solve_norm(initial_pressure_Pa=...)``), TANG from the stored tractions
+    and slip area (``solve_tang(initial_traction=..., initial_slip=...)``), index by index of the grid (its origin
+    is the patch's contact point, which moves with the patch). Only the start changes: the solution is the same to
+    the solvers' tolerance. The influence numbers of a grid are reused by InfluenceGrid's shared cache whenever the
+    counts and sizes repeat. ``solves``, ``warm_solves`` and ``iterations`` (NORM + TANG, all solves) count the use.
+    """
+
+    def __init__(self):
+        self.grids: dict = {}
+        self.solves = 0
+        self.warm_solves = 0
+        self.iterations = 0
+
+    def guess(self, nx: int, ny: int, dx: float, dy: float):
+        """(pressure, (t_x, t_y), slip) stored for this grid, or None."""
+        entry = self.grids.get((nx, ny))
+        if entry is None or not (math.isclose(entry[0], dx, rel_tol=1e-9) and math.isclose(entry[1], dy, rel_tol=1e-9)):
+            return None
+        return entry[2]
+
+    def store(self, nx: int, ny: int, dx: float, dy: float, solution, warm: bool, iterations: int) -> None:
+        self.grids[(nx, ny)] = (dx, dy, solution)
+        self.solves += 1
+        self.warm_solves += int(warm)
+        self.iterations += int(iterations)
+
+
 def _options(options: Mapping | None) -> dict:
     opts = validate_options(OPTIONS, options, "bem")
     options = options or {}
@@ -294,6 +325,7 @@ class BemModel:
         *,
         normal_force_N: float | None = None,
         options: Mapping | None = None,
+        warm_start: BemWarmStart | None = None,
     ) -> ContactResult:
         """Solve one patch (see the module docstring); forces on the wheel in the contact frame.
 
@@ -303,6 +335,8 @@ class BemModel:
             material: G, nu, mu of the (quasi-identical) pair.
             normal_force_N: None = approach control with ``geometry.approach_m``; else F_N > 0, N.
             options: see :data:`DEFAULT_OPTIONS`; unknown keys raise ValueError.
+            warm_start: optional :class:`BemWarmStart` of this patch: its last solution on the same grid starts
+                NORM and TANG (and is replaced by this one's), the solution unchanged to the tolerance.
 
         Returns:
             ContactResult with fields on the grid; semi-axes (extents of the contact along x, y)
@@ -311,6 +345,7 @@ class BemModel:
         """
         start = time.perf_counter()
         opts = _options(options)
+        opts["warm_start"] = warm_start
         fine = self._solve(geometry, creepage, material, normal_force_N, opts, None, start)
         if fine.status == "no-contact" or not fine.success:
             return fine
@@ -337,6 +372,7 @@ class BemModel:
         """
         start = time.perf_counter()
         opts = _options(options)
+        opts["warm_start"] = None
         if result.status == "no-contact" or not result.success or opts["extrapolate"]:
             return result
         out = self._estimate(geometry, creepage, material, normal_force_N, opts, result, start, refine=False)
@@ -449,6 +485,7 @@ class BemModel:
             if x_lim[1] <= x_lim[0] or y_lim[1] <= y_lim[0]:
                 return no_contact("the sampled undeformed distance gives an empty potential contact area")
         k_diff = float(opts["difference_parameter"])
+        warm = opts.get("warm_start") if opts["problem"] == "rolling" and k_diff == 0.0 else None
         norm_method = opts["norm_method"]
         tol, max_it = float(opts["tolerance"]), int(opts["max_iterations"])
         if geometry.undeformed is not None:
@@ -473,9 +510,11 @@ class BemModel:
             xx, yy = np.meshgrid(x, y)
             h = np.asarray(geometry.gap_m(xx, yy), float)
             influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
+            guess = warm.guess(nx, ny, dx, dy) if warm is not None else None
             norm = solve_norm(
-                influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it, method=norm_method
-            )
+                influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it, method=norm_method,
+                initial_pressure_Pa=None if guess is None else guess[0],
+            )  # fmt: skip
             contact = norm.pressure_Pa > 0
             edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
             given = geometry.undeformed is not None and geometry.undeformed.potential_area_m is not None
@@ -517,6 +556,7 @@ class BemModel:
                 tolerance=tol,
                 max_iterations=max_it,
                 kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
+                **_warm_traction(guess, norm.pressure_Pa),
             )
             if k_diff == 0.0:
                 break
@@ -537,6 +577,9 @@ class BemModel:
             contact = norm.pressure_Pa > 0
         p = norm.pressure_Pa
         contact = p > 0
+        if warm is not None:
+            solution = (p, (tang.traction_x_Pa, tang.traction_y_Pa), tang.in_slip & contact)
+            warm.store(nx, ny, dx, dy, solution, guess is not None, norm.iterations + tang.iterations)
         if not contact.any():
             return no_contact("NORM found no element in contact")
         area = dx * dy
@@ -619,6 +662,13 @@ class BemModel:
                 "transient_forces_N": history,
             },
         )
+
+
+def _warm_traction(guess, pressure_Pa) -> dict:
+    """solve_tang's warm-start arguments from a BemWarmStart guess (none without one or without contact)."""
+    if guess is None or not (pressure_Pa > 0).any():
+        return {}
+    return {"initial_traction": guess[1], "initial_slip": guess[2]}
 
 
 def _transient(influence, mu, fields_in, steps, tol, max_it, opts):
