@@ -275,8 +275,38 @@ def cmd_run(args) -> int:
         f"in {summary['wall_time_s']:.3g} s (real-time factor {summary['real_time_factor']:.3g}); "
         f"start-up {timing['startup_s']:.2g} s, set-up and compiled-code loading {timing['setup_s']:.2g} s"
     )
+    for line in patch_summary_lines(summary):
+        _print(line)
     _print(f"output written to {out_dir}")
     return EXIT_OK if summary.get("success", summary["status"] == "ok") and summary["status"] == "ok" else EXIT_FAILED
+
+
+def patch_summary_lines(summary: dict) -> list[str]:
+    """One line per patch slot in contact (SimulationResult.patch_summary) and one for the BEM warm start, e.g.
+    "left tread patch: sampled (bem), ellipticity residual 0.36 (max 0.41), max pressure 1136 MPa, area 101 mm^2".
+    """
+    lines = []
+    for name, entry in (summary.get("patch_summary") or {}).items():
+        geometry = ", ".join(
+            g if share == 1.0 else f"{g} {100 * share:.0f} %" for g, share in entry["geometry"].items()
+        )  # fmt: skip
+        text = f"{name} patch: {geometry} ({', '.join(entry['law'])})"
+        residual = entry.get("ellipticity_residual")
+        if residual:
+            text += f", ellipticity residual {residual['median']:.2g} (max {residual['max']:.2g})"
+        if entry.get("max_pressure_Pa") is not None:
+            text += f", max pressure {entry['max_pressure_Pa'] / 1e6:.4g} MPa"
+        if entry.get("contact_area_m2") is not None:
+            text += f", area {entry['contact_area_m2'] * 1e6:.4g} mm^2"
+        lines.append(text + " (largest over the run)")
+    callback = summary.get("callback") or {}
+    bem = callback.get("bem")
+    if bem:
+        lines.append(
+            f"bem: {bem['solves']} solves, {bem['warm_solves']} warm-started, {bem['iterations']} NORM + TANG "
+            f"iterations; patch sampling {callback['sampling_seconds']:.3g} s of {callback['seconds']:.3g} s"
+        )
+    return lines
 
 
 def _progress_bar(quiet: bool, label: str):

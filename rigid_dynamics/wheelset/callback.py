@@ -12,6 +12,7 @@ import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
 from rigid_dynamics.wheelset.compiled_rhs import CallbackOutcome
+from rigid_dynamics.wheelset.formed_patches import PatchFormer, candidate_forces, transported_creepage
 from rigid_dynamics.wheelset.layout import PATCH_ELLIPSE, PATCH_SAMPLED
 from rigid_dynamics.wheelset.providers import SIDES
 
@@ -27,9 +28,14 @@ class PatchCallback:
     ``solves_undeformed_distance``) gets the undeformed distance sampled from the real surfaces at the pose the
     patch carries (search.patch_undeformed_distance: the static wheelset search's own sampling, with the box fitted
     to the rigid overlap, so the element size of a solver that fills the box follows the patch), unless the
-    provider gave one. On an elastic track (``elastic``) the pose is moved along the track's vertical by the rail
-    displacement under the wheel that the candidate's approach implies (one correction: the sampled approach
-    equals the candidate's to second order; the rail's lateral displacement is not sampled separately).
+    provider gave one. The side's patches are formed as the static wheelset case forms them (``patches``
+    "contact", the default: CONTACT's module 1, formed_patches.py: interpenetration regions joined or split, each
+    patch solved in the plane of its weighted reference point, the forces returned in the candidate's frame) or
+    (``patches`` "search", and on an elastic track) each candidate on its own plane at its deepest point
+    (search.patch_undeformed_distance). On an elastic track (``elastic``) the pose is moved along the track's
+    vertical by the rail displacement under the wheel that the candidate's approach implies (one correction: the
+    sampled approach equals the candidate's to second order; the rail's lateral displacement is not sampled
+    separately).
 
     BEM in the loop (``warm_start``, default True): each candidate (side, slot) keeps a bem.BemWarmStart, the
     last solve on each grid starting the next one on the same grid; a sampled patch is solved on square elements
@@ -57,6 +63,8 @@ class PatchCallback:
         self.warm: dict = {}
         self.sizes: dict = {}
         self.sampling_seconds = 0.0
+        self.patches = "contact"
+        self.former = None
 
     @property
     def surfaces(self):
@@ -64,6 +72,20 @@ class PatchCallback:
         if callable(self._surfaces) and not hasattr(self._surfaces, "wheels"):
             self._surfaces = self._surfaces()
         return self._surfaces
+
+    def stats(self) -> dict:
+        """What the callback did over the run (SimulationResult.callback_stats): solves and seconds, the seconds
+        spent sampling patches, whether patches were sampled and the BEM warm start's counts (:meth:`warm_counts`).
+        """
+        return {
+            "model": getattr(self.model, "name", str(self.model)),
+            "solves": int(self.calls),
+            "seconds": float(self.seconds),
+            "sampled_patches": bool(self.sample),
+            "sampling_seconds": float(self.sampling_seconds),
+            "bem_warm_start": bool(self.bem and self.warm_start),
+            **({"bem": self.warm_counts()} if self.bem else {}),
+        }
 
     def warm_counts(self) -> dict:
         """BEM solves, warm-started solves and NORM + TANG iterations over the run (all candidates)."""
@@ -81,10 +103,24 @@ class PatchCallback:
         start = time.perf_counter()
         self.calls += 1
         t = patch.t_s
+        target = False
         try:
+            creepage = Creepage(
+                float(patch.creepage_long),
+                float(patch.creepage_lat),
+                float(patch.spin_creepage_1_per_m),
+                float(patch.rolling_speed_m_per_s),
+            )
             geometry = self.geometries.get(patch.candidate)
             if self.sample and (geometry is None or geometry.undeformed is None):
-                geometry = self._sampled(patch, geometry)
+                target = self._formed(patch) if self.patches == "contact" and not self.elastic else False
+                if target is None:  # its region is in a patch served by a deeper candidate
+                    return _JOINED
+                if target is False:
+                    geometry = self._sampled(patch, geometry)
+                else:
+                    geometry = target.geometry
+                    creepage = transported_creepage(patch, creepage, self._axle(patch), target)
             elif geometry is None:
                 frame = np.array([patch.e_x, patch.e_y, patch.normal], float).T
                 geometry = ContactGeometry(
@@ -97,12 +133,6 @@ class PatchCallback:
                     contact_angle_rad=float(patch.contact_angle_rad),
                     rolling_radius_m=float(patch.rolling_radius_m),
                 )
-            creepage = Creepage(
-                float(patch.creepage_long),
-                float(patch.creepage_lat),
-                float(patch.spin_creepage_1_per_m),
-                float(patch.rolling_speed_m_per_s),
-            )
             result = self._solve(patch, geometry, creepage)
         except Exception as exc:  # noqa: BLE001 (any failure of a user model is reported as the run's status)
             self.message = f"contact model {getattr(self.model, 'name', self.model)!r} raised at t = {t:.6g} s: {exc}"
@@ -121,11 +151,11 @@ class PatchCallback:
                 geometry.undeformed, geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m,
                 geometry.ellipse_angle_rad, geometry.approach_m,
             )  # fmt: skip
+        forces = (result.normal_force_N, result.creep_force_long_N, result.creep_force_lat_N, result.spin_moment_Nm)
+        if target is not False and result.status != "no-contact":
+            forces = candidate_forces(patch, target, result)
         return CallbackOutcome(
-            float(result.normal_force_N or 0.0),
-            float(result.creep_force_long_N or 0.0),
-            float(result.creep_force_lat_N or 0.0),
-            float(result.spin_moment_Nm or 0.0),
+            *(float(v or 0.0) for v in forces),
             _number(result.semi_axis_long_m),
             _number(result.semi_axis_lat_m),
             _number(result.contact_area_m2),
@@ -134,6 +164,25 @@ class PatchCallback:
             float(residual),
             0,
         )
+
+    def _formed(self, patch):
+        """The formed patch (formed_patches.PatchFormer.served) this candidate serves at its pose."""
+        from rigid_dynamics.contact.search import WheelsetPose
+
+        start = time.perf_counter()
+        if self.former is None:
+            self.former = PatchFormer(self.surfaces)
+        pose = WheelsetPose(*(float(v) for v in patch.centre_m), float(patch.yaw_rad), float(patch.roll_rad),
+                            float(patch.spin_rad))  # fmt: skip
+        served = self.former.served(SIDES[int(patch.side)], pose, patch.point_m)
+        self.sampling_seconds += time.perf_counter() - start
+        return served
+
+    @staticmethod
+    def _axle(patch) -> np.ndarray:
+        from rigid_dynamics.kinematics import wheelset_rotation
+
+        return wheelset_rotation(float(patch.yaw_rad), float(patch.roll_rad), float(patch.spin_rad))[:, 1]
 
     def _sampled(self, patch, given):
         """The patch's ContactGeometry with the undeformed distance sampled from the real surfaces at its pose."""
@@ -211,6 +260,8 @@ def _solves_gap(model) -> bool:
 
 _FAILED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_ELLIPSE, np.nan, 1)
 """The callback's answer for a patch whose contact model failed (its message kept in PatchCallback.message)."""
+_JOINED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_SAMPLED, np.nan, 0)
+"""The answer for a candidate whose interpenetration region is joined into a patch a deeper candidate serves."""
 
 
 def _number(value) -> float:

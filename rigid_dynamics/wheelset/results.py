@@ -71,6 +71,8 @@ class SimulationResult:
             (:func:`_half_step_check`; compiled DP54/BS32 runs: from a run at a tenth of both tolerances); None
             otherwise.
         scene: the scene that ran.
+        callback_stats: runs with a contact model solved through the callback (callback.PatchCallback): its solves,
+            seconds, the seconds spent sampling patches and the BEM warm start's counts; None otherwise.
     """
 
     status: str
@@ -99,6 +101,7 @@ class SimulationResult:
     track_states: np.ndarray | None = None
     track_state_names: tuple = ()
     track_full_states: np.ndarray | None = field(default=None, repr=False)
+    callback_stats: dict | None = None
 
     @property
     def success(self) -> bool:
@@ -269,7 +272,52 @@ class SimulationResult:
             "peak_rail_lateral_displacement_m": self._lateral_rail_peaks(num),
             **self._error_summary(num),
             **self._auto_summary(),
+            "patch_summary": self.patch_summary(),
+            "callback": self.callback_stats,
         }
+
+    def patch_summary(self) -> dict:
+        """Per patch slot in contact (``"left tread"``, ``"right second"``, ...): which geometry the model saw
+        (layout.PATCH_GEOMETRY_NAMES: its share of the recorded samples in contact), which law served it
+        (compiled_laws.LAW_CODES names), the ellipticity residual of a sampled gap (median and largest), and the
+        largest max pressure (Pa) and contact area (m^2); slots never in contact are left out.
+        """
+        from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK, LAW_CODES
+        from rigid_dynamics.wheelset.layout import PATCH_GEOMETRY_NAMES
+        from rigid_dynamics.wheelset.table import SLOT_NAMES
+
+        if "patch_geometry_code" not in self.patches or not len(self.t):
+            return {}
+        law_names = {code: name for name, code in LAW_CODES.items()}
+        law_names[LAW_CALLBACK] = self.contact_model or "callback"
+        out = {}
+        for i, side in enumerate(SIDES):
+            for j, slot in enumerate(SLOT_NAMES):
+                touching = np.nan_to_num(np.asarray(self.patches["normal_force_N"], float)[:, i, j]) > 0
+                if not touching.any():
+                    continue
+
+                def column(name, touching=touching, i=i, j=j):
+                    return np.asarray(self.patches[name], float)[:, i, j][touching]
+
+                geometry, law, residual = column("patch_geometry_code"), column("contact_law_code"), None
+                res = column("ellipticity_residual")
+                res = res[np.isfinite(res)]
+                if res.size:
+                    residual = {"median": float(np.median(res)), "max": float(res.max())}
+                pmax, area = column("max_pressure_Pa"), column("contact_area_m2")
+                out[f"{side} {slot}"] = {
+                    "samples_in_contact": int(touching.sum()),
+                    "geometry": {
+                        n: float(np.mean(geometry == k)) for k, n in enumerate(PATCH_GEOMETRY_NAMES)
+                        if np.any(geometry == k)
+                    },
+                    "law": sorted({law_names.get(int(c), str(int(c))) for c in law[np.isfinite(law)]}),
+                    "ellipticity_residual": residual,
+                    "max_pressure_Pa": float(np.nanmax(pmax)) if np.isfinite(pmax).any() else None,
+                    "contact_area_m2": float(np.nanmax(area)) if np.isfinite(area).any() else None,
+                }  # fmt: skip
+        return out
 
     def _lateral_rail_peaks(self, num):
         """Per rail the largest |lateral displacement| of the lateral track (signed, y along the track's lateral

@@ -319,6 +319,7 @@ def simulate(
         track_states=track_states,
         track_state_names=tuple(track_names or ()),
         track_full_states=track_full,
+        callback_stats=model.callback.stats() if model.callback is not None else None,
     )
     if checked and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
         result = _half_step_check(result, provider, model_obj, compiled)

@@ -1,0 +1,109 @@
+"""The patches of the dynamics loop formed as the static wheelset case forms them (CONTACT's module 1,
+rigid_dynamics.contact.wheelset_patches): which formed patch a compiled contact candidate serves, the creepages at
+the formed patch's reference point and its forces in the candidate's contact frame.
+
+The compiled 3-D search gives each side's candidates at the local minima of the normal gap, with the contact plane
+at the deepest point (at most two per side). The static case (equal to CONTACT) instead splits the vertical gap
+along the contact locus into interpenetration regions, joins close ones (D_COMB) and solves each patch in the plane
+of its weighted reference point and contact angle, with the undeformed distance evaluated exactly from the surfaces.
+For a gap-solving model (callback.PatchCallback with patches "contact") the side's patches are formed so at the
+pose the candidate carries (once per side and pose) and
+
+* a candidate serves the formed patch that holds its interpenetration region (the region whose lateral extent
+  holds the candidate's contact point, or the nearest within ``MATCH_DISTANCE_M``) when that region is the patch's
+  deepest; a candidate whose region was joined into a patch served by a deeper one gets no force (its region's
+  pressure is in that patch); a candidate with no region within ``MATCH_DISTANCE_M`` is solved on its own plane
+  (search.patch_undeformed_distance);
+* the creepages at the formed patch's wheel point p' (normal n', frame e_x', e_y') follow from the candidate's
+  (xi, eta, phi at p with n) by the wheel's rigid motion: v(p') = v(p) + omega x (p' - p) with v(p) = V (xi e_x +
+  eta e_y) and omega ~ Omega a (a the axle, Omega = -V / r_roll), phi' = phi + Omega a . (n' - n) / V; the parts
+  left out (the normal approach rate times the tilt of the plane, the yaw rate times the offset) are of the
+  order of the creepage times 1e-2 for offsets of millimetres;
+* the forces on the wheel (N', T_x', T_y' in the formed frame, spin moment M_z' about n' at p') are returned in
+  the candidate's frame, and M_z is the moment about the candidate's normal through its point (the moment of the
+  offset p' - p included). The components of that offset's moment about the candidate's tangents (at most the
+  offset, millimetres, times the force) are left out: the compiled code applies a patch's force at its point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigid_dynamics.contact.types import Creepage
+
+MATCH_DISTANCE_M = 5.0e-3
+"""Largest lateral distance from a candidate's contact point to an interpenetration region it may serve, m."""
+
+
+class PatchFormer:
+    """The formed patches of each side at the last pose asked (cached: both candidates of a side share them)."""
+
+    def __init__(self, surfaces):
+        self.surfaces = surfaces
+        self._last: dict = {}
+
+    def patches(self, side: str, pose):
+        """(formed patches, regions) of ``side`` at ``pose`` (contact.wheelset_patches.wheel_patches)."""
+        from rigid_dynamics.contact.wheelset_patches import wheel_patches
+
+        key = (pose.x_m, pose.y_m, pose.z_m, pose.yaw_rad, pose.roll_rad, pose.spin_rad)
+        last = self._last.get(side)
+        if last is not None and last[0] == key:
+            return last[1]
+        wheel, rail = self.surfaces.fast[side]
+        formed, _ = wheel_patches(
+            wheel, rail, pose, side, wheel_lateral_range_m=wheel.y_range_m, rail_lateral_range_m=rail.y_range_m,
+            nominal_radius_m=self.surfaces.nominal_radius_m,
+        )  # fmt: skip
+        self._last[side] = (key, formed)
+        return formed
+
+    def last(self, side: str) -> list:
+        """The formed patches of ``side`` at the last pose asked (empty before any)."""
+        last = self._last.get(side)
+        return [] if last is None else list(last[1])
+
+    def served(self, side: str, pose, point_m):
+        """The formed patch the candidate at ``point_m`` serves; None when its region is served by a deeper
+        candidate; ``False`` when no region lies within MATCH_DISTANCE_M (module docstring).
+        """
+        formed = self.patches(side, pose)
+        y = float(point_m[1])
+        best, best_distance = None, MATCH_DISTANCE_M
+        for patch in formed:
+            for region in patch.regions:
+                lo, hi = float(np.min(region.ends_m[:, 0])), float(np.max(region.ends_m[:, 0]))
+                distance = max(lo - y, y - hi, 0.0)
+                if distance < best_distance or (distance == 0.0 and best_distance == 0.0):
+                    best, best_distance = (patch, region), distance
+        if best is None:
+            return False
+        patch, region = best
+        deepest = min(patch.regions, key=lambda r: r.min_gap_m)
+        return patch if deepest is region else None
+
+
+def transported_creepage(patch, creepage: Creepage, axle, target) -> Creepage:
+    """The creepages at the formed patch ``target`` (a WheelPatch) from the candidate's (module docstring).
+
+    ``patch``: the compiled_rhs.CallbackPatch; ``axle``: the wheelset's axle direction (main frame).
+    """
+    speed = float(creepage.rolling_speed_m_per_s)
+    e_x, e_y, n = (np.asarray(v, float) for v in (patch.e_x, patch.e_y, patch.normal))
+    omega = -speed / float(patch.rolling_radius_m) * np.asarray(axle, float)
+    velocity = speed * (creepage.longitudinal * e_x + creepage.lateral * e_y)
+    moved = velocity + np.cross(omega, np.asarray(target.wheel_point_m, float) - np.asarray(patch.point_m, float))
+    frame = target.geometry.frame
+    spin = creepage.spin_1_per_m + float(omega @ (frame[:, 2] - n)) / speed
+    return Creepage(float(moved @ frame[:, 0]) / speed, float(moved @ frame[:, 1]) / speed, float(spin), speed)
+
+
+def candidate_forces(patch, target, result) -> tuple[float, float, float, float]:
+    """(N, T_x, T_y, M_z) on the wheel in the candidate's contact frame from the formed patch's ``result``."""
+    frame = target.geometry.frame
+    local = np.array([result.creep_force_long_N or 0.0, result.creep_force_lat_N or 0.0, result.normal_force_N or 0.0])
+    force = frame @ local
+    e_x, e_y, n = (np.asarray(v, float) for v in (patch.e_x, patch.e_y, patch.normal))
+    offset = np.asarray(target.geometry.point_m, float) - np.asarray(patch.point_m, float)
+    moment = (result.spin_moment_Nm or 0.0) * frame[:, 2] + np.cross(offset, force)
+    return float(force @ n), float(force @ e_x), float(force @ e_y), float(moment @ n)
