@@ -230,20 +230,25 @@ class PatchCallback:
         from rigid_dynamics.contact.bem.model import BemWarmStart
 
         key = (int(patch.side), int(patch.candidate))
-        warm = self.warm.setdefault(key, BemWarmStart()) if self.warm_start else None
+        warm = self.warm.setdefault(key, BemWarmStart(enabled=self.warm_start))
         options = self.options
         named = options and any(k in options for k in ("nx", "ny", "element_size_m", "dx_m", "dy_m"))
         if geometry.undeformed is not None and not named:
-            und = geometry.undeformed
-            extent = math.sqrt(float(np.ptp(und.x_m)) * float(np.ptp(und.y_m)))  # ~BEM_ELEMENTS^2 elements in all
             size = self.sizes.get(key)
-            wanted = extent / BEM_ELEMENTS
+            wanted = ladder_element_size(geometry.undeformed)
             if size is None or not (0.5 * wanted <= size <= 2.0 * wanted):
-                size = 2.0 ** (round(4.0 * math.log2(wanted)) / 4.0)
+                size = wanted
                 self.sizes[key] = size
-            # the fitted box is about twice the overlap's extent: CONTACT-size elements across the contact
-            options = dict(options or {}, element_size_m=0.5 * size)
+            options = dict(options or {}, element_size_m=size)
         return self.model.solve(geometry, creepage, self.material, options=options, warm_start=warm)
+
+
+def ladder_element_size(undeformed) -> float:
+    """The BEM element size of a sampled patch in the loop: the sampled box's geometric-mean side over
+    BEM_ELEMENTS, halved (the box is about twice the contact's extent), rounded to the ladder 2^(k/4) m.
+    """
+    extent = math.sqrt(float(np.ptp(undeformed.x_m)) * float(np.ptp(undeformed.y_m)))
+    return 0.5 * 2.0 ** (round(4.0 * math.log2(extent / BEM_ELEMENTS)) / 4.0)
 
 
 BEM_ELEMENTS = 40

@@ -235,18 +235,20 @@ class BemWarmStart:
     and slip area (``solve_tang(initial_traction=..., initial_slip=...)``), index by index of the grid (its origin
     is the patch's contact point, which moves with the patch). Only the start changes: the solution is the same to
     the solvers' tolerance. The influence numbers of a grid are reused by InfluenceGrid's shared cache whenever the
-    counts and sizes repeat. ``solves``, ``warm_solves`` and ``iterations`` (NORM + TANG, all solves) count the use.
+    counts and sizes repeat. ``solves``, ``warm_solves`` and ``iterations`` (NORM + TANG, all solves) count the use;
+    with ``enabled`` False it only counts (every solve starts cold: the reference for the saving).
     """
 
-    def __init__(self):
+    def __init__(self, enabled: bool = True):
+        self.enabled = bool(enabled)
         self.grids: dict = {}
         self.solves = 0
         self.warm_solves = 0
         self.iterations = 0
 
     def guess(self, nx: int, ny: int, dx: float, dy: float):
-        """(pressure, (t_x, t_y), slip) stored for this grid, or None."""
-        entry = self.grids.get((nx, ny))
+        """(pressure, (t_x, t_y), slip) stored for this grid, or None (always None when not ``enabled``)."""
+        entry = self.grids.get((nx, ny)) if self.enabled else None
         if entry is None or not (math.isclose(entry[0], dx, rel_tol=1e-9) and math.isclose(entry[1], dy, rel_tol=1e-9)):
             return None
         return entry[2]
