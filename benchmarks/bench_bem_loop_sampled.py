@@ -8,10 +8,10 @@ right-hand sides). Writes ``benchmarks/results/bem_loop_sampled.md`` and ``.json
 The scene: curve-flange (S1002/UIC60 1:40, R = 100 m, 50 km/h) started at the pose its FASTSIM run settles to
 (y = -6.28 mm, yaw -4.55 mrad: the left wheel on its flange root, contact angle 0.56 rad), settling distance 0.
 Per run: wall time of the integration (the compiled code loaded before the clock), time per simulated second, the
-callback's BEM solves, warm-started solves, NORM + TANG iterations and patch-sampling seconds, and the flange patch's
-(left wheel, slot 0) normal force, contact area, max pressure and ellipticity residual at the last sample. The
-sampled flange patch at the last sample is then solved again on elements of the loop's size, half and a quarter of
-it (same pose, creepages of the loop) to state the discretisation error of those numbers.
+callback's BEM solves, warm-started solves, NORM + TANG iterations and patch-sampling seconds, and the flange
+patch's (left wheel, slot 0) normal force, contact area, max pressure and ellipticity residual at the first and the
+last sample. The sampled flange patch at the last sample is then solved again on elements of the loop's size, half
+and a quarter of it (same pose, creepages of the loop) to state the discretisation error of those numbers.
 """
 
 from __future__ import annotations
@@ -46,9 +46,9 @@ def scene_for(geometry: str, duration_s: float):
     )  # fmt: skip
 
 
-def flange_patch(result) -> dict:
+def flange_patch(result, sample: int) -> dict:
     keys = ("normal_force_N", "contact_area_m2", "max_pressure_Pa", "ellipticity_residual", "contact_angle_rad")
-    return {k: float(np.asarray(result.patches[k])[-1, 0, 0]) for k in keys}
+    return {k: float(np.asarray(result.patches[k])[sample, 0, 0]) for k in keys}
 
 
 def run(geometry: str, warm: bool, duration_s: float) -> tuple[dict, object]:
@@ -72,7 +72,8 @@ def run(geometry: str, warm: bool, duration_s: float) -> tuple[dict, object]:
         "norm_tang_iterations": stats.get("bem", {}).get("iterations"),
         "sampling_s": stats.get("sampling_seconds"),
         "callback_s": stats.get("seconds"),
-        "flange_patch_last_sample": flange_patch(result),
+        "flange_patch_first_sample": flange_patch(result, 0),
+        "flange_patch_last_sample": flange_patch(result, -1),
     }
     print(json.dumps(row), flush=True)
     return row, result
@@ -120,18 +121,25 @@ def main(argv):
     simulate(scene_for("ellipse", 0.001))  # compiled code loaded and numba's cache warm before the timed runs
     rows = []
     sampled_result = None
-    for geometry, warm in (("sampled", True), ("sampled", False), ("ellipse", True)):
+    # warm and cold twice, interleaved (the shared machine's load changes): the faster of each pair is reported
+    for geometry, warm in (("sampled", True), ("sampled", False), ("sampled", True), ("sampled", False),
+                           ("ellipse", True)):  # fmt: skip
         row, result = run(geometry, warm, duration)
         rows.append(row)
         if geometry == "sampled" and warm:
             sampled_result = result
+    best = {}
+    for row in rows:
+        key = (row["patch_geometry"], row["warm_start"])
+        if key not in best or row["integration_wall_s"] < best[key]["integration_wall_s"]:
+            best[key] = row
     grid = grid_study(sampled_result)
     commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     machine = {"platform": platform.platform(), "cpu_count": os.cpu_count(), "load": os.getloadavg()}
     summary = {"duration_s": duration, "commit": commit.stdout.strip(), "machine": machine, "runs": rows, "grid": grid}
     out = ROOT / "benchmarks" / "results"
     write_atomic(out / "bem_loop_sampled.json", json.dumps(summary, indent=2) + "\n")
-    warm, cold, ellipse = rows
+    warm, cold, ellipse = best[("sampled", True)], best[("sampled", False)], best[("ellipse", True)]
     lines = [
         "# BEM on the sampled patch in the loop (benchmarks/bench_bem_loop_sampled.py)",
         "",
@@ -140,29 +148,39 @@ def main(argv):
         f"Commit {summary['commit']}; {duration} s simulated per run; machine {machine['platform']}, "
         f"{machine['cpu_count']} cores shared with other jobs (load average {machine['load'][0]:.1f} at the end).",
         "",
+        "Every run, in the order run (the flange patch: the left wheel's slot 0 at the first sample, t = 0, where the "
+        "states agree but for the static equilibrium's height, 2 um apart, and at the last):",
+        "",
         "| patch geometry | warm start | s per simulated s | BEM solves | warm-started | NORM+TANG iterations | "
-        "sampling s | flange N kN | flange area mm2 | flange pmax MPa | ellipticity residual |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "sampling s | flange N kN (t=0, end) | area mm2 | pmax MPa | contact angle rad | ellipticity residual |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
+
+    def pair(r, key, scale, digits):
+        a, b = r["flange_patch_first_sample"][key] * scale, r["flange_patch_last_sample"][key] * scale
+        return f"{a:.{digits}f}, {b:.{digits}f}"
+
     for r in rows:
-        f = r["flange_patch_last_sample"]
         lines.append(
             f"| {r['patch_geometry']} | {'yes' if r['warm_start'] else 'no'} | {r['seconds_per_simulated_second']:.0f} "
             f"| {r['bem_solves']} | {r['warm_solves']} | {r['norm_tang_iterations']} | {r['sampling_s']:.2f} | "
-            f"{f['normal_force_N'] / 1e3:.2f} | {f['contact_area_m2'] * 1e6:.1f} | {f['max_pressure_Pa'] / 1e6:.0f} | "
-            f"{f['ellipticity_residual']:.2f} |"
+            f"{pair(r, 'normal_force_N', 1e-3, 1)} | {pair(r, 'contact_area_m2', 1e6, 1)} | "
+            f"{pair(r, 'max_pressure_Pa', 1e-6, 0)} | {pair(r, 'contact_angle_rad', 1.0, 3)} | "
+            f"{pair(r, 'ellipticity_residual', 1.0, 2)} |"
         )
     saved = 1.0 - warm["integration_wall_s"] / cold["integration_wall_s"]
     iterations = 1.0 - warm["norm_tang_iterations"] / cold["norm_tang_iterations"]
-    fw, fe = warm["flange_patch_last_sample"], ellipse["flange_patch_last_sample"]
+    fw, fe = warm["flange_patch_first_sample"], ellipse["flange_patch_first_sample"]
     lines += [
         "",
         f"Warm start: {100 * iterations:.0f} % fewer NORM + TANG iterations and {100 * saved:.0f} % less wall time "
-        "on the sampled run (same run otherwise; the two runs' states agree to the solvers' tolerance).",
-        "Sampled flange patch against the ellipse at the last sample: area "
+        "on the sampled run (the faster of two runs each; same run otherwise, the flange patch's numbers agree to "
+        "the solvers' tolerance).",
+        "Sampled flange patch against the ellipse at t = 0: area "
         f"{100 * (fw['contact_area_m2'] / fe['contact_area_m2'] - 1):+.0f} %, "
         f"max pressure {100 * (fw['max_pressure_Pa'] / fe['max_pressure_Pa'] - 1):+.0f} %, normal force "
-        f"{100 * (fw['normal_force_N'] / fe['normal_force_N'] - 1):+.1f} % (the runs' states differ slightly).",
+        f"{100 * (fw['normal_force_N'] / fe['normal_force_N'] - 1):+.1f} % (the conformal patch is stiffer; the "
+        "runs then part: at the end the sampled run's flange contact has moved to a smaller angle).",
         "",
         "The sampled flange patch at the last state on finer elements (discretisation error of the numbers above):",
         "",

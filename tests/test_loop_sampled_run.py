@@ -51,7 +51,8 @@ def test_sampled_run_says_per_patch_that_the_geometry_was_sampled(runs):
     assert callback["sampled_patches"] and callback["bem"]["solves"] > 0
     assert 0 < callback["bem"]["warm_solves"] <= callback["bem"]["solves"]
     lines = patch_summary_lines(summary)
-    assert lines[0].startswith("left tread patch: sampled (bem), ellipticity residual ")
+    assert flange["contact"] == "flange"
+    assert lines[0].startswith("left flange patch (slot tread): sampled (bem), ellipticity residual ")
 
 
 def test_ellipse_choice_gives_the_quadric(runs):
@@ -61,7 +62,8 @@ def test_ellipse_choice_gives_the_quadric(runs):
     assert np.all(result.patches["patch_geometry_code"][touching] == PATCH_ELLIPSE)
     assert np.all(np.isnan(result.patches["ellipticity_residual"][touching]))
     assert not result.summary()["callback"]["sampled_patches"]
-    assert patch_summary_lines(result.summary())[0].startswith("left tread patch: ellipse (bem), max pressure ")
+    line = patch_summary_lines(result.summary())[0]
+    assert line.startswith("left flange patch (slot tread): ellipse (bem), max pressure ")
 
 
 def test_sampled_and_ellipse_flange_patches_differ(runs):
@@ -103,3 +105,13 @@ def test_out_of_round_wheel_in_the_sampled_gap():
         heights.append(state[2])
     assert abs(heights[1] - heights[0]) > 2.0e-4  # the polygon moved the wheel's height by more than the approach
     assert forces[1] == pytest.approx(forces[0], rel=0.02)
+
+
+def test_bad_patch_geometry_exits_2_naming_it(capsys, tmp_path):
+    """``--set patch_geometry="circle"``: one line naming the key, the value and the choices, exit 2, nothing run."""
+    from hardening_helpers import assert_error, run
+
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "run", "curve-flange", "--set", 'patch_geometry="circle"', "--out", out, "--quiet")
+    assert_error(code, err, "patch_geometry = 'circle'", "sampled, ellipse")
+    assert not out.exists()

@@ -283,14 +283,16 @@ def cmd_run(args) -> int:
 
 def patch_summary_lines(summary: dict) -> list[str]:
     """One line per patch slot in contact (SimulationResult.patch_summary) and one for the BEM warm start, e.g.
-    "left tread patch: sampled (bem), ellipticity residual 0.36 (max 0.41), max pressure 1136 MPa, area 101 mm^2".
+    "left flange patch (slot tread): sampled (bem), ellipticity residual 0.51 (max 3.7), max pressure 2345 MPa, area
+    164.5 mm^2 (largest over the run)".
     """
     lines = []
     for name, entry in (summary.get("patch_summary") or {}).items():
         geometry = ", ".join(
             g if share == 1.0 else f"{g} {100 * share:.0f} %" for g, share in entry["geometry"].items()
         )  # fmt: skip
-        text = f"{name} patch: {geometry} ({', '.join(entry['law'])})"
+        side, slot = name.split(" ", 1)
+        text = f"{side} {entry['contact']} patch (slot {slot}): {geometry} ({', '.join(entry['law'])})"
         residual = entry.get("ellipticity_residual")
         if residual:
             text += f", ellipticity residual {residual['median']:.2g} (max {residual['max']:.2g})"

@@ -279,8 +279,9 @@ class SimulationResult:
     def patch_summary(self) -> dict:
         """Per patch slot in contact (``"left tread"``, ``"right second"``, ...): which geometry the model saw
         (layout.PATCH_GEOMETRY_NAMES: its share of the recorded samples in contact), which law served it
-        (compiled_laws.LAW_CODES names), the ellipticity residual of a sampled gap (median and largest), and the
-        largest max pressure (Pa) and contact area (m^2); slots never in contact are left out.
+        (compiled_laws.LAW_CODES names), whether it is a flange or a tread contact (its median contact angle against
+        the track's ``flange_contact_angle_rad``), the ellipticity residual of a sampled gap (median and largest),
+        and the largest max pressure (Pa) and contact area (m^2); slots never in contact are left out.
         """
         from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK, LAW_CODES
         from rigid_dynamics.wheelset.layout import PATCH_GEOMETRY_NAMES
@@ -290,6 +291,7 @@ class SimulationResult:
             return {}
         law_names = {code: name for name, code in LAW_CODES.items()}
         law_names[LAW_CALLBACK] = self.contact_model or "callback"
+        flange_angle = self.scene.track.flange_contact_angle_rad if self.scene is not None else 0.5
         out = {}
         for i, side in enumerate(SIDES):
             for j, slot in enumerate(SLOT_NAMES):
@@ -306,8 +308,11 @@ class SimulationResult:
                 if res.size:
                     residual = {"median": float(np.median(res)), "max": float(res.max())}
                 pmax, area = column("max_pressure_Pa"), column("contact_area_m2")
+                angle = float(np.median(column("contact_angle_rad")))
                 out[f"{side} {slot}"] = {
                     "samples_in_contact": int(touching.sum()),
+                    "contact": "flange" if angle > flange_angle else "tread",
+                    "median_contact_angle_rad": angle,
                     "geometry": {
                         n: float(np.mean(geometry == k)) for k, n in enumerate(PATCH_GEOMETRY_NAMES)
                         if np.any(geometry == k)
