@@ -18,13 +18,19 @@ R0 = 0.46
 THETA_FLAT = 0.6  # CONTACT's theta_wc of the flat's centre
 
 
-def _write(tmp_path, flat, header=None):
+def _write(tmp_path, flat, header=None, th_intpol=1):
     profile = load_profile("S1002", "wheel")
     y_mm, z_mm = profile.y_m * 1e3, -profile.z_m * 1e3  # z up in the files
     sparse = np.linspace(-3.1, 3.1, 63)
     theta = np.concatenate([sparse[sparse < 0.45], np.linspace(0.5, 0.7, 101), sparse[sparse > 0.75]])
     (tmp_path / "slices").mkdir()
-    lines = header or ["% synthetic flat", "0.0  1.0   TH_OFFSET, TH_SCALE", f"{theta.size}   NSLC", "0 0 0", "2"]
+    lines = header or [
+        "% synthetic flat",
+        "0.0  1.0   TH_OFFSET, TH_SCALE",
+        f"{theta.size}   NSLC",
+        "0 0 0",
+        str(th_intpol),
+    ]
     for k, th in enumerate(theta):
         r_irr = float(flat.evaluate(0.5 * math.pi - th, 0.0)[0])
         name = f"slices/s_{k}.txt"
@@ -51,9 +57,42 @@ def test_slices_reader_recovers_a_parametric_flat(tmp_path):
     assert abs(float(slices.irregularity.evaluate(0.5 * math.pi + 2.0, 0.0)[0])) < 1e-7
 
 
+class _Parabola:
+    """R_irr = c (theta - theta_0)^2 within 0.1 rad of theta_0 (the dense slices), constant beyond (continuous)."""
+
+    c = 0.1  # m / rad^2
+
+    def evaluate(self, alpha, y):
+        theta = 0.5 * math.pi - np.asarray(alpha, float)
+        return (self.c * np.minimum((theta - THETA_FLAT) ** 2, 0.01),)
+
+
+def test_approximating_slices_read_as_contacts_b_spline(tmp_path):
+    """TH_INTPOL 2: the slices are the control points of a cubic B-spline along the angle (CONTACT's approximating
+    spline). Reference, closed form: on uniform knots h a cubic B-spline whose control points lie on c theta^2 is
+    c (theta^2 + h^2 / 3) (the B-spline reproduces quadratics shifted by c h^2 / 3), here 1.33e-7 m on the 2 mrad
+    dense slices; TH_INTPOL 1 passes through the slices. Values relative to the first (base) slice, on the constant
+    part."""
+    parabola = _Parabola()
+    (tmp_path / "a").mkdir()
+    (tmp_path / "i").mkdir()
+    approx = read_wheel_slices(_write(tmp_path / "a", parabola, th_intpol=2))
+    interp = read_wheel_slices(_write(tmp_path / "i", parabola, th_intpol=1))
+    assert (approx.th_intpol, interp.th_intpol) == (2, 1)
+    h = 0.2 / 100
+    theta = THETA_FLAT + h * np.arange(-30, 31)
+    alpha = 0.5 * math.pi - theta
+    for y in (-0.02, 0.0, 0.03):
+        ys = np.full_like(alpha, y)
+        want = parabola.c * ((theta - THETA_FLAT) ** 2 - 0.01)  # relative to the base slice (constant part)
+        np.testing.assert_allclose(interp.irregularity.evaluate(alpha, ys)[0], want, atol=1e-11)
+        np.testing.assert_allclose(approx.irregularity.evaluate(alpha, ys)[0], want + parabola.c * h**2 / 3, atol=1e-11)
+
+
 @pytest.mark.parametrize(
     ("header", "pattern"),
     [
+        (["0.0 1.0", "160", "0 0 0", "3"], r"TH_INTPOL = 3: expected 1 \(interpolating\) or 2"),
         (["0.0 1.0", "3", "0 0 0", "2"], r"NSLC = 3: expected at least 4 slices"),
         (["0.0 1.0", "x", "0 0 0", "2"], r"expected NSLC"),
         (["0.0 1.0", "160", "2 0 0", "2"], r"NFEAT = 2: expected 0"),

@@ -19,17 +19,23 @@ radial deviation of slice k from the base is
 
 on the lateral range common to all slices. Angles: CONTACT's theta_wc is the wheel's angle with the contact at
 theta_wc = -PITCH; in this package the wheel's material angle at its lowest point is alpha = pi/2 - phi with
-phi = -PITCH (wheelset_case: phi' = -pitch rate), so alpha = pi/2 - theta_wc. The slices are interpolated with a
-periodic bicubic spline (MeasuredWheelIrregularity), not CONTACT's approximating spline (TH_INTPOL 2), so values
-between slices near sharp edges differ slightly; CONTACT's constant extrapolation outside the slices' angle range
-is not reproduced either (the spline is periodic).
+phi = -PITCH (wheelset_case: phi' = -pitch rate), so alpha = pi/2 - theta_wc. Along the angle the surface is
+CONTACT's (its m_bspline_make, read to learn, not copied): TH_INTPOL 1 interpolates the slices; TH_INTPOL 2 takes
+them as the *control points* of a cubic B-spline with knots at the slice angles (the ends extended by three
+intervals, one phantom control point extrapolated linearly at each end), which smooths over about one slice
+either side (on uniform spacing h the value at a slice is (c_{k-1} + 4 c_k + c_{k+1}) / 6: a quadratic c theta^2
+reads c (theta^2 + h^2 / 3)). Both are stored as their values at the slice angles, through which the periodic
+bicubic spline of MeasuredWheelIrregularity passes: a cubic spline with those knots is fixed by those values, so
+away from the wrap-around it is CONTACT's spline. CONTACT's constant extrapolation outside the slices' angle
+range is not reproduced (the spline is periodic).
 
 The wheel profile of a case that uses such a file should be the base slice's file (R_irr is relative to it).
 
 Status: verified on a parametric flat written as slices (tests/test_geometry_slices.py) and compared with
-CONTACT's published solution of its examples/wheelflat.inp (benchmarks/results/wheelflat_contact.md): with the
-flat at the contact the reference point within 0.2 mm, approach within 1.4 %, FX 2 %, area +8.5 %, peak pressure
-+13 %; the interpolation between slices (CONTACT approximates) is the first suspect for the rest.
+CONTACT's published solution of its examples/wheelflat.inp (benchmarks/results/wheelflat_contact.md). The
+example's file says TH_INTPOL 2; read as interpolating (before TH_INTPOL was honoured) the peak pressure was +13 %
+and +34 % off CONTACT's at -37 and -40 deg, read as CONTACT reads it +-8 to 12 %
+(benchmarks/results/wheelflat_slice_interpolation.md).
 """
 
 from __future__ import annotations
@@ -57,12 +63,14 @@ class WheelSlices:
         irregularity: R_irr(alpha, y_p) relative to the base (MeasuredWheelIrregularity).
         theta_rad: CONTACT's slice angles theta_wc, rad, shape (n,).
         source: the file.
+        th_intpol: the file's TH_INTPOL: 1 interpolating, 2 approximating spline along the angle (module docstring).
     """
 
     base: Profile
     irregularity: MeasuredWheelIrregularity
     theta_rad: np.ndarray
     source: str
+    th_intpol: int = 1
 
 
 def _lines(path: Path):
@@ -156,7 +164,9 @@ def read_wheel_slices(path, lateral_step_m: float = 5.0e-4, smoothing_wavelength
     nfeat = _numbers(path, lines[2], 1, "NFEAT NKINK NACCEL")[0]
     if nfeat != 0:
         raise _err(path, f"NFEAT = {nfeat:g}: expected 0 (lateral features in slices files are not read here)")
-    _numbers(path, lines[3], 1, "TH_INTPOL")
+    (th_intpol,) = _numbers(path, lines[3], 1, "TH_INTPOL")
+    if th_intpol not in (1.0, 2.0):
+        raise _err(path, f"TH_INTPOL = {th_intpol:g}: expected 1 (interpolating) or 2 (approximating spline)")
     count = int(count)
     if count < 4 or len(lines) < 4 + count:
         raise _err(path, f"NSLC = {count}: expected at least 4 slices, each on a line 'TH_SLC file'")
@@ -198,7 +208,24 @@ def read_wheel_slices(path, lateral_step_m: float = 5.0e-4, smoothing_wavelength
         lam = (smoothing_wavelength_m * 1e3 / (2.0 * math.pi)) ** 4 / step_mm
         y_mm = grid * 1e3
         deviation = np.array([make_smoothing_spline(y_mm, row, lam=lam)(y_mm) for row in deviation])
+    if th_intpol == 2.0:
+        deviation = approximating_values(theta, deviation)
     alpha = 0.5 * math.pi - theta  # module docstring
     order = np.argsort(alpha)
     irregularity = MeasuredWheelIrregularity(alpha[order], grid, deviation[order])
-    return WheelSlices(base, irregularity, theta, str(path))
+    return WheelSlices(base, irregularity, theta, str(path), int(th_intpol))
+
+
+def approximating_values(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Values at the angles ``theta`` (increasing, n >= 4) of the cubic B-spline whose control points are ``rows``
+    (n, m): CONTACT's approximating spline of TH_INTPOL 2 (module docstring): knots at the angles, the ends extended
+    by three intervals, a phantom control point 2 c_1 - c_2 (2 c_n - c_(n-1)) at each end.
+    """
+    from scipy.interpolate import BSpline
+
+    theta = np.asarray(theta, float)
+    rows = np.asarray(rows, float)
+    d0, d1 = theta[1] - theta[0], theta[-1] - theta[-2]
+    knots = np.concatenate([theta[0] - d0 * np.arange(3, 0, -1), theta, theta[-1] + d1 * np.arange(1, 4)])
+    control = np.concatenate([[2 * rows[0] - rows[1]], rows, [2 * rows[-1] - rows[-2]]])
+    return BSpline(knots, control, 3)(theta)
