@@ -290,7 +290,8 @@ class SimulationResult:
         if "patch_geometry_code" not in self.patches or not len(self.t):
             return {}
         law_names = {code: name for name, code in LAW_CODES.items()}
-        law_names[LAW_CALLBACK] = self.contact_model or "callback"
+        # the callback's model; auto's BEM rung (auto.AUTO_RUNGS' last, recorded as LAW_LINEAR + 3 = LAW_CALLBACK)
+        law_names[LAW_CALLBACK] = "bem" if self.contact_model == "auto" else self.contact_model or "callback"
         flange_angle = self.scene.track.flange_contact_angle_rad if self.scene is not None else 0.5
         out = {}
         for i, side in enumerate(SIDES):
