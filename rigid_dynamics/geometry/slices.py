@@ -34,8 +34,8 @@ The wheel profile of a case that uses such a file should be the base slice's fil
 Status: verified on a parametric flat written as slices (tests/test_geometry_slices.py) and compared with
 CONTACT's published solution of its examples/wheelflat.inp (benchmarks/results/wheelflat_contact.md). The
 example's file says TH_INTPOL 2; read as interpolating (before TH_INTPOL was honoured) the peak pressure was +13 %
-and +34 % off CONTACT's at -37 and -40 deg, read as CONTACT reads it +-8 to 12 %
-(benchmarks/results/wheelflat_slice_interpolation.md).
+and +34 % off CONTACT's at -37 and -40 deg, read as CONTACT reads it -8.0 % and +14.7 %, the area +9.8 % and -3.8 %
+(benchmarks/results/wheelflat_slice_interpolation.md: still outside 3 % / 5 %; the rest is not explained).
 """
 
 from __future__ import annotations
