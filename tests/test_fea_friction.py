@@ -105,3 +105,76 @@ def test_cattaneo_mindlin_closed_form_limits():
     near = cattaneo_mindlin(1.0 - 1e-12, 1.0, 1.0, 1.0, 1.0, 0.3)
     assert near["shift_m"] == pytest.approx(3 * 1.7 / 16, rel=1e-6)
     assert near["stick_radius_ratio"] < 1e-3
+
+
+# --- steady rolling (transient shifts) on the full block ---------------------------------------------------------
+
+N_ROLL = 4.0
+
+
+@pytest.fixture(scope="module")
+def rolling_circle():
+    import dolfinx_solver  # noqa: F401
+
+    from fea.domain import hertz_block_domain
+    from fea.solver import solve_rigid_indenter
+    from meshing.hertz import HertzBlockSpec
+
+    ref = hertz_elliptic(0.5 / RADIUS_M, 0.5 / RADIUS_M, FORCE_N, E_STAR)
+    a = ref.semi_axis_long_m
+    domain = hertz_block_domain(HertzBlockSpec(a, a, N_ROLL, domain_factor=10.0, symmetry="full"))
+    normal = solve_rigid_indenter(
+        domain,
+        lambda x, y: (x * x + y * y) / (2 * RADIUS_M),
+        E_BLOCK,
+        NU,
+        normal_force_N=FORCE_N,
+        initial_approach_m=ref.approach_m,
+        length_scale_m=a,
+    )
+    assert normal.success, normal.message
+    return domain, normal, a
+
+
+def _roll(rolling_circle, creepage, step_per_a=N_ROLL):
+    from fea.friction import solve_rolling
+
+    domain, normal, a = rolling_circle
+    return solve_rolling(
+        domain, normal, E_BLOCK, NU, MU, creepage, step_m=a / step_per_a, patch_length_m=2 * a, length_scale_m=a
+    )
+
+
+@pytest.mark.slow
+def test_rolling_at_large_creepage_slides_at_mu_p(rolling_circle):
+    """Coulomb's bound: far beyond saturation the whole patch slides, F = -mu P along the creepage (on the wheel)."""
+    sol = _roll(rolling_circle, (0.002, 0.004, 0.0))
+    assert sol.success and sol.status == "ok", sol.message
+    fx, fy = sol.creep_force_N
+    assert math.hypot(fx, fy) == pytest.approx(MU * FORCE_N, rel=1e-3)
+    assert fx < 0 and fy < 0 and fy / fx == pytest.approx(2.0, rel=0.05)
+    assert not sol.stick[sol.in_contact].any()
+
+
+@pytest.mark.slow
+def test_rolling_at_small_creepage_against_kalker_linear_theory(rolling_circle):
+    """Kalker's linear theory (F_x = -G a b C11 xi, C11 from the project's copy of Kalker's table, an independent
+    reference) at xi = 5e-5 (F about 0.04 mu P: the saturation's part below 1.5 %).
+
+    The error this states is large: on the suite's mesh (4 elements per semi-axis, full block of 10 a) the FEA's
+    rolling creep force is 14 % above Kalker's (stiffer; at xi = 5e-4 13.5 % above the BEM's -0.372 mu P), and the
+    step of the transient (a/2, a/4, a/8: -0.457, -0.422, -0.420 mu P at xi = 5e-4) is not the cause: the mesh is.
+    Measured, not a claim of accuracy; see docs/models.md ("FEA with Coulomb friction") for the finer mesh.
+    """
+    from rigid_dynamics.contact.kalker import kalker_coefficients
+
+    domain, normal, a = rolling_circle
+    xi = 5e-5
+    sol = _roll(rolling_circle, (xi, 0.0, 0.0))
+    assert sol.success and sol.status == "ok", sol.message
+    g = E_PA / (2 * (1 + NU))  # the pair's combined shear modulus (equal bodies)
+    kalker = -g * a * a * float(kalker_coefficients(1.0, NU).c11) * xi
+    assert sol.creep_force_N[0] < kalker  # stiffer than the half-space
+    assert sol.creep_force_N[0] == pytest.approx(kalker, rel=0.16)
+    assert abs(sol.creep_force_N[1]) < 0.01 * abs(sol.creep_force_N[0])
+    assert sol.steady_error_N <= 1e-3 * MU * FORCE_N
