@@ -518,9 +518,12 @@ def solve_rolling(
             ratio = change / before if before > 0 else 0.0
             remaining = change * ratio / (1.0 - ratio) if ratio < 1.0 else math.inf
             if steps * step_m >= patch_length_m and remaining <= steady_tolerance * mu_p:
-                status, message = "ok", (
-                    f"steady after {steps} shifts ({steps * step_m:.4g} m rolled; the creep force within "
-                    f"{remaining / mu_p:.2g} mu P of its steady value, Aitken's estimate)"
+                status, message = (
+                    "ok",
+                    (
+                        f"steady after {steps} shifts ({steps * step_m:.4g} m rolled; the creep force within "
+                        f"{remaining / mu_p:.2g} mu P of its steady value, Aitken's estimate)"
+                    ),
                 )
                 break
     force = out["force"] if out is not None else np.zeros((n, 2))
