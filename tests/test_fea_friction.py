@@ -162,8 +162,8 @@ def test_rolling_at_small_creepage_against_kalker_linear_theory(rolling_circle):
     reference) at xi = 5e-5 (F about 0.04 mu P: the saturation's part below 1.5 %).
 
     The error this states is large: on the suite's mesh (4 elements per semi-axis, full block of 10 a) the FEA's
-    rolling creep force is 14 % above Kalker's (stiffer; at xi = 5e-4 13.5 % above the BEM's -0.372 mu P), and the
-    step of the transient (a/2, a/4, a/8: -0.457, -0.422, -0.420 mu P at xi = 5e-4) is not the cause: the mesh is.
+    rolling creep force is 14 % above Kalker's (stiffer; at xi = 5e-4 14.5 % above the BEM's -0.372 mu P), and the
+    step of the transient (a/2, a/4, a/8: -0.457, -0.426, -0.420 mu P at xi = 5e-4) is not the main cause: the mesh is.
     Measured, not a claim of accuracy; see docs/models.md ("FEA with Coulomb friction") for the finer mesh.
     """
     from rigid_dynamics.contact.kalker import kalker_coefficients
