@@ -93,10 +93,11 @@ def _rail(x, y, surf):
 
 
 @njit(cache=True, _nrt=False)
-def _rail_distance(b0, b1, b2, patch, surf):
-    """t along n from the base point (b0, b1, b2) to the rail surface; +inf off the rail (module docstring)."""
+def _rail_distance(b0, b1, b2, patch, surf, t):
+    """The distance t along n from the base point (b0, b1, b2) to the rail, Newton's method from t; +inf off the
+    rail (module docstring).
+    """
     n0, n1, n2 = patch.normal
-    t = 0.0
     for _ in range(patch.iterations):
         big_n, n_x, n_y = _rail(b0 + t * n0, b1 + t * n1, surf)
         f = b2 + t * n2 - big_n
@@ -131,17 +132,30 @@ def _mul(rot, v0, v1, v2, i):
 @njit(cache=True, _nrt=False)
 def gap_point(gx, gy, surf, patch):
     """The gap along n at the contact-plane point (gx, gy) of ``patch``, m (module docstring)."""
+    return _gap_solve(gx, gy, surf, patch, (math.nan, 0.0, 0.0, 0.0))[0]
+
+
+@njit(cache=True, _nrt=False)
+def _gap_solve(gx, gy, surf, patch, start):
+    """(gap, alpha, y_d, s, t) at (gx, gy): Newton's iterations from start = (alpha, y_d, s, t) of a nearby point
+    (alpha NaN: from the patch's parameters, module docstring). The roots are the same; a near start saves
+    iterations.
+    """
     ex, ey, nn = patch.e_x, patch.e_y, patch.normal
     c = patch.point
     b0 = c[0] + gx * ex[0] + gy * ey[0]
     b1 = c[1] + gx * ex[1] + gy * ey[1]
     b2 = c[2] + gx * ex[2] + gy * ey[2]
-    t_rail = _rail_distance(b0, b1, b2, patch, surf)
     rot, ctr = patch.rot, patch.centre
     radius = _wheel(patch.alpha0, patch.y0, surf)[0]
-    alpha = patch.alpha0 + gx / radius
-    lat = patch.y0 + gy * (ey[0] * rot[0, 1] + ey[1] * rot[1, 1] + ey[2] * rot[2, 1])
-    s = 0.0
+    if math.isnan(start[0]):
+        t_rail = _rail_distance(b0, b1, b2, patch, surf, 0.0)
+        alpha = patch.alpha0 + gx / radius
+        lat = patch.y0 + gy * (ey[0] * rot[0, 1] + ey[1] * rot[1, 1] + ey[2] * rot[2, 1])
+        s = 0.0
+    else:
+        t_rail = _rail_distance(b0, b1, b2, patch, surf, start[3])
+        alpha, lat, s = start[0], start[1], start[2]
     for _ in range(patch.iterations):
         r, r_a, r_y = _wheel(alpha, lat, surf)
         ca, sa = math.cos(alpha), math.sin(alpha)
@@ -164,8 +178,8 @@ def gap_point(gx, gy, surf, patch):
         if not (abs(d_a) * radius + abs(d_y) + abs(d_s) > 1e-15):
             break
     if not (lat >= surf.y_range[0] and lat <= surf.y_range[1]):
-        return math.inf
-    return s - t_rail
+        return math.inf, alpha, lat, s, t_rail
+    return s - t_rail, alpha, lat, s, t_rail
 
 
 @njit(cache=True)
@@ -184,8 +198,16 @@ def sample_grid(surf, patch, box, xs, ys, gap):
     for j in range(ny):
         ys[j] = box[2] + (box[3] - box[2]) * j / (ny - 1)
     for j in range(ny):
+        # along the row each point starts from its neighbour's roots (alpha shifted by the step over the radius)
+        start = (math.nan, 0.0, 0.0, 0.0)
         for i in range(nx):
-            gap[j, i] = gap_point(xs[i], ys[j], surf, patch)
+            g, alpha, lat, s, t = _gap_solve(xs[i], ys[j], surf, patch, start)
+            gap[j, i] = g
+            if math.isfinite(g) and math.isfinite(alpha) and math.isfinite(t):
+                step = (xs[i + 1] - xs[i]) if i + 1 < nx else 0.0
+                start = (alpha + step / _wheel(alpha, lat, surf)[0], lat, s, t)
+            else:
+                start = (math.nan, 0.0, 0.0, 0.0)
 
 
 @njit(cache=True, _nrt=False)
@@ -238,18 +260,48 @@ def fitted_grid(surf, patch, fit, xs, ys, gap):
     c0, c1, r0, r1 = _overlap_extent(gap)
     if c0 < 0:
         return passes
-    sx = (x_hi - x_lo) / max(nx - 1, 1)
-    lo, hi = xs[c0], xs[c1]
-    pad = fit.margin * (hi - lo) + 2 * sx
-    fx0, fx1 = max(min(lo - pad, -sx), -lim_x, x_lo), min(max(hi + pad, sx), lim_x, x_hi)
-    sy = (y_hi - y_lo) / max(ny - 1, 1)
-    lo, hi = ys[r0], ys[r1]
-    pad = fit.margin * (hi - lo) + 2 * sy
-    fy0, fy1 = max(min(lo - pad, -sy), -lim_y, y_lo), min(max(hi + pad, sy), lim_y, y_hi)
+    fx0, fx1, fy0, fy1 = _shrunk_box(xs, ys, (c0, c1, r0, r1), fit.margin)
     if fx1 - fx0 < 0.8 * (x_hi - x_lo) or fy1 - fy0 < 0.8 * (y_hi - y_lo):
         sample_grid(surf, patch, (fx0, fx1, fy0, fy1), xs, ys, gap)
         passes += 1
     return passes
+
+
+@njit(cache=True, _nrt=False)
+def _shrunk_box(xs, ys, extent, margin):
+    """fitted_grid's last box: the overlap's extent (columns c0..c1, rows r0..r1 of the grid xs, ys) plus margin
+    of it and two spacings each side, within the grid's box and _FIELD_LIMITS_M.
+    """
+    lim_x, lim_y = FIELD_LIMITS_M
+    c0, c1, r0, r1 = extent
+    nx, ny = xs.shape[0], ys.shape[0]
+    x_lo, x_hi, y_lo, y_hi = xs[0], xs[nx - 1], ys[0], ys[ny - 1]
+    sx = (x_hi - x_lo) / max(nx - 1, 1)
+    lo, hi = xs[c0], xs[c1]
+    pad = margin * (hi - lo) + 2 * sx
+    fx0, fx1 = max(min(lo - pad, -sx), -lim_x, x_lo), min(max(hi + pad, sx), lim_x, x_hi)
+    sy = (y_hi - y_lo) / max(ny - 1, 1)
+    lo, hi = ys[r0], ys[r1]
+    pad = margin * (hi - lo) + 2 * sy
+    fy0, fy1 = max(min(lo - pad, -sy), -lim_y, y_lo), min(max(hi + pad, sy), lim_y, y_hi)
+    return fx0, fx1, fy0, fy1
+
+
+@njit(cache=True, _nrt=False)
+def warm_grid(surf, patch, box, margin, xs, ys, gap):
+    """The gap on the given box (x_lo, x_hi, y_lo, y_hi; the last evaluation's) when it still fits the overlap as
+    fitted_grid's would: the overlap touches no side and the shrunk box keeps at least 80 % of each side. Returns
+    True when it fits (then xs, ys, gap hold it), else False (call fitted_grid).
+    """
+    if not box[1] > box[0]:
+        return False
+    sample_grid(surf, patch, (box[0], box[1], box[2], box[3]), xs, ys, gap)
+    c0, c1, r0, r1 = _overlap_extent(gap)
+    nx, ny = xs.shape[0], ys.shape[0]
+    if c0 <= 0 or c1 >= nx - 1 or r0 <= 0 or r1 >= ny - 1:
+        return False
+    fx0, fx1, fy0, fy1 = _shrunk_box(xs, ys, (c0, c1, r0, r1), margin)
+    return not (fx1 - fx0 < 0.8 * (box[1] - box[0]) or fy1 - fy0 < 0.8 * (box[3] - box[2]))
 
 
 @njit(cache=True, _nrt=False)

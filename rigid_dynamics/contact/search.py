@@ -526,7 +526,9 @@ def _gap_at(geo: _SideGeometry, alpha0, y0, centre, frame, gx, gy, iterations):
 
         surf, patch = _gap_records(geo, alpha0, y0, centre, frame, iterations)
         out = np.empty(gx.size)
-        gk.gap_points(np.ascontiguousarray(gx, float).ravel(), np.ascontiguousarray(gy, float).ravel(), surf, patch, out)
+        gk.gap_points(
+            np.ascontiguousarray(gx, float).ravel(), np.ascontiguousarray(gy, float).ravel(), surf, patch, out
+        )
         return out.reshape(gx.shape)
     return _gap_at_python(geo, alpha0, y0, centre, frame, gx, gy, iterations)
 

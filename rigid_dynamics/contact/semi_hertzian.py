@@ -69,6 +69,7 @@ class KpecModel:
     description = "CONTACT's KPEC semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
     OPTIONS = OPTIONS
     solves_undeformed_distance = True
+    compiled_law = "kpec"
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
@@ -199,6 +200,7 @@ class AnalynModel(KpecModel):
 
     name = "analyn"
     description = "CONTACT's ANALYN semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
+    compiled_law = None  # not compiled into the dynamics loop: its patches go through the callback
 
     @staticmethod
     def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):
