@@ -410,11 +410,18 @@ def blended_flexibilities(ellipse, kalker, load, creep):
 
 
 @njit(cache=True)
-def fastsim_strips(pressure, in_contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, in_slip):
-    """Step 5 of the module docstring: fills tx, ty (Pa) and in_slip; returns (Fx N, Fy N, Mz N m) on the wheel.
+def fastsim_strips(normal, grid, creep, flexibilities, traction):
+    """Step 5 of the module docstring: normal = (pressure Pa, in_contact) (ny, nx), grid = (x, y) m (element
+    centres), creep = (mu, xi, eta, phi 1/m), flexibilities = (L1, L2, L3) m/Pa; fills traction = (tx, ty Pa,
+    in_slip) (ny, nx); returns (Fx N, Fy N, Mz N m) on the wheel.
 
     Mz is the moment about the grid origin (the contact reference point) about the normal.
     """
+    pressure, in_contact = normal
+    x, y = grid
+    mu, xi, eta, phi = creep
+    l1, l2, l3 = flexibilities
+    tx, ty, in_slip = traction
     ny, nx = pressure.shape
     dx = x[1] - x[0] if nx > 1 else 1.0
     dy = y[1] - y[0] if ny > 1 else 1.0
@@ -478,7 +485,7 @@ def fastrip_strips(
     make the small-creepage force converge slowly: 5 % off Kalker's linear theory at 160 elements per side, against
     0.5 % at 40-160 here).
     """
-    fastsim_strips(pressure, in_contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, in_slip)
+    fastsim_strips((pressure, in_contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, in_slip))
     ny, nx = pressure.shape
     dx = x[1] - x[0] if nx > 1 else 1.0
     dy = y[1] - y[0] if ny > 1 else 1.0

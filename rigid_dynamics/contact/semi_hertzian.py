@@ -145,7 +145,7 @@ class KpecModel:
                 p, contact, x, y, mu, nu, a_fl, p0, xi_s, eta_s, phi_s, xi, eta, phi, l1, l2, l3, tx, ty, slip
             )
         else:
-            fx, fy, mz = fastsim_strips(p, contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
+            fx, fy, mz = fastsim_strips((p, contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, slip))
         edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
         fields = ContactFields(
             x_m=x, y_m=y, pressure_Pa=p, traction_long_Pa=tx, traction_lat_Pa=ty, in_contact=contact, in_slip=slip

@@ -356,8 +356,9 @@ def _kpec_law(par, tables, field, c, geometry, creep):
     a, b = flexibility_ellipse(contact, dx, dy)
     xi, eta, phi = creep
     l1, l2, l3 = blended_flexibilities((a, b), _kalker_c(tables, a / b), (fn_kpec, g_mod, mu), creep)
-    fx, fy, mz = fastsim_strips(pressure, contact, xs, ys, mu, xi, eta, phi, l1, l2, l3, field.tx, field.ty,
-                                field.slip)  # fmt: skip
+    fx, fy, mz = fastsim_strips(
+        (pressure, contact), (xs, ys), (mu, xi, eta, phi), (l1, l2, l3), (field.tx, field.ty, field.slip)
+    )
     return total * dx * dy, a, b, fx, fy, mz, count * dx * dy, pmax
 
 
