@@ -55,8 +55,10 @@ def held():
 def test_regression_loop_kpec_equals_static_kpec_on_the_sampled_gap(held):
     scene, run, _ = held
     from rigid_dynamics.wheelset.equilibrium import initial_state
+    from rigid_dynamics.wheelset.state import n_states
 
-    y = initial_state(scene)
+    y = np.zeros(n_states(int(run.par["track_positions"])))  # the full state of the compiled right-hand side
+    y[:12] = initial_state(scene)  # the run's start (rolling velocities)
     y[:6] = POSE
     ncand = run.sides.shape[0]
     rec = np.zeros((ncand + 2, lay.N_FIELDS))
