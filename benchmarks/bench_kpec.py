@@ -109,7 +109,7 @@ def kernel_time(result, geometry, creepage) -> float:
     def run():
         out = kpec_pressure(h, f.x_m, f.y_m, g, nu, p, contact)
         l1, l2, l3, _, _ = simplified_flexibilities(contact, dx, dy, out[0], g, nu, mu, xi, eta, phi)
-        fastsim_strips(p, contact, f.x_m, f.y_m, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
+        fastsim_strips((p, contact), (f.x_m, f.y_m), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, slip))
 
     run()
     return median_time(run, 200)
@@ -126,7 +126,7 @@ p, c = np.zeros(h.shape), np.zeros(h.shape, dtype=np.bool_)
 tx, ty, s = np.zeros(h.shape), np.zeros(h.shape), np.zeros(h.shape, dtype=np.bool_)
 out = kpec.kpec_pressure(h, x, x, 82e9, 0.28, p, c)
 l1, l2, l3, a, b = kpec.simplified_flexibilities(c, 1e-4, 1e-4, out[0], 82e9, 0.28, 0.3, 1e-3, 1e-3, 0.5)
-kpec.fastsim_strips(p, c, x, x, 0.3, 1e-3, 1e-3, 0.5, l1, l2, l3, tx, ty, s)
+kpec.fastsim_strips((p, c), (x, x), (0.3, 1e-3, 1e-3, 0.5), (l1, l2, l3), (tx, ty, s))
 kpec.analyn_pressure(h, x, x, 82e9, 0.28, p, c)
 kpec.fastrip_strips(p, c, x, x, 0.3, 0.28, a, 1e9, -1.0, -1.0, 0.1, 1e-3, 1e-3, 0.5, l1, l2, l3, tx, ty, s)
 print(time.perf_counter() - t0)

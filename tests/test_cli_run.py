@@ -61,6 +61,8 @@ SCENE_ERRORS = [
     ("duration_s = 3.0", "duration_s = nan", r"'duration_s' = nan: expected a finite number"),
     ("speed_m_per_s = 20.0", "speed_m_per_s = 20.0\nfastsim_strips = 0", r"fastsim_strips = 0: expected an integer"),
     ("speed_m_per_s = 20.0", "speed_m_per_s = 20.0\nfastsim_strips = 2.5", r"'fastsim_strips' = 2.5"),
+    ("speed_m_per_s = 20.0", "speed_m_per_s = 20.0\nkpec_points = 4", r"kpec_points = 4: expected an integer from 8"),
+    ("speed_m_per_s = 20.0", "speed_m_per_s = 20.0\nkpec_points = 2.5", r"'kpec_points' = 2.5"),
     (
         'wheel_profile = "conical"',
         'wheel_profile = "/no/such/wheel.prw"',

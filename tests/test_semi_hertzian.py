@@ -209,7 +209,7 @@ def _compiled_caller(h, x, y, g, nu, mu, xi, eta, phi, p, contact, tx, ty, slip)
     """A compiled caller as the dynamics loop will be: the kernels take plain arrays and scalars only."""
     out = kpec_pressure(h, x, y, g, nu, p, contact)
     l1, l2, l3, _, _ = simplified_flexibilities(contact, x[1] - x[0], y[1] - y[0], out[0], g, nu, mu, xi, eta, phi)
-    return fastsim_strips(p, contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
+    return fastsim_strips((p, contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, slip))
 
 
 def test_kernels_compose_in_compiled_code_as_the_rung():

@@ -173,20 +173,36 @@ def kpec_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact
     Returns (normal force N (the pressure before the in-row gaps are cleared, CONTACT's F_N for the flexibilities),
     p_max Pa, A, B, y_m, a, b (the equivalent ellipse), penetration m); zeros when min h >= 0.
     """
+    ny = h.shape[0]
+    rows = (np.full(ny, -1, dtype=np.int64), np.full(ny, -1, dtype=np.int64))
+    return kpec_pressure_into(h, x, y, (shear_modulus_Pa, poisson_ratio), (pressure, in_contact), rows)
+
+
+@njit(cache=True, _nrt=False)
+def kpec_pressure_into(h, x, y, material, fields, rows):
+    """:func:`kpec_pressure` without allocation (the dynamics loop): material = (G Pa, nu), fields = (pressure,
+    in_contact) (ny, nx) filled here, rows = (first, last) (ny,) int64 scratch.
+    """
+    shear_modulus_Pa, poisson_ratio = material
+    pressure, in_contact = fields
+    first, last = rows
     ny, nx = h.shape
     dx = x[1] - x[0] if nx > 1 else 1.0
     dy = y[1] - y[0] if ny > 1 else 1.0
     for j in range(ny):
+        first[j] = -1
+        last[j] = -1
         for i in range(nx):
             pressure[j, i] = 0.0
             in_contact[j, i] = False
-    h_min = h.min()
+    h_min = np.inf
+    for j in range(ny):
+        for i in range(nx):
+            h_min = min(h_min, h[j, i])
     if not h_min < 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     e_star = shear_modulus_Pa / (1.0 - poisson_ratio)
     curv_a, curv_b, y_mid, a, b, j0, i0 = equivalent_ellipse(h, x, y, e_star)
-    first = np.full(ny, -1, dtype=np.int64)
-    last = np.full(ny, -1, dtype=np.int64)
     most = 0
     for j in range(ny):
         thr = (1.0 - min(1.0, _row_threshold(y[j], h_min, curv_a, curv_b, y_mid, a, b))) * h_min
@@ -334,6 +350,20 @@ def analyn_pressure(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_conta
 @njit(cache=True)
 def simplified_flexibilities(in_contact, dx, dy, normal_force_N, shear_modulus_Pa, poisson_ratio, mu, xi, eta, phi):
     """Step 6 of the module docstring: (L1, L2, L3) in m/Pa and the equivalent ellipse (a, b) in m."""
+    a, b = flexibility_ellipse(in_contact, dx, dy)
+    if a == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    coef = np.empty((1, 4))
+    _coefficients_many(np.array([a / b]), np.array([poisson_ratio]), coef)
+    l1, l2, l3 = blended_flexibilities(
+        (a, b), (coef[0, 0], coef[0, 1], coef[0, 2]), (normal_force_N, shear_modulus_Pa, mu), (xi, eta, phi)
+    )
+    return l1, l2, l3, a, b
+
+
+@njit(cache=True, _nrt=False)
+def flexibility_ellipse(in_contact, dx, dy):
+    """Step 6's ellipse of the contact area: (a, b), m (zeros without contact)."""
     ny, nx = in_contact.shape
     count = 0
     i_lo, i_hi, j_lo, j_hi = nx, -1, ny, -1
@@ -346,16 +376,24 @@ def simplified_flexibilities(in_contact, dx, dy, normal_force_N, shear_modulus_P
                 j_lo = min(j_lo, j)
                 j_hi = max(j_hi, j)
     if count == 0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0
     area = count * dx * dy
     length = dx * max(1, i_hi - i_lo + 1)
     width = dy * max(1, j_hi - j_lo + 1)
     a = math.sqrt(area / math.pi) * math.sqrt(length / width)
     b = math.sqrt(area / math.pi) * math.sqrt(width / length)
-    coef = np.empty((1, 4))
-    _coefficients_many(np.array([a / b]), np.array([poisson_ratio]), coef)
-    c11, c22, c23 = coef[0, 0], coef[0, 1], coef[0, 2]
-    g = shear_modulus_Pa
+    return a, b
+
+
+@njit(cache=True, _nrt=False)
+def blended_flexibilities(ellipse, kalker, load, creep):
+    """Step 6's (L1, L2, L3), m/Pa, of the ellipse (a, b) with Kalker's (C11, C22, C23) for a/b, load = (F_N N,
+    G Pa, mu) and creep = (xi, eta, phi).
+    """
+    a, b = ellipse
+    c11, c22, c23 = kalker
+    normal_force_N, g, mu = load
+    xi, eta, phi = creep
     l1 = 8.0 * a / (3.0 * c11 * g)
     l2 = 8.0 * a / (3.0 * c22 * g)
     l3 = math.pi * a * math.sqrt(a / b) / (4.0 * c23 * g)
@@ -368,15 +406,22 @@ def simplified_flexibilities(in_contact, dx, dy, normal_force_N, shear_modulus_P
     l_c = num / max(den, 1e-300) if num > 0.0 else l1
     ratio = max(1e-10, math.sqrt((xi * xi + eta * eta) / (ch_xi * ch_xi + ch_eta * ch_eta)))
     w = min(1.0, max(0.0, ratio / 3.0))
-    return (1.0 - w) * l1 + w * l_c, (1.0 - w) * l2 + w * l_c, (1.0 - w) * l3 + w * l_c, a, b
+    return (1.0 - w) * l1 + w * l_c, (1.0 - w) * l2 + w * l_c, (1.0 - w) * l3 + w * l_c
 
 
 @njit(cache=True)
-def fastsim_strips(pressure, in_contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, in_slip):
-    """Step 5 of the module docstring: fills tx, ty (Pa) and in_slip; returns (Fx N, Fy N, Mz N m) on the wheel.
+def fastsim_strips(normal, grid, creep, flexibilities, traction):
+    """Step 5 of the module docstring: normal = (pressure Pa, in_contact) (ny, nx), grid = (x, y) m (element
+    centres), creep = (mu, xi, eta, phi 1/m), flexibilities = (L1, L2, L3) m/Pa; fills traction = (tx, ty Pa,
+    in_slip) (ny, nx); returns (Fx N, Fy N, Mz N m) on the wheel.
 
     Mz is the moment about the grid origin (the contact reference point) about the normal.
     """
+    pressure, in_contact = normal
+    x, y = grid
+    mu, xi, eta, phi = creep
+    l1, l2, l3 = flexibilities
+    tx, ty, in_slip = traction
     ny, nx = pressure.shape
     dx = x[1] - x[0] if nx > 1 else 1.0
     dy = y[1] - y[0] if ny > 1 else 1.0
@@ -440,7 +485,7 @@ def fastrip_strips(
     make the small-creepage force converge slowly: 5 % off Kalker's linear theory at 160 elements per side, against
     0.5 % at 40-160 here).
     """
-    fastsim_strips(pressure, in_contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, in_slip)
+    fastsim_strips((pressure, in_contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, in_slip))
     ny, nx = pressure.shape
     dx = x[1] - x[0] if nx > 1 else 1.0
     dy = y[1] - y[0] if ny > 1 else 1.0

@@ -520,6 +520,24 @@ def _gap_at(geo: _SideGeometry, alpha0, y0, centre, frame, gx, gy, iterations):
     solver's elements see the exact undeformed distance at their centres.
     """
     gx, gy = np.broadcast_arrays(np.asarray(gx, float), np.asarray(gy, float))
+    if isinstance(geo.wheel, TabulatedWheel) and isinstance(geo.rail, TabulatedRail):
+        # the tabulated surfaces: the compiled sampler (contact._gap_kernels), the one the dynamics loop uses
+        from rigid_dynamics.contact import _gap_kernels as gk
+
+        surf, patch = _gap_records(geo, alpha0, y0, centre, frame, iterations)
+        out = np.empty(gx.size)
+        gk.gap_points(
+            np.ascontiguousarray(gx, float).ravel(), np.ascontiguousarray(gy, float).ravel(), surf, patch, out
+        )
+        return out.reshape(gx.shape)
+    return _gap_at_python(geo, alpha0, y0, centre, frame, gx, gy, iterations)
+
+
+def _gap_at_python(geo: _SideGeometry, alpha0, y0, centre, frame, gx, gy, iterations):
+    """:func:`_gap_at` in numpy with the surfaces' own ``evaluate`` (any surface; the reference of the compiled
+    sampler's regression test).
+    """
+    gx, gy = np.broadcast_arrays(np.asarray(gx, float), np.asarray(gy, float))
     e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]
     base = centre + gx[..., None] * e_x + gy[..., None] * e_y
     # Rail: p = base + t n on z = N(x, y)  (n points from the rail into the wheel).
@@ -537,6 +555,24 @@ def _gap_at(geo: _SideGeometry, alpha0, y0, centre, frame, gx, gy, iterations):
         alpha, lat, s = alpha + delta[..., 0], lat + delta[..., 1], s + delta[..., 2]
     inside = (lat >= geo.y_range[0]) & (lat <= geo.y_range[1])
     return np.where(inside, s - t_rail, np.inf)
+
+
+def _gap_records(geo: _SideGeometry, alpha0, y0, centre, frame, iterations):
+    """The records (_gap_kernels.GapSurfaces, GapPatch) of a tabulated side geometry and a patch."""
+    from rigid_dynamics.contact._gap_kernels import GapPatch, GapSurfaces
+
+    wheel, rail = geo.wheel, geo.rail
+    surf = GapSurfaces(
+        wheel.table_tuple, rail.table_tuple, np.ascontiguousarray(wheel.irregularity_rows, float).reshape(-1, 7),
+        np.ascontiguousarray(rail.irregularity_rows, float).reshape(-1, 7), np.asarray(rail.lateral_map, float),
+        np.array(geo.y_range, float), np.array(geo.rail_range, float),
+    )  # fmt: skip
+    vec = [tuple(float(v) for v in frame[:, k]) for k in range(3)]
+    patch = GapPatch(
+        np.ascontiguousarray(geo.rot, float), np.asarray(geo.centre, float), tuple(float(v) for v in centre), *vec,
+        float(alpha0), float(y0), int(iterations),
+    )  # fmt: skip
+    return surf, patch
 
 
 def _sample_field(geo: _SideGeometry, alpha0, y0, centre, frame, x_range, y_range, npts, iterations):

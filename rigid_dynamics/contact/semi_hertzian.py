@@ -69,6 +69,7 @@ class KpecModel:
     description = "CONTACT's KPEC semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
     OPTIONS = OPTIONS
     solves_undeformed_distance = True
+    compiled_law = "kpec"
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
@@ -144,7 +145,7 @@ class KpecModel:
                 p, contact, x, y, mu, nu, a_fl, p0, xi_s, eta_s, phi_s, xi, eta, phi, l1, l2, l3, tx, ty, slip
             )
         else:
-            fx, fy, mz = fastsim_strips(p, contact, x, y, mu, xi, eta, phi, l1, l2, l3, tx, ty, slip)
+            fx, fy, mz = fastsim_strips((p, contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, slip))
         edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())
         fields = ContactFields(
             x_m=x, y_m=y, pressure_Pa=p, traction_long_Pa=tx, traction_lat_Pa=ty, in_contact=contact, in_slip=slip
@@ -199,6 +200,7 @@ class AnalynModel(KpecModel):
 
     name = "analyn"
     description = "CONTACT's ANALYN semi-Hertzian normal + FASTSIM per strip (non-elliptic patches)"
+    compiled_law = None  # not compiled into the dynamics loop: its patches go through the callback
 
     @staticmethod
     def _normal(h, x, y, shear_modulus_Pa, poisson_ratio, pressure, in_contact):

@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact.fastsim import _fastsim_one, flexibilities_one
+from rigid_dynamics.contact.kpec import blended_flexibilities, fastsim_strips, flexibility_ellipse, kpec_pressure_into
 from rigid_dynamics.contact.linear import linear_one
 from rigid_dynamics.contact.vermeulen_johnson import saturate_one
 from rigid_dynamics.wheelset.layout import (
@@ -40,17 +41,19 @@ from rigid_dynamics.wheelset.layout import (
     N_FIELDS,
 )
 
-LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO = range(6)
+LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO, LAW_KPEC = range(7)
 LAW_CODES = {
     "hertz": LAW_HERTZ,
     "linear": LAW_LINEAR,
     "vermeulen-johnson": LAW_VERMEULEN_JOHNSON,
     "fastsim": LAW_FASTSIM,
     "auto": LAW_AUTO,
+    "kpec": LAW_KPEC,
 }
 """The laws compiled into the loop, by the name a contact model declares (contact.models.HertzianModel.compiled_law);
 LAW_CALLBACK: every patch through the callback (bem, fea, user models); LAW_AUTO: auto's rung chosen per patch
-(linear, Vermeulen-Johnson and FASTSIM inline, BEM through the callback)."""
+(linear, Vermeulen-Johnson and FASTSIM inline, BEM through the callback); LAW_KPEC: CONTACT's KPEC + FASTSIM per strip
+on the patch's gap (:func:`_kpec_law`; the gap sampled by compiled_patch.py, or the quadric)."""
 
 
 class TabulatedHertzKalker:
@@ -285,6 +288,78 @@ def _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record):
         for f in range(len(AUTO_FEATURE_NAMES)):
             rec[c, AUTO_FEATURES + f] = feats[f]
     return normal, sa, sb, tx, ty, mz, to_callback
+
+
+@njit(cache=True, _nrt=False)
+def _kalker_c(tables, ratio):
+    """Kalker's (C11, C22, C23) for a/b = ratio from the tables (:func:`_hertz_kalker`'s interpolation)."""
+    kk = tables.kalker
+    i, w = _uniform(math.log(ratio), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    return (
+        kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w,
+        kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w,
+        kk[KALKER_C23, i] * (1 - w) + kk[KALKER_C23, i + 1] * w,
+    )
+
+
+@njit(cache=True, _nrt=False)
+def _quadric_field(par, field, c, geometry):
+    """The quadric gap A x'^2 + B y'^2 - q of geometry = (q, A, B, angle) on field's grid of candidate c: the box
+    of the overlap ellipse's extent with the sampled grid's margin (kpec_margin of the extent and two spacings each
+    side).
+    """
+    q, ca, cb, angle = geometry
+    cs, sn = math.cos(angle), math.sin(angle)
+    xs, ys, gap = field.xs[c], field.ys[c], field.gap[c]
+    nx, ny = xs.shape[0], ys.shape[0]
+    grow = 1.0 + 2.0 * par.kpec_margin
+    hx = math.sqrt(q * (cs * cs / ca + sn * sn / cb)) * grow / max(1.0 - 4.0 / (nx - 1), 0.5)
+    hy = math.sqrt(q * (sn * sn / ca + cs * cs / cb)) * grow / max(1.0 - 4.0 / (ny - 1), 0.5)
+    for i in range(nx):
+        xs[i] = -hx + 2.0 * hx * i / (nx - 1)
+    for j in range(ny):
+        ys[j] = -hy + 2.0 * hy * j / (ny - 1)
+    for j in range(ny):
+        for i in range(nx):
+            xr, yr = cs * xs[i] + sn * ys[j], -sn * xs[i] + cs * ys[j]
+            gap[j, i] = ca * xr * xr + cb * yr * yr - q
+
+
+@njit(cache=True, _nrt=False)
+def _kpec_law(par, tables, field, c, geometry, creep):
+    """CONTACT's KPEC + FASTSIM per strip (contact.kpec; the static semi_hertzian.KpecModel's steps) on candidate
+    c's gap in ``field`` (compiled_patch.PatchScratch: sampled, else the quadric of geometry = (q, A, B, angle)
+    filled here), approach-driven: the gap already holds -q at the contact point. creep = (xi, eta, phi).
+    Kalker's C_ij of the flexibilities from the run's tables (relative error < 1e-7). Returns (N, a, b, T_x, T_y,
+    M_z, area m^2, max pressure Pa); (a, b): the flexibilities' ellipse of the contact area; M_z about the contact
+    point.
+    """
+    if field.sampled[c] == 0.0:
+        _quadric_field(par, field, c, geometry)
+    xs, ys, gap = field.xs[c], field.ys[c], field.gap[c]
+    g_mod = par.shear_modulus_Pa
+    nu = 1.0 - g_mod / par.contact_modulus_Pa
+    mu = par.friction_coefficient
+    pressure, contact = field.pressure, field.contact
+    # fn_kpec: CONTACT's F_N of the flexibilities, the pressure before the in-row gaps are cleared
+    fn_kpec = kpec_pressure_into(gap, xs, ys, (g_mod, nu), (pressure, contact), (field.first, field.last))[0]
+    dx, dy = xs[1] - xs[0], ys[1] - ys[0]
+    total, count, pmax = 0.0, 0, 0.0
+    for j in range(gap.shape[0]):
+        for i in range(gap.shape[1]):
+            total += pressure[j, i]
+            pmax = max(pmax, pressure[j, i])
+            if contact[j, i]:
+                count += 1
+    if count == 0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    a, b = flexibility_ellipse(contact, dx, dy)
+    xi, eta, phi = creep
+    l1, l2, l3 = blended_flexibilities((a, b), _kalker_c(tables, a / b), (fn_kpec, g_mod, mu), creep)
+    fx, fy, mz = fastsim_strips(
+        (pressure, contact), (xs, ys), (mu, xi, eta, phi), (l1, l2, l3), (field.tx, field.ty, field.slip)
+    )
+    return total * dx * dy, a, b, fx, fy, mz, count * dx * dy, pmax
 
 
 @njit(cache=True)

@@ -122,6 +122,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     ``tolerance``: auto's; ``python_geometry``: the geometry given by Python for any provider.
     """
     from rigid_dynamics.contact.fastsim import FLEXIBILITY_CODES
+    from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
 
     mode = GEOMETRY_GIVEN if python_geometry else geometry_mode(provider)
     m = model_wheelset
@@ -138,6 +139,9 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     par["fastsim_nx"], par["fastsim_ny"] = int(opts["nx"]), int(opts["ny"])
     par["fastsim_parabolic"] = 1.0 if opts["traction_bound"] == "parabolic" else 0.0
     par["flexibility_code"] = FLEXIBILITY_CODES[opts["flexibility"]]
+    par["kpec_nx"] = par["kpec_ny"] = scene.kpec_points
+    par["kpec_margin"] = SEARCH_OPTIONS["field_margin"]
+    par["patch_sampled"] = 1.0 if scene.patch_geometry == "sampled" else 0.0
     if code == LAW_AUTO:
         auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
     hk = hertz_kalker_tables(tables)

@@ -32,8 +32,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, objmode
 
-from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_LINEAR, _law
+from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_KPEC, LAW_LINEAR, _kpec_law, _law
 from rigid_dynamics.wheelset.compiled_motion import _assemble, _patch_creepages, _rotation
+from rigid_dynamics.wheelset.compiled_patch import patch_scratch, sample_candidates
 from rigid_dynamics.wheelset.compiled_search import search_geometry, search_geometry_on_track
 from rigid_dynamics.wheelset.compiled_tables import _table_geometry, table_scratch
 from rigid_dynamics.wheelset.layout import (
@@ -54,6 +55,7 @@ from rigid_dynamics.wheelset.layout import (
     G_CONTACT_ANGLE,
     G_CURVATURE_LAT,
     G_CURVATURE_LONG,
+    G_ELLIPSE_ANGLE,
     G_LEVER,
     G_NORMAL,
     G_ROLLING_RADIUS,
@@ -68,6 +70,7 @@ from rigid_dynamics.wheelset.layout import (
     OK,
     PATCH_ELLIPSE,
     PATCH_GEOMETRY,
+    PATCH_SAMPLED,
     ROLLING_RADIUS,
     S_EX,
     S_EY,
@@ -96,7 +99,8 @@ from rigid_dynamics.wheelset.track import rail_lateral_under_wheel, rail_under_w
 class Workspace(NamedTuple):
     """Scratch of the right-hand side (no allocation in the loop): the tables mode's (compiled_tables.TableScratch),
     the patch record (candidates + 2, layout.N_FIELDS), the candidate geometry (candidates, layout.N_GEO), the
-    scratch rows (layout.SCRATCH_ROWS, 3) and an empty field array for FASTSIM's kernel.
+    scratch rows (layout.SCRATCH_ROWS, 3), an empty field array for FASTSIM's kernel and the sampled patches
+    (compiled_patch.PatchScratch) of the gap-solving laws.
     """
 
     tables: tuple
@@ -104,6 +108,7 @@ class Workspace(NamedTuple):
     cg: np.ndarray
     scratch: np.ndarray
     dummy: np.ndarray
+    patch: tuple
 
 
 class CallbackPatch(NamedTuple):
@@ -216,10 +221,11 @@ def _served_law(par, rec, c, record):
 
 
 @njit(cache=True, _nrt=False)
-def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, record, out):
+def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
     """d/dt of the full state into ``out`` from the candidate geometry cg (ncand, layout.N_GEO) (a candidate with
     q = NaN is absent: recorded as NaN); fills the patch record rec (ncand + 2, layout.N_FIELDS) and the side
-    forces when ``record``; sc: the scratch rows (layout.SCRATCH_ROWS, 3); dummy: FASTSIM's empty field array.
+    forces when ``record``; sc: the scratch rows (layout.SCRATCH_ROWS, 3); dummy: FASTSIM's empty field array;
+    field: the sampled patches (compiled_patch.PatchScratch) of LAW_KPEC.
     Returns the status (layout.STATUS). (The run's and the workspace's arrays are passed apart, not as their
     records: a record argument is passed field by field, and this runs for every right-hand side.)
     """
@@ -280,6 +286,15 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, record, out):
             law = LAW_CALLBACK
             if st != 0:
                 return CALLBACK_FAILED
+        elif par.model_code == LAW_KPEC:
+            angle = g[G_ELLIPSE_ANGLE] if math.isfinite(g[G_ELLIPSE_ANGLE]) else 0.0
+            normal, sa, sb, tx, ty, mz, area, pmax = _kpec_law(
+                par, tables, field, c, (q, ca, cb, angle), (xi, eta, spin)
+            )
+            sampled = field.sampled[c] > 0.0
+            geom = PATCH_SAMPLED if sampled else PATCH_ELLIPSE
+            resid = field.residual[c] if sampled else math.nan
+            law = LAW_KPEC
         else:
             normal, sa, sb, tx, ty, mz, to_callback = _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
             # a compiled law sees the quadric: Hertz's ellipse, its area and max pressure
@@ -344,7 +359,12 @@ def _rhs(t, y, run, ws, record, full, out):
     scan; mode layout.GEOMETRY_GIVEN: ws.cg as the caller filled it), then :func:`_forces`. Returns the status.
     """
     _geometry(y, run, ws, full)
-    return _forces(t, y, run.par, run.tables, run.sides, ws.cg, ws.rec, ws.scratch, ws.dummy, record, out)
+    if run.par.model_code == LAW_KPEC:
+        if run.mode == GEOMETRY_SEARCH and run.par.patch_sampled > 0:
+            sample_candidates(y, run, ws.cg, ws.patch, ws.scratch[S_SEARCH_CENTRE])
+        else:
+            ws.patch.sampled[:] = 0.0
+    return _forces(t, y, run.par, run.tables, run.sides, ws.cg, ws.rec, ws.scratch, ws.dummy, ws.patch, record, out)
 
 
 @njit(cache=True, _nrt=False)
@@ -373,8 +393,9 @@ def workspace(run, rec):
     """
     ncand = run.sides.shape[0]
     return Workspace(
-        table_scratch(run.par, ncand), rec, np.zeros((ncand, N_GEO)), np.zeros((N_SCRATCH, 3)), np.zeros((1, 1))
-    )
+        table_scratch(run.par, ncand), rec, np.zeros((ncand, N_GEO)), np.zeros((N_SCRATCH, 3)), np.zeros((1, 1)),
+        patch_scratch(run.par, ncand),
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -415,7 +436,8 @@ def rhs_given(t, y, par, tables, sides, cg, out, rec, record):
     parameter record, Hertz/Kalker tables and sides only: called from Python per right-hand side, where every
     array of a record costs its unboxing.)
     """
-    return _forces(t, y, par, tables, sides, cg, rec, np.zeros((N_SCRATCH, 3)), np.zeros((1, 1)), record, out)
+    field = patch_scratch(par, sides.shape[0])  # no surfaces here: a gap-solving law sees the quadric
+    return _forces(t, y, par, tables, sides, cg, rec, np.zeros((N_SCRATCH, 3)), np.zeros((1, 1)), field, record, out)
 
 
 @njit(cache=True, _nrt=False)
@@ -445,3 +467,19 @@ def force_difference(f4, f3):
             if d > worst:
                 worst = d
     return worst
+
+
+@njit(cache=True)
+def patches_once(t, y, run, out, rec, cg, field):
+    """:func:`contact_once` (search or tables mode) that also copies the sampled patches (compiled_patch.PatchScratch
+    of the run's grid, from compiled_patch.patch_scratch) into ``field``: for tests and the benchmark's inspection.
+    """
+    ws = workspace(run, rec)
+    st = _rhs(t, y, run, ws, True, True, out)
+    cg[:, :] = ws.cg
+    field.gap[:] = ws.patch.gap
+    field.xs[:] = ws.patch.xs
+    field.ys[:] = ws.patch.ys
+    field.residual[:] = ws.patch.residual
+    field.sampled[:] = ws.patch.sampled
+    return st

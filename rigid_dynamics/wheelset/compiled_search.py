@@ -52,6 +52,7 @@ from rigid_dynamics.wheelset.layout import (
     G_CONTACT_ANGLE,
     G_CURVATURE_LAT,
     G_CURVATURE_LONG,
+    G_ELLIPSE_ANGLE,
     G_LEVER,
     G_NORMAL,
     G_ROLLING_RADIUS,
@@ -236,6 +237,8 @@ def patch_geometry(alpha, y_d, h, rot, centre, surfaces, vb, g):
         big_a, big_b = mean + half, mean - half
     else:
         big_a, big_b = mean - half, mean + half
+        angle -= math.copysign(0.5 * math.pi, angle)  # A's direction
+    g[G_ELLIPSE_ANGLE] = angle
     g[G_APPROACH] = -h
     g[G_LEVER], g[G_LEVER + 1] = 0.5 * (p[0] + qx) - centre[0], 0.5 * (p[1] + qy) - centre[1]
     g[G_LEVER + 2] = 0.5 * (p[2] + qz) - centre[2]

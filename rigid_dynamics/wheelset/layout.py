@@ -111,16 +111,18 @@ GEOMETRY_FIELDS = (
     "rolling_radius_m",
     "wheel_lateral_m",
     "contact_angle_rad",
+    "ellipse_angle_rad",
 )
 """Per candidate: approach q (NaN: absent), the contact point less the wheelset centre (main frame), the contact
 normal (rail into wheel), the relative curvatures A (rolling direction) and B, rolling radius, the wheel's lateral
-coordinate y_d of the point, contact angle."""
+coordinate y_d of the point, contact angle, and the angle from the rolling direction to A's principal axis (the
+search's; 0 where the geometry has none: tables, given)."""
 (
     G_APPROACH, G_LEVER, _G_LEVER_Y, _G_LEVER_Z, G_NORMAL, _G_NORMAL_Y, _G_NORMAL_Z, G_CURVATURE_LONG,
-    G_CURVATURE_LAT, G_ROLLING_RADIUS, G_WHEEL_LATERAL, G_CONTACT_ANGLE,
-) = range(12)  # fmt: skip
+    G_CURVATURE_LAT, G_ROLLING_RADIUS, G_WHEEL_LATERAL, G_CONTACT_ANGLE, G_ELLIPSE_ANGLE,
+) = range(13)  # fmt: skip
 """G_LEVER and G_NORMAL are the first of their three components (x, y, z)."""
-N_GEO = 12
+N_GEO = 13
 
 # --- the contact-geometry table of providers.TableProvider -----------------------------------------------------------
 TABLE_FIELDS = (
@@ -249,6 +251,10 @@ PARAMETER_FIELDS = (
     ("fastsim_nx", "FASTSIM elements per strip"),
     ("fastsim_ny", "FASTSIM strips"),
     ("fastsim_parabolic", "1: parabolic traction bound"),
+    ("kpec_nx", "KPEC in the loop: grid points (element centres) along x of the sampled gap"),
+    ("kpec_ny", "KPEC in the loop: grid points along y"),
+    ("kpec_margin", "KPEC in the loop: the grid's margin around the rigid overlap, fraction of its extent"),
+    ("patch_sampled", "1: a gap-solving compiled law sees the sampled gap (search), 0: the quadric (ellipse)"),
     ("flexibility_code", "contact.fastsim.FLEXIBILITY_CODES value"),
     ("irregular", "1: running-direction irregularities on"),
     ("nominal_radius_m", "nominal rolling radius"),

@@ -520,6 +520,9 @@ class DynamicsScene:
         fastsim_elements_per_strip, fastsim_strips: FASTSIM's grid (nx, ny) when the model is "fastsim" or "auto"
             picks it. 20 x 20 keeps the creep forces within ~0.5 % of a 200 x 200 grid, 15 x 10 within 1 %,
             9 x 8 within 2 % (benchmarks/results/fastsim_grid.md) at 1/2, 1/3 and 1/9 of the cost.
+        kpec_points: grid points per direction of the sampled gap (and of the quadric's) that the compiled KPEC
+            law ("kpec") solves per patch in the loop (compiled_patch.py); the error of the default against a
+            grid twice as fine is in benchmarks/results/kpec_loop.md.
     """
 
     name: str = "scene"
@@ -539,6 +542,7 @@ class DynamicsScene:
     patch_geometry: str = "sampled"
     fastsim_elements_per_strip: int = 20
     fastsim_strips: int = 20
+    kpec_points: int = 24
     settling_distance_m: float = 10.0
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
@@ -559,6 +563,9 @@ class DynamicsScene:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1000:
                 raise ValueError(f"{name} = {value!r}: expected an integer from 1 to 1000")
+        value = self.kpec_points
+        if isinstance(value, bool) or not isinstance(value, int) or not 8 <= value <= 256:
+            raise ValueError(f"kpec_points = {value!r}: expected an integer from 8 to 256")
         for name, cls in (
             ("wheelset", WheelsetParameters),
             ("suspension", SuspensionParameters),

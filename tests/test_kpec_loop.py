@@ -1,0 +1,195 @@
+"""The compiled KPEC law in the dynamics loop (compiled_laws._kpec_law on the gap compiled_patch.py samples).
+
+* Regression (two code paths of ours): at a held pose of ``curve-flange`` (3-D search, flange contact on the left
+  wheel) the loop's forces, area and max pressure per patch equal the static ``kpec`` model (semi_hertzian.KpecModel)
+  solved on the same sampled gap, grid and creepages (Kalker's C_ij: the loop's tables, relative error < 1e-7).
+* Against CONTACT's own KPEC (tests/data/contact_kpec, its ``mbench_a22_kpec`` example, as tests/test_kpec_contact.py):
+  the loop's compiled law on the gap of the wheelset case's patch at CONTACT's poses (the same 0.2 mm grid), to the
+  static test's tolerances. This checks the law the loop runs; the loop's own grid (kpec_points over the fitted box)
+  is coarser than CONTACT's, its effect is measured in benchmarks/results/kpec_loop.md.
+* A short ``wheelrail run curve-flange --set contact_model="kpec"`` records sampled patches with a finite
+  ellipticity residual; the flange patch's area and max pressure differ from patch_geometry="ellipse".
+"""
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rigid_dynamics.contact.semi_hertzian import KpecModel
+from rigid_dynamics.contact.types import ContactGeometry, Creepage, UndeformedDistance
+from rigid_dynamics.wheelset import compiled_rhs
+from rigid_dynamics.wheelset import layout as lay
+from rigid_dynamics.wheelset.compiled_laws import LAW_KPEC, _kpec_law, hertz_kalker_tables, tables_for
+from rigid_dynamics.wheelset.compiled_patch import patch_scratch
+from rigid_dynamics.wheelset.layout import new_parameters
+from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model
+from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
+from wheelrail.scenes import load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+# the flange-contact pose of tests/test_search_flange.py (curve-flange: left wheel on its flange root)
+POSE = (1.277976414642136, -0.006342631482373633, -0.4602028328462104, -0.009009176923680725, 7.54273503739788e-4,
+        2.7759919663658916)  # fmt: skip
+
+
+def _static_kpec(xs, ys, gap, creepage, material):
+    """The static KpecModel on the loop's grid: element centres xs, ys, the gap at them."""
+    dx, dy = xs[1] - xs[0], ys[1] - ys[0]
+    area = (xs[0] - 0.5 * dx, xs[-1] + 0.5 * dx, ys[0] - 0.5 * dy, ys[-1] + 0.5 * dy)
+    und = UndeformedDistance(x_m=xs.copy(), y_m=ys.copy(), distance_m=gap.copy(), potential_area_m=area)
+    q = -float(gap.min())
+    geometry = ContactGeometry(curvature_long_1_per_m=1.0, curvature_lat_1_per_m=1.0, approach_m=q, undeformed=und)
+    return KpecModel().solve(geometry, creepage, material, options={"nx": xs.size, "ny": ys.size})
+
+
+@pytest.fixture(scope="module")
+def held():
+    scene = replace(load_scene("curve-flange"), contact_model="kpec", contact_provider="search")
+    model = WheelsetModel(scene, build_provider(scene), get_contact_model("kpec"))
+    return scene, model.packed, None
+
+
+def test_regression_loop_kpec_equals_static_kpec_on_the_sampled_gap(held):
+    scene, run, _ = held
+    from rigid_dynamics.wheelset.equilibrium import initial_state
+    from rigid_dynamics.wheelset.state import n_states
+
+    y = np.zeros(n_states(int(run.par["track_positions"])))  # the full state of the compiled right-hand side
+    y[:12] = initial_state(scene)  # the run's start (rolling velocities)
+    y[:6] = POSE
+    ncand = run.sides.shape[0]
+    rec = np.zeros((ncand + 2, lay.N_FIELDS))
+    cg = np.zeros((ncand, lay.N_GEO))
+    field = patch_scratch(run.par, ncand)
+    out = np.zeros_like(y)
+    assert compiled_rhs.patches_once(0.0, y, run, out, rec, cg, field) == lay.OK
+    material = scene.material
+    checked = 0
+    for c in range(ncand):
+        if not rec[c, lay.NORMAL_FORCE] > 0:
+            continue
+        assert rec[c, lay.PATCH_GEOMETRY] == lay.PATCH_SAMPLED and rec[c, lay.CONTACT_LAW] == LAW_KPEC
+        assert math.isfinite(rec[c, lay.ELLIPTICITY_RESIDUAL])
+        creep = Creepage(rec[c, lay.CREEPAGE_LONG], rec[c, lay.CREEPAGE_LAT], rec[c, lay.SPIN_CREEPAGE], 10.0)
+        res = _static_kpec(field.xs[c], field.ys[c], field.gap[c], creep, material)
+        assert res.success
+        assert rec[c, lay.NORMAL_FORCE] == pytest.approx(res.normal_force_N, rel=1e-9)
+        assert rec[c, lay.CONTACT_AREA] == pytest.approx(res.contact_area_m2, rel=1e-9)
+        assert rec[c, lay.MAX_PRESSURE] == pytest.approx(res.max_pressure_Pa, rel=1e-9)
+        mu_n = material.friction_coefficient * res.normal_force_N
+        assert abs(rec[c, lay.CREEP_FORCE_LONG] - res.creep_force_long_N) < 1e-6 * mu_n
+        assert abs(rec[c, lay.CREEP_FORCE_LAT] - res.creep_force_lat_N) < 1e-6 * mu_n
+        assert abs(rec[c, lay.SPIN_MOMENT] - res.spin_moment_Nm) < 1e-6 * mu_n * 0.01
+        checked += 1
+    assert checked >= 2
+    assert max(rec[c, lay.CONTACT_ANGLE] for c in range(ncand) if rec[c, lay.NORMAL_FORCE] > 0) > 0.5
+
+
+@pytest.fixture(scope="module")
+def contact_cases():
+    """The wheelset case's patches at CONTACT's mbench_a22_kpec poses (tests/test_kpec_contact.py's runs)."""
+    from test_kpec_contact import OPTIONS, STEP_OF_CASE
+
+    from comparisons.manchester import MATERIAL, a22_case
+    from rigid_dynamics.contact.track import build_track
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    track = build_track(a22_case(0))
+    out = {}
+    for case, step in STEP_OF_CASE.items():
+        sol = solve_wheelset_case(a22_case(step, "deck"), MATERIAL, "kpec", OPTIONS, track=track)
+        out[case] = [p for p in sol.patches if p.side == "right"]
+    return MATERIAL, out
+
+
+@pytest.mark.parametrize("case", [1, 2, 3])
+def test_loop_kpec_law_equals_contacts_kpec(contact_cases, case):
+    """The loop's compiled KPEC law on the gap of the wheelset case's patch (CONTACT's 0.2 mm grid, the same
+    creepages) against CONTACT's printed KPEC output, at tests/test_kpec_contact.py's tolerances per case (F_N,
+    p_max, area relative; F_x, F_s in mu F_N).
+    """
+    from test_kpec_contact import TOLERANCES, _reference
+
+    material, cases = contact_cases
+    ref = {k: float(v) for k, v in _reference()[case].items() if k != "method" and v != ""}
+    (patch,) = cases[case]
+    res, geo = patch.result, patch.geometry
+    xs, ys = np.asarray(res.fields.x_m, float), np.asarray(res.fields.y_m, float)
+    gap = np.asarray(geo.gap_m(*np.meshgrid(xs, ys)), float)
+    gap = np.where(np.isfinite(gap), gap, 1.0)
+    par = new_parameters()
+    g, nu = material.shear_modulus_Pa, material.poisson_ratio
+    par["shear_modulus_Pa"], par["contact_modulus_Pa"] = g, g / (1 - nu)
+    par["friction_coefficient"] = material.friction_coefficient
+    par["kpec_nx"], par["kpec_ny"] = xs.size, ys.size
+    field = patch_scratch(par, 1)
+    field.xs[0], field.ys[0], field.gap[0], field.sampled[0] = xs, ys, gap, 1.0
+    cr = patch.creepage
+    fn, _, _, fx, fy, _, area, pmax = _kpec_law(
+        par, hertz_kalker_tables(tables_for(g, nu)), field, 0, (geo.approach_m, 1.0, 1.0, 0.0),
+        (cr.longitudinal, cr.lateral, cr.spin_1_per_m),
+    )  # fmt: skip
+    mu_fn = material.friction_coefficient * ref["fn_N"]
+    diffs = {
+        "fn": fn / ref["fn_N"] - 1,
+        "pmax": pmax / (ref["pmax_N_per_mm2"] * 1e6) - 1,
+        "area": area / (ref["contact_area_mm2"] * 1e-6) - 1,
+        "fx": (fx + ref["fx_N"]) / mu_fn,
+        "fs": (fy - ref["fs_N"]) / mu_fn,
+    }
+    bad = {k: v for k, v in diffs.items() if abs(v) > TOLERANCES[case][k]}
+    assert not bad, (case, diffs)
+    # and the static rung on the same patch to round-off (the law is the same)
+    assert fn == pytest.approx(res.normal_force_N, rel=1e-9)
+    assert abs(fx - res.creep_force_long_N) < 1e-6 * mu_fn and abs(fy - res.creep_force_lat_N) < 1e-6 * mu_fn
+
+
+def _cli_run(tmp_path, name, *sets):
+    from wheelrail.cli import main
+
+    out = tmp_path / name
+    args = ["run", "curve-flange", "--set", 'contact_model="kpec"', "--set", "duration_s=0.2", "--quiet", "--no-plots"]
+    for item in sets:
+        args += ["--set", item]
+    assert main([*args, "--out", str(out)]) == 0
+    with np.load(out / "timeseries.npz") as data:
+        return {k: data[k] for k in data.files}
+
+
+def test_cli_curve_flange_kpec_records_sampled_flange_patches(tmp_path):
+    """``wheelrail run curve-flange --set contact_model="kpec"`` (0.2 s: the left wheel reaches its flange root by
+    0.14 s): every patch in contact is sampled (patch_geometry_code 1) and served by KPEC, with a finite ellipticity
+    residual on the flange patch (contact angle > 0.4 rad); with patch_geometry="ellipse" the same law sees the
+    quadric, and the flange patch's area and max pressure differ (the message prints by how much).
+    """
+    sampled = _cli_run(tmp_path, "sampled")
+    ellipse = _cli_run(tmp_path, "ellipse", 'patch_geometry="ellipse"')
+    assert str(sampled["status"]) == "ok" and str(ellipse["status"]) == "ok"
+    stats = {}
+    for label, data, code in (("sampled", sampled, lay.PATCH_SAMPLED), ("ellipse", ellipse, lay.PATCH_ELLIPSE)):
+        force = data["patch_normal_force_N"]
+        on = force > 0
+        assert np.all(data["patch_patch_geometry_code"][on] == code)
+        assert np.all(data["patch_contact_law_code"][on] == LAW_KPEC)
+        flange = on & (data["patch_contact_angle_rad"] > 0.4) & (data["t"][:, None, None] >= 0.15)
+        assert flange.sum() >= 5, label
+        if label == "sampled":
+            assert np.all(np.isfinite(data["patch_ellipticity_residual"][flange]))
+        else:
+            assert np.all(np.isnan(data["patch_ellipticity_residual"][on]))
+        stats[label] = (
+            float(np.mean(data["patch_contact_area_m2"][flange])),
+            float(np.mean(data["patch_max_pressure_Pa"][flange])),
+            float(np.median(data["patch_ellipticity_residual"][flange])),
+        )
+    (a_s, p_s, r_s), (a_e, p_e, _) = stats["sampled"], stats["ellipse"]
+    message = (
+        f"flange patch (t >= 0.15 s, mean): sampled area {a_s * 1e6:.1f} mm^2, p_max {p_s / 1e6:.0f} MPa "
+        f"(residual median {r_s:.2f}); ellipse area {a_e * 1e6:.1f} mm^2, p_max {p_e / 1e6:.0f} MPa; "
+        f"area {a_s / a_e - 1:+.1%}, p_max {p_s / p_e - 1:+.1%}"
+    )
+    print(message)
+    assert abs(a_s / a_e - 1) > 0.01 or abs(p_s / p_e - 1) > 0.01, message
