@@ -68,15 +68,17 @@ def test_ellipse_choice_gives_the_quadric(runs):
 
 def test_sampled_and_ellipse_flange_patches_differ(runs):
     """The flange root's patch is not an ellipse (the S1002 root and the UIC60 gauge corner are both 13 mm arcs).
-    At the start (the same pose but for the static equilibrium's height, 2 um apart) the sampled patch on the left
-    flange root is 54 % larger than the quadric's, its peak 33 % higher and its normal force 32 % larger (the
-    conformal patch is stiffer); recorded 164.5 / 106.8 mm^2, 1797 / 1354 MPa, 127 / 96 kN. The sampled numbers are
-    grid-converged within 2 % (benchmarks/results/bem_loop_sampled.md)."""
+    At the start (the same pose but for the static equilibrium's height, 13 um apart) the sampled patch on the left
+    flange root (each candidate on its own plane: in a curve the formed patches are not used, see
+    wheelset_model.WheelsetModel) is 28 % larger than the quadric's with 2 % more normal force; its peak pressure is
+    higher (2.6 against 1.35 GPa on the loop's elements) but not converged: the edge of the conformal root keeps
+    rising with the grid (h28b measured 4.1 -> 5.8 GPa), so it is not asserted as a number. The compiled KPEC on the
+    same sampled gap gives 98.2 kN and 139 mm^2 (tests/test_kpec_loop.py), a second method within 0.2 % / 2 %."""
     s, e = (runs[g].patches for g in ("sampled", "ellipse"))
-    assert runs["sampled"].states[0, 2] == pytest.approx(runs["ellipse"].states[0, 2], abs=5e-6)
-    assert s["contact_area_m2"][0, 0, 0] == pytest.approx(1.54 * e["contact_area_m2"][0, 0, 0], rel=0.05)
-    assert s["max_pressure_Pa"][0, 0, 0] == pytest.approx(1.33 * e["max_pressure_Pa"][0, 0, 0], rel=0.05)
-    assert s["normal_force_N"][0, 0, 0] == pytest.approx(1.32 * e["normal_force_N"][0, 0, 0], rel=0.05)
+    assert runs["sampled"].states[0, 2] == pytest.approx(runs["ellipse"].states[0, 2], abs=2e-5)
+    assert s["contact_area_m2"][0, 0, 0] == pytest.approx(1.28 * e["contact_area_m2"][0, 0, 0], rel=0.05)
+    assert s["max_pressure_Pa"][0, 0, 0] > 1.3 * e["max_pressure_Pa"][0, 0, 0]
+    assert s["normal_force_N"][0, 0, 0] == pytest.approx(1.02 * e["normal_force_N"][0, 0, 0], rel=0.03)
 
 
 def test_out_of_round_wheel_in_the_sampled_gap():
