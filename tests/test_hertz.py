@@ -15,10 +15,9 @@ import math
 import numpy as np
 import pytest
 from scipy.integrate import quad
-from scipy.special import elliprd, elliprf, elliprg
+from scipy.special import elliprd
 
 from rigid_dynamics.contact.hertz import (
-    _agm_k_e,
     ellipse_shape_from_curvature_ratio,
     elliptic_kdbc,
     hertz_approach_from_force,
@@ -119,17 +118,6 @@ def test_axial_function_inversion_accuracy():
     assert rel.max() < 1e-13, f"max relative residual {rel.max():.2e}"
     # monotone: larger curvature ratio -> more slender ellipse
     assert np.all(np.diff(p[:801]) <= 0)
-
-
-def test_agm_k_and_e_against_carlson_forms():
-    """The arithmetic-geometric mean's K and E (which replaced scipy's cython ``ellipkm1``/``ellipe``) against
-    Carlson's symmetric forms K = R_F(0, p, 1), E = 2 R_G(0, p, 1) (scipy's, an independent algorithm), from round
-    ellipses to p = 1e-16."""
-    p = np.concatenate([np.logspace(-16, 0, 400), np.linspace(0.01, 0.99, 99)])
-    k, e = np.array([_agm_k_e(pi, True) for pi in p]).T
-    np.testing.assert_allclose(k, elliprf(0.0, p, 1.0), rtol=2e-15)
-    np.testing.assert_allclose(e, 2.0 * elliprg(0.0, p, 1.0), rtol=1e-14)
-    assert math.isnan(_agm_k_e(0.5, False)[1])
 
 
 def test_elliptic_functions_against_carlson_forms():
