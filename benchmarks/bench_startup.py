@@ -34,6 +34,7 @@ COMMANDS = {
     "python -c pass": ["-c", "pass"],
     "python -c 'import numba, scipy.fft' (the floor with numba)": ["-c", "import numba, scipy.fft"],
     "python -c 'import numpy'": ["-c", "import numpy"],
+    "one cached numba kernel (the floor of a compiled command)": [str(ROOT / "benchmarks" / "numba_floor_kernel.py")],
 }  # fmt: skip
 
 

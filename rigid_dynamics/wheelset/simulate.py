@@ -115,7 +115,9 @@ def build_provider(scene: DynamicsScene):
             from rigid_dynamics.wheelset.providers import ProfileSectionProvider
 
             section = ProfileSectionProvider(scene.wheelset, track)
-        return TableProvider(section, scene.wheelset.nominal_radius_m, irregularities=irr)
+        return TableProvider(
+            section, scene.wheelset.nominal_radius_m, irregularities=irr, cache_parameters=(scene.wheelset, track)
+        )
     if choice == "search":
         from rigid_dynamics.wheelset.providers import SearchProvider
 
@@ -293,6 +295,9 @@ def simulate(
                 limit = _limit_at_largest_force(probe, t, states, patches, wc, we, track_full, limit)
             if limit is not None:
                 status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit)
+    cache = getattr(provider, "cache", None)  # the contact tables' disk cache (providers/table_cache.py)
+    if cache is not None and cache.note:
+        message = f"{message}; {cache.note}"
     result = SimulationResult(
         status=status,
         message=message,

@@ -35,6 +35,9 @@ class TableProvider:
         lateral_step_m: grid spacing in y.
         roll_range_rad, roll_points: theta grid.
         irregularities: running-direction irregularities applied on top (optional).
+        cache_parameters: (wheelset, track) that define ``section`` (as :func:`~rigid_dynamics.wheelset.simulate.
+            build_provider` builds it, default section options): the tables are then loaded from / saved to the
+            on-disk cache (providers/table_cache.py); :attr:`cache` says how (None without).
     """
 
     name = "tables"
@@ -49,6 +52,7 @@ class TableProvider:
         roll_range_rad: float = 0.01,
         roll_points: int = 11,
         irregularities: Irregularities | None = None,
+        cache_parameters: tuple | None = None,
     ):
         for name, value in (
             ("lateral_range_m", lateral_range_m),
@@ -67,8 +71,23 @@ class TableProvider:
         self.side = probe.side.copy()
         self.slot = probe.slot.copy()
         n = len(probe)
+        shape = (12, n, len(self.roll_grid), len(self.y_grid))
+        self.cache = None
+        if cache_parameters is None:
+            self.table = self._build(section, shape)
+        else:
+            self.table = self._cached(
+                section, shape, cache_parameters, (lateral_range_m, lateral_step_m, roll_range_rad, roll_points)
+            )
+        self.irregularities = running_direction_only(irregularities, self.name)
+        if self.irregularities is not None:
+            self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
+
+    def _build(self, section: ContactProvider, shape: tuple) -> np.ndarray:
+        """Sample ``section`` on the (roll, y) grid: the (12, candidates, roll, y) table."""
         # quantities: q, dq/dz, py, pz, ny, nz, A, B, radius, angle, y_d, merge approach (12)
-        table = np.empty((12, n, len(self.roll_grid), len(self.y_grid)))
+        n = shape[1]
+        table = np.empty(shape)
         for i, theta in enumerate(self.roll_grid):
             for j, y in enumerate(self.y_grid):
                 p = section.patches(np.array([0.0, y, self.z_ref]), 0.0, theta, 0.0)
@@ -87,10 +106,28 @@ class TableProvider:
                 table[10, :, i, j] = p.wheel_lateral_m
                 merge = p.merge_approach_m if p.merge_approach_m is not None else np.full(n, -np.inf)
                 table[11, :, i, j] = np.maximum(merge, -1.0)  # finite, for the interpolation
-        self.table = table
-        self.irregularities = running_direction_only(irregularities, self.name)
-        if self.irregularities is not None:
-            self._irr_sides = np.array([applies_to(self.irregularities, s) for s in SIDES])
+        return table
+
+    def _cached(self, section: ContactProvider, shape: tuple, parameters: tuple, grid: tuple) -> np.ndarray:
+        """The table from the on-disk cache when its file is whole, else built and saved (table_cache.py)."""
+        from rigid_dynamics.wheelset.providers import table_cache
+
+        key = table_cache.table_key(*parameters, type(section).__name__, grid)
+        arrays, note = table_cache.load(key, shape)
+        if (
+            arrays is not None
+            and np.array_equal(arrays["side"], self.side)
+            and np.array_equal(arrays["slot"], self.slot)
+        ):
+            self.cache = table_cache.TableCacheResult("hit", table_cache.cache_dir() / f"tables-{key}.npz")
+            return arrays["table"]
+        if arrays is not None:
+            note = "contact-table cache file with other candidates (side/slot): rebuilt"
+        table = self._build(section, shape)
+        path, save_note = table_cache.save(key, table, np.asarray(self.side), np.asarray(self.slot))
+        notes = "; ".join(x for x in (note, save_note) if x)
+        self.cache = table_cache.TableCacheResult("rebuilt" if note else "built", path, notes)
+        return table
 
     def compiled_geometry(self) -> int:
         """The compiled right-hand side evaluates these tables itself (layout.GEOMETRY_TABLES; compiled_tables.py)."""
