@@ -91,9 +91,10 @@ def test_wheel_flat_at_5_ms_is_not_ok():
     assert result.summary()["force_error_estimate"] > 1.0
 
 
-def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_is_ok():
+def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_passes():
     """Issue 13's case on the scene as shipped (elastic track): at 5 ms the run fails numerically and says so
-    (status step-unstable, RK4's stability limit in the message); the first 0.03 s at its own step are ok."""
+    (status step-unstable, RK4's stability limit in the message); the first 0.03 s at its own step pass the step's
+    check."""
     shipped = load_scene("wheel-flat")
     coarse = replace(
         shipped, duration_s=0.05, integrator=replace(shipped.integrator, fixed_step_s=5e-3, output_step_s=5e-3)
@@ -102,7 +103,15 @@ def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_i
     assert result.status == "step-unstable" and not result.success
     assert "stability limit" in result.message and "5 ms" in result.message
     own = simulate(replace(shipped, duration_s=0.03))
-    assert own.status == "ok", own.message
+    # the step passes; the run ends "warning" for the beam's modal cut-off alone (5 kHz: the lateral peaks 12 % off,
+    # benchmarks/results/wheelflat_cutoff.md), which the summary states next to the step's estimate
+    assert own.status == "warning" and "force error estimate" not in own.message, own.message
+    assert "modal cut-off error estimate" in own.message and "cutoff_frequency_Hz = 5000" in own.message
+    stated = own.summary()["discretisation_errors"]
+    assert stated["step"]["estimate"] < shipped.integrator.force_tolerance
+    assert stated["modal_cutoff"]["estimate"] > 0.1 and stated["modal_cutoff"]["component"] == "lateral_creep_force"
+    assert stated["contact_grid"]["estimate"] is None and "not estimated" in stated["contact_grid"]["method"]
+    assert stated["geometry_tables"]["estimate"] is None
 
 
 def test_failure_within_the_start_limit_is_judged_at_the_impact():

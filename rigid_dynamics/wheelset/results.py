@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigid_dynamics.wheelset.discretisation import discretisation_errors
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES
 from rigid_dynamics.wheelset.state import STATE_NAMES
@@ -271,6 +272,7 @@ class SimulationResult:
             ),
             "peak_rail_lateral_displacement_m": self._lateral_rail_peaks(num),
             **self._error_summary(num),
+            "discretisation_errors": discretisation_errors(self),
             **self._auto_summary(),
             "patch_summary": self.patch_summary(),
             "callback": self.callback_stats,
