@@ -115,7 +115,8 @@ def main() -> int:
         print(json.dumps(run_one(scene, duration, model, npz)))
         return 0
     from comparisons.bench import machine
-    from comparisons.files import write_json_atomic, write_text_atomic
+    from comparisons.files import write_json_atomic
+    from rigid_dynamics.files import write_text
 
     scratch = OUT / "auto_vs_bem_runs"
     scratch.mkdir(parents=True, exist_ok=True)
@@ -218,7 +219,7 @@ def main() -> int:
         "same function for hunting-conical.",
         "",
     ]
-    write_text_atomic(OUT / "auto_vs_bem.md", "\n".join(lines))
+    write_text(OUT / "auto_vs_bem.md", "\n".join(lines))
     print(f"written {OUT / 'auto_vs_bem.md'}")
     return 0
 

@@ -1,21 +1,12 @@
-"""Atomic file writing for the comparisons (temporary name in the same folder, then rename)."""
+"""JSON files of the comparisons, written through the one atomic writer (:mod:`rigid_dynamics.files`)."""
 
 from __future__ import annotations
 
 import json
 import math
-import os
 from pathlib import Path
 
-
-def write_text_atomic(path: str | Path, text: str) -> Path:
-    """Write ``text`` to ``path`` through a temporary file renamed over it (never a half file)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-    return path
+from rigid_dynamics.files import write_text
 
 
 def _clean(value):
@@ -36,14 +27,4 @@ def _clean(value):
 
 def write_json_atomic(path: str | Path, data) -> Path:
     """JSON (non-finite numbers as null) written atomically."""
-    return write_text_atomic(path, json.dumps(_clean(data), indent=2) + "\n")
-
-
-def save_figure_atomic(fig, path: str | Path, **kwargs) -> Path:
-    """``fig.savefig`` to a temporary PNG renamed over ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
-    fig.savefig(tmp, **kwargs)
-    os.replace(tmp, path)
-    return path
+    return write_text(path, json.dumps(_clean(data), indent=2) + "\n")

@@ -82,6 +82,17 @@ def write_text(path: str | Path, text: str) -> Path:
     return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
+def write_npz(path: str | Path, **arrays) -> Path:
+    """Write arrays to a compressed NPZ file atomically (numpy imported here: this module stays stdlib-only)."""
+    import numpy as np
+
+    def writer(tmp: Path) -> None:
+        with open(tmp, "wb") as handle:
+            np.savez_compressed(handle, **arrays)
+
+    return atomic_write(path, writer)
+
+
 def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:
     """Save a matplotlib figure atomically; the format comes from the suffix of ``path`` (PNG if none)."""
     path = Path(path)

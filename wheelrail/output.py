@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigid_dynamics.files import WriteError, atomic_write, save_figure
+from rigid_dynamics.files import WriteError, atomic_write, save_figure, write_npz, write_text
 from wheelrail.config import ConfigError
 
 __all__ = [
@@ -88,21 +88,6 @@ def write_json(path: str | Path, data) -> Path:
     """Write ``data`` as JSON atomically."""
     text = to_json(data)
     return atomic_write(path, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
-
-
-def write_text(path: str | Path, text: str) -> Path:
-    """Write text atomically."""
-    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
-
-
-def write_npz(path: str | Path, **arrays) -> Path:
-    """Write arrays to an NPZ file atomically."""
-
-    def writer(tmp: Path) -> None:
-        with open(tmp, "wb") as handle:
-            np.savez_compressed(handle, **arrays)
-
-    return atomic_write(path, writer)
 
 
 def safe_name(text: str) -> str:
