@@ -115,8 +115,7 @@ def main() -> int:
         print(json.dumps(run_one(scene, duration, model, npz)))
         return 0
     from comparisons.bench import machine
-    from comparisons.files import write_json_atomic
-    from rigid_dynamics.files import write_text
+    from rigid_dynamics.files import write_json, write_text
 
     scratch = OUT / "auto_vs_bem_runs"
     scratch.mkdir(parents=True, exist_ok=True)
@@ -160,7 +159,7 @@ def main() -> int:
             per["auto"]["mu"],
         )
         rows.append({"scene": scene, "auto": per["auto"], "bem": per["bem"], "error": err})
-    write_json_atomic(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})
+    write_json(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})
     lines = [
         "# `auto` against always-BEM on embedded scenes",
         "",

@@ -528,8 +528,7 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
     import io
     from pathlib import Path
 
-    from comparisons.files import write_json_atomic
-    from rigid_dynamics.files import write_text
+    from rigid_dynamics.files import write_json, write_text
 
     out_dir = Path(out_dir)
     rows = [r.row() for r in runs]
@@ -560,7 +559,7 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
         "plots": plots,
         "claims": [{k: v for k, v in c.items()} for c in claims],
     }
-    write_json_atomic(out_dir / "bench.json", summary)
+    write_json(out_dir / "bench.json", summary)
     text = markdown(runs, cases, quick, wall_s, plots)
     head, sep, rest = text.partition("## Per case")
     write_text(out_dir / "bench.md", head + claims_markdown(claims) + "\n" + sep + rest)

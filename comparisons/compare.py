@@ -462,8 +462,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
     pictures), so that a run of tens of seconds is not silent.
     """
     from comparisons.contact_plots import plot_contact_fields
-    from comparisons.files import write_json_atomic
-    from rigid_dynamics.files import write_text
+    from rigid_dynamics.files import write_json, write_text
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -545,7 +544,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
         "headlines": report["headlines"],
         "rung_differences": [d.removeprefix("- ") for d in differences],
     }
-    write_json_atomic(out_dir / "compare.json", summary)
+    write_json(out_dir / "compare.json", summary)
     return summary
 
 
