@@ -115,7 +115,7 @@ def main() -> int:
         print(json.dumps(run_one(scene, duration, model, npz)))
         return 0
     from comparisons.bench import machine
-    from comparisons.files import write_json_atomic, write_text_atomic
+    from rigid_dynamics.files import write_json, write_text
 
     scratch = OUT / "auto_vs_bem_runs"
     scratch.mkdir(parents=True, exist_ok=True)
@@ -159,7 +159,7 @@ def main() -> int:
             per["auto"]["mu"],
         )
         rows.append({"scene": scene, "auto": per["auto"], "bem": per["bem"], "error": err})
-    write_json_atomic(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})
+    write_json(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})
     lines = [
         "# `auto` against always-BEM on embedded scenes",
         "",
@@ -218,7 +218,7 @@ def main() -> int:
         "same function for hunting-conical.",
         "",
     ]
-    write_text_atomic(OUT / "auto_vs_bem.md", "\n".join(lines))
+    write_text(OUT / "auto_vs_bem.md", "\n".join(lines))
     print(f"written {OUT / 'auto_vs_bem.md'}")
     return 0
 

@@ -18,8 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from comparisons.auto_thresholds import thresholds_document  # noqa: E402
-from comparisons.files import write_json_atomic  # noqa: E402
 from rigid_dynamics.contact.auto import THRESHOLDS_PATH  # noqa: E402
+from rigid_dynamics.files import write_json  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -40,7 +40,7 @@ def main(argv=None) -> int:
             pass
     command = "benchmarks/derive_auto_thresholds.py " + " ".join(argv if argv is not None else sys.argv[1:])
     doc = thresholds_document(csv_arg, quick=args.quick, command=command.strip())
-    write_json_atomic(args.out, doc)
+    write_json(args.out, doc)
     levels = doc["levels"]
     for level, rungs in levels.items():
         qualified = [r for r, e in rungs.items() if e["thresholds"] is not None]

@@ -417,7 +417,7 @@ def plot_case(runs: list[BenchRun], case: str, path) -> bool:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from comparisons.files import save_figure_atomic
+    from rigid_dynamics.files import save_figure
 
     floor = 1e-6
     ok = [r for r in runs if r.case == case and r.status == "ok" and r.error is not None]
@@ -430,7 +430,7 @@ def plot_case(runs: list[BenchRun], case: str, path) -> bool:
     ax.set_title(case)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    save_figure_atomic(fig, path, dpi=110, metadata={"Description": "error [%] against wall time [s]"})
+    save_figure(fig, path, dpi=110, metadata={"Description": "error [%] against wall time [s]"})
     plt.close(fig)
     return True
 
@@ -484,7 +484,7 @@ def plot_overview(runs: list[BenchRun], path) -> bool:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from comparisons.files import save_figure_atomic
+    from rigid_dynamics.files import save_figure
 
     floor = 1e-6
     cases = [c for c in dict.fromkeys(r.case for r in runs) if any(
@@ -511,7 +511,7 @@ def plot_overview(runs: list[BenchRun], path) -> bool:
     labels = list(handles)
     fig.legend([handles[k] for k in labels], labels, loc="lower center", ncol=min(len(labels), 7), fontsize=8)
     fig.tight_layout(rect=(0, 0.06, 1, 1))
-    save_figure_atomic(fig, path, dpi=100, metadata={"Description": "error [%] against wall time [s], every case"})
+    save_figure(fig, path, dpi=100, metadata={"Description": "error [%] against wall time [s], every case"})
     plt.close(fig)
     return True
 
@@ -528,7 +528,7 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
     import io
     from pathlib import Path
 
-    from comparisons.files import write_json_atomic, write_text_atomic
+    from rigid_dynamics.files import write_json, write_text
 
     out_dir = Path(out_dir)
     rows = [r.row() for r in runs]
@@ -536,7 +536,7 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
     writer = csv.DictWriter(buffer, fieldnames=list(rows[0]) if rows else ["case"])
     writer.writeheader()
     writer.writerows(rows)
-    write_text_atomic(out_dir / "bench.csv", buffer.getvalue())
+    write_text(out_dir / "bench.csv", buffer.getvalue())
     plots = {}
     if plot_overview(runs, out_dir / "overview.png"):
         plots["overview"] = "overview.png"
@@ -559,8 +559,8 @@ def write_bench(runs: list[BenchRun], cases, out_dir, quick: bool, wall_s: float
         "plots": plots,
         "claims": [{k: v for k, v in c.items()} for c in claims],
     }
-    write_json_atomic(out_dir / "bench.json", summary)
+    write_json(out_dir / "bench.json", summary)
     text = markdown(runs, cases, quick, wall_s, plots)
     head, sep, rest = text.partition("## Per case")
-    write_text_atomic(out_dir / "bench.md", head + claims_markdown(claims) + "\n" + sep + rest)
+    write_text(out_dir / "bench.md", head + claims_markdown(claims) + "\n" + sep + rest)
     return summary

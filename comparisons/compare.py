@@ -306,8 +306,8 @@ def _plot_pressures(entries, bem_fields, out_dir):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from comparisons.files import save_figure_atomic
     from comparisons.named_cases import grid_interpolate
+    from rigid_dynamics.files import save_figure
 
     names = [n for n, f in entries if f is not None]
     fields = [f for _, f in entries if f is not None]
@@ -320,7 +320,7 @@ def _plot_pressures(entries, bem_fields, out_dir):
         ax.set_title(name, fontsize=9)
         _zoom(ax, box)
     fig.colorbar(mesh, ax=list(axes), label="pressure [MPa] (one scale)", shrink=0.9)
-    save_figure_atomic(fig, out_dir / "pressure.png", dpi=110, bbox_inches="tight", metadata=_MAP_METADATA)
+    save_figure(fig, out_dir / "pressure.png", dpi=110, bbox_inches="tight", metadata=_MAP_METADATA)
     plt.close(fig)
     if bem_fields is None:
         return ["pressure.png"]
@@ -342,7 +342,7 @@ def _plot_pressures(entries, bem_fields, out_dir):
         ax.set_title(f"{name} - bem", fontsize=9)
         _zoom(ax, box)
     fig.colorbar(mesh, ax=list(axes), label="p - p_BEM [MPa] (black: BEM outline)", shrink=0.9)
-    save_figure_atomic(fig, out_dir / "pressure_difference.png", dpi=110, bbox_inches="tight", metadata=_MAP_METADATA)
+    save_figure(fig, out_dir / "pressure_difference.png", dpi=110, bbox_inches="tight", metadata=_MAP_METADATA)
     plt.close(fig)
     return ["pressure.png", "pressure_difference.png"]
 
@@ -353,7 +353,7 @@ def _plot_subsurface(cuts, sources, out_dir):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from comparisons.files import save_figure_atomic
+    from rigid_dynamics.files import save_figure
 
     n_xz = cuts["n_xz"]
     nd = len(cuts["depth"])
@@ -381,7 +381,7 @@ def _plot_subsurface(cuts, sources, out_dir):
         if s["max_von_mises_depth_m"] is not None:
             row[0].axhline(s["max_von_mises_depth_m"] * 1e3, color="c", lw=0.8, ls="--")
     fig.tight_layout()
-    save_figure_atomic(fig, out_dir / "subsurface.png", dpi=100)
+    save_figure(fig, out_dir / "subsurface.png", dpi=100)
     plt.close(fig)
     return "subsurface.png"
 
@@ -436,11 +436,10 @@ def _render_3d(pv, cuts, source, pressure_fields, out_dir) -> tuple[str | None, 
         )  # fmt: skip
         plotter.view_isometric()
         plotter.add_text(source["source"], font_size=9)
-        path = out_dir / "subsurface_3d.png"
-        tmp = out_dir / ".subsurface_3d.tmp.png"
-        plotter.screenshot(str(tmp))
+        from rigid_dynamics.files import atomic_write
+
+        path = atomic_write(out_dir / "subsurface_3d.png", lambda tmp: plotter.screenshot(str(tmp)))
         plotter.close()
-        tmp.replace(path)
         return path.name, "ok"
     except Exception as exc:  # rendering needs an off-screen OpenGL context; its absence is reported, not fatal
         return None, f"{type(exc).__name__}: {exc}"
@@ -463,7 +462,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
     pictures), so that a run of tens of seconds is not silent.
     """
     from comparisons.contact_plots import plot_contact_fields
-    from comparisons.files import write_json_atomic, write_text_atomic
+    from rigid_dynamics.files import write_json, write_text
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -533,8 +532,8 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
 
     differences = explain(solved, getattr(named.case, "material", None), options)
     report = _report(named, models, solved, sources, cuts, pictures, notes, differences)
-    write_text_atomic(out_dir / "report.md", report["markdown"])
-    write_text_atomic(out_dir / "report.html", report["html"])
+    write_text(out_dir / "report.md", report["markdown"])
+    write_text(out_dir / "report.html", report["html"])
     summary = {
         "case": named.name,
         "success": all(solved.get(m, {}).get("status") == "ok" for m in models),
@@ -545,7 +544,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
         "headlines": report["headlines"],
         "rung_differences": [d.removeprefix("- ") for d in differences],
     }
-    write_json_atomic(out_dir / "compare.json", summary)
+    write_json(out_dir / "compare.json", summary)
     return summary
 
 

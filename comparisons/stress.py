@@ -47,6 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigid_dynamics.files import write_text
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.simulate import SimulationResult, simulate
 
@@ -529,16 +530,6 @@ def run_stress_sweep(
     }
 
 
-def _atomic_write(path: Path, text: str) -> None:
-    from rigid_dynamics.files import atomic_write
-
-    def writer(tmp: Path) -> None:
-        with open(tmp, "w", encoding="utf-8", newline="") as handle:
-            handle.write(text)
-
-    atomic_write(path, writer)
-
-
 def write_records(records: list[dict], folder: str | Path, stem: str = "stress") -> dict[str, Path]:
     """Write records as ``<stem>.csv`` and ``<stem>.json`` into ``folder`` (each atomically). Returns the paths."""
     folder = Path(folder)
@@ -549,8 +540,8 @@ def write_records(records: list[dict], folder: str | Path, stem: str = "stress")
     writer.writeheader()
     for record in records:
         writer.writerow({k: ("" if record.get(k) is None else record.get(k)) for k in RECORD_FIELDS})
-    _atomic_write(paths["csv"], buffer.getvalue())
-    _atomic_write(paths["json"], json.dumps(records, indent=2) + "\n")
+    write_text(paths["csv"], buffer.getvalue())
+    write_text(paths["json"], json.dumps(records, indent=2) + "\n")
     return paths
 
 

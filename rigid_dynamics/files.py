@@ -10,16 +10,21 @@ the 0600 of a temporary file.
 :func:`ignore_sigpipe` restores Python's start-up setting (SIGPIPE ignored) that gmsh and dolfinx reset: with it at
 its default, a write to a closed pipe or socket kills the process mid-write instead of raising BrokenPipeError.
 
-It lives in the lowest layer (stdlib only) so that every package can use it: ``wheelrail.output``
-re-exports it, the plots of ``comparisons`` and ``fea`` save through :func:`save_figure`.
+:func:`json_ready` is the one JSON sanitiser (NaN/inf -> null, numpy values -> numbers and lists) behind
+:func:`to_json` and :func:`write_json`.
+
+It lives in the lowest layer (stdlib only; numpy imported by :func:`write_npz` alone) so that every package can use
+it: ``wheelrail.output`` re-exports it, ``comparisons`` and ``fea`` write and save their plots through it.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import tempfile
 from collections.abc import Callable
-from pathlib import Path
+from pathlib import Path, PurePath
 
 
 class WriteError(OSError):
@@ -80,6 +85,51 @@ def _remove(tmp_path: Path | None) -> None:
 def write_text(path: str | Path, text: str) -> Path:
     """Write text (UTF-8) atomically."""
     return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+def json_ready(value):
+    """``value`` as data JSON can hold, recursively: NaN and inf -> None (JSON has no NaN), numpy scalars and arrays
+    -> numbers and lists, paths -> strings, tuples -> lists, dict keys that JSON cannot take -> strings. Other
+    objects are left for ``json.dumps`` to refuse (TypeError). The one JSON sanitiser of every written file.
+    """
+    if isinstance(value, float):  # numpy.float64 too
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {_json_key(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, PurePath):
+        return str(value)
+    if hasattr(value, "item") and getattr(value, "ndim", None) == 0:  # numpy scalar or 0-d array
+        return json_ready(value.item())
+    if hasattr(value, "tolist") and hasattr(value, "ndim"):  # numpy array
+        return json_ready(value.tolist())
+    return value
+
+
+def _json_key(key):
+    return key if key is None or isinstance(key, (str, int, float, bool)) else str(key)
+
+
+def to_json(data) -> str:
+    """JSON text (indent 2) of :func:`json_ready` ``(data)``: NaN/inf written as null."""
+    return json.dumps(json_ready(data), indent=2)
+
+
+def write_json(path: str | Path, data) -> Path:
+    """Write ``data`` as JSON (:func:`to_json`, a closing newline) atomically."""
+    return write_text(path, to_json(data) + "\n")
+
+
+def write_npz(path: str | Path, **arrays) -> Path:
+    """Write arrays to a compressed NPZ file atomically (numpy imported here: this module stays stdlib-only)."""
+    import numpy as np
+
+    def writer(tmp: Path) -> None:
+        with open(tmp, "wb") as handle:
+            np.savez_compressed(handle, **arrays)
+
+    return atomic_write(path, writer)
 
 
 def save_figure(fig, path: str | Path, **savefig_kwargs) -> Path:

@@ -122,3 +122,25 @@ def test_case_key_reads_a_slices_file(tmp_path):
     (tmp_path / "bad.toml").write_text(text.replace("wheel.slcw", "nothere.slcw"))
     with pytest.raises(ConfigError, match=r"key 'irregularities.wheel_slices_file' = .*nothere.slcw.*no such file"):
         load_case(tmp_path / "bad.toml")
+
+
+def test_cli_contact_reads_a_relative_slices_file_from_another_folder(tmp_path, monkeypatch, capsys):
+    """``wheelrail contact case/case.toml`` run from elsewhere: the case's relative ``wheel_slices_file`` refers to
+    the case's folder (the one case loader, also behind ``--set``), and a missing one is a one-line error."""
+    from hardening_helpers import assert_error, run, wheelset_case
+
+    folder = tmp_path / "case"
+    folder.mkdir()
+    _write(folder, WheelFlat(0.05, R0, centre_angle_rad=0.5 * math.pi - THETA_FLAT))
+    text = wheelset_case('[irregularities]\nwheel_slices_file = "wheel.slcw"\nside = "right"\n')
+    (folder / "case.toml").write_text(text)
+    (folder / "bad.toml").write_text(text.replace("wheel.slcw", "nothere.slcw"))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    code, out, err = run(capsys, "contact", "../case/case.toml", "--set", "loading.wheel_load_N=7e4")
+    assert code == 0, err
+    assert out.strip()
+    code, out, err = run(capsys, "contact", "../case/bad.toml")
+    assert_error(code, err, "irregularities.wheel_slices_file", "nothere.slcw", "no such file")
+    assert list(elsewhere.iterdir()) == []

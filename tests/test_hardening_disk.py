@@ -58,3 +58,31 @@ def test_disk_full_before_the_work(capsys, tmp_path, monkeypatch):
     assert_error(code, err, "--out", "cannot be written (No space left on device)")
     assert not (tmp_path / "o").exists()
     assert not (tmp_path / "o" / LOCK_NAME).exists()
+
+
+def test_one_json_sanitiser_writes_nan_and_numpy_values_as_json(tmp_path):
+    """rigid_dynamics.files.json_ready (behind wheelrail.output.write_json and the comparisons' JSON): NaN and inf,
+    also as numpy float32 scalars and inside arrays, become null; numpy values become numbers and lists."""
+    import json
+    import math
+    from pathlib import Path
+
+    import numpy as np
+
+    data = {
+        "nan": math.nan,
+        "inf32": np.float32("inf"),
+        "array": np.array([1.0, np.nan]),
+        "int64": np.int64(3),
+        "path": Path("a/b"),
+        "nested": ({1: np.float64(-math.inf)},),
+    }
+    path = files.write_json(tmp_path / "x.json", data)
+    assert json.loads(path.read_text(encoding="utf-8"), parse_constant=lambda c: c) == {
+        "nan": None,
+        "inf32": None,
+        "array": [1.0, None],
+        "int64": 3,
+        "path": "a/b",
+        "nested": [{"1": None}],
+    }

@@ -374,14 +374,19 @@ def _build_wheelset_case(geometry: dict, wheel_load_N, approach_m, kinematics: d
     return case
 
 
-def load_case(path: str | Path, method: str | None = None) -> ContactCase:
-    """Read and validate a case file (an embedded case name is accepted too).
+def load_case(path: str | Path, method: str | None = None, overrides: dict | None = None) -> ContactCase:
+    """Read and validate a case file (an embedded case name is accepted too): the one case loader.
 
-    With ``method`` (a registered model name) the ``[solver]`` table is checked against that model's
-    declared options too (:func:`check_solver_options`).
+    Relative file names in the case (``irregularities.wheel_slices_file``) refer to the case file's folder,
+    whatever the working directory. ``overrides``: {dotted key: value} applied to the document before
+    validation (the CLI's ``--set``, :mod:`wheelrail.overrides`). With ``method`` (a registered model name) the
+    ``[solver]`` table is checked against that model's declared options too (:func:`check_solver_options`).
     """
+    from wheelrail.overrides import apply_overrides
+
     path = resolve_case_path(path)
-    case = parse_case(read_toml(path, "case file"), name=Path(path).stem, base_dir=Path(path).parent)
+    doc = apply_overrides(read_toml(path, "case file"), overrides or {})
+    case = parse_case(doc, name=Path(path).stem, base_dir=Path(path).parent)
     if method is not None:
         check_solver_options(case, method)
     return case

@@ -148,8 +148,8 @@ def _demo(scene, source, models, out_dir) -> int:
     """The work of :func:`cmd_demo` in its checked, locked folder."""
     from comparisons.compare import _html, run_compare
     from comparisons.demo import peak_patch_case
-    from comparisons.files import write_text_atomic
     from comparisons.named_cases import NamedCase
+    from rigid_dynamics.files import write_text
     from rigid_dynamics.wheelset import simulate
     from wheelrail.output import subfolder
     from wheelrail.scenes import write_run_outputs
@@ -238,8 +238,8 @@ def _demo(scene, source, models, out_dir) -> int:
         compare_md,
     ]
     text = "\n".join(lines) + "\n"
-    write_text_atomic(out_dir / "report.md", text)
-    write_text_atomic(out_dir / "report.html", _html(text, f"wheelrail demo: {source.stem}"))
+    write_text(out_dir / "report.md", text)
+    write_text(out_dir / "report.html", _html(text, f"wheelrail demo: {source.stem}"))
     print(f"report: {out_dir / 'report.md'} (and report.html)")
     for line in headlines:
         print(line)

@@ -23,8 +23,6 @@ the terminal) is refused before anything is written.
 
 from __future__ import annotations
 
-import json
-import math
 import os
 import shutil
 import socket
@@ -33,9 +31,7 @@ from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 
-import numpy as np
-
-from rigid_dynamics.files import WriteError, atomic_write, save_figure
+from rigid_dynamics.files import WriteError, atomic_write, save_figure, to_json, write_json, write_npz, write_text
 from wheelrail.config import ConfigError
 
 __all__ = [
@@ -56,53 +52,6 @@ __all__ = [
 
 LOCK_NAME = ".wheelrail.lock"
 """The lock file a run holds in its output folder (pid and host of the run)."""
-
-
-def _json_default(value):
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, Path):
-        return str(value)
-    raise TypeError(f"cannot write {type(value).__name__} to JSON")
-
-
-def _finite_or_none(value):
-    """Replace NaN/inf by None (JSON has no NaN), recursively."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _finite_or_none(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite_or_none(v) for v in value]
-    return value
-
-
-def to_json(data) -> str:
-    """JSON text with NaN/inf written as null."""
-    return json.dumps(_finite_or_none(data), indent=2, default=_json_default)
-
-
-def write_json(path: str | Path, data) -> Path:
-    """Write ``data`` as JSON atomically."""
-    text = to_json(data)
-    return atomic_write(path, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
-
-
-def write_text(path: str | Path, text: str) -> Path:
-    """Write text atomically."""
-    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
-
-
-def write_npz(path: str | Path, **arrays) -> Path:
-    """Write arrays to an NPZ file atomically."""
-
-    def writer(tmp: Path) -> None:
-        with open(tmp, "wb") as handle:
-            np.savez_compressed(handle, **arrays)
-
-    return atomic_write(path, writer)
 
 
 def safe_name(text: str) -> str:

@@ -74,14 +74,11 @@ def load_scene_with(scene: str | Path, sets: list[str] | None):
 def load_case_with(case: str | Path, sets: list[str] | None, method: str | None = None):
     """Read, override and validate a contact case (embedded name or path); returns (ContactCase, path, overrides).
 
-    With ``method`` the ``[solver]`` table is checked against that model's options (as ``load_case``).
+    The CLI's front to :func:`wheelrail.cases.load_case` (the one case loader: relative files in the case refer to
+    its folder). With ``method`` the ``[solver]`` table is checked against that model's options.
     """
-    from wheelrail.cases import check_solver_options, parse_case, resolve_case_path
+    from wheelrail.cases import load_case, resolve_case_path
 
     path = resolve_case_path(case)
     overrides = parse_sets(sets)
-    doc = apply_overrides(read_toml(path, "case file"), overrides)
-    parsed = parse_case(doc, name=path.stem)
-    if method is not None:
-        check_solver_options(parsed, method)
-    return parsed, path, overrides
+    return load_case(path, method=method, overrides=overrides), path, overrides

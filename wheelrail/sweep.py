@@ -217,7 +217,7 @@ def run_point(task: dict) -> dict:
         else:
             from wheelrail.cases import parse_case, solution_record, solve_case
 
-            case = parse_case(doc, name=task["name"])
+            case = parse_case(doc, name=task["name"], base_dir=Path(task["base_dir"]))
             numbers = _case_numbers(solution_record(solve_case(case, method)), method)
     except ConfigError as exc:
         return {**record, "status": "invalid-input", "success": False, "message": str(exc)}

@@ -87,7 +87,6 @@ def write_grid_csv(path: str | Path, running_name: str, running, lateral_m, valu
     lines = [",".join([running_name, *(repr(float(y)) for y in lateral_m)])]
     for r, row in zip(np.asarray(running, float), np.asarray(values_m, float), strict=True):
         lines.append(",".join([repr(float(r)), *(repr(float(v)) for v in row)]))
-    from rigid_dynamics.files import atomic_write
+    from rigid_dynamics.files import write_text
 
-    text = "\n".join(lines) + "\n"
-    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return write_text(path, "\n".join(lines) + "\n")

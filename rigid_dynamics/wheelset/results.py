@@ -477,12 +477,6 @@ def save_timeseries(result: SimulationResult, path: str | Path) -> Path:
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_suffix(".npz")
-    from rigid_dynamics.files import atomic_write
+    from rigid_dynamics.files import write_npz
 
-    arrays = timeseries_arrays(result)
-
-    def writer(tmp: Path) -> None:
-        with open(tmp, "wb") as handle:
-            np.savez_compressed(handle, **arrays)
-
-    return atomic_write(path, writer)  # the one atomic write (usual permissions, no half file on a kill)
+    return write_npz(path, **timeseries_arrays(result))  # the one atomic write (usual permissions, no half file)
