@@ -129,7 +129,9 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   bodies only (K = 0);
 * ``kinetic_friction_coefficient`` (float > 0 or None): the friction coefficient in slip (CONTACT's FKIN); the
   material's ``friction_coefficient`` is then the static one (FSTAT: adhesion holds up to it). None: one
-  coefficient.
+  coefficient. This key follows CONTACT's Coulomb law before v23.1 (FSTAT > FKIN allowed). CONTACT's current law
+  (v23.1 on, user guide "Coulomb friction", L = 0) takes one coefficient: its input file rejects FSTAT != FKIN
+  and its library uses min(FSTAT, FKIN) throughout; the default None is that law.
 """
 
 PROBLEMS = ("rolling", "shift", "transient")
