@@ -41,3 +41,25 @@ def test_demo_bad_options(tmp_path, capsys, args, text):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(text)
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_demo_says_why_it_exits_1(tmp_path, monkeypatch, capsys):
+    """A rung short of its own tolerance (here the FEA's mesh-tolerance-not-met, as the full demo's FEA can end) makes
+    the demo exit 1 with one line naming the rung and its status, not a bare exit status."""
+    monkeypatch.setattr(compare, "CUT_POINTS", (11, 7))
+    real = compare.run_compare
+
+    def short_of_tolerance(*args, **kwargs):
+        result = real(*args, **kwargs)
+        result["models"]["fastsim"]["status"] = "mesh-tolerance-not-met"
+        return {**result, "success": False}
+
+    monkeypatch.setattr(compare, "run_compare", short_of_tolerance)
+    text = resolve_scene_path("polygonal-wheel").read_text().replace("duration_s = 2.0", "duration_s = 0.1")
+    scene = tmp_path / "short.toml"
+    scene.write_text(text)
+    assert main(["demo", str(scene), "--models", "hertz", "fastsim", "--out", str(tmp_path / "demo")]) == 1
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("demo: ended with a rung short of its own tolerance or failed (exit 1): ")
+    assert "fastsim mesh-tolerance-not-met" in last

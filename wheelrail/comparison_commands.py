@@ -243,7 +243,15 @@ def _demo(scene, source, models, out_dir) -> int:
     print(f"report: {out_dir / 'report.md'} (and report.html)")
     for line in headlines:
         print(line)
-    return 0 if compare["success"] else 1
+    if compare["success"]:
+        return 0
+    failed = {m: v.get("status") for m, v in models.items() if v.get("status") not in (None, "ok")}
+    print(
+        "demo: ended with a rung short of its own tolerance or failed (exit 1): "
+        + ", ".join(f"{m} {status}" for m, status in failed.items())
+        + "; see the report's table"
+    )
+    return 1
 
 
 def _auto_summary(result) -> list:
