@@ -29,8 +29,9 @@ G_BLOCK = E_BLOCK / (2 * (1 + NU))
 N_PER_SEMI_AXIS = 9.0
 
 
-@pytest.fixture(scope="module")
-def hertz_circle():
+def _indented_circle(**spec):
+    """The Hertz circle's block (meshing.hertz.HertzBlockSpec with ``spec``) pressed to FORCE_N by the rigid sphere:
+    (domain, frictionless normal solution, semi-axis a)."""
     import dolfinx_solver  # noqa: F401
 
     from fea.domain import hertz_block_domain
@@ -39,7 +40,7 @@ def hertz_circle():
 
     ref = hertz_elliptic(0.5 / RADIUS_M, 0.5 / RADIUS_M, FORCE_N, E_STAR)
     a = ref.semi_axis_long_m
-    domain = hertz_block_domain(HertzBlockSpec(a, a, N_PER_SEMI_AXIS))
+    domain = hertz_block_domain(HertzBlockSpec(a, a, **spec))
     normal = solve_rigid_indenter(
         domain,
         lambda x, y: (x * x + y * y) / (2 * RADIUS_M),
@@ -51,6 +52,11 @@ def hertz_circle():
     )
     assert normal.success, normal.message
     return domain, normal, a
+
+
+@pytest.fixture(scope="module")
+def hertz_circle():
+    return _indented_circle(elements_per_semi_axis=N_PER_SEMI_AXIS)
 
 
 @pytest.mark.slow
@@ -114,26 +120,7 @@ N_ROLL = 4.0
 
 @pytest.fixture(scope="module")
 def rolling_circle():
-    import dolfinx_solver  # noqa: F401
-
-    from fea.domain import hertz_block_domain
-    from fea.solver import solve_rigid_indenter
-    from meshing.hertz import HertzBlockSpec
-
-    ref = hertz_elliptic(0.5 / RADIUS_M, 0.5 / RADIUS_M, FORCE_N, E_STAR)
-    a = ref.semi_axis_long_m
-    domain = hertz_block_domain(HertzBlockSpec(a, a, N_ROLL, domain_factor=10.0, symmetry="full"))
-    normal = solve_rigid_indenter(
-        domain,
-        lambda x, y: (x * x + y * y) / (2 * RADIUS_M),
-        E_BLOCK,
-        NU,
-        normal_force_N=FORCE_N,
-        initial_approach_m=ref.approach_m,
-        length_scale_m=a,
-    )
-    assert normal.success, normal.message
-    return domain, normal, a
+    return _indented_circle(elements_per_semi_axis=N_ROLL, domain_factor=10.0, symmetry="full")
 
 
 def _roll(rolling_circle, creepage, step_per_a=N_ROLL):
