@@ -27,6 +27,7 @@ import pytest
 
 from rigid_dynamics.contact.registry import get_model
 from rigid_dynamics.contact.search import WheelsetPose
+from rigid_dynamics.contact.types import Creepage
 from rigid_dynamics.contact.wheelset_patches import wheel_patches
 from rigid_dynamics.wheelset.layout import PATCH_SAMPLED
 from rigid_dynamics.wheelset.simulate import build_provider
@@ -172,3 +173,32 @@ def test_conformal_flange_root_is_solved_in_contacts_weighted_plane(curve):
     assert direction(force_formed) == pytest.approx(patch.geometry.contact_angle_rad, abs=0.05)
     assert direction(force_own) == pytest.approx(float(own.values["contact_angle_rad"][j]), abs=0.05)
     assert direction(force_formed) - direction(force_own) == pytest.approx(0.28, abs=0.03)
+
+
+def test_conformal_flange_root_resultant_direction_from_the_arcs_normals(curve):
+    """Which plane is nearer the conformal patch's own force direction: the formed patch's BEM pressure (0.25 mm
+    elements, no creepage) put back on the curved rail surface, each element's pressure acting along the rail's
+    normal below it (its contact angle arctan N_y at the element's track y); the resultant's angle, 0.83 rad, is
+    within 0.05 rad of the formed plane's (0.853) and 0.25 rad from the own plane's (0.576). The own-plane patch's
+    pressure so mapped gives 0.88 rad (measured, h28c): both put the conformal root's resultant near CONTACT's
+    weighted angle. A first-order estimate (the planar pressure on curved normals), not a conformal solution."""
+    model, formed = curve["formed"]
+    (patch,) = model.callback.former.last("left")
+    geometry = patch.geometry
+    scene = model.scene
+    result = get_model("bem").solve(
+        geometry, Creepage(0.0, 0.0, 0.0, scene.speed_m_per_s), scene.material, options={"element_size_m": 2.5e-4}
+    )
+    fields = result.fields
+    x, y = np.meshgrid(fields.x_m, fields.y_m)
+    points = geometry.point_m + x.ravel()[:, None] * geometry.frame[:, 0] + y.ravel()[:, None] * geometry.frame[:, 1]
+    pressure = fields.pressure_Pa.ravel()
+    loaded = pressure > 0
+    _, rail = model.callback.surfaces.fast["left"]
+    slope = np.asarray(rail.evaluate(points[loaded, 0], points[loaded, 1])[2])
+    angle = np.arctan(slope)  # the left rail's contact angle (towards the track centre) below each element
+    weight = pressure[loaded]
+    resultant = math.atan2(float(weight @ np.sin(angle)), float(weight @ np.cos(angle)))
+    own_plane = float(curve["own-plane"][1].values["contact_angle_rad"][_touching(curve["own-plane"][1], 0)])
+    assert resultant == pytest.approx(geometry.contact_angle_rad, abs=0.05)
+    assert resultant - own_plane > 0.2
