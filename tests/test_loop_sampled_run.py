@@ -68,7 +68,7 @@ def test_ellipse_choice_gives_the_quadric(runs):
 
 def test_sampled_and_ellipse_flange_patches_differ(runs):
     """The flange root's patch is not an ellipse (the S1002 root and the UIC60 gauge corner are both 13 mm arcs).
-    At the start (each run's own static equilibrium of height and roll, the heights 13 um apart) the sampled patch on
+    At the start (each run's own static equilibrium of height and roll, the heights within 20 um) the sampled patch on
     the left flange root, formed as CONTACT's module 1 forms it (formed_patches.py: the plane of the weighted contact
     angle, 0.79 rad, where the ellipse sits at the candidate's 0.54 rad), is 54 % larger than the quadric's and carries
     32 % more normal force: its plane leans towards the flange, so less of its force holds the wheel up and the
