@@ -228,12 +228,6 @@ class WheelsetModel:
         surfaces = _patch_surfaces(scene, provider) if scene.patch_geometry == "sampled" else None
         if code == LAW_CALLBACK:
             self.callback = PatchCallback(contact_model, model_options, scene.material, surfaces, self.elastic)
-            if scene.track.curve_radius_m > 0:
-                # the formed patches (formed_patches.py) are not yet right in a canted curve: on curve-flange's
-                # settled pose they give the right tread patch 72 kN where the candidate's own plane, the compiled
-                # KPEC on the same sampled gap and the ellipse all give 84-85 kN (tangent track: within 0.2 %); in a
-                # curve each candidate is sampled on its own plane until that is found
-                self.callback.patches = "search"
         elif code == LAW_AUTO:
             from rigid_dynamics.contact.registry import get_model
 
