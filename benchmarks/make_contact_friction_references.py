@@ -201,7 +201,7 @@ def hertz_rows(out: Path, laws: list[tuple]) -> list[dict]:
                 "fy_over_fstat_fn": _g(p, "FY/FSTAT/FN"),
                 "approach_mm": _g(p, "APPROACH"),
                 "pmax_N_per_mm2": _g(p, "PMAX"),
-                "fric_power_W": _g(p, "FRIC.POWER"),
+                "fric_power_as_printed": _g(p, "FRIC.POWER"),
                 "npot": _g(p, "NPOT"),
                 "ncon": _g(p, "NCON"),
                 "nadh": _g(p, "NADH"),
@@ -230,21 +230,22 @@ def make_falling() -> None:
     # CONTACT's example tractcurv: 4 series of 30 cases (see SOURCE.md)
     out = run_deck(None, "tractcurv", example=True)
     series = (
-        [{"series": 1, "model": "half-space, Coulomb (L=0, M=0)", "frclaw": 0}] * 30
-        + [{"series": 2, "model": "interfacial layer, exponential (L=4, M=4)", "frclaw": 4}] * 30
-        + [{"series": 3, "model": "FASTSIM parabolic bound, Coulomb (L=0, M=3, B=3)", "frclaw": 0}] * 30
-        + [{"series": 4, "model": "modified FASTSIM, exponential (L=4, M=3, B=3)", "frclaw": 4}] * 30
+        [{"series": 1, "model": "half-space Coulomb (L=0 M=0)", "frclaw": 0}] * 30
+        + [{"series": 2, "model": "half-space with interfacial layer; exponential (L=4 M=4)", "frclaw": 4}] * 30
+        + [{"series": 3, "model": "FASTSIM parabolic bound; Coulomb (L=0 M=3 B=3)", "frclaw": 0}] * 30
+        + [{"series": 4, "model": "modified FASTSIM; exponential (L=4 M=3 B=3)", "frclaw": 4}] * 30
     )
     write_csv(DATA / "falling" / "tractcurv.csv", hertz_rows(out, series))
 
 
 # ---------------------------------------------------------------------------------------------- (c) force control
 
-FORCE_CASES = [  # (y_ws mm, yaw rad, roll rad, FX_WS N)
-    (0.0, 0.0, 0.0, 1500.0),
-    (0.0, 0.0, 0.0, -1500.0),
-    (0.0, 0.0, 0.0, 2700.0),
-    (5.0, 0.0120, -0.00035540, 1500.0),
+FORCE_CASES = [  # (y_ws mm, yaw rad, roll rad, FX_WS N, D_SEP mm, D_COMB mm)
+    (0.0, 0.0, 0.0, 1500.0, 8.0, 4.0),
+    (0.0, 0.0, 0.0, -1500.0, 8.0, 4.0),
+    (0.0, 0.0, 0.0, 2700.0, 8.0, 4.0),
+    (5.0, 0.0120, -0.00035540, 1500.0, 8.0, 4.0),
+    (5.0, 0.0120, -0.00035540, 1500.0, 6.0, 3.0),  # the patches kept apart: two patches
 ]
 
 
@@ -255,7 +256,8 @@ def force_deck() -> str:
         "",
     ]
     lines = list(head)
-    for k, (y, yaw, roll, fx) in enumerate(FORCE_CASES):
+    for k, (y, yaw, roll, fx, dsep, dcomb) in enumerate(FORCE_CASES):
+        new_sep = k > 0 and (dsep, dcomb) != FORCE_CASES[k - 1][4:]
         lines += [
             "  1 MODULE",
             " 1203110    C-P-B-T-N-F-S   CONFIG, PVTIME, BOUND,  TANG,   NORM,   FORCE,  STRESS",
@@ -276,9 +278,13 @@ def force_deck() -> str:
             ]
         else:
             lines += [
-                " 0111002    V-L-D-C-M-Z-E  VARFRC, FRCLAW, DISCNS, INFLCF, MATER, ZTRACK, EWHEEL",
+                f" 01{2 if new_sep else 1}1002    V-L-D-C-M-Z-E  VARFRC, FRCLAW, DISCNS, INFLCF, MATER, ZTRACK, EWHEEL",
                 " 0100321    H-G-I-A-O-W-R  HEAT, GAUSEI, IESTIM, MATFIL, OUTPUT, FLOW, RETURN",
             ]
+            if new_sep:
+                lines.append(
+                    f"  0.200   0.200   1.000   90d   {dsep:.1f}   {dcomb:.1f}      DX, DS, DQREL, A_SEP, D_SEP, D_COMB"
+                )
         lines += [
             f"  0.0  {y:.1f}  10000.  {roll:.8f}  {yaw:.4f}  0.0      S, Y, FZ, ROLL, YAW, PITCH",
             f" 2000. 0.0    0.0   0.0        0.0  {fx:.1f}     VS,VY,VZ, VROLL,VYAW, FX_WS",
@@ -296,6 +302,7 @@ def make_force_control() -> None:
     rows = wheelrail_rows(out)
     for r in rows:
         r["fx_ws_prescribed_N"] = FORCE_CASES[r["case"] - 1][3]
+        r["d_sep_mm"], r["d_comb_mm"] = FORCE_CASES[r["case"] - 1][4:]
     write_csv(DATA / "force_control" / "force_control.csv", rows)
 
 
