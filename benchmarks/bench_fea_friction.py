@@ -171,7 +171,7 @@ def rolling_rows() -> list[dict]:
 
 
 def observed_order(rows: list[dict], key: str) -> dict:
-    """Order p from the last three meshes of each series (ratio 2 in n): p = log2((F1 - F2)/(F2 - F3))."""
+    """Order p from the last three meshes of each series (a constant ratio r in n): p = log_r((e1 - e2)/(e2 - e3))."""
     out = {}
     for series in sorted({r[key] for r in rows}):
         values = [r for r in rows if r[key] == series]
@@ -223,8 +223,12 @@ def markdown(data: dict) -> str:
             f"{r['creep_force_N']:.1f} | {r['reference']} {r['reference_N']:.1f} "
             f"(+-{100 * r['reference_relative_error']:.1f} %) | {100 * r['error']:+.1f} % |"
         )
-    orders = ", ".join(f"xi = {k}: {v:.2f}" for k, v in data["rolling_order"].items())
-    lines += ["", f"Observed order of the circle's error against the BEM (last three meshes): {orders}."]
+    lines += [
+        "",
+        "No observed order is claimed for the circle: its meshes are not a constant-ratio series and the errors at",
+        "xi = 5e-5 are not monotone (the trailing edge falls on the unstructured face's nodes differently on each",
+        "mesh), so the 3-D creep force's error cannot be stated from two meshes (docs/models.md).",
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -238,7 +242,6 @@ def main() -> None:
         "rolling": rolling_rows(),
     }
     data["carter_order"] = observed_order(data["carter"], "slip_ratio")
-    data["rolling_order"] = observed_order(data["rolling"], "xi")
     write_text(OUT / "fea_friction.json", json.dumps(data, indent=1, default=float) + "\n")
     write_text(OUT / "fea_friction.md", markdown(data))
     print(markdown(data))
