@@ -16,7 +16,8 @@ Formulations (option ``formulation``):
 * ``"profiles"``: local rail and wheel sections meshed from the real profiles around the patch's
   contact points (:mod:`meshing.profile_sections`), same two-body solver; yaw is neglected.
 
-Frictionless in all cases: creep forces are None.
+Frictionless in all cases: creep forces are None (``extra["tangential"]`` says why: the rolling solver of
+:mod:`fea.friction` does not yet state its 3-D error).
 
 Frame: contact frame of the patch (x rolling, y lateral, z normal rail -> wheel); the block stands
 for the body below the contact plane, the pressure acts on the wheel along +z. Units SI.
@@ -429,6 +430,11 @@ class FeaModel:
                 f"minus the wheel tractions of {opts.surface_traction.get('source', 'the given fields')}"
                 if opts.surface_traction
                 else "none (frictionless)"
+            ),
+            "tangential": (
+                "not available: creep forces None (fea.friction.solve_rolling meets Carter's 2-D solution, but its "
+                "3-D creep force is 3-6 % stiff at 12 elements per semi-axis and not regular enough to state its "
+                "error; docs/models.md, FEA with Coulomb friction)"
             ),
             "young_modulus_Pa": young_body,
             "element_size_m": spec.contact_size_m,
