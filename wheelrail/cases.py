@@ -79,6 +79,7 @@ WHEELSET_GEOMETRY_KEYS = {
     "wheel_profile_mirror_z",
     "rail_profile_mirror_y",
     "rail_profile_mirror_z",
+    "track_distance_m",
 }
 QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
 WHEELSET_KINEMATICS_KEYS = {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s", "wheel_rotation_rad"}

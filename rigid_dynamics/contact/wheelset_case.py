@@ -187,6 +187,8 @@ class WheelsetCase:
         wheel_irregularities_right, wheel_irregularities_left: out-of-roundness of each wheel, a tuple of
             rigid_dynamics.geometry wheel irregularities (``HarmonicOutOfRoundness``, ``WheelFlat``,
             ``MeasuredWheelIrregularity``: anything with ``evaluate(angle_rad, y_m)``); () is a round wheel.
+        track_distance_m: the wheelset's position along the track, m (CONTACT's S_WS): the place of a friction law
+            that varies along the track (every patch's ``track_distance_m``); moves nothing else.
     """
 
     wheel_profile: str
@@ -198,6 +200,7 @@ class WheelsetCase:
     flange_back_distance_m: float = 1.360
     nominal_radius_m: float = 0.46
     rail_inclination_rad: float = 0.0
+    track_distance_m: float = 0.0
     wheel_load_N: float | None = None
     approach_m: float | None = None
     rolling_speed_m_per_s: float = 1.0
@@ -533,6 +536,8 @@ class _Evaluator:
             options = self.model_options
             if self.estimates:
                 options = {**(options or {}), "estimate_grid_error": False}
+            if self.case.track_distance_m != 0.0:
+                geometry = dataclasses.replace(geometry, track_distance_m=float(self.case.track_distance_m))
             result = self.model.solve(geometry, creepage, self.material, normal_force_N=None, options=options)
             if not result.success:
                 failed.append(f"{side} patch {k}: {result.message}")
