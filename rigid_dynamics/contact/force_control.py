@@ -25,13 +25,12 @@ class ForceControlOutcome(NamedTuple):
     """The solved creepage and how well it holds.
 
     Fields:
-        status: "ok", "not-attainable" (no creepage up to ``max_creepage`` reaches the force: ``creepage`` is the
-            one of the largest force found) or "not-converged" (the creep-force evaluation failed).
-        creepage: the solved longitudinal creepage xi (-).
-        force_N: F_x at that creepage, N.
-        residual_N: force_N - target, N.
-        evaluations: creep-force evaluations.
-        message: one line saying what happened.
+
+    * ``status``: "ok", "not-attainable" (no creepage up to ``max_creepage`` reaches the force: ``creepage`` is the
+      one of the largest force found) or "not-converged" (the creep-force evaluation failed);
+    * ``creepage``: the solved longitudinal creepage xi (-);
+    * ``force_N``: F_x at that creepage, N; ``residual_N``: force_N - target, N;
+    * ``evaluations``: creep-force evaluations; ``message``: one line saying what happened.
     """
 
     status: str

@@ -589,12 +589,13 @@ def solve_tang_law(
     ``tolerance``) times max mu_s p in an iteration; the update is under-relaxed (halved) if the change grows. No
     friction memory (the steady law).
 
+    The other arguments are those of :func:`solve_tang` (steady rolling only).
+
     Args:
-        law: the FrictionLaw; ``place``: its variable at each element (ny, nx), rad or m (ignored when the law does
-            not vary).
+        law: the FrictionLaw.
+        place: the law's variable at each element (ny, nx), rad or m (ignored when the law does not vary).
         rolling_speed_m_per_s: V > 0 (slip velocity = V times the dimensionless slip).
         max_friction_iterations: outer iteration limit; not converged -> ``converged`` False.
-        Other arguments as :func:`solve_tang` (steady rolling only).
     """
     from rigid_dynamics.contact.friction import friction_coefficient
 
