@@ -11,7 +11,9 @@ term 0.12 at 100 mm/s (rational: 0.06 at 100 mm/s and 0.06 at 0.3162 mm/s).
 
 Tolerances (issue 26): Fx within 1 % of mu_s FN (mu_s = mu(0) = 0.3), PMAX within 3 %; we also compare the slip
 element count. Recorded on this commit: Fx 0.01 % of mu_s FN (the 4 digits CONTACT prints), PMAX 0.01 %, slip and
-adhesion counts equal; force control: the solved creepage within 0.3 % of CONTACT's.
+adhesion counts equal; force control: the solved creepage within 0.3 % of CONTACT's. And in 3-D (traction_3d.csv:
+CONTACT's tractcurv patch with its exponential law, without friction memory and interface layer): the BemModel's
+traction curve to CONTACT's 4 digits, and a case file's force control to CONTACT's F = 1 creepage within 0.1 %.
 """
 
 import csv
@@ -98,3 +100,78 @@ def test_unattainable_force_is_a_status(strip):
     out = solve_for_force(lambda s: -_rolling(strip, "exponential", -s)[1], -0.95 * mu_fn,
                           force_tolerance_N=1e-5 * mu_fn, first_creepage=1e-3, max_creepage=0.004)  # fmt: skip
     assert out.status == "not-attainable" and "no creepage up to 0.004" in out.message, out
+
+
+TRACTION_3D = Path(__file__).parent / "data" / "contact_veldep" / "traction_3d.csv"
+
+
+def _traction_rows(control: str) -> list[dict]:
+    with TRACTION_3D.open(encoding="utf-8") as fh:
+        return [r for r in csv.DictReader(fh) if r["control"] == control]
+
+
+def _eurosprinter():
+    """CONTACT's tractcurv patch: A = 0.8 1/m and B such that Hertz's a/b = 0.5 at 106.7 kN (B = 0.28142 1/m,
+    CONTACT prints 0.2814e-3 1/mm), the grid 48 x 44 over 1.1 times the ellipse (our margin), exponential law."""
+    from scipy.optimize import brentq
+
+    from rigid_dynamics.contact.bem.model import hertz_ellipse
+    from rigid_dynamics.contact.types import ContactGeometry
+    from rigid_dynamics.materials import Material
+
+    e_star = 82e9 / (1 - 0.28)
+
+    def ratio(b):
+        a_m, b_m = hertz_ellipse(0.8, b, e_star, normal_force_N=106700.0)[:2]
+        return a_m / b_m - 0.5
+
+    geometry = ContactGeometry(0.8, brentq(ratio, 0.1, 0.79, xtol=1e-14))
+    material = Material(82e9, 0.28).with_friction(FrictionLaw((falling("exponential", 0.14, 0.19, 1.25),)))
+    return geometry, material, {"nx": 48, "ny": 44, "margin": 1.1, "estimate_grid_error": False}
+
+
+def test_traction_curve_with_falling_friction_3d():
+    """The BEM rung (BemModel, a quadric patch) over CONTACT's 3-D traction curve with the exponential law: Fx /
+    (mu_s FN) to CONTACT's 4 digits at every creepage (rising branch, maximum 0.987 at xi = 0.004, falling to 0.755
+    at 0.1), PMAX 640.7 MPa, slip counts equal."""
+    from rigid_dynamics.contact.bem.model import BemModel
+    from rigid_dynamics.contact.types import Creepage
+
+    geometry, material, options = _eurosprinter()
+    for row in _traction_rows("creepage"):
+        result = BemModel().solve(geometry, Creepage(float(row["cksi"]), 0.0, 0.0, 10.0), material,
+                                  normal_force_N=106700.0, options=options)  # fmt: skip
+        assert result.success, result.message
+        ratio = result.creep_force_long_N / (0.33 * 106700.0)
+        assert abs(ratio - float(row["fx_fstat_fn"])) <= 1e-4, (row, ratio)
+        assert result.max_pressure_Pa / 1e6 == pytest.approx(float(row["pmax_N_per_mm2"]), rel=1e-3)
+        assert result.extra["slip_elements"] == int(row["nslip"])
+
+
+def test_traction_case_to_a_prescribed_force_3d(tmp_path, capsys):
+    """A contact case file with ``[friction]`` (exponential) and ``longitudinal_force_N`` on CONTACT's tractcurv
+    patch: the solved creepage equals CONTACT's F = 1 solution (4 digits printed) within 0.1 %, near the curve's
+    maximum too (0.95 mu_s FN)."""
+    import json
+
+    from hardening_helpers import run
+
+    geometry, _, _ = _eurosprinter()
+    for row in _traction_rows("force"):
+        path = tmp_path / "case.toml"
+        path.write_text(
+            "[material]\nshear_modulus_Pa = 82e9\npoisson_ratio = 0.28\n"
+            '[friction]\nlaw = "exponential"\nkinetic = 0.14\nterm_1 = 0.19\nhalf_velocity_1_m_per_s = 1.25\n'
+            '[geometry]\nkind = "quadric"\n'
+            f"radius_long_m = {0.5 / geometry.curvature_long_1_per_m!r}\n"
+            f"radius_lat_m = {0.5 / geometry.curvature_lat_1_per_m!r}\n"
+            "[loading]\nnormal_force_N = 106700.0\n"
+            f"longitudinal_force_N = {float(row['fx_fstat_fn']) * 0.33 * 106700.0!r}\n"
+            "[kinematics]\nrolling_speed_m_per_s = 10.0\n"
+            "[solver]\nnx = 48\nny = 44\nmargin = 1.1\nestimate_grid_error = false\n"
+        )
+        code, out, err = run(capsys, "contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "o"))
+        data = json.loads(out)
+        control = data["case"]["force_control"]
+        assert code == 0 and data["status"] == "ok" and control["status"] == "ok", (code, control, err)
+        assert control["solved_creepage_long"] == pytest.approx(float(row["cksi"]), rel=1e-3), control
