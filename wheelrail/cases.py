@@ -659,7 +659,7 @@ def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> Ca
 
     control = None
     if case.longitudinal_force_N is not None:
-        solution, control = _force_controlled_wheelset(case, method, progress)
+        solution, control = solve_wheelset_to_force(case, method, progress)
     else:
         solution = solve_wheelset_case(
             case.wheelset, case.material, method, options=case.solver_options, progress=progress
@@ -726,7 +726,7 @@ def _force_controlled(case: ContactCase, solve_at) -> tuple[Creepage, dict]:
     return dataclasses.replace(base, longitudinal=xi), {"force_control": record}
 
 
-def _force_controlled_wheelset(case: ContactCase, method: str, progress=None):
+def solve_wheelset_to_force(case: ContactCase, method: str, progress=None):
     """A wheelset case with ``longitudinal_force_N`` (CONTACT's F = 1 of its wheel-rail module): the pitch rate
     solved so that the creep forces on the solved wheels sum to that force along the track's x (N, on the wheels).
 
