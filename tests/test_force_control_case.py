@@ -42,6 +42,15 @@ def test_small_traction_force_gives_kalkers_linear_creepage(tmp_path, capsys):
     assert math.isclose(control["solved_creepage_long"], linear, rel_tol=0.03), (control, linear)
 
 
+def test_printed_line_states_the_solved_creepage(tmp_path, capsys):
+    path = tmp_path / "case.toml"
+    path.write_text(_case("900.0") + BEM)
+    code, out, err = run(capsys, "contact", str(path), "--method", "bem", "--out", str(tmp_path / "o"))
+    line = next(x for x in out.splitlines() if x.startswith("force control:"))
+    assert code == 0 and line.startswith("force control: ok, longitudinal force 900 N prescribed, creepage -"), line
+    assert "N (tolerance 3 N," in line
+
+
 def test_force_beyond_friction_is_a_status(tmp_path, capsys):
     path = tmp_path / "case.toml"
     path.write_text(_case("-4e4") + BEM)  # 1.33 mu FN
