@@ -1,6 +1,7 @@
 """The ``[friction]`` table of contact case files: the law it gives, and bad values ending with one
 ``wheelrail: error:`` line and exit 2 (docs/files.md)."""
 
+import math
 import re
 
 import pytest
@@ -87,3 +88,55 @@ def test_friction_table_with_material_coefficient_is_refused(tmp_path, capsys):
     assert code == 2 and "key 'material.friction_coefficient' = 0.3: not allowed with a [friction] table" in err
     with pytest.raises(ConfigError, match="expected a table"):
         parse_case({**_case("coefficient = 0.3\n"), "friction": 0.3})
+
+
+def test_wheelset_case_with_a_friction_table(tmp_path, capsys):
+    """A wheelset case reads [friction] too. Regression test of two paths: a law varying with the surface
+    inclination whose nodes both carry 0.3 (element-wise) gives the forces of material.friction_coefficient = 0.3
+    to 1e-9. And the gauge face lubricated (0.1 above 0.5 rad, 0.3 below 0.3 rad) on the named case a22-flange
+    (A-2.2 at 8 mm shift): the right wheel's flange patch's tangential force drops to within 0.1 FN, the left
+    wheel's tread patch's stays as it was to 2 %."""
+    import json
+    import tomllib
+    from pathlib import Path
+
+    case = Path(__file__).parents[1] / "comparisons" / "cases" / "a22-flange" / "case.toml"
+    text = case.read_text(encoding="utf-8").split("[solver]")[0]  # the deck's geometry and load, our solver below
+    assert tomllib.loads(text)["geometry"]["lateral_shift_m"] == 0.008
+    base = text + (
+        '[solver]\nfriction_place = "element"\n[solver.model]\nelement_size_m = 2e-4\nestimate_grid_error = false\n'
+    )
+    patches = {}
+    for name, friction in {
+        "plain": None,
+        "uniform": "coefficient = [0.3, 0.3]",
+        "lubricated": "coefficient = [0.3, 0.1]",
+    }.items():
+        text = base
+        if friction is not None:
+            text = base.replace("friction_coefficient = 0.3\n", "", 1) + (
+                '[friction]\nlaw = "coulomb"\nvaries_with = "surface_inclination"\nnodes_rad = [0.3, 0.5]\n'
+                f"{friction}\n"
+            )
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        code, out, err = run(capsys, "contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / name))
+        data = json.loads(out)
+        assert code in (0, 1) and data["solver_converged"], (name, data["message"], err)
+        patches[name] = data["patches"]
+    for a, b in zip(patches["plain"], patches["uniform"], strict=True):
+        assert (a["creep_force_long_N"], a["creep_force_lat_N"]) == pytest.approx(
+            (b["creep_force_long_N"], b["creep_force_lat_N"]), rel=1e-9, abs=1e-6
+        )
+
+    def tangential(p):
+        return math.hypot(p["creep_force_long_N"], p["creep_force_lat_N"])
+
+    flange = {k: max(v, key=lambda p: p["contact_angle_rad"]) for k, v in patches.items()}
+    tread = {
+        k: max((p for p in v if p["side"] == "left"), key=lambda p: p["normal_force_N"]) for k, v in patches.items()
+    }
+    assert flange["plain"]["contact_angle_rad"] > 0.9 and tread["plain"]["contact_angle_rad"] < 0.1
+    assert tangential(flange["lubricated"]) <= 0.1 * flange["lubricated"]["normal_force_N"] * (1 + 1e-6)
+    assert tangential(flange["plain"]) > 0.15 * flange["plain"]["normal_force_N"]
+    assert tangential(tread["lubricated"]) == pytest.approx(tangential(tread["plain"]), rel=0.02)
