@@ -175,3 +175,15 @@ def test_traction_case_to_a_prescribed_force_3d(tmp_path, capsys):
         control = data["case"]["force_control"]
         assert code == 0 and data["status"] == "ok" and control["status"] == "ok", (code, control, err)
         assert control["solved_creepage_long"] == pytest.approx(float(row["cksi"]), rel=1e-3), control
+
+
+def test_one_coulomb_coefficient_as_contact_runs_fstat_above_fkin(strip):
+    """CONTACT with FSTAT 0.4 > FKIN 0.3 (L = 0, rev 2707, data/contact_veldep/fstat_above_fkin.inp) uses 0.4 for
+    adhesion and slip: full slip at xi = -0.004 carries FX = 2.489e5 N of FN = 6.222e5 N. The same 0.4 as our one
+    Coulomb coefficient gives it to CONTACT's 4 digits."""
+    grid, x, p = strip
+    wx, wy = rigid_slip(x, np.zeros(1), -0.004, 0.0, 0.0)
+    t = solve_tang_law(grid, p, FrictionLaw((coulomb(0.4),)), 0.0, wx, wy, SPEED_M_PER_S, tolerance=1e-9,
+                       max_iterations=200)  # fmt: skip
+    assert t.converged and bool(t.in_slip[p > 0].all())
+    assert float(t.traction_x_Pa.sum() * grid.dx_m * grid.dy_m) == pytest.approx(2.489e5, rel=2e-4)

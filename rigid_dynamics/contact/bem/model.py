@@ -129,8 +129,8 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   With dq = dx the steady state of this recursion is exactly the steady-rolling discretisation. Quasi-identical
   bodies only (K = 0);
 * ``kinetic_friction_coefficient``: withdrawn (any value but None is an error naming the replacement). It gave a
-  kinetic coefficient below the static one, CONTACT's Coulomb law before v23.1. CONTACT v23.1 on takes one
-  coefficient for adhesion and slip (its input rejects FSTAT != FKIN), and friction that drops once an element
+  kinetic coefficient below the static one, CONTACT's Coulomb law before v23.1. CONTACT v23.1 on uses one
+  coefficient for adhesion and slip (rev 2707 copies FSTAT into FKIN for L = 0), and friction that drops once an element
   slides is a falling law of the slip velocity: the material's friction law (``Material.friction``, a case's
   ``[friction]`` table), solved element-wise (:func:`~.tang.solve_tang_law`);
 * ``max_friction_iterations`` (int >= 1, default 100): outer iterations of a falling friction law (the traction
@@ -293,7 +293,7 @@ def _options(options: Mapping | None) -> dict:
     if opts["kinetic_friction_coefficient"] is not None:
         raise ValueError(
             f"option kinetic_friction_coefficient = {opts['kinetic_friction_coefficient']!r}: withdrawn (CONTACT "
-            "v23.1 on takes one coefficient for adhesion and slip); expected a falling friction law instead, a "
+            "v23.1 on uses one coefficient for adhesion and slip); expected a falling friction law instead, a "
             '[friction] table with law = "linear", "rational", "exponential" or "polach"'
         )
     size = opts["element_size_m"]
