@@ -187,3 +187,20 @@ def test_one_coulomb_coefficient_as_contact_runs_fstat_above_fkin(strip):
                        max_iterations=200)  # fmt: skip
     assert t.converged and bool(t.in_slip[p > 0].all())
     assert float(t.traction_x_Pa.sum() * grid.dx_m * grid.dy_m) == pytest.approx(2.489e5, rel=2e-4)
+
+
+def test_carter_2d_as_contact_publishes_it():
+    """The Coulomb baseline of this path against CONTACT's published carter2d.ref_out (SOURCE.md): FX / (mu FN)
+    0.6480, PMAX 113.9 MPa, 50 elements in contact of which 20 slip."""
+    nx, dx, dy = 55, 0.04e-3, 0.2
+    x = -1.05e-3 + dx * np.arange(nx)
+    grid = InfluenceGrid(nx, 1, dx, dy, 82e9, 0.28, 0.0)
+    p = solve_norm(
+        grid, (1.0 * x**2)[None, :], normal_force_N=35780.0, tolerance=1e-10, max_iterations=2000
+    ).pressure_Pa
+    wx, wy = rigid_slip(x, np.zeros(1), -2.4e-4, 0.0, 0.0)
+    t = solve_tang_law(grid, p, FrictionLaw((coulomb(0.3),)), 0.0, wx, wy, 30.0, tolerance=1e-9, max_iterations=200)
+    assert t.converged
+    assert float(t.traction_x_Pa.sum() * dx * dy) / (0.3 * 35780.0) == pytest.approx(0.6480, abs=1e-4)
+    assert p.max() / 1e6 == pytest.approx(113.9, rel=5e-4)
+    assert int((p > 0).sum()) == 50 and int(t.in_slip.sum()) == 20
