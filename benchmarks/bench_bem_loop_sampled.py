@@ -148,8 +148,10 @@ def main(argv):
         f"Commit {summary['commit']}; {duration} s simulated per run; machine {machine['platform']}, "
         f"{machine['cpu_count']} cores shared with other jobs (load average {machine['load'][0]:.1f} at the end).",
         "",
-        "Every run, in the order run (the flange patch: the left wheel's slot 0 at the first sample, t = 0, where the "
-        "states agree but for the static equilibrium's height, 13 um apart, and at the last):",
+        "Every run, in the order run (the flange patch: the left wheel's slot 0 at the first sample, t = 0, each run "
+        "at its own static equilibrium of height and roll, and at the last; the contact angle is the compiled "
+        "candidate's, the sampled patch is solved in the plane of CONTACT's weighted contact angle, "
+        "formed_patches.py):",
         "",
         "| patch geometry | warm start | s per simulated s | BEM solves | warm-started | NORM+TANG iterations | "
         "sampling s | flange N kN (t=0, end) | area mm2 | pmax MPa | contact angle rad | ellipticity residual |",
@@ -179,12 +181,12 @@ def main(argv):
         "Sampled flange patch against the ellipse at t = 0: area "
         f"{100 * (fw['contact_area_m2'] / fe['contact_area_m2'] - 1):+.0f} %, "
         f"max pressure {100 * (fw['max_pressure_Pa'] / fe['max_pressure_Pa'] - 1):+.0f} %, normal force "
-        f"{100 * (fw['normal_force_N'] / fe['normal_force_N'] - 1):+.1f} % (the runs then part). In this canted "
-        "curve each candidate is sampled on its own plane (wheelset_model.WheelsetModel: the formed patches are not "
-        "yet right in a curve); the peak at t = 0 sits on the conformal root's edge and is not converged.",
+        f"{100 * (fw['normal_force_N'] / fe['normal_force_N'] - 1):+.1f} % (at each run's own static equilibrium; "
+        "the runs then part). The sampled patch is formed as CONTACT's module 1 forms it, in a curve as on tangent "
+        "track: on this conformal root its plane leans towards the flange (tests/test_loop_sampled_curve.py), so its "
+        "normal force at the equilibrium exceeds the ellipse's; the peak at t = 0 is not converged.",
         "",
-        "The flange patch at the last state formed as on tangent track (formed_patches.py, not the own-plane sampling "
-        "the loop uses in this curve: N agrees within 0.3 %, area within 6 %) on finer elements:",
+        "The loop's flange patch at the last state (formed_patches.py) on finer elements:",
         "",
         "| element mm | N kN | area mm2 | pmax MPa | Fx kN | Fy kN | s |",
         "|---|---|---|---|---|---|---|",

@@ -128,7 +128,9 @@ out = kpec.kpec_pressure(h, x, x, 82e9, 0.28, p, c)
 l1, l2, l3, a, b = kpec.simplified_flexibilities(c, 1e-4, 1e-4, out[0], 82e9, 0.28, 0.3, 1e-3, 1e-3, 0.5)
 kpec.fastsim_strips((p, c), (x, x), (0.3, 1e-3, 1e-3, 0.5), (l1, l2, l3), (tx, ty, s))
 kpec.analyn_pressure(h, x, x, 82e9, 0.28, p, c)
-kpec.fastrip_strips(p, c, x, x, 0.3, 0.28, a, 1e9, -1.0, -1.0, 0.1, 1e-3, 1e-3, 0.5, l1, l2, l3, tx, ty, s)
+from rigid_dynamics.contact.fastrip import StripTheory
+strip = StripTheory(a, 1e9, 0.28, -1.0, -1.0, 0.1)
+kpec.fastrip_strips((p, c), (x, x), (0.3, 1e-3, 1e-3, 0.5), (l1, l2, l3), (tx, ty, s), strip)
 print(time.perf_counter() - t0)
 """
 

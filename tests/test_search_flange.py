@@ -85,10 +85,11 @@ def flange_search():
 def _kernel_args(provider, pose):
     wheel, rail = provider.surfaces.fast["left"]
     rot = wheelset_rotation(pose[3], pose[4], pose[5])
-    return (
-        rot, np.array(pose[:3]), wheel.table_tuple, rail.table_tuple, np.array(wheel.y_range_m),
-        np.array(rail.y_range_m), wheel.irregularity_rows, rail.irregularity_rows, rail.lateral_map,
+    surf = kern.Surfaces(
+        wheel.table_tuple, rail.table_tuple, wheel.irregularity_rows, rail.irregularity_rows, rail.lateral_map,
+        np.array(wheel.y_range_m), np.array(rail.y_range_m),
     )  # fmt: skip
+    return rot, np.array(pose[:3]), surf
 
 
 def _compiled_patches(provider, pose):

@@ -11,9 +11,10 @@ The mathematics of search._gap_at: at a contact-plane point (x, y) of a patch wi
   R sin a] + x_t, tangents t_a, t_y), started at alpha0 + x / R(alpha0, y0) and y0 + y (e_y . C_D e_2);
 * gap s - t (negative where the undeformed bodies overlap), +inf where y_d leaves the wheel profile.
 
-Surfaces: the record :class:`GapSurfaces` (Hermite tables of the ideal profiles and closed-form irregularity rows of
-_search_kernels). Patch: :class:`GapPatch` (pose, patch point and frame as float triples, the wheel parameters of the
-contact point, Newton iterations). The grid kernels fill caller-given arrays (no allocation: they run in the loop
+Surfaces: the record :class:`GapSurfaces` (_search_kernels.Surfaces: Hermite tables of the ideal profiles and
+closed-form irregularity rows, the one record of a side's surfaces in every compiled contact kernel). Patch:
+:class:`GapPatch` (pose, patch point and frame as float triples, the wheel parameters of the contact point, Newton
+iterations). The grid kernels fill caller-given arrays (no allocation: they run in the loop
 without NRT).
 
 :func:`fitted_grid` is search._fitted_field's box (start at +-scale times the quadric's overlap semi-axes, at least
@@ -30,25 +31,16 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.contact._search_kernels import _table, rail_irregularity, wheel_irregularity
+from rigid_dynamics.contact._search_kernels import Surfaces, _table, rail_irregularity, wheel_irregularity
 
 _FAR = 0.05  # m, search._FAR_M
 FIELD_LIMITS_M = (0.05, 0.03)  # search._FIELD_LIMITS_M: largest |x|, |y| of the sampled field
+BOX_X_LO, BOX_X_HI, BOX_Y_LO, BOX_Y_HI = range(4)
+"""Entries of a grid's box (x_lo, x_hi, y_lo, y_hi), m, contact frame (a tuple, or a row of an array of boxes)."""
 
 
-class GapSurfaces(NamedTuple):
-    """One side's tabulated surfaces: ``wheel``/``rail`` tables (lower, step, values, slopes x step, curvatures),
-    irregularity rows (k, 7) of each, the rail's lateral map (sign, offset), the wheel's and the rail's lateral
-    ranges (2,), m.
-    """
-
-    wheel: tuple
-    rail: tuple
-    wheel_irr: np.ndarray
-    rail_irr: np.ndarray
-    rail_map: np.ndarray
-    y_range: np.ndarray
-    rail_range: np.ndarray
+GapSurfaces = Surfaces
+"""One side's tabulated surfaces (_search_kernels.Surfaces, the record the search and the locus kernels take)."""
 
 
 class GapPatch(NamedTuple):
@@ -84,7 +76,7 @@ def _rail(x, y, surf):
     """N, N_x, N_y of the rail at main-frame (x, y) (y clipped to the rail's range)."""
     lo, hi = surf.rail_range[0], surf.rail_range[1]
     yc = min(max(y, lo), hi)
-    big_n, n_y, _ = _table(yc, surf.rail[0], surf.rail[1], surf.rail[2], surf.rail[3], surf.rail[4])
+    big_n, n_y, _ = _table(yc, *surf.rail)
     n_x = 0.0
     if surf.rail_irr.shape[0] > 0:
         v, vx, vy, _, _, _ = rail_irregularity(x, yc, surf.rail_irr, surf.rail_map[0], surf.rail_map[1])
@@ -119,7 +111,7 @@ def _rail_distance(b0, b1, b2, patch, surf, t):
 @njit(cache=True, _nrt=False)
 def _wheel(alpha, y_d, surf):
     """R, R_a, R_y of the wheel at (alpha, y_d) (nan off the profile)."""
-    r, r_y, _ = _table(y_d, surf.wheel[0], surf.wheel[1], surf.wheel[2], surf.wheel[3], surf.wheel[4])
+    r, r_y, _ = _table(y_d, *surf.wheel)
     v, r_a, _ = wheel_irregularity(alpha, surf.wheel_irr)
     return r + v, r_a, r_y
 
@@ -148,14 +140,14 @@ def _gap_solve(gx, gy, surf, patch, start):
     b2 = c[2] + gx * ex[2] + gy * ey[2]
     rot, ctr = patch.rot, patch.centre
     radius = _wheel(patch.alpha0, patch.y0, surf)[0]
-    if math.isnan(start[0]):
+    alpha, lat, s, t_start = start
+    if math.isnan(alpha):
         t_rail = _rail_distance(b0, b1, b2, patch, surf, 0.0)
         alpha = patch.alpha0 + gx / radius
         lat = patch.y0 + gy * (ey[0] * rot[0, 1] + ey[1] * rot[1, 1] + ey[2] * rot[2, 1])
         s = 0.0
     else:
-        t_rail = _rail_distance(b0, b1, b2, patch, surf, start[3])
-        alpha, lat, s = start[0], start[1], start[2]
+        t_rail = _rail_distance(b0, b1, b2, patch, surf, t_start)
     for _ in range(patch.iterations):
         r, r_a, r_y = _wheel(alpha, lat, surf)
         ca, sa = math.cos(alpha), math.sin(alpha)
@@ -192,11 +184,12 @@ def gap_points(gx, gy, surf, patch, out):
 @njit(cache=True, _nrt=False)
 def sample_grid(surf, patch, box, xs, ys, gap):
     """The gap on the grid xs x ys (linspace of box = (x_lo, x_hi, y_lo, y_hi), filled here) into gap (ny, nx)."""
+    x_lo, x_hi, y_lo, y_hi = box
     nx, ny = xs.shape[0], ys.shape[0]
     for i in range(nx):
-        xs[i] = box[0] + (box[1] - box[0]) * i / (nx - 1)
+        xs[i] = x_lo + (x_hi - x_lo) * i / (nx - 1)
     for j in range(ny):
-        ys[j] = box[2] + (box[3] - box[2]) * j / (ny - 1)
+        ys[j] = y_lo + (y_hi - y_lo) * j / (ny - 1)
     for j in range(ny):
         # along the row each point starts from its neighbour's roots (alpha shifted by the step over the radius)
         start = (math.nan, 0.0, 0.0, 0.0)
@@ -293,15 +286,16 @@ def warm_grid(surf, patch, box, margin, xs, ys, gap):
     fitted_grid's would: the overlap touches no side and the shrunk box keeps at least 80 % of each side. Returns
     True when it fits (then xs, ys, gap hold it), else False (call fitted_grid).
     """
-    if not box[1] > box[0]:
+    x_lo, x_hi, y_lo, y_hi = box[BOX_X_LO], box[BOX_X_HI], box[BOX_Y_LO], box[BOX_Y_HI]
+    if not x_hi > x_lo:
         return False
-    sample_grid(surf, patch, (box[0], box[1], box[2], box[3]), xs, ys, gap)
+    sample_grid(surf, patch, (x_lo, x_hi, y_lo, y_hi), xs, ys, gap)
     c0, c1, r0, r1 = _overlap_extent(gap)
     nx, ny = xs.shape[0], ys.shape[0]
     if c0 <= 0 or c1 >= nx - 1 or r0 <= 0 or r1 >= ny - 1:
         return False
     fx0, fx1, fy0, fy1 = _shrunk_box(xs, ys, (c0, c1, r0, r1), margin)
-    return not (fx1 - fx0 < 0.8 * (box[1] - box[0]) or fy1 - fy0 < 0.8 * (box[3] - box[2]))
+    return not (fx1 - fx0 < 0.8 * (x_hi - x_lo) or fy1 - fy0 < 0.8 * (y_hi - y_lo))
 
 
 @njit(cache=True, _nrt=False)
@@ -332,11 +326,12 @@ def quadric_grid(quadric, q, box, xs, ys, gap):
     """The quadric gap A x'^2 + B y'^2 - q (quadric = (A, B, angle)) on the grid of box into xs, ys, gap."""
     big_a, big_b, angle = quadric
     c, s = math.cos(angle), math.sin(angle)
+    x_lo, x_hi, y_lo, y_hi = box
     nx, ny = xs.shape[0], ys.shape[0]
     for i in range(nx):
-        xs[i] = box[0] + (box[1] - box[0]) * i / (nx - 1)
+        xs[i] = x_lo + (x_hi - x_lo) * i / (nx - 1)
     for j in range(ny):
-        ys[j] = box[2] + (box[3] - box[2]) * j / (ny - 1)
+        ys[j] = y_lo + (y_hi - y_lo) * j / (ny - 1)
     for j in range(ny):
         for i in range(nx):
             xr, yr = c * xs[i] + s * ys[j], -s * xs[i] + c * ys[j]

@@ -10,23 +10,75 @@ t_a, t_y and the second derivatives (R_ay = 0: the irregularities depend on the 
 * plane gap: from p = o + x e_x + y e_y, Newton for t with (p + t n)_z = N((p + t n)_x, (p + t n)_y) (rail), and
   Newton in (a, y_d, s) for x_w(a, y_d) = p + s n (wheel; 3 x 3 by Cramer's rule); gap = s - t, +inf where
   either does not converge or leaves a surface.
+
+One side's surfaces come as the record _search_kernels.Surfaces; a kernel's outputs as the records :class:`Locus`,
+:class:`OverlapLine` and :class:`PlaneGap` (caller-given arrays, filled here). The wheel point and its derivatives
+sit in an (18,) scratch vector at the offsets W_POINT, W_T_ALPHA, W_T_Y, W_X_AA, W_X_AY, W_X_YY (x, y, z each).
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact._search_kernels import _table, rail_irregularity, wheel_irregularity
 
+W_POINT, W_T_ALPHA, W_T_Y, W_X_AA, W_X_AY, W_X_YY = range(0, 18, 3)
+"""Offsets in the wheel scratch vector (W_LEN,) of :func:`_wheel`: the point, the tangents t_a, t_y and the second
+derivatives x_aa, x_ay, x_yy (main frame; x, y, z at offset + 0, 1, 2)."""
+W_LEN = 18
+
+
+class Locus(NamedTuple):
+    """A locus kernel's outputs for n wheel parameters y_d: the wheel angle alpha (n,) rad, the wheel point
+    (n, 3) m (main frame), the vertical gap (n,) m, the rail height there (n,) m and the rail's contact angle (n,)
+    rad.
+    """
+
+    alpha: np.ndarray
+    point: np.ndarray
+    gap: np.ndarray
+    rail_z: np.ndarray
+    angle: np.ndarray
+
+
+class OverlapLine(NamedTuple):
+    """:func:`out_of_round_locus`'s integrals per y_d: weight (n,) m^3, weighted_x (n,) m, overlap_x (n, 2) m."""
+
+    weight: np.ndarray
+    weighted_x: np.ndarray
+    overlap_x: np.ndarray
+
+
+class SortedLocus(NamedTuple):
+    """The locus sorted by its main-frame y: y (n,), the wheel's y_d (n,), alpha (n,) and the point's x (n,) (the
+    starts of :func:`plane_gap`).
+    """
+
+    y: np.ndarray
+    lateral: np.ndarray
+    alpha: np.ndarray
+    x: np.ndarray
+
+
+class PlaneGap(NamedTuple):
+    """:func:`plane_gap`'s outputs per plane point: gap (k,) m, the wheel parameters alpha (k,) rad, y_d (k,) m."""
+
+    gap: np.ndarray
+    alpha: np.ndarray
+    lateral: np.ndarray
+
 
 @njit(cache=True)
-def _wheel(alpha, y, rot, centre, wheel, wheel_irr, out):
-    """Fill out[0:3] point, [3:6] t_a, [6:9] t_y, [9:12] x_aa, [12:15] x_ay, [15:18] x_yy (main frame); return R."""
-    r, r_y, r_yy = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
-    v, r_a, r_aa = wheel_irregularity(alpha, wheel_irr)
+def _wheel(alpha, y, rot, centre, surf, out):
+    """Fill out (W_LEN,) at W_POINT the point, W_T_ALPHA t_a, W_T_Y t_y, W_X_AA x_aa, W_X_AY x_ay, W_X_YY x_yy (main
+    frame); return R.
+    """
+    r, r_y, r_yy = _table(y, *surf.wheel)
+    v, r_a, r_aa = wheel_irregularity(alpha, surf.wheel_irr)
     r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
     loc = (
@@ -40,50 +92,56 @@ def _wheel(alpha, y, rot, centre, wheel, wheel_irr, out):
     for k in range(6):
         a, b, c = loc[k]
         for i in range(3):
-            out[3 * k + i] = rot[i, 0] * a + rot[i, 1] * b + rot[i, 2] * c
+            out[W_POINT + 3 * k + i] = rot[i, 0] * a + rot[i, 1] * b + rot[i, 2] * c
     for i in range(3):
-        out[i] += centre[i]
+        out[W_POINT + i] += centre[i]
     return r
 
 
 @njit(cache=True)
-def _rail(x, y, rail, rail_irr, rail_map, rail_range):
+def _rail(x, y, surf):
     """(N, N_x, N_y) at main-frame (x, y), y clipped to the rail's range."""
-    yc = min(max(y, rail_range[0]), rail_range[1])
-    n, n_y, _ = _table(yc, rail[0], rail[1], rail[2], rail[3], rail[4])
-    if rail_irr.shape[0] > 0:
-        v, vx, vy, _, _, _ = rail_irregularity(x, yc, rail_irr, rail_map[0], rail_map[1])
+    yc = min(max(y, surf.rail_range[0]), surf.rail_range[1])
+    n, n_y, _ = _table(yc, *surf.rail)
+    if surf.rail_irr.shape[0] > 0:
+        v, vx, vy, _, _, _ = rail_irregularity(x, yc, surf.rail_irr, surf.rail_map[0], surf.rail_map[1])
         return n + v, vx, n_y + vy
     return n, 0.0, n_y
 
 
 @njit(cache=True)
-def contact_locus(lats, alpha_start, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, right,
-                  iterations, alpha, point, gap, rail_z, angle):  # fmt: skip
-    """Fill alpha, point (n, 3), gap, rail_z, angle for the wheel parameters ``lats`` (see the module docstring)."""
-    w = np.empty(18)
+def contact_locus(lats, alpha_start, rot, centre, surf, right, iterations, out):
+    """Fill the :class:`Locus` ``out`` for the wheel parameters ``lats`` (see the module docstring) of the wheelset
+    pose (C_D ``rot``, ``centre``) on the surfaces ``surf`` (_search_kernels.Surfaces) of the left or the ``right``
+    side, Newton from alpha_start.
+    """
+    alpha, point, gap, rail_z, angle = out
+    rail_range = surf.rail_range
+    w = np.empty(W_LEN)
     a = alpha_start
     for k in range(lats.shape[0]):
         y = lats[k]
         if not math.isfinite(a) or abs(a - alpha_start) > 0.2:
             a = alpha_start
         for _ in range(iterations):  # from the neighbour's angle: one or two steps suffice
-            _wheel(a, y, rot, centre, wheel, wheel_irr, w)
-            f = w[5] * w[7] - w[8] * w[4]
-            df = w[11] * w[7] + w[5] * w[13] - w[14] * w[4] - w[8] * w[10]
+            _wheel(a, y, rot, centre, surf, w)
+            # f = t_a,z t_y,y - t_y,z t_a,y and its derivative along alpha
+            ta_y, ta_z, ty_y, ty_z = w[W_T_ALPHA + 1], w[W_T_ALPHA + 2], w[W_T_Y + 1], w[W_T_Y + 2]
+            f = ta_z * ty_y - ty_z * ta_y
+            df = w[W_X_AA + 2] * ty_y + ta_z * w[W_X_AY + 1] - w[W_X_AY + 2] * ta_y - ty_z * w[W_X_AA + 1]
             if not abs(df) > 1e-12:
                 break
             step = min(max(f / df, -0.05), 0.05)
             a -= step
             if abs(step) < 1e-13:
                 break
-        _wheel(a, y, rot, centre, wheel, wheel_irr, w)
+        _wheel(a, y, rot, centre, surf, w)
         alpha[k] = a
         point[k, 0], point[k, 1], point[k, 2] = w[0], w[1], w[2]
         if not (w[1] >= rail_range[0] and w[1] <= rail_range[1]) or not math.isfinite(w[2]):
             gap[k], rail_z[k], angle[k] = math.inf, math.nan, math.nan
             continue
-        n, n_x, n_y = _rail(w[0], w[1], rail, rail_irr, rail_map, rail_range)
+        n, n_x, n_y = _rail(w[0], w[1], surf)
         if not math.isfinite(n):
             gap[k], rail_z[k], angle[k] = math.inf, math.nan, math.nan
             continue
@@ -95,12 +153,14 @@ def contact_locus(lats, alpha_start, rot, centre, wheel, wheel_irr, rail, rail_i
 
 
 @njit(cache=True)
-def plane_gap(xs, ys, origin, frame, loc_y, loc_lat, loc_alpha, loc_x, rot, centre, wheel, wheel_irr, rail, rail_irr,
-              rail_map, rail_range, y_range, iterations, gap, alpha_out, lat_out):  # fmt: skip
-    """Fill gap, alpha_out, lat_out at the plane points (xs[k], ys[k]) (see the module docstring); loc_* is the
-    locus sorted by its main-frame y (start values).
+def plane_gap(xs, ys, origin, frame, starts, rot, centre, surf, iterations, out):
+    """Fill the :class:`PlaneGap` ``out`` at the plane points (xs[k], ys[k]) of the plane (origin, frame: columns
+    e_x, e_y, n) (see the module docstring); ``starts``: the :class:`SortedLocus` (start values).
     """
-    w = np.empty(18)
+    loc_y, loc_lat, loc_alpha, loc_x = starts
+    gap, alpha_out, lat_out = out
+    rail_range, y_range = surf.rail_range, surf.y_range
+    w = np.empty(W_LEN)
     ex0, ex1, ex2 = frame[0, 0], frame[1, 0], frame[2, 0]
     ey0, ey1, ey2 = frame[0, 1], frame[1, 1], frame[2, 1]
     n0, n1, n2 = frame[0, 2], frame[1, 2], frame[2, 2]
@@ -113,7 +173,7 @@ def plane_gap(xs, ys, origin, frame, loc_y, loc_lat, loc_alpha, loc_x, rot, cent
         ok = False
         for _ in range(iterations + 4):
             px, py, pz = b0 + t * n0, b1 + t * n1, b2 + t * n2
-            big_n, n_x, n_y = _rail(px, py, rail, rail_irr, rail_map, rail_range)
+            big_n, n_x, n_y = _rail(px, py, surf)
             f = pz - big_n
             slope = n2 - n_x * n0 - n_y * n1
             if abs(slope) < 1e-3:
@@ -130,20 +190,20 @@ def plane_gap(xs, ys, origin, frame, loc_y, loc_lat, loc_alpha, loc_x, rot, cent
         # wheel: start at the locus point of the same track y
         lat = np.interp(b1, loc_y, loc_lat)
         a = np.interp(b1, loc_y, loc_alpha)
-        r = _wheel(a, lat, rot, centre, wheel, wheel_irr, w)
+        r = _wheel(a, lat, rot, centre, surf, w)
         a += (b0 - np.interp(b1, loc_y, loc_x)) / r
-        _wheel(a, lat, rot, centre, wheel, wheel_irr, w)
+        _wheel(a, lat, rot, centre, surf, w)
         s = n0 * (w[0] - b0) + n1 * (w[1] - b1) + n2 * (w[2] - b2)
         converged = False
         for _ in range(iterations):
-            _wheel(a, lat, rot, centre, wheel, wheel_irr, w)
+            _wheel(a, lat, rot, centre, surf, w)
             f0, f1, f2 = w[0] - b0 - s * n0, w[1] - b1 - s * n1, w[2] - b2 - s * n2
             if math.sqrt(f0 * f0 + f1 * f1 + f2 * f2) < 1e-12:
                 converged = True
                 break
             # J = [t_a, t_y, -n] (columns); solve J d = -f by Cramer's rule
-            a0, a1, a2 = w[3], w[4], w[5]
-            c0, c1, c2 = w[6], w[7], w[8]
+            a0, a1, a2 = w[W_T_ALPHA], w[W_T_ALPHA + 1], w[W_T_ALPHA + 2]
+            c0, c1, c2 = w[W_T_Y], w[W_T_Y + 1], w[W_T_Y + 2]
             m0, m1, m2 = -n0, -n1, -n2
             det = a0 * (c1 * m2 - c2 * m1) - c0 * (a1 * m2 - a2 * m1) + m0 * (a1 * c2 - a2 * c1)
             if det == 0.0 or not math.isfinite(det):
@@ -154,7 +214,7 @@ def plane_gap(xs, ys, origin, frame, loc_y, loc_lat, loc_alpha, loc_x, rot, cent
             ds = (a0 * (c1 * r2 - c2 * r1) - c0 * (a1 * r2 - a2 * r1) + r0 * (a1 * c2 - a2 * c1)) / det
             a, lat, s = a + da, lat + dl, s + ds
         if not converged:
-            _wheel(a, lat, rot, centre, wheel, wheel_irr, w)
+            _wheel(a, lat, rot, centre, surf, w)
             f0, f1, f2 = w[0] - b0 - s * n0, w[1] - b1 - s * n1, w[2] - b2 - s * n2
             converged = math.sqrt(f0 * f0 + f1 * f1 + f2 * f2) < 1e-10
         if converged and lat >= y_range[0] and lat <= y_range[1]:
@@ -164,21 +224,20 @@ def plane_gap(xs, ys, origin, frame, loc_y, loc_lat, loc_alpha, loc_x, rot, cent
 
 
 @njit(cache=True)
-def _vertical_gap(a, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w):
+def _vertical_gap(a, y, rot, centre, surf, w):
     """Vertical gap N(x, y) - z of the wheel point (a, y_d) (filled into w); +inf off the rail."""
-    _wheel(a, y, rot, centre, wheel, wheel_irr, w)
-    if not (w[1] >= rail_range[0] and w[1] <= rail_range[1]) or not math.isfinite(w[2]):
+    _wheel(a, y, rot, centre, surf, w)
+    if not (w[1] >= surf.rail_range[0] and w[1] <= surf.rail_range[1]) or not math.isfinite(w[2]):
         return math.inf
-    n, _, _ = _rail(w[0], w[1], rail, rail_irr, rail_map, rail_range)
+    n, _, _ = _rail(w[0], w[1], surf)
     if not math.isfinite(n):
         return math.inf
     return n - w[2]
 
 
 @njit(cache=True)
-def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_points, rot, centre, wheel,
-                       wheel_irr, rail, rail_irr, rail_map, rail_range, right, alpha, point, gap, rail_z, angle,
-                       weight, weighted_x, overlap_x):  # fmt: skip
+def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_points, rot, centre, surf, right, out,
+                       line):  # fmt: skip
     """Contact locus of an out-of-round wheel: for each y_d the wheel angle of the smallest vertical gap, found by
     a scan of ``scan_points`` angles over alpha_start +- half_window and golden-section refinement (no assumption
     of one stationary point: a flat has two lowest points along x and a hump between), and the squared
@@ -189,9 +248,12 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
     by the trapezoidal rule on ``integration_points`` points over the overlap found by the scan (widened by one
     scan step on each side); overlap_x[k] = the x range where g < 0, its ends interpolated linearly between the
     integration points (nan, nan without interpenetration).
-    Fills alpha, point, gap, rail_z, angle like :func:`contact_locus`.
+    Fills the :class:`Locus` ``out`` like :func:`contact_locus` and the :class:`OverlapLine` ``line`` (weight,
+    weighted_x, overlap_x).
     """
-    w = np.empty(18)
+    alpha, point, gap, rail_z, angle = out
+    weight, weighted_x, overlap_x = line
+    w = np.empty(W_LEN)
     golden = 0.5 * (math.sqrt(5.0) - 1.0)
     step = 2.0 * half_window / (scan_points - 1)
     g_scan = np.empty(scan_points)
@@ -201,7 +263,7 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
         first, last = -1, -1
         for i in range(scan_points):
             a = alpha_start - half_window + i * step
-            g = _vertical_gap(a, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+            g = _vertical_gap(a, y, rot, centre, surf, w)
             g_scan[i] = g
             if g < best:
                 best, kbest = g, i
@@ -210,7 +272,7 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
                     first = i
                 last = i
         if kbest < 0:
-            _wheel(alpha_start, y, rot, centre, wheel, wheel_irr, w)
+            _wheel(alpha_start, y, rot, centre, surf, w)
             alpha[k] = alpha_start
             point[k, 0], point[k, 1], point[k, 2] = w[0], w[1], w[2]
             gap[k], rail_z[k], angle[k] = math.inf, math.nan, math.nan
@@ -222,27 +284,27 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
         hi = alpha_start - half_window + min(kbest + 1, scan_points - 1) * step
         c1 = hi - golden * (hi - lo)
         c2 = lo + golden * (hi - lo)
-        g1 = _vertical_gap(c1, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
-        g2 = _vertical_gap(c2, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+        g1 = _vertical_gap(c1, y, rot, centre, surf, w)
+        g2 = _vertical_gap(c2, y, rot, centre, surf, w)
         for _ in range(30):
             if g1 <= g2:
                 hi, c2, g2 = c2, c1, g1
                 c1 = hi - golden * (hi - lo)
-                g1 = _vertical_gap(c1, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+                g1 = _vertical_gap(c1, y, rot, centre, surf, w)
             else:
                 lo, c1, g1 = c1, c2, g2
                 c2 = lo + golden * (hi - lo)
-                g2 = _vertical_gap(c2, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+                g2 = _vertical_gap(c2, y, rot, centre, surf, w)
         a_min = 0.5 * (lo + hi)
-        g_min = _vertical_gap(a_min, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+        g_min = _vertical_gap(a_min, y, rot, centre, surf, w)
         if g_scan[kbest] < g_min:
             a_min = alpha_start - half_window + kbest * step
-            g_min = _vertical_gap(a_min, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+            g_min = _vertical_gap(a_min, y, rot, centre, surf, w)
         alpha[k] = a_min
         point[k, 0], point[k, 1], point[k, 2] = w[0], w[1], w[2]
         gap[k] = g_min
         if math.isfinite(g_min):
-            n, n_x, n_y = _rail(w[0], w[1], rail, rail_irr, rail_map, rail_range)
+            n, n_x, n_y = _rail(w[0], w[1], surf)
             rail_z[k] = n
             norm = math.sqrt(n_x * n_x + n_y * n_y + 1.0)
             tilt = -n_y / norm if right else n_y / norm
@@ -263,7 +325,7 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
         x_prev, c_prev, g_prev = math.nan, 0.0, math.nan
         x_lo, x_hi = math.inf, -math.inf
         for i in range(integration_points):
-            g = _vertical_gap(a_lo + i * h, y, rot, centre, wheel, wheel_irr, rail, rail_irr, rail_map, rail_range, w)
+            g = _vertical_gap(a_lo + i * h, y, rot, centre, surf, w)
             c = -g if g < 0.0 else 0.0
             x = w[0]
             if c > 0.0:

@@ -18,17 +18,58 @@ rigid_dynamics.geometry.irregularities; an empty array is the ideal surface):
   |wrap(a - a0)| <= theta/2;
 * rail, code 0, corrugation: [0, k = 2 pi / lambda, A, phi, y_c, b, t]: N_irr = A cos(k x + phi) w(y_r), w the
   C2 lateral band (1 - quintic smooth step of (|y_r - y_c| - b) / t).
+
+The columns of a row are named below (IRR_CODE, then the code's parameters: POLYGON_*, FLAT_*, CHORD_*,
+CORRUGATION_*). One side's surfaces travel as the record :class:`Surfaces` (the tables, the irregularity rows, the
+rail's lateral map and both lateral ranges), the same record for every compiled contact kernel (the search here,
+_patch_kernels, _gap_kernels).
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 _FAR = 0.05  # |h| beyond this (m) is not a contact candidate (another branch of the rail, or far away)
 _ROOT_RESIDUAL = 1.0e-15  # m: a vertical residual this small ends Newton's iterations on h (round-off ~1e-16 m)
+
+# --- the columns of an irregularity row (module docstring) ---------------------------------------------------------
+IRR_CODE = 0
+"""The row's code: wheel POLYGON, ROUNDED_FLAT, CHORD_FLAT; rail CORRUGATION (its only code)."""
+POLYGON, ROUNDED_FLAT, CHORD_FLAT = range(3)
+CORRUGATION = 0
+POLYGON_ORDER, POLYGON_AMPLITUDE, POLYGON_PHASE = range(1, 4)
+"""Harmonic out-of-roundness: order n, amplitude A (m), phase phi (rad)."""
+FLAT_ANGLE, FLAT_RADIUS, FLAT_LENGTH, FLAT_DEPTH = range(1, 5)
+"""Rounded flat: centre angle a0 (rad), wheel radius r_w, length L and depth d (m)."""
+CHORD_ANGLE, CHORD_RADIUS, CHORD_DEPTH, CHORD_HALF_ANGLE = range(1, 5)
+"""New (chord) flat: centre angle a0 (rad), wheel radius r_w and depth d (m), half angle theta/2 (rad)."""
+(
+    CORRUGATION_WAVENUMBER, CORRUGATION_AMPLITUDE, CORRUGATION_PHASE, CORRUGATION_CENTRE, CORRUGATION_HALF_WIDTH,
+    CORRUGATION_TAPER,
+) = range(1, 7)  # fmt: skip
+"""Rail corrugation: k = 2 pi / lambda (1/m), amplitude A (m), phase phi (rad), band centre y_c, half width b and
+taper t of the lateral band (m, rail frame)."""
+IRR_COLUMNS = 7
+
+
+class Surfaces(NamedTuple):
+    """One side's tabulated surfaces, as every compiled contact kernel takes them: the ``wheel`` and ``rail`` tables
+    (lower, step, values, slopes x step, curvatures; search._LateralTable), the irregularity rows (k, IRR_COLUMNS)
+    of each (module docstring; (0, IRR_COLUMNS): ideal), the rail's lateral map (sign, offset: y_r = sign y -
+    offset), and the wheel's (y_d) and the rail's (main-frame y) lateral ranges (2,), m.
+    """
+
+    wheel: tuple
+    rail: tuple
+    wheel_irr: np.ndarray
+    rail_irr: np.ndarray
+    rail_map: np.ndarray
+    y_range: np.ndarray
+    rail_range: np.ndarray
 
 
 @njit(cache=True, _nrt=False)
@@ -59,26 +100,26 @@ def wheel_irregularity(alpha, irr):
     """(R_irr, dR_irr/da, d2R_irr/da2) of the rows of ``irr`` at the angle alpha (module docstring)."""
     v, va, vaa = 0.0, 0.0, 0.0
     for k in range(irr.shape[0]):
-        code = irr[k, 0]
-        if code == 0.0:
-            n, amp = irr[k, 1], irr[k, 2]
-            arg = n * alpha + irr[k, 3]
+        code = irr[k, IRR_CODE]
+        if code == POLYGON:
+            n, amp = irr[k, POLYGON_ORDER], irr[k, POLYGON_AMPLITUDE]
+            arg = n * alpha + irr[k, POLYGON_PHASE]
             c = amp * math.cos(arg)
             v += c
             va -= amp * n * math.sin(arg)
             vaa -= n * n * c
-        elif code == 1.0:
-            da = _wrap_pi(alpha - irr[k, 1])
-            r_w, length, depth = irr[k, 2], irr[k, 3], irr[k, 4]
+        elif code == ROUNDED_FLAT:
+            da = _wrap_pi(alpha - irr[k, FLAT_ANGLE])
+            r_w, length, depth = irr[k, FLAT_RADIUS], irr[k, FLAT_LENGTH], irr[k, FLAT_DEPTH]
             s = r_w * da
             if abs(s) <= 0.5 * length:
                 wave = 2.0 * math.pi / length
                 v -= 0.5 * depth * (1.0 + math.cos(wave * s))
                 va += 0.5 * depth * wave * r_w * math.sin(wave * s)
                 vaa += 0.5 * depth * (wave * r_w) ** 2 * math.cos(wave * s)
-        else:
-            da = _wrap_pi(alpha - irr[k, 1])
-            r_w, depth, half = irr[k, 2], irr[k, 3], irr[k, 4]
+        else:  # CHORD_FLAT
+            da = _wrap_pi(alpha - irr[k, CHORD_ANGLE])
+            r_w, depth, half = irr[k, CHORD_RADIUS], irr[k, CHORD_DEPTH], irr[k, CHORD_HALF_ANGLE]
             if abs(da) <= half:
                 f = (r_w - depth) / math.cos(da)
                 t = math.tan(da)
@@ -94,7 +135,8 @@ def rail_irregularity(x, y, irr, sign, offset):
     v, vx, vy, vxx, vxy, vyy = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     y_r = sign * y - offset
     for k in range(irr.shape[0]):
-        wave, amp, phase, y_c, half, taper = irr[k, 1], irr[k, 2], irr[k, 3], irr[k, 4], irr[k, 5], irr[k, 6]
+        wave, amp, phase = irr[k, CORRUGATION_WAVENUMBER], irr[k, CORRUGATION_AMPLITUDE], irr[k, CORRUGATION_PHASE]
+        y_c, half, taper = irr[k, CORRUGATION_CENTRE], irr[k, CORRUGATION_HALF_WIDTH], irr[k, CORRUGATION_TAPER]
         u = y_r - y_c
         xi = (abs(u) - half) / taper
         if xi <= 0.0:
@@ -116,24 +158,25 @@ def rail_irregularity(x, y, irr, sign, offset):
 
 
 @njit(cache=True, _nrt=False)
-def _checked_root(h, py, pz, rail, rail_range, rail_irr_value):
+def _checked_root(h, py, pz, surf, rail_irr_value):
     """Return h after Newton's iterations on the rail, or +inf: outside the rail, beyond _FAR, or not converged (the
     normal leaves the rail before meeting it: residual above 1e-10 m).
     """
-    if not (py >= rail_range[0] and py <= rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
+    if not (py >= surf.rail_range[0] and py <= surf.rail_range[1]) or not math.isfinite(h) or abs(h) > _FAR:
         return math.inf
-    big_n = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])[0] + rail_irr_value
+    big_n = _table(py, *surf.rail)[0] + rail_irr_value
     if not abs(pz - big_n) < 1e-10:
         return math.inf
     return h
 
 
 @njit(cache=True, _nrt=False)
-def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, h_start=0.0):
+def _distance_ideal(alpha, y, rot, centre, surf, iterations, h_start=0.0):
     """h(alpha, y) on ideal surfaces (no irregularity rows): the irregular kernel's arithmetic with R_a = N_x = 0."""
-    if y < y_range[0] or y > y_range[1]:
+    if y < surf.y_range[0] or y > surf.y_range[1]:
         return math.inf
-    r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
+    rail, rail_range = surf.rail, surf.rail_range
+    r, r_y, _ = _table(y, *surf.wheel)
     if not math.isfinite(r):
         return math.inf
     ca, sa = math.cos(alpha), math.sin(alpha)
@@ -161,7 +204,7 @@ def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, ite
             py = rail_range[0]
         elif py > rail_range[1]:
             py = rail_range[1]
-        big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
+        big_n, n_y, _ = _table(py, *rail)
         f = p2 + h * n2 - big_n
         if inside and abs(f) < _ROOT_RESIDUAL:  # h exact to round-off already
             return h if abs(h) <= _FAR else math.inf
@@ -172,22 +215,21 @@ def _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, ite
         h -= step
         if abs(step) < 1e-13:
             break
-    return _checked_root(h, p1 + h * n1, p2 + h * n2, rail, rail_range, 0.0)
+    return _checked_root(h, p1 + h * n1, p2 + h * n2, surf, 0.0)
 
 
 @njit(cache=True, _nrt=False)
-def _distance_irregular(
-    alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map, h_start=0.0
-):
+def _distance_irregular(alpha, y, rot, centre, surf, iterations, h_start=0.0):
     """h(alpha, y) for one wheel point; +inf outside the surfaces or beyond _FAR. Newton's method on h starts
     from h_start (a nearby point's h saves iterations; the converged root is the same).
     """
-    if y < y_range[0] or y > y_range[1]:
+    if y < surf.y_range[0] or y > surf.y_range[1]:
         return math.inf
-    r, r_y, _ = _table(y, wheel[0], wheel[1], wheel[2], wheel[3], wheel[4])
+    rail, rail_range, rail_irr, rail_map = surf.rail, surf.rail_range, surf.rail_irr, surf.rail_map
+    r, r_y, _ = _table(y, *surf.wheel)
     if not math.isfinite(r):
         return math.inf
-    v, r_a, _ = wheel_irregularity(alpha, wheel_irr)
+    v, r_a, _ = wheel_irregularity(alpha, surf.wheel_irr)
     r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
     xd0, xd1, xd2 = r * ca, y, r * sa
@@ -215,7 +257,7 @@ def _distance_irregular(
             py = rail_range[0]
         elif py > rail_range[1]:
             py = rail_range[1]
-        big_n, n_y, _ = _table(py, rail[0], rail[1], rail[2], rail[3], rail[4])
+        big_n, n_y, _ = _table(py, *rail)
         v, n_x, vy, _, _, _ = rail_irregularity(p0 + h * n0, py, rail_irr, rail_map[0], rail_map[1])
         big_n, n_y = big_n + v, n_y + vy
         f = p2 + h * n2 - big_n
@@ -234,76 +276,52 @@ def _distance_irregular(
         h,
         py,
         p2 + h * n2,
-        rail,
-        rail_range,
+        surf,
         rail_irregularity(x, py, rail_irr, rail_map[0], rail_map[1])[0] if rail_irr.shape[0] > 0 else 0.0,
     )
 
 
 @njit(cache=True, _nrt=False)
-def distance(
-    alpha, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, h_start=0.0
-):
-    """h(alpha, y): the ideal kernel when there are no irregularity rows, else the irregular one."""
-    if wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0:
-        return _distance_ideal(alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, h_start)
-    return _distance_irregular(
-        alpha, y, rot, centre, wheel, rail, y_range, rail_range, iterations, wheel_irr, rail_irr, rail_map, h_start
-    )
+def _ideal(surf):
+    """Whether the surfaces have no irregularity rows (the ideal kernel serves them)."""
+    return surf.wheel_irr.shape[0] == 0 and surf.rail_irr.shape[0] == 0
+
+
+@njit(cache=True, _nrt=False)
+def distance(alpha, y, rot, centre, surf, iterations, h_start=0.0):
+    """h(alpha, y) of the wheelset pose (C_D ``rot`` (3, 3), ``centre`` (3,), m) on the :class:`Surfaces` ``surf``
+    with ``iterations`` Newton steps on h: the ideal kernel when there are no irregularity rows, else the irregular
+    one.
+    """
+    if _ideal(surf):
+        return _distance_ideal(alpha, y, rot, centre, surf, iterations, h_start)
+    return _distance_irregular(alpha, y, rot, centre, surf, iterations, h_start)
 
 
 @njit(cache=True)
-def distance_grid(alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations):
-    """H on the grid alphas x ys, shape (len(alphas), len(ys))."""
+def distance_grid(alphas, ys, rot, centre, surf, iterations):
+    """H on the grid alphas x ys, shape (len(alphas), len(ys)) (:func:`distance`)."""
     out = np.empty((alphas.shape[0], ys.shape[0]))
-    ideal = wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0
+    ideal = _ideal(surf)
     for i in range(alphas.shape[0]):
         for j in range(ys.shape[0]):
             if ideal:
-                out[i, j] = _distance_ideal(alphas[i], ys[j], rot, centre, wheel, rail, y_range, rail_range, iterations)
+                out[i, j] = _distance_ideal(alphas[i], ys[j], rot, centre, surf, iterations)
             else:
-                out[i, j] = _distance_irregular(
-                    alphas[i],
-                    ys[j],
-                    rot,
-                    centre,
-                    wheel,
-                    rail,
-                    y_range,
-                    rail_range,
-                    iterations,
-                    wheel_irr,
-                    rail_irr,
-                    rail_map,
-                )
+                out[i, j] = _distance_irregular(alphas[i], ys[j], rot, centre, surf, iterations)
     return out
 
 
 @njit(cache=True)
-def distance_points(
-    alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations
-):
-    """H at the points (alphas[k], ys[k])."""
+def distance_points(alphas, ys, rot, centre, surf, iterations):
+    """H at the points (alphas[k], ys[k]) (:func:`distance`)."""
     out = np.empty(alphas.shape[0])
-    ideal = wheel_irr.shape[0] == 0 and rail_irr.shape[0] == 0
+    ideal = _ideal(surf)
     for k in range(alphas.shape[0]):
         if ideal:
-            out[k] = _distance_ideal(alphas[k], ys[k], rot, centre, wheel, rail, y_range, rail_range, iterations)
+            out[k] = _distance_ideal(alphas[k], ys[k], rot, centre, surf, iterations)
         else:
-            out[k] = _distance_irregular(
-                alphas[k],
-                ys[k],
-                rot,
-                centre,
-                wheel,
-                rail,
-                y_range,
-                rail_range,
-                iterations,
-                wheel_irr,
-                rail_irr,
-                rail_map,
-            )
+            out[k] = _distance_irregular(alphas[k], ys[k], rot, centre, surf, iterations)
     return out
 
 
@@ -355,18 +373,18 @@ def _descent_length(a, y, g_a, g_y, h0, args, hs, radius, y_range):
 
 
 @njit(cache=True, _nrt=False)
-def refine_point(
-    a, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
-    max_iter, tol, fixed_alpha,
-):  # fmt: skip
-    """Damped Newton on h(alpha, y) from one start (central differences, 9 points).
+def refine_point(a, y, rot, centre, surf, iterations, radius, max_iter, tol, fixed_alpha):
+    """Damped Newton on h(alpha, y) from one start (central differences, 9 points; :func:`distance`'s arguments,
+    the wheel radius (m, scales the angle steps), at most ``max_iter`` steps, converged below a step of ``tol`` m;
+    ``fixed_alpha``: along y alone).
 
     Returns (alpha, y, converged, h near the point (a start for its distance), and the last difference Hessian
     h_aa, h_yy, h_ay in m/m^2, derivatives by arc length a r and y).
     """
     d = 1.0e-5  # m, difference step in arc length
     da = d / radius
-    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations)
+    args = (rot, centre, surf, iterations)
+    y_range = surf.y_range
     h_aa = h_yy = h_ay = math.nan
     hs = 0.0
     for _ in range(max_iter):
@@ -419,21 +437,15 @@ def refine_point(
 
 
 @njit(cache=True)
-def refine(
-    alphas, ys, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations, radius,
-    max_iter, tol, fixed_alpha,
-):  # fmt: skip
+def refine(alphas, ys, rot, centre, surf, iterations, radius, max_iter, tol, fixed_alpha):
     """refine_point from each start; returns (alpha, y, h, converged)."""
     k_max = alphas.shape[0]
     out_a, out_y, out_h = alphas.copy(), ys.copy(), np.empty(k_max)
     converged = np.zeros(k_max, dtype=np.bool_)
     for k in range(k_max):
         a, y, ok, hs, _, _, _ = refine_point(
-            out_a[k], out_y[k], rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map,
-            iterations, radius, max_iter, tol, fixed_alpha,
-        )  # fmt: skip
-        out_a[k], out_y[k], converged[k] = a, y, ok
-        out_h[k] = distance(
-            a, y, rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iterations
+            out_a[k], out_y[k], rot, centre, surf, iterations, radius, max_iter, tol, fixed_alpha
         )
+        out_a[k], out_y[k], converged[k] = a, y, ok
+        out_h[k] = distance(a, y, rot, centre, surf, iterations)
     return out_a, out_y, out_h, converged

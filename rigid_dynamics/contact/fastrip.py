@@ -44,6 +44,7 @@ Symbols: a, b semi-axes (m), p0 (Pa), xi, eta (-), phi (1/m), mu (-), G (Pa), t 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -52,6 +53,20 @@ from rigid_dynamics.contact.fastsim import effective_flexibilities
 from rigid_dynamics.contact.kalker import kalker_coefficients
 from rigid_dynamics.contact.models import HertzianModel
 from rigid_dynamics.contact.options import Option, declare
+
+
+class StripTheory(NamedTuple):
+    """The strip theory's data of one patch (module docstring): the semi-axis a along rolling (m; KPEC's patch: its
+    equivalent ellipse's), p0 = 3 F_N/(2 pi a b) (Pa), Poisson's ratio nu and the non-dimensional creepages xi',
+    eta', phi' (:func:`strip_creepages`).
+    """
+
+    semi_axis_long_m: float
+    max_pressure_Pa: float
+    poisson_ratio: float
+    xi_s: float
+    eta_s: float
+    phi_s: float
 
 
 @njit(cache=True, inline="always")
@@ -73,15 +88,21 @@ def _circle_integral(radius, centre, x1, x2):
 
 
 @njit(cache=True)
-def _fastrip_strips(a, b, p0, mu, nu, xi_s, eta_s, phi_s, l1, l2, l3, xi, eta, phi, nx, ny, px_out, py_out, slip_out):
+def _fastrip_strips(strip, b, creep, flexibilities, traction):
     """FaStrip on Kalker's strip layout (module docstring); returns (Fx, Fy, Mz, slip fraction).
 
-    ``xi_s, eta_s, phi_s``: the strip theory's non-dimensional creepages; ``xi, eta, phi``: the creepages
-    (FASTSIM pass with flexibilities l1, l2, l3 in m/Pa). The tractions are integrated exactly over each element
-    (closed form of the square roots, split at the adhesion/slip boundary), so the element values are element
-    means. Fills px_out, py_out (Pa) and slip_out (element mostly in the slip zone) of shape (ny, nx), element k
-    of strip j at x = a_y - (k + 1/2) 2 a_y/nx.
+    ``strip``: the :class:`StripTheory` (a, p0, nu and the non-dimensional creepages xi_s, eta_s, phi_s); ``b``:
+    the lateral semi-axis, m; ``creep`` = (mu, xi, eta, phi): friction and the creepages (FASTSIM pass with
+    ``flexibilities`` = (l1, l2, l3) in m/Pa; the tuples of kpec.fastsim_strips). The tractions are integrated
+    exactly over each element (closed form of the square roots, split at the adhesion/slip boundary), so the
+    element values are element means. Fills ``traction`` = (px_out, py_out (Pa), slip_out (element mostly in the
+    slip zone)) of shape (ny, nx), element k of strip j at x = a_y - (k + 1/2) 2 a_y/nx.
     """
+    a, p0, nu, xi_s, eta_s, phi_s = strip
+    mu, xi, eta, phi = creep
+    l1, l2, l3 = flexibilities
+    px_out, py_out, slip_out = traction
+    ny, nx = px_out.shape
     fx = 0.0
     fy = 0.0
     mz = 0.0
@@ -244,10 +265,10 @@ def fastrip(
     px = np.zeros((ny, nx))
     py = np.zeros((ny, nx))
     slip = np.zeros((ny, nx), dtype=np.bool_)
+    strip = StripTheory(a, float(p0), float(poisson_ratio), float(xi_s), float(eta_s), float(phi_s))
     fx, fy, mz, frac = _fastrip_strips(
-        a, b, p0, friction_coefficient, poisson_ratio, xi_s, eta_s, phi_s,
-        float(l1), float(l2), float(l3), xi, eta, phi, int(nx), int(ny), px, py, slip,
-    )  # fmt: skip
+        strip, b, (float(friction_coefficient), xi, eta, phi), (float(l1), float(l2), float(l3)), (px, py, slip)
+    )
     return (sign * fx, fy, sign * mz, frac), sign * px, py, slip
 
 

@@ -464,11 +464,11 @@ def fastsim_strips(normal, grid, creep, flexibilities, traction):
 
 
 @njit(cache=True)
-def fastrip_strips(
-    pressure, in_contact, x, y, mu, nu, a, p0, xi_s, eta_s, phi_s, xi, eta, phi, l1, l2, l3, tx, ty, in_slip
-):  # fmt: skip
+def fastrip_strips(normal, grid, creep, flexibilities, traction, strip):
     """FaStrip per strip on the KPEC patch (CONTACT's "modified FaStrip", M = 5; Sichani, Enblom, Berg, VSD 54
-    (2016) 748-764; strip theory as :mod:`.fastrip`'s docstring): fills tx, ty (Pa), in_slip; returns (Fx, Fy, Mz).
+    (2016) 748-764; strip theory as :mod:`.fastrip`'s docstring): :func:`fastsim_strips`'s arguments and the
+    strip theory's data ``strip`` (:class:`~.fastrip.StripTheory`: a and p0 of the equivalent ellipse, nu, xi',
+    eta', phi'); fills traction = (tx, ty Pa, in_slip); returns (Fx, Fy, Mz).
 
     First the FASTSIM pass of :func:`fastsim_strips` (its tractions give the slip directions). Then per row j with
     contact from x_s to x_e (element edges; half-length a_j, middle x_m): with the strip creepages xi', eta', phi'
@@ -485,7 +485,12 @@ def fastrip_strips(
     make the small-creepage force converge slowly: 5 % off Kalker's linear theory at 160 elements per side, against
     0.5 % at 40-160 here).
     """
-    fastsim_strips((pressure, in_contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, in_slip))
+    fastsim_strips(normal, grid, creep, flexibilities, traction)
+    pressure, in_contact = normal
+    x, y = grid
+    mu = creep[0]
+    tx, ty, in_slip = traction
+    a, p0, nu, xi_s, eta_s, phi_s = strip
     ny, nx = pressure.shape
     dx = x[1] - x[0] if nx > 1 else 1.0
     dy = y[1] - y[0] if ny > 1 else 1.0

@@ -740,17 +740,16 @@ def search_side(
     if compiled:
         from rigid_dynamics.contact import _search_kernels as kern
 
-        args = (
-            geo.rot,
-            geo.centre,
-            wheel.table_tuple,
-            rail.table_tuple,
-            np.array(geo.y_range),
-            np.array(geo.rail_range),
-            wheel.irregularity_rows,
-            rail.irregularity_rows,
-            rail.lateral_map,
+        surf = kern.Surfaces(
+            wheel=wheel.table_tuple,
+            rail=rail.table_tuple,
+            wheel_irr=wheel.irregularity_rows,
+            rail_irr=rail.irregularity_rows,
+            rail_map=rail.lateral_map,
+            y_range=np.array(geo.y_range),
+            rail_range=np.array(geo.rail_range),
         )
+        args = (geo.rot, geo.centre, surf)
 
         def points(a, y, n_iter=iters):
             return kern.distance_points(np.ascontiguousarray(a, float), np.ascontiguousarray(y, float), *args, n_iter)

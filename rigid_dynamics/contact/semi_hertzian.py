@@ -136,14 +136,13 @@ class KpecModel:
         slip = np.zeros(p.shape, dtype=np.bool_)
         xi, eta, phi = creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m
         if opts["tangential"] == "fastrip":
-            from rigid_dynamics.contact.fastrip import strip_creepages
+            from rigid_dynamics.contact.fastrip import StripTheory, strip_creepages
 
             xi_s, eta_s, phi_s, p0, *_ = strip_creepages(
                 a_fl, b_fl, fn_kpec, xi, eta, phi, shear_modulus_Pa=g_mod, poisson_ratio=nu, friction_coefficient=mu
             )
-            fx, fy, mz = fastrip_strips(
-                p, contact, x, y, mu, nu, a_fl, p0, xi_s, eta_s, phi_s, xi, eta, phi, l1, l2, l3, tx, ty, slip
-            )
+            strip = StripTheory(a_fl, p0, nu, xi_s, eta_s, phi_s)
+            fx, fy, mz = fastrip_strips((p, contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, slip), strip)
         else:
             fx, fy, mz = fastsim_strips((p, contact), (x, y), (mu, xi, eta, phi), (l1, l2, l3), (tx, ty, slip))
         edge = bool(contact[0, :].any() or contact[-1, :].any() or contact[:, 0].any() or contact[:, -1].any())

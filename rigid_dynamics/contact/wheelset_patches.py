@@ -106,9 +106,8 @@ def contact_locus(geo: _SideGeometry, step_m: float = 5.0e-5, iterations: int = 
         alpha, point = np.empty(n), np.empty((n, 3))
         gap, rail_z, angle = np.empty(n), np.empty(n), np.empty(n)
         kern.contact_locus(
-            lat, alpha_start, geo.rot, geo.centre, geo.wheel.table_tuple, geo.wheel.irregularity_rows,
-            geo.rail.table_tuple, geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range),
-            geo.side == "right", iterations, alpha, point, gap, rail_z, angle,
+            lat, alpha_start, geo.rot, geo.centre, _surfaces(geo), geo.side == "right", iterations,
+            kern.Locus(alpha, point, gap, rail_z, angle),
         )  # fmt: skip
         return ContactLocus(alpha, lat, point, gap, rail_z, angle)
     alpha = np.full(n, alpha_start)
@@ -167,10 +166,10 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
         # the round wheel's locus screens the y_d that can touch
         alpha, point = np.empty(n), np.empty((n, 3))
         gap, rail_z, angle = np.empty(n), np.empty(n), np.empty(n)
-        rail_args = (geo.rail.table_tuple, geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range))
+        surf = _surfaces(geo)
         kern.contact_locus(
-            lat, alpha_start, geo.rot, geo.centre, geo.wheel.table_tuple, np.zeros((0, 7)), *rail_args,
-            geo.side == "right", 6, alpha, point, gap, rail_z, angle,
+            lat, alpha_start, geo.rot, geo.centre, surf._replace(wheel_irr=np.zeros((0, 7))), geo.side == "right", 6,
+            kern.Locus(alpha, point, gap, rail_z, angle),
         )  # fmt: skip
         turns = np.linspace(-math.pi, math.pi, 4097)
         rise = max(float(_irregularity_sum(geo.wheel.irregularities, turns, np.zeros_like(turns))[0].max()), 0.0)
@@ -183,8 +182,8 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
             out = [np.empty(k), np.empty((k, 3)), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k),
                    np.empty((k, 2))]  # fmt: skip
             kern.out_of_round_locus(
-                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, geo.rot, geo.centre,
-                geo.wheel.table_tuple, geo.wheel.irregularity_rows, *rail_args, geo.side == "right", *out,
+                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, geo.rot, geo.centre, surf,
+                geo.side == "right", kern.Locus(*out[:5]), kern.OverlapLine(*out[5:]),
             )  # fmt: skip
             for target, value in zip((alpha, point, gap, rail_z, angle, weight, weighted_x, overlap), out, strict=True):
                 target[near] = value
@@ -266,6 +265,16 @@ def _compiled(geo: _SideGeometry) -> bool:
     from rigid_dynamics.contact.search import TabulatedRail, TabulatedWheel
 
     return isinstance(geo.wheel, TabulatedWheel) and isinstance(geo.rail, TabulatedRail)
+
+
+def _surfaces(geo: _SideGeometry):
+    """The _search_kernels.Surfaces record of a side with tabulated surfaces (:func:`_compiled`)."""
+    from rigid_dynamics.contact._search_kernels import Surfaces
+
+    return Surfaces(
+        geo.wheel.table_tuple, geo.rail.table_tuple, geo.wheel.irregularity_rows, geo.rail.irregularity_rows,
+        geo.rail.lateral_map, np.array(geo.y_range), np.array(geo.rail_range),
+    )  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -384,12 +393,13 @@ def plane_gap(geo: _SideGeometry, locus: ContactLocus, origin, frame, x_m, y_m, 
 
         order = np.argsort(locus.point_m[:, 1])
         gap, alpha, lat = np.empty(x.size), np.empty(x.size), np.empty(x.size)
+        starts = kern.SortedLocus(
+            np.ascontiguousarray(locus.point_m[order, 1]), locus.lateral_m[order], locus.alpha_rad[order],
+            np.ascontiguousarray(locus.point_m[order, 0]),
+        )  # fmt: skip
         kern.plane_gap(
-            x, y, np.asarray(origin, float), np.ascontiguousarray(frame), np.ascontiguousarray(locus.point_m[order, 1]),
-            locus.lateral_m[order], locus.alpha_rad[order], np.ascontiguousarray(locus.point_m[order, 0]), geo.rot,
-            geo.centre, geo.wheel.table_tuple, geo.wheel.irregularity_rows, geo.rail.table_tuple,
-            geo.rail.irregularity_rows, geo.rail.lateral_map, np.array(geo.rail_range), np.array(geo.y_range),
-            iterations, gap, alpha, lat,
+            x, y, np.asarray(origin, float), np.ascontiguousarray(frame), starts, geo.rot, geo.centre, _surfaces(geo),
+            iterations, kern.PlaneGap(gap, alpha, lat),
         )  # fmt: skip
         return gap.reshape(shape), alpha.reshape(shape), lat.reshape(shape)
     e_x, e_y, n = frame[:, 0], frame[:, 1], frame[:, 2]

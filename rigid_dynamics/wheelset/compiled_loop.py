@@ -262,12 +262,12 @@ def _dense(y, h, kst, p, theta, out):
     nst = y.shape[0]
     for i in range(nst):
         out[i] = y[i]
-    th1 = theta
-    th2 = th1 * theta
-    th3 = th2 * theta
-    th4 = th3 * theta
     for s in range(kst.shape[0]):
-        w = h * (p[s, 0] * th1 + p[s, 1] * th2 + p[s, 2] * th3 + p[s, 3] * th4)
+        total, power = 0.0, theta  # sum_p P[s, p] theta^(p+1), left to right
+        for q in range(p.shape[1]):
+            total += p[s, q] * power
+            power *= theta
+        w = h * total
         if w != 0.0:
             for i in range(nst):
                 out[i] += w * kst[s, i]
@@ -507,7 +507,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             errs[k_out] = force_err if k_out == k_first else np.nan
             k_out += 1
             for sd in range(2):
-                if f4[sd, 0] > fmax:
+                if f4[sd, NORMAL_FORCE] > fmax:
                     return _outcome(
                         FORCE_ANOMALY, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, FORCE_ANOMALY
                     )
@@ -643,7 +643,7 @@ def rk4_run(y, t0, h, steps, run, outputs, out_start):
                 pending = np.nan
                 k_out += 1
                 for sd in range(2):
-                    if f4[sd, 0] > fmax:
+                    if f4[sd, NORMAL_FORCE] > fmax:
                         return _outcome(FORCE_ANOMALY, t, y, h, step + 1, 0, k_out, evals, 0, FORCE_ANOMALY)
                 if abs(y[Y]) > ymax:
                     return _outcome(DERAILED, t, y, h, step + 1, 0, k_out, evals, 0, DERAILED)

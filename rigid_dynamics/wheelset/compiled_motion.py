@@ -37,6 +37,12 @@ from rigid_dynamics.wheelset.state import (
 )
 from rigid_dynamics.wheelset.track import track_rates as _track_rates
 
+SPEED_ROW, XI_ROW, ETA_ROW, SPIN_ROW = range(4)
+"""Rows of :func:`patch_creepages`' output (4, n): the rolling speed V (m/s), xi, eta (-) and the spin (1/m)."""
+VERTICAL_LEFT, VERTICAL_RIGHT, LATERAL_LEFT, LATERAL_RIGHT = range(4)
+"""Entries of :func:`track_rates`' rail forces (N): vertical left, right, then (the lateral track) lateral left,
+right."""
+
 
 @njit(cache=True, _nrt=False)
 def _patch_creepages(lever, n, om, vx, vy, vz, rail_vy, rail_vz, vel, ex, ey):
@@ -80,7 +86,7 @@ def patch_creepages(lever, normal, om, v_c, rail_vy, rail_vz, frames, out):
         )
         if not speed > 0.0:
             xi = eta = spin = ex[0] = ex[1] = ex[2] = ey[0] = ey[1] = ey[2] = np.nan
-        out[0, k], out[1, k], out[2, k], out[3, k] = speed, xi, eta, spin
+        out[SPEED_ROW, k], out[XI_ROW, k], out[ETA_ROW, k], out[SPIN_ROW, k] = speed, xi, eta, spin
         for i in range(3):
             frames[k, i, 0], frames[k, i, 1], frames[k, i, 2] = ex[i], ey[i], normal[k, i]
 
@@ -269,5 +275,6 @@ def track_rates(par, y, rail_force, out):
     """:func:`_track_rates` alone (full state ``y`` with the track; rates into ``out``) under ``rail_force``
     (vertical left, right[, lateral left, right]); returns the dampers' power.
     """
-    fy0, fy1 = (rail_force[2], rail_force[3]) if rail_force.shape[0] > 2 else (0.0, 0.0)
-    return _track_rates(par, y, rail_force[0], rail_force[1], fy0, fy1, out, 0.0)
+    lateral = rail_force.shape[0] > LATERAL_LEFT
+    fy0, fy1 = (rail_force[LATERAL_LEFT], rail_force[LATERAL_RIGHT]) if lateral else (0.0, 0.0)
+    return _track_rates(par, y, rail_force[VERTICAL_LEFT], rail_force[VERTICAL_RIGHT], fy0, fy1, out, 0.0)

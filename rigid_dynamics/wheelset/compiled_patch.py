@@ -26,6 +26,10 @@ import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact._gap_kernels import (
+    BOX_X_HI,
+    BOX_X_LO,
+    BOX_Y_HI,
+    BOX_Y_LO,
     GapPatch,
     GapSurfaces,
     GridFit,
@@ -155,7 +159,7 @@ def sample_candidates(y, run, cg, field, centre):
             total += 1
         else:
             total += 1 + fitted_grid(surf, patch, fit, xs, ys, gap)
-        box[0], box[1], box[2], box[3] = xs[0], xs[-1], ys[0], ys[-1]
+        box[BOX_X_LO], box[BOX_X_HI], box[BOX_Y_LO], box[BOX_Y_HI] = xs[0], xs[-1], ys[0], ys[-1]
         angle = g[G_ELLIPSE_ANGLE]
         if not math.isfinite(angle):
             angle = 0.0

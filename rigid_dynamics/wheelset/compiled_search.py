@@ -41,6 +41,7 @@ import numpy as np
 from numba import njit
 
 from rigid_dynamics.contact._search_kernels import (
+    Surfaces,
     _table,
     distance,
     rail_irregularity,
@@ -128,11 +129,12 @@ def rotation(yaw, roll, spin, rot):
 
 
 @njit(cache=True, _nrt=False)
-def _vertical_gap(cos_a, sin_a, r_irr, y_d, rot, centre, wheel, rail, rail_range, rail_irr, rail_map):
-    """N(p_x, p_y) - p_z of the wheel point (alpha, y_d) (cos, sin of alpha and R_irr(alpha) given); +inf where
-    the wheel or the rail is not defined.
+def _vertical_gap(cos_a, sin_a, r_irr, y_d, rot, centre, surf):
+    """N(p_x, p_y) - p_z of the wheel point (alpha, y_d) (cos, sin of alpha and R_irr(alpha) given) on the
+    _search_kernels.Surfaces ``surf``; +inf where the wheel or the rail is not defined.
     """
-    r = _table(y_d, *wheel)[0]
+    rail_range, rail_irr, rail_map = surf.rail_range, surf.rail_irr, surf.rail_map
+    r = _table(y_d, *surf.wheel)[0]
     if not math.isfinite(r):
         return math.inf
     r += r_irr
@@ -141,7 +143,7 @@ def _vertical_gap(cos_a, sin_a, r_irr, y_d, rot, centre, wheel, rail, rail_range
     if not (py >= rail_range[0] and py <= rail_range[1]):
         return math.inf
     pz = rot[2, 0] * x0 + rot[2, 1] * y_d + rot[2, 2] * x2 + centre[2]
-    big_n = _table(py, *rail)[0]
+    big_n = _table(py, *surf.rail)[0]
     if rail_irr.shape[0] > 0:
         px = rot[0, 0] * x0 + rot[0, 1] * y_d + rot[0, 2] * x2 + centre[0]
         big_n += rail_irregularity(px, py, rail_irr, rail_map[0], rail_map[1])[0]
@@ -173,14 +175,14 @@ def _rot(rot, v, out):
 
 
 @njit(cache=True, _nrt=False)
-def patch_geometry(alpha, y_d, h, rot, centre, surfaces, vb, g):
+def patch_geometry(alpha, y_d, h, rot, centre, surf, right, vb, g):
     """Geometry of the patch at the refined minimum (alpha, y_d) with distance h into g (layout.GEOMETRY_FIELDS):
-    search._patch's point, normal and principal relative curvatures, on the tabulated surfaces ``surfaces`` =
-    (wheel, rail, wheel irregularities, rail irregularities, rail map, right side). vb: scratch (12, 3).
+    search._patch's point, normal and principal relative curvatures, on the tabulated surfaces ``surf``
+    (_search_kernels.Surfaces) of the left or the ``right`` side. vb: scratch (12, 3).
     """
-    wheel, rail, wheel_irr, rail_irr, rail_map, right = surfaces
-    r, r_y, r_yy = _table(y_d, *wheel)
-    v, r_a, r_aa = wheel_irregularity(alpha, wheel_irr)
+    rail_irr, rail_map = surf.rail_irr, surf.rail_map
+    r, r_y, r_yy = _table(y_d, *surf.wheel)
+    v, r_a, r_aa = wheel_irregularity(alpha, surf.wheel_irr)
     r += v
     ca, sa = math.cos(alpha), math.sin(alpha)
     loc = vb[V_LOCAL]
@@ -218,7 +220,7 @@ def patch_geometry(alpha, y_d, h, rot, centre, surfaces, vb, g):
     e2[1] = n[2] * e1[0] - n[0] * e1[2]
     e2[2] = n[0] * e1[1] - n[1] * e1[0]
     w11, w12, w22 = _tensor(t_a, t_y, x_aa, x_ay, x_yy, n, e1, e2)
-    big_n, n_y, n_yy = _table(qy, *rail)
+    big_n, n_y, n_yy = _table(qy, *surf.rail)
     _, n_x, vy, n_xx, n_xy, vyy = rail_irregularity(qx, qy, rail_irr, rail_map[0], rail_map[1])
     n_y += vy
     n_yy += vyy
@@ -314,7 +316,8 @@ def search_side(s, centre, spin, search, full, cg):
     iters, radius = int(sp[s, S_NEWTON]), sp[s, S_RADIUS]
     alpha_mid = 0.5 * math.pi - spin
     n_start = 0
-    args = (rot, centre, wheel, rail, y_range, rail_range, wheel_irr, rail_irr, rail_map, iters)
+    surf = Surfaces(wheel, rail, wheel_irr, rail_irr, rail_map, y_range, rail_range)
+    args = (rot, centre, surf, iters)
     if full:
         step = sp[s, S_SCAN]
         # y_d whose lowest point can lie over the rail: p_y = rot[1, 1] y_d + rot[1, 0] x + rot[1, 2] z + c_y with
@@ -339,7 +342,7 @@ def search_side(s, centre, spin, search, full, cg):
             hk = math.inf
             if k < n_scan:
                 yk = y0 + k * step
-                gk = _vertical_gap(cos_a, sin_a, r_irr, yk, rot, centre, wheel, rail, rail_range, rail_irr, rail_map)
+                gk = _vertical_gap(cos_a, sin_a, r_irr, yk, rot, centre, surf)
                 if gk < 0.0:
                     hk = distance(alpha_mid, yk, *args, h_start)
                     if math.isfinite(hk):
@@ -370,9 +373,8 @@ def search_side(s, centre, spin, search, full, cg):
                 if i < n_a:
                     a_i = alpha_mid + (2.0 * i / (n_a - 1) - 1.0) * half if n_a > 1 else alpha_mid
                     gk = _vertical_gap(
-                        math.cos(a_i), math.sin(a_i), wheel_irregularity(a_i, wheel_irr)[0], y_s, rot, centre, wheel,
-                        rail, rail_range, rail_irr, rail_map,
-                    )  # fmt: skip
+                        math.cos(a_i), math.sin(a_i), wheel_irregularity(a_i, wheel_irr)[0], y_s, rot, centre, surf
+                    )
                 else:
                     gk = math.inf
                 if i >= 1 and g_prev < g_prev2 and g_prev <= gk and g_prev < limit:
@@ -401,8 +403,8 @@ def search_side(s, centre, spin, search, full, cg):
         cand[j, C_MERGED] = 0.0
         if not full and mem[s, m, M_MERGED] > 0:
             # merged into a deeper candidate's region at the last scan: carried to the next scan as a warm start
-            for f in range(6):
-                cand[j, f if f < 3 else f + 1] = mem[s, m, f]
+            cand[j, C_ALPHA], cand[j, C_YD], cand[j, C_H] = mem[s, m, M_ANGLE], mem[s, m, M_YD], mem[s, m, M_H]
+            cand[j, C_H_AA], cand[j, C_H_YY], cand[j, C_H_AY] = mem[s, m, M_H_AA], mem[s, m, M_H_YY], mem[s, m, M_H_AY]
             cand[j, C_ALPHA] += alpha_mid
             cand[j, C_MARK], cand[j, C_MERGED] = -1.0, 1.0  # not a candidate of this evaluation
             continue
@@ -457,8 +459,7 @@ def search_side(s, centre, spin, search, full, cg):
                     a_t = cand[k, C_ALPHA] + t * (cand[best, C_ALPHA] - cand[k, C_ALPHA])
                     gap = _vertical_gap(
                         math.cos(a_t), math.sin(a_t), wheel_irregularity(a_t, wheel_irr)[0],
-                        cand[k, C_YD] + t * (cand[best, C_YD] - cand[k, C_YD]), rot, centre, wheel, rail, rail_range,
-                        rail_irr, rail_map,
+                        cand[k, C_YD] + t * (cand[best, C_YD] - cand[k, C_YD]), rot, centre, surf,
                     )  # fmt: skip
                     if not gap < 0:
                         inside = False
@@ -493,14 +494,14 @@ def search_side(s, centre, spin, search, full, cg):
     for i in range(min(n_kept, 2)):
         k = order[i]
         if cand[k, C_H] < 0:
-            surfaces = (wheel, rail, wheel_irr, rail_irr, rail_map, right)
-            patch_geometry(cand[k, C_ALPHA], cand[k, C_YD], cand[k, C_H], rot, centre, surfaces, vb, cg[c0 + n_patch])
+            alpha, y_d, h = cand[k, C_ALPHA], cand[k, C_YD], cand[k, C_H]
+            patch_geometry(alpha, y_d, h, rot, centre, surf, right, vb, cg[c0 + n_patch])
             n_patch += 1
     if n_patch == 2 and cg[c1, G_CONTACT_ANGLE] < cg[c0, G_CONTACT_ANGLE]:
         for f in range(N_GEO):
             cg[c0, f], cg[c1, f] = cg[c1, f], cg[c0, f]
     if n_patch == 0:
-        gap = cand[order[0], 2] if n_kept > 0 else ABSENT_GAP_M
+        gap = cand[order[0], C_H] if n_kept > 0 else ABSENT_GAP_M
         sign = sp[s, S_SIGN]
         g = cg[c0]
         g[G_APPROACH] = -gap

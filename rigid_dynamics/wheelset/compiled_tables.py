@@ -54,6 +54,7 @@ from rigid_dynamics.wheelset.layout import (
     T_ROLLING_RADIUS,
     T_WHEEL_LATERAL,
 )
+from rigid_dynamics.wheelset.state import ROLL, SPIN, YAW, X, Y, Z
 from rigid_dynamics.wheelset.track import rail_lateral_under_wheel, rail_under_wheel
 
 IRR_GRID = 81
@@ -278,7 +279,7 @@ def _table_geometry(y, par, geometry, sides, scratch, cg):
     passes = 2 if par.lateral_track > 0.5 else 1
     for sweep in range(passes):
         # a rail moved laterally by u: the wheelset at y - u relative to that rail (one look-up per side)
-        _lookup(geometry, y[1] - (0.0 if passes == 1 else (lat0 if sweep == 0 else lat1)), y[4], scratch.work)
+        _lookup(geometry, y[Y] - (0.0 if passes == 1 else (lat0 if sweep == 0 else lat1)), y[ROLL], scratch.work)
         _table_candidates(y, par, geometry.slots, sides, scratch, rails, sweep if passes == 2 else -1, cg)
 
 
@@ -289,8 +290,8 @@ def _table_candidates(y, par, slots, sides, scratch, rails, only_side, cg):
     right).
     """
     work = scratch.work
-    xc, zc = y[0], y[2]
-    sps = math.sin(y[3])
+    xc, zc = y[X], y[Z]
+    sps = math.sin(y[YAW])
     zref = par.z_ref_m
     for c in range(cg.shape[0]):
         if only_side >= 0 and sides[c] != only_side:
@@ -314,7 +315,7 @@ def _table_candidates(y, par, slots, sides, scratch, rails, only_side, cg):
             and (par.irregular_right if sides[c] == 1 else par.irregular_left) > 0
         ):
             geo = scratch.section
-            _irregularity(par, work, c, q, xc + g[G_LEVER], y[5], geo, scratch.beta_grid)
+            _irregularity(par, work, c, q, xc + g[G_LEVER], y[SPIN], geo, scratch.beta_grid)
             q = geo[I_APPROACH]
             g[G_LEVER] += geo[I_OFFSET_X]
             g[G_LEVER + 2] += geo[I_OFFSET_Z]

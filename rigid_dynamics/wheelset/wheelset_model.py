@@ -55,7 +55,14 @@ from rigid_dynamics.wheelset import compiled_rhs
 from rigid_dynamics.wheelset import track as track_model
 from rigid_dynamics.wheelset.callback import PatchCallback
 from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_FASTSIM, tables_for
-from rigid_dynamics.wheelset.compiled_motion import patch_creepages, track_rates
+from rigid_dynamics.wheelset.compiled_motion import (
+    ETA_ROW,
+    SPEED_ROW,
+    SPIN_ROW,
+    XI_ROW,
+    patch_creepages,
+    track_rates,
+)
 from rigid_dynamics.wheelset.compiled_records import law_code, model_parameters, pack
 from rigid_dynamics.wheelset.layout import (
     AUTO_PATCH_FIELDS,
@@ -134,7 +141,7 @@ def _creepages(lever, normal, omega, v_c, rail_velocity=None):
     frames = np.empty((n, 3, 3))
     out = np.empty((4, n))
     patch_creepages(lever, normal, np.asarray(omega, float), np.asarray(v_c, float), rail_vy, rail_vz, frames, out)
-    return frames, out[0], out[1], out[2], out[3]
+    return frames, out[SPEED_ROW], out[XI_ROW], out[ETA_ROW], out[SPIN_ROW]
 
 
 @dataclass(eq=False)
@@ -228,12 +235,6 @@ class WheelsetModel:
         surfaces = _patch_surfaces(scene, provider) if scene.patch_geometry == "sampled" else None
         if code == LAW_CALLBACK:
             self.callback = PatchCallback(contact_model, model_options, scene.material, surfaces, self.elastic)
-            if scene.track.curve_radius_m > 0:
-                # the formed patches (formed_patches.py) are not yet right in a canted curve: on curve-flange's
-                # settled pose they give the right tread patch 72 kN where the candidate's own plane, the compiled
-                # KPEC on the same sampled gap and the ellipse all give 84-85 kN (tangent track: within 0.2 %); in a
-                # curve each candidate is sampled on its own plane until that is found
-                self.callback.patches = "search"
         elif code == LAW_AUTO:
             from rigid_dynamics.contact.registry import get_model
 
