@@ -12,8 +12,9 @@ A case file has the tables
 * ``[loading]``: ``normal_force_N`` (quadric) or ``wheel_load_N`` (wheelset), or ``approach_m``; a quadric case may
   add ``longitudinal_force_N`` (the creep force on the wheel along x, N; CONTACT's F = 1): its longitudinal creepage
   is then solved (``kinematics.creepage_long`` not given) and ``case.force_control`` in the JSON states the solved
-  creepage and the force residual; a wheelset case may add it too (the creep forces on its wheels summed along the
-  track's x): its pitch rate is then solved (``kinematics.pitch_rate_rad_per_s`` not given);
+  creepage and the force residual; a wheelset case may add it too (the contact forces on its wheels summed along
+  the wheelset's longitudinal axis, CONTACT's FX_WS): its pitch rate is then solved
+  (``kinematics.pitch_rate_rad_per_s`` not given);
 * ``[kinematics]``: ``creepage_long``, ``creepage_lat``, ``spin_creepage_1_per_m``,
   ``rolling_speed_m_per_s`` (quadric); a wheelset case takes ``rolling_speed_m_per_s``, ``roll_rad``,
   ``pitch_rate_rad_per_s`` and ``wheel_rotation_rad`` (phi, the wheels' rotation angle: an irregularity centred
@@ -728,7 +729,8 @@ def _force_controlled(case: ContactCase, solve_at) -> tuple[Creepage, dict]:
 
 def solve_wheelset_to_force(case: ContactCase, method: str, progress=None):
     """A wheelset case with ``longitudinal_force_N`` (CONTACT's F = 1 of its wheel-rail module): the pitch rate
-    solved so that the creep forces on the solved wheels sum to that force along the track's x (N, on the wheels).
+    solved so that the contact forces on the solved wheels sum to that force along the wheelset's longitudinal
+    axis (N, on the wheels; CONTACT's FX_WS is the same on the rail, of opposite sign).
 
     The unknown is the wheelset's longitudinal creepage xi_ws = 1 - omega / omega_0, omega the wheels' spin rate and
     omega_0 the free-rolling one (the zero-axle-moment spin rate of the case solved without the force): the pitch
@@ -740,6 +742,7 @@ def solve_wheelset_to_force(case: ContactCase, method: str, progress=None):
     options = dict(case.solver_options)
     free = solve_wheelset_case(case.wheelset, case.material, method, options=options, progress=progress)
     omega_0 = free.spin_rate_rad_per_s
+    cos_yaw, sin_yaw = math.cos(case.wheelset.yaw_rad), math.sin(case.wheelset.yaw_rad)
     solutions: dict = {}
 
     def force_of(xi: float):
@@ -748,7 +751,9 @@ def solve_wheelset_to_force(case: ContactCase, method: str, progress=None):
         solutions[xi] = solution
         if not solution.success:
             return math.nan
-        return float(sum(p.force_main_N[0] for p in solution.patches if math.isfinite(p.result.normal_force_N)))
+        # along the wheelset's longitudinal axis, as CONTACT's FX_WS: F_x cos(psi) + F_y sin(psi) in track axes
+        forces = [p.force_main_N for p in solution.patches if math.isfinite(p.result.normal_force_N)]
+        return float(sum(f[0] * cos_yaw + f[1] * sin_yaw for f in forces))
 
     load = sum(free.wheel_vertical_load_N.values()) or float(case.wheelset.wheel_load_N or 0.0)
     tolerance = 1e-4 * case.material.friction_coefficient * load
