@@ -12,8 +12,9 @@ term 0.12 at 100 mm/s (rational: 0.06 at 100 mm/s and 0.06 at 0.3162 mm/s).
 Tolerances (issue 26): Fx within 1 % of mu_s FN (mu_s = mu(0) = 0.3), PMAX within 3 %; we also compare the slip
 element count. Recorded on this commit: Fx 0.01 % of mu_s FN (the 4 digits CONTACT prints), PMAX 0.01 %, slip and
 adhesion counts equal; force control: the solved creepage within 0.3 % of CONTACT's. And in 3-D (traction_3d.csv:
-CONTACT's tractcurv patch with its exponential law, without friction memory and interface layer): the BemModel's
-traction curve to CONTACT's 4 digits, and a case file's force control to CONTACT's F = 1 creepage within 0.1 %.
+CONTACT's tractcurv patch with its exponential law, without friction memory and interface layer): a case file's
+force control to CONTACT's F = 1 creepage within 0.1 %; and h5c's 3-D creep cases under L = 0, 2, 3, 4
+(tests/data/contact_friction/falling) to CONTACT's 4 digits.
 """
 
 import csv
@@ -130,22 +131,50 @@ def _eurosprinter():
     return geometry, material, {"nx": 48, "ny": 44, "margin": 1.1, "estimate_grid_error": False}
 
 
-def test_traction_curve_with_falling_friction_3d():
-    """The BEM rung (BemModel, a quadric patch) over CONTACT's 3-D traction curve with the exponential law: Fx /
-    (mu_s FN) to CONTACT's 4 digits at every creepage (rising branch, maximum 0.987 at xi = 0.004, falling to 0.755
-    at 0.1), PMAX 640.7 MPa, slip counts equal."""
+FALLING_3D = Path(__file__).parent / "data" / "contact_friction" / "falling" / "falling_friction.csv"
+LAW_NAMES = {0: "coulomb", 2: "linear", 3: "rational", 4: "exponential"}
+
+
+def _falling_rows() -> list[dict]:
+    with FALLING_3D.open(encoding="utf-8") as fh:
+        return [{k: float(v) if v else 0.0 for k, v in row.items()} for row in csv.DictReader(fh)]
+
+
+@pytest.mark.parametrize("row", _falling_rows(), ids=lambda r: f"{int(r['case'])}")
+def test_creep_forces_with_falling_friction_3d(row):
+    """The BEM rung (BemModel, a quadric patch) against CONTACT's 3-D creep cases of h5c's reference
+    (tests/data/contact_friction/falling: the tractcurv patch, L = 0, 2, 3, 4 with mu_k 0.14 + 0.19 at 1250 mm/s,
+    longitudinal creepage to 0.25 and two combined cases with spin): Fx and Fy / (mu_s FN) to CONTACT's 4 printed
+    digits (1e-4) without spin, within 0.2 % with it (recorded: up to 0.13 %), PMAX 640.7 MPa, slip counts equal."""
     from rigid_dynamics.contact.bem.model import BemModel
+    from rigid_dynamics.contact.friction import coulomb as coulomb_law
     from rigid_dynamics.contact.types import Creepage
 
-    geometry, material, options = _eurosprinter()
-    for row in _traction_rows("creepage"):
-        result = BemModel().solve(geometry, Creepage(float(row["cksi"]), 0.0, 0.0, 10.0), material,
-                                  normal_force_N=106700.0, options=options)  # fmt: skip
-        assert result.success, result.message
-        ratio = result.creep_force_long_N / (0.33 * 106700.0)
-        assert abs(ratio - float(row["fx_fstat_fn"])) <= 1e-4, (row, ratio)
-        assert result.max_pressure_Pa / 1e6 == pytest.approx(float(row["pmax_N_per_mm2"]), rel=1e-3)
-        assert result.extra["slip_elements"] == int(row["nslip"])
+    geometry, _, options = _eurosprinter()
+    code = int(row["frclaw"])
+    if code == 0:
+        law = coulomb_law(row["mu_static"])
+    else:
+        law = falling(LAW_NAMES[code], row["mu_kin"], row["mu_1"], row["sabsh1_mm_per_s"] * 1e-3, row["mu_2"],
+                      (row["sabsh2_mm_per_s"] or 1.0) * 1e-3)  # fmt: skip
+    from rigid_dynamics.materials import Material
+
+    material = Material(82e9, 0.28).with_friction(FrictionLaw((law,)))
+    creepage = Creepage(row["cksi"], row["ceta"], row["cphi_1_per_mm"] * 1e3, row["veloc_mm_per_s"] * 1e-3)
+    result = BemModel().solve(geometry, creepage, material, normal_force_N=row["fn_N"], options=options)
+    assert result.success, result.message
+    scale = row["mu_static"] * row["fn_N"]
+    errors = (
+        result.creep_force_long_N / scale - row["fx_over_fstat_fn"],
+        result.creep_force_lat_N / scale - row["fy_over_fstat_fn"],
+    )
+    print(int(row["case"]), f"{errors[0]:.5f} {errors[1]:.5f}")
+    # without spin to CONTACT's printed digits; with spin within 0.2 % (the issue's tolerance is 1 %): our rigid slip
+    # is taken at the element centre, without CONTACT's empirical spin offset (bem/model.py)
+    limit = 1e-4 if row["cphi_1_per_mm"] == 0.0 else 2e-3
+    assert max(abs(e) for e in errors) <= limit, errors
+    assert result.max_pressure_Pa / 1e6 == pytest.approx(row["pmax_N_per_mm2"], rel=1e-3)
+    assert result.extra["slip_elements"] == int(row["nslip"])
 
 
 def test_traction_case_to_a_prescribed_force_3d(tmp_path, capsys):
