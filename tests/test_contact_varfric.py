@@ -1,8 +1,9 @@
 """The wheelset case with friction varying in place against CONTACT's friction-variation example.
 
-Reference: CONTACT's published output of ``examples/mbench_a22_varfric`` (tests/data/contact_varfric, SOURCE.md
-there): the A-2.2 deck of the right wheel with mu = 0.2 at a surface inclination of 20 deg and 0.3 at 10 deg
-(CONTACT's V = 1; one law per planar patch, interpolated at its contact angle), and a case with mu from 0.2 at
+Reference: CONTACT's published output of ``examples/mbench_a22_varfric`` (tests/data/contact_friction/varfric,
+SOURCE.md there, h5c's copy): the A-2.2 deck of the right wheel with mu = 0.2 at a surface inclination of 20 deg
+and 0.3 at 10 deg (CONTACT's V = 1; one law per planar patch, interpolated at its contact angle; D_SEP 6, D_COMB 3
+mm), and a case with mu from 0.2 at
 S = 0 to 0.3 at S = 100 mm along the track, the wheelset at 60 mm (V = 2). Our run: the same deck (``kinematics =
 "deck"``), the ``bem`` rung on CONTACT's 0.2 mm grid, the friction law as a ``FrictionLaw`` varying with the surface
 inclination (the patch's contact angle) or the track distance.
@@ -26,14 +27,24 @@ import pytest
 from comparisons.manchester import MATERIAL, sweep
 from rigid_dynamics.contact.friction import coulomb, varying
 
-DATA = Path(__file__).parent / "data" / "contact_varfric" / "mbench_a22_varfric.csv"
+DATA = Path(__file__).parent / "data" / "contact_friction" / "varfric" / "mbench_a22_varfric.csv"
+CONFORMAL_CASES = (5, 7)
+"""CONTACT's D = 4 cases (conformal contact, friction per grid row on a curved surface): not solved here."""
 
 
 def _reference() -> dict:
+    """h5c's copy of CONTACT's published mbench_a22_varfric.ref_out (tests/data/contact_friction/varfric), planar
+    cases, with the A-2.2 step of the same shift and CONTACT's friction coefficient of each patch as ``fstat``."""
     out: dict = {}
     with DATA.open(encoding="utf-8") as fh:
         for row in csv.DictReader(fh):
-            out.setdefault(int(row["contact_case"]), []).append({k: float(v) for k, v in row.items()})
+            case = int(row["case"])
+            if case in CONFORMAL_CASES:
+                continue
+            values = {k: float(v) for k, v in row.items() if v != ""}
+            values["a22_step"] = round(values["y_ws_mm"] / 0.5)
+            values["fstat"] = values["mu"]
+            out.setdefault(case, []).append(values)
     return out
 
 
