@@ -241,6 +241,15 @@ def _contact_table(record: dict) -> str:
             value = patch.get(key)
             cells.append(f"{'-':>13}" if value is None else f"{value * scale:13.5g}")
         lines.append(f"{patch['side']:<8}" + "".join(cells))
+    control = record.get("case", {}).get("force_control")
+    if control is not None:
+        solved = control["solved_creepage_long"]
+        lines.append(
+            f"force control: {control['status']}, longitudinal force {control['target_longitudinal_force_N']:.6g} N "
+            f"prescribed, creepage {'-' if solved is None else format(solved, '.6g')} solved, residual "
+            f"{'-' if control['residual_N'] is None else format(control['residual_N'], '.3g')} N "
+            f"(tolerance {control['force_tolerance_N']:.3g} N, {control['evaluations']} evaluations)"
+        )
     lines.append(f"wall time {record['wall_time_s']:.3g} s (set-up, compiled-code loading {record['setup_s']:.2g} s)")
     return "\n".join(lines)
 
