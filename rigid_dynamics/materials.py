@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from rigid_dynamics.contact.friction import FrictionLaw, uniform
+
 STANDARD_GRAVITY_M_PER_S2 = 9.80665
 """Standard acceleration of gravity (CGPM 1901), m/s^2."""
 
@@ -21,12 +23,16 @@ class Material:
     Attributes:
         shear_modulus_Pa: G, shear modulus of both bodies, Pa.
         poisson_ratio: nu, Poisson's ratio of both bodies, in (-1, 0.5).
-        friction_coefficient: mu, Coulomb friction coefficient (static = kinetic), >= 0.
+        friction_coefficient: mu, Coulomb friction coefficient (static = kinetic), >= 0; with ``friction`` given,
+            that law's largest static coefficient (for the rungs that take one number).
+        friction: the pair's friction law (:class:`~rigid_dynamics.contact.friction.FrictionLaw`: falling friction,
+            variation in place), or None: Coulomb with ``friction_coefficient``. Build it with :meth:`with_friction`.
     """
 
     shear_modulus_Pa: float = 82.0e9
     poisson_ratio: float = 0.28
     friction_coefficient: float = 0.3
+    friction: FrictionLaw | None = None
 
     def __post_init__(self) -> None:
         for name in ("shear_modulus_Pa", "poisson_ratio", "friction_coefficient"):
@@ -39,6 +45,24 @@ class Material:
             raise ValueError(f"poisson_ratio = {self.poisson_ratio!r}: expected a value in (-1, 0.5)")
         if self.friction_coefficient < 0:
             raise ValueError(f"friction_coefficient = {self.friction_coefficient!r}: expected >= 0")
+        if self.friction is not None:
+            if not isinstance(self.friction, FrictionLaw):
+                raise ValueError(f"friction = {self.friction!r}: expected a FrictionLaw or None")
+            if self.friction_coefficient != self.friction.max_static:
+                raise ValueError(
+                    f"friction_coefficient = {self.friction_coefficient!r}: expected the friction law's largest "
+                    f"static coefficient {self.friction.max_static!r} (build the material with with_friction)"
+                )
+
+    def with_friction(self, law: FrictionLaw | None) -> Material:
+        """This material with the friction law ``law`` (None: Coulomb with the current ``friction_coefficient``)."""
+        if law is None:
+            return Material(self.shear_modulus_Pa, self.poisson_ratio, self.friction_coefficient)
+        return Material(self.shear_modulus_Pa, self.poisson_ratio, law.max_static, law)
+
+    def friction_law(self) -> FrictionLaw:
+        """The friction law: ``friction``, or one Coulomb coefficient ``friction_coefficient`` everywhere."""
+        return self.friction if self.friction is not None else uniform(self.friction_coefficient)
 
     @property
     def young_modulus_Pa(self) -> float:

@@ -58,21 +58,32 @@ def test_element_size_through_the_cli(tmp_path, capsys):
     assert code == 0 and data["success"] and data["patches"][0]["status"] == "ok", data
 
 
-def test_shift_problem_and_kinetic_friction_through_the_cli(tmp_path, capsys):
-    """A quadric case solved as Cattaneo's shift problem with static and kinetic friction, from the [solver] table."""
+def test_shift_problem_through_the_cli(tmp_path, capsys):
+    """A quadric case solved as Cattaneo's shift problem from the [solver] table, its friction from [friction]."""
     import json
 
     path = tmp_path / "case.toml"
-    solver = 'nx = 24\nny = 24\nproblem = "shift"\nshift_long_m = 1e-3\nkinetic_friction_coefficient = 0.25\n'
+    solver = 'nx = 24\nny = 24\nproblem = "shift"\nshift_long_m = 1e-3\n'
     solver += "grid_tolerance = 0.1\n"  # 24 x 24: area estimate ~3 %
-    path.write_text(CASE + solver)
+    text = re.sub(r"friction_coefficient = [0-9.]+\n", "", CASE)
+    path.write_text(text + solver + '[friction]\nlaw = "coulomb"\ncoefficient = 0.25\n')
     code = main(["contact", str(path), "--method", "bem", "--json", "--out", str(tmp_path / "out")])
     out = capsys.readouterr().out
     assert code == 0, out
     data = json.loads(out)
     patch = data["patches"][0]
-    # a shift of 1 mm is far beyond full slip: the force on the wheel is -mu_k F_N
+    # a shift of 1 mm is far beyond full slip: the force on the wheel is -mu F_N
     assert data["success"] and abs(patch["creep_force_long_N"] / -0.25e5 - 1) < 1e-6, patch
+
+
+def test_withdrawn_kinetic_friction_coefficient(tmp_path, capsys):
+    """The withdrawn option ends with one line naming its replacement (CONTACT v23.1 on: one coefficient)."""
+    path = tmp_path / "case.toml"
+    path.write_text(CASE + "kinetic_friction_coefficient = 0.25\n")
+    code = main(["contact", str(path), "--method", "bem"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "kinetic_friction_coefficient = 0.25: withdrawn" in err[0] and "[friction] table" in err[0], err
 
 
 def test_transient_problem_through_the_cli(tmp_path, capsys):

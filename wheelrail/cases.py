@@ -3,6 +3,8 @@
 A case file has the tables
 
 * ``[material]``: ``shear_modulus_Pa`` or ``young_modulus_Pa``, ``poisson_ratio``, ``friction_coefficient``;
+* ``[friction]`` (optional, instead of ``material.friction_coefficient``): the friction law (Coulomb, CONTACT's
+  falling laws, Polach's law) and its variation in place, docs/files.md;
 * ``[geometry]``: ``kind = "quadric"`` with ``radius_long_m``, ``radius_lat_m`` (relative radii of
   curvature, h = x^2/(2 R_long) + y^2/(2 R_lat)); or ``kind = "wheelset"`` with ``wheel_profile``,
   ``rail_profile``, ``lateral_shift_m``, ``yaw_rad``, ``gauge_m``, ``gauge_height_m``,
@@ -40,11 +42,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from rigid_dynamics.contact.friction import friction_law_from_table
 from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
 from rigid_dynamics.materials import Material
 from wheelrail.config import ConfigError, check_keys, get_number, get_table, read_toml, resolve_embedded
 
-TOP_LEVEL_TABLES = {"name", "description", "material", "geometry", "loading", "kinematics", "solver", "irregularities"}
+TOP_LEVEL_TABLES = {
+    "name", "description", "material", "friction", "geometry", "loading", "kinematics", "solver", "irregularities"
+}  # fmt: skip
 QUADRIC_GEOMETRY_KEYS = {"kind", "radius_long_m", "radius_lat_m"}
 IRREGULARITY_KEYS = {
     "wheel_flat_length_m",
@@ -118,8 +123,23 @@ class ContactCase:
     name: str = ""
 
 
-def read_material(table: dict, prefix: str = "material") -> Material:
-    """[material] -> Material. Exactly one of shear_modulus_Pa and young_modulus_Pa."""
+def read_material(table: dict, prefix: str = "material", friction: dict | None = None) -> Material:
+    """[material] -> Material. Exactly one of shear_modulus_Pa and young_modulus_Pa.
+
+    ``friction``: the ``[friction]`` table (rigid_dynamics.contact.friction.friction_law_from_table), which then
+    replaces ``friction_coefficient`` (giving both is an error).
+    """
+    if friction is not None:
+        if "friction_coefficient" in table:
+            raise ConfigError(
+                f"key '{prefix}.friction_coefficient' = {table['friction_coefficient']!r}: not allowed with a "
+                "[friction] table (it gives the friction law; remove one of the two)"
+            )
+        try:
+            law = friction_law_from_table(friction)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
+        return read_material({**table, "friction_coefficient": law.max_static}, prefix).with_friction(law)
     check_keys(table, {"shear_modulus_Pa", "young_modulus_Pa", "poisson_ratio", "friction_coefficient"}, prefix)
     has_g, has_e = "shear_modulus_Pa" in table, "young_modulus_Pa" in table
     if has_g == has_e:
@@ -168,7 +188,8 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
     ``base_dir``: folder that relative file names in the case (``irregularities.wheel_slices_file``) refer to.
     """
     check_keys(doc, TOP_LEVEL_TABLES, "")
-    material = read_material(get_table(doc, "material"))
+    friction = get_table(doc, "friction") if "friction" in doc else None
+    material = read_material(get_table(doc, "material"), friction=friction)
     geometry_table = get_table(doc, "geometry")
     kinematics = get_table(doc, "kinematics", required=False)
     solver = _read_solver(get_table(doc, "solver", required=False))

@@ -287,3 +287,84 @@ def friction_coefficient(record, slip_velocity_m_per_s, place):
     term_2 = (1.0 - w) * record.term_2[i] + w * record.term_2[j]
     half_2 = (1.0 - w) * record.half_velocity_2_m_per_s[i] + w * record.half_velocity_2_m_per_s[j]
     return _law_value(record.law_code, kinetic, term_1, half_1, term_2, half_2, slip_velocity_m_per_s)
+
+
+# --- the [friction] table of case files and scenes -----------------------------------------------------------------
+TABLE_LAW_KEYS = {
+    "coulomb": ("coefficient",),
+    "linear": ("kinetic", "term_1", "half_velocity_1_m_per_s", "term_2", "half_velocity_2_m_per_s"),
+    "polach": ("static", "polach_a", "polach_b_s_per_m"),
+}
+TABLE_LAW_KEYS["rational"] = TABLE_LAW_KEYS["exponential"] = TABLE_LAW_KEYS["linear"]
+OPTIONAL_TABLE_KEYS = {"term_2": 0.0, "half_velocity_2_m_per_s": 1.0}
+"""Keys of a ``[friction]`` table per law (besides ``law``, ``varies_with`` and ``nodes_rad`` / ``nodes_m``), and the
+defaults of the optional ones. The names follow CONTACT v24.1's friction input (user guide, "friction law"):
+coefficient = FSTAT = FKIN (L = 0); kinetic, term_1, half_velocity_1, term_2, half_velocity_2 = FKIN, FLIN1, SABS1,
+FLIN2, SABS2 (L = 2, 3, 4; SABS in m/s here, mm/s in CONTACT); static, polach_a, polach_b = Polach's mu_0, A, B
+(L = 5: CONTACT's FSTAT, POLACH_A, POLACH_B with B in s/mm there)."""
+
+
+def friction_law_from_table(table: dict, prefix: str = "friction") -> FrictionLaw:
+    """A ``[friction]`` table (the keys of :data:`TABLE_LAW_KEYS`; docs/files.md) -> :class:`FrictionLaw`.
+
+    With ``varies_with`` other than "none", ``nodes_rad`` (surface_inclination) or ``nodes_m`` (rail_lateral,
+    track_distance) gives the nodes, and every law parameter is one number (the same at every node) or a list of
+    one number per node. Raises ValueError with one line naming the key, its value and what was expected.
+    """
+    if not isinstance(table, dict):
+        raise ValueError(f"key '{prefix}' = {table!r}: expected a table")
+    law = table.get("law", "coulomb")
+    if law not in TABLE_LAW_KEYS:
+        raise ValueError(f"key '{prefix}.law' = {law!r}: expected one of {', '.join(TABLE_LAW_KEYS)}")
+    varies_with = table.get("varies_with", "none")
+    if varies_with not in VARIES_NAMES:
+        raise ValueError(f"key '{prefix}.varies_with' = {varies_with!r}: expected one of {', '.join(VARIES_NAMES)}")
+    node_key = {"none": None, "surface_inclination": "nodes_rad"}.get(varies_with, "nodes_m")
+    allowed = {"law", "varies_with", *TABLE_LAW_KEYS[law]} | ({node_key} if node_key else set())
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ValueError(
+            f"key '{prefix}.{unknown[0]}' = {table[unknown[0]]!r}: not a key of law = {law!r} with varies_with = "
+            f"{varies_with!r} (expected {', '.join(sorted(allowed))})"
+        )
+    nodes: tuple[float, ...] = ()
+    count = 1
+    if node_key is not None:
+        raw = table.get(node_key)
+        if not isinstance(raw, list) or not raw or not all(_is_number(v) for v in raw):
+            raise ValueError(f"key '{prefix}.{node_key}' = {raw!r}: expected a list of numbers for {varies_with}")
+        nodes = tuple(float(v) for v in raw)
+        if any(b <= a for a, b in zip(nodes, nodes[1:], strict=False)):
+            raise ValueError(f"key '{prefix}.{node_key}' = {raw!r}: expected strictly ascending values")
+        count = len(nodes)
+    values = {}
+    for name in TABLE_LAW_KEYS[law]:
+        if name not in table:
+            if name in OPTIONAL_TABLE_KEYS:
+                values[name] = [OPTIONAL_TABLE_KEYS[name]] * count
+                continue
+            raise ValueError(f"key '{prefix}.{name}' is missing: law = {law!r} needs {', '.join(TABLE_LAW_KEYS[law])}")
+        raw = table[name]
+        items = raw if isinstance(raw, list) else [raw] * count
+        if len(items) != count or not all(_is_number(v) for v in items):
+            expected = f"a number or a list of {count} numbers (one per node)" if node_key else "a number"
+            raise ValueError(f"key '{prefix}.{name}' = {raw!r}: expected {expected}")
+        values[name] = [float(v) for v in items]
+    laws = []
+    for i in range(count):
+        try:
+            if law == "coulomb":
+                laws.append(coulomb(values["coefficient"][i]))
+            elif law == "polach":
+                laws.append(polach(values["static"][i], values["polach_a"][i], values["polach_b_s_per_m"][i]))
+            else:
+                laws.append(falling(law, *(values[name][i] for name in TABLE_LAW_KEYS[law])))
+        except ValueError as exc:
+            raise ValueError(f"table [{prefix}]{f' node {i + 1}' if node_key else ''}: {exc}") from None
+    if node_key is None:
+        return FrictionLaw((laws[0],))
+    return varying(varies_with, nodes, laws)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)

@@ -112,6 +112,11 @@ class ContactGeometry:
         ellipse_angle_rad: angle from the rolling direction (x) to the principal direction of A, rad.
         undeformed: sampled gap field for non-Hertzian solvers, or None (then the quadric form holds).
         is_elliptic: whether the local gap is well described by the quadric form (Hertz valid).
+        friction_place: optional f(varies_with, x_m, y_m) -> the friction law's place variable (rad or m) at points
+            of the contact plane (element-wise variation); None: the patch's reference point gives one value for
+            the whole patch (contact_angle_rad for "surface_inclination", contact_point_rail_m[0] for
+            "rail_lateral", track_distance_m for "track_distance"), as CONTACT does for a planar patch.
+        track_distance_m: the patch's position along the track, m (CONTACT's S of the wheelset).
     """
 
     curvature_long_1_per_m: float
@@ -127,6 +132,8 @@ class ContactGeometry:
     ellipse_angle_rad: float = 0.0
     undeformed: UndeformedDistance | None = None
     is_elliptic: bool = True
+    friction_place: Callable | None = None
+    track_distance_m: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("curvature_long_1_per_m", "curvature_lat_1_per_m", "approach_m"):

@@ -37,7 +37,7 @@ import numpy as np
 from rigid_dynamics.contact.bem.influence import InfluenceGrid
 from rigid_dynamics.contact.bem.norm import METHODS as NORM_METHODS
 from rigid_dynamics.contact.bem.norm import solve_norm
-from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang
+from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang, solve_tang_law
 from rigid_dynamics.contact.options import Option, declare, validate_options
 from rigid_dynamics.contact.options import defaults as option_defaults
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
@@ -70,8 +70,9 @@ OPTIONS = declare(
     Option("shift_long_m", float, 0.0, "shift problem: rigid shift along x, m"),
     Option("shift_lat_m", float, 0.0, "shift problem: rigid shift along y, m"),
     Option("shift_rotation_rad", float, 0.0, "shift problem: rigid rotation about the normal, rad"),
-    Option("kinetic_friction_coefficient", float, None, "friction coefficient in slip (the material's is static)",
+    Option("kinetic_friction_coefficient", float, None, "withdrawn: give a falling friction law ([friction])",
            minimum=0.0, exclusive_minimum=True, allow_none=True),
+    Option("max_friction_iterations", int, 50, "outer iterations of a falling friction law", minimum=1),
     Option("transient_steps", int, None, "transient problem: rolling steps of dx (None: nx)", minimum=1,
            allow_none=True),
 )  # fmt: skip
@@ -127,11 +128,19 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   sec. 5.2); the result is the last step's, ``extra["transient_forces_N"]`` the (F_x, F_y, M_z) of every step.
   With dq = dx the steady state of this recursion is exactly the steady-rolling discretisation. Quasi-identical
   bodies only (K = 0);
-* ``kinetic_friction_coefficient`` (float > 0 or None): the friction coefficient in slip (CONTACT's FKIN); the
-  material's ``friction_coefficient`` is then the static one (FSTAT: adhesion holds up to it). None: one
-  coefficient. This key follows CONTACT's Coulomb law before v23.1 (FSTAT > FKIN allowed). CONTACT's current law
-  (v23.1 on, user guide "Coulomb friction", L = 0) takes one coefficient: its input file rejects FSTAT != FKIN
-  and its library uses min(FSTAT, FKIN) throughout; the default None is that law.
+* ``kinetic_friction_coefficient``: withdrawn (any value but None is an error naming the replacement). It gave a
+  kinetic coefficient below the static one, CONTACT's Coulomb law before v23.1. CONTACT v23.1 on takes one
+  coefficient for adhesion and slip (its input rejects FSTAT != FKIN), and friction that drops once an element
+  slides is a falling law of the slip velocity: the material's friction law (``Material.friction``, a case's
+  ``[friction]`` table), solved element-wise (:func:`~.tang.solve_tang_law`);
+* ``max_friction_iterations`` (int >= 1, default 50): outer iterations of a falling friction law (the traction
+  bound of the slip elements updated from their slip velocities); the solution is "not-converged" beyond it.
+
+Friction: the material's law (:meth:`~rigid_dynamics.materials.Material.friction_law`) bounds the traction
+element-wise: mu_s = mu(0, place) bounds adhesion, an element in slip carries mu(V |s|, place) p. The place of an
+element is ``geometry.friction_place`` at its centre, or the patch's reference point for the whole patch (the
+contact angle, the rail-profile lateral coordinate of the contact point, or ``geometry.track_distance_m``), as
+CONTACT does for a planar patch (CONTACT's V = 1, 2). Falling friction is solved for steady rolling only.
 """
 
 PROBLEMS = ("rolling", "shift", "transient")
@@ -262,9 +271,31 @@ class BemWarmStart:
         self.iterations += int(iterations)
 
 
+def _friction_places(geometry: ContactGeometry, law, xx: np.ndarray, yy: np.ndarray):
+    """The friction law's place variable at the element centres (see :data:`DEFAULT_OPTIONS`, "Friction")."""
+    if not law.varies:
+        return 0.0
+    if geometry.friction_place is not None:
+        return np.asarray(geometry.friction_place(law.varies_with, xx, yy), float)
+    value = {
+        "surface_inclination": geometry.contact_angle_rad,
+        "rail_lateral": geometry.contact_point_rail_m[0],
+        "track_distance": geometry.track_distance_m,
+    }[law.varies_with]
+    if not math.isfinite(value):
+        raise ValueError(f"friction varies_with = {law.varies_with!r}: the patch has no such place ({value!r})")
+    return float(value)
+
+
 def _options(options: Mapping | None) -> dict:
     opts = validate_options(OPTIONS, options, "bem")
     options = options or {}
+    if opts["kinetic_friction_coefficient"] is not None:
+        raise ValueError(
+            f"option kinetic_friction_coefficient = {opts['kinetic_friction_coefficient']!r}: withdrawn (CONTACT "
+            "v23.1 on takes one coefficient for adhesion and slip); expected a falling friction law instead, a "
+            '[friction] table with law = "linear", "rational", "exponential" or "polach"'
+        )
     size = opts["element_size_m"]
     if size is not None:
         both = [k for k in ("nx", "ny", "dx_m", "dy_m") if k in options]
@@ -442,7 +473,7 @@ class BemModel:
         """:meth:`solve` on one grid; ``fixed_area`` ((x0, x1), (y0, y1)) imposes the potential area (m)."""
         if normal_force_N is not None and (not math.isfinite(normal_force_N) or normal_force_N <= 0):
             raise ValueError(f"normal_force_N = {normal_force_N!r}: expected None or a finite number > 0")
-        g_mod, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
+        g_mod, nu = material.shear_modulus_Pa, material.poisson_ratio
         e_star = g_mod / (1.0 - nu)
         curv = (geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m)
         margin = float(opts["margin"])
@@ -542,26 +573,30 @@ class BemModel:
             wx, wy = rigid_slip(x, y, opts["shift_long_m"], opts["shift_lat_m"], opts["shift_rotation_rad"])
         else:
             wx, wy = rigid_slip(x + offset, y, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m)
+        law = material.friction_law()
+        places = _friction_places(geometry, law, xx, yy)
+        if problem != "rolling" and not law.is_coulomb:
+            raise ValueError(f"problem = {problem!r}: a falling friction law is solved for steady rolling only")
+        mu_place = np.broadcast_to(np.vectorize(law.static_coefficient, otypes=[float])(places), xx.shape)
         previous = norm.normal_force_N
         history = None
         for _ in range(1 if k_diff == 0.0 or problem == "transient" else 20):
             if problem == "transient":
                 steps = int(opts["transient_steps"] or nx)
                 fields_in = (norm.pressure_Pa, (wx, wy), (xx, yy))
-                tang, history = _transient(influence, mu, fields_in, steps, tol, max_it, opts)
+                tang, history = _transient(influence, mu_place, fields_in, steps, tol, max_it, opts)
                 break
-            tang = solve_tang(
-                influence,
-                norm.pressure_Pa,
-                mu,
-                wx,
-                wy,
-                problem=problem,
-                tolerance=tol,
-                max_iterations=max_it,
-                kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
-                **_warm_traction(guess, norm.pressure_Pa),
-            )
+            if problem == "rolling":
+                tang = solve_tang_law(
+                    influence, norm.pressure_Pa, law, places, wx, wy, creepage.rolling_speed_m_per_s,
+                    tolerance=tol, max_iterations=max_it, max_friction_iterations=opts["max_friction_iterations"],
+                    **_warm_traction(guess, norm.pressure_Pa),
+                )  # fmt: skip
+            else:
+                tang = solve_tang(
+                    influence, norm.pressure_Pa, mu_place, wx, wy, problem=problem, tolerance=tol,
+                    max_iterations=max_it, **_warm_traction(guess, norm.pressure_Pa),
+                )  # fmt: skip
             if k_diff == 0.0:
                 break
             norm = solve_norm(
@@ -702,7 +737,6 @@ def _transient(influence, mu, fields_in, steps, tol, max_it, opts):
             tolerance=tol,
             max_iterations=max_it,
             coarse_start=False,
-            kinetic_friction_coefficient=opts["kinetic_friction_coefficient"],
         )
         tx, ty = tang.traction_x_Pa, tang.traction_y_Pa
         history.append([float(tx.sum() * area), float(ty.sum() * area), float((xx * ty - yy * tx).sum() * area)])

@@ -43,6 +43,7 @@ Linearisation of the slip-element equation (derivative of e_perp . s with respec
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -257,6 +258,8 @@ class TangSolution:
         linear_iterations: GMRES iterations summed over the Newton steps.
         residual: max over the contact of |s| (adhesion) and |e_perp . s| (slip) over max |w|.
         converged: residual below the tolerance with unchanged sets within the iteration limit.
+        friction_iterations: outer iterations of a falling friction law (:func:`solve_tang_law`; 0: none).
+        friction_change: the last outer iteration's largest change of the traction bound over max mu(0) p.
     """
 
     traction_x_Pa: np.ndarray
@@ -268,6 +271,8 @@ class TangSolution:
     linear_iterations: int
     residual: float
     converged: bool
+    friction_iterations: int = 0
+    friction_change: float = 0.0
 
 
 def solve_tang(
@@ -296,10 +301,12 @@ def solve_tang(
     Args:
         influence: grid and influence coefficients.
         pressure_Pa: p (ny, nx), Pa (the normal solution).
-        friction_coefficient: mu >= 0, the static coefficient (adhesion holds while |t| <= mu p).
-        kinetic_friction_coefficient: mu_k, 0 <= mu_k (<= mu expected), the traction in slip |t| = mu_k p;
-            None: mu_k = mu (Coulomb with one coefficient). With mu_k < mu an element leaves adhesion at mu p and
-            slides at mu_k p (CONTACT's FSTAT, FKIN).
+        friction_coefficient: mu >= 0, the static coefficient (adhesion holds while |t| <= mu p): one number or
+            an (ny, nx) array, element-wise (friction varying in place).
+        kinetic_friction_coefficient: mu_k > 0 (<= mu expected), the traction in slip |t| = mu_k p, one number or
+            an (ny, nx) array; None: mu_k = mu (Coulomb with one coefficient). This is the inner step of falling
+            friction (:func:`solve_tang_law` sets mu_k = mu(slip velocity) element-wise and iterates); a constant
+            mu_k < mu on its own is CONTACT's Coulomb law before v23.1, which CONTACT no longer takes.
         rigid_slip_x, rigid_slip_y: w (ny, nx); creepage field (rolling, -) or rigid shift (shift, m).
         problem: "rolling" (steady state) or "shift" (Cattaneo: one step from the unloaded state).
         tolerance: relative tolerance on the slip residual (and GMRES).
@@ -323,12 +330,17 @@ def solve_tang(
     for name, arr in (("pressure_Pa", p), ("rigid_slip_x", rigid_slip_x), ("rigid_slip_y", rigid_slip_y)):
         if np.shape(arr) != shape:
             raise ValueError(f"{name} has shape {np.shape(arr)}: expected (ny, nx) = {shape}")
-    if not math.isfinite(friction_coefficient) or friction_coefficient < 0:
-        raise ValueError(f"friction_coefficient = {friction_coefficient!r}: expected a finite number >= 0")
-    mu_k = friction_coefficient if kinetic_friction_coefficient is None else kinetic_friction_coefficient
-    if not math.isfinite(mu_k) or mu_k < 0 or (mu_k == 0 and friction_coefficient > 0):
+    mu_s = np.broadcast_to(np.asarray(friction_coefficient, float), shape)
+    if not np.all(np.isfinite(mu_s)) or np.any(mu_s < 0):
+        raise ValueError(f"friction_coefficient = {friction_coefficient!r}: expected finite numbers >= 0")
+    mu_k = (
+        mu_s
+        if kinetic_friction_coefficient is None
+        else np.broadcast_to(np.asarray(kinetic_friction_coefficient, float), shape)
+    )
+    if not np.all(np.isfinite(mu_k)) or np.any(mu_k < 0) or np.any((mu_k == 0) & (mu_s > 0)):
         raise ValueError(
-            f"kinetic_friction_coefficient = {kinetic_friction_coefficient!r}: expected a finite number > 0 "
+            f"kinetic_friction_coefficient = {kinetic_friction_coefficient!r}: expected finite numbers > 0 "
             "(or None: the static coefficient)"
         )
     if not tolerance > 0:
@@ -353,9 +365,9 @@ def solve_tang(
         wy = wy + cy
     contact = p > 0
     bound = mu_k * np.where(contact, p, 0.0)  # traction in slip
-    bound_static = friction_coefficient * np.where(contact, p, 0.0)  # adhesion holds up to this
+    bound_static = mu_s * np.where(contact, p, 0.0)  # adhesion holds up to this
     zeros = np.zeros(shape)
-    if not contact.any() or friction_coefficient == 0.0:
+    if not contact.any() or not np.any(mu_s[contact] > 0.0):
         sx, sy = np.where(contact, wx, 0.0), np.where(contact, wy, 0.0)
         return TangSolution(zeros, zeros.copy(), sx, sy, contact.copy(), 0, 0, 0.0, True)
     scale = float(np.max(np.hypot(wx, wy)[contact]))
@@ -420,13 +432,13 @@ def solve_tang(
         first = solve_tang(
             coarse,
             restrict(p),
-            friction_coefficient,
+            restrict(np.array(mu_s)),
             restrict(np.asarray(rigid_slip_x, float)),
             restrict(np.asarray(rigid_slip_y, float)),
             problem=problem,
             tolerance=max(tolerance, 1e-2),  # coarse start only: its discretisation error is larger
             max_iterations=max_iterations,
-            kinetic_friction_coefficient=mu_k,
+            kinetic_friction_coefficient=restrict(np.array(mu_k)),
         )
         tx = np.where(contact, prolong(first.traction_x_Pa), 0.0)
         ty = np.where(contact, prolong(first.traction_y_Pa), 0.0)
@@ -545,3 +557,75 @@ def solve_tang(
     sx = np.where(slip, sx, 0.0)
     sy = np.where(slip, sy, 0.0)
     return TangSolution(tx, ty, sx, sy, slip, it, lin_total, residual, converged)
+
+
+def solve_tang_law(
+    influence: InfluenceGrid,
+    pressure_Pa: np.ndarray,
+    law,
+    place: np.ndarray,
+    rigid_slip_x: np.ndarray,
+    rigid_slip_y: np.ndarray,
+    rolling_speed_m_per_s: float,
+    *,
+    tolerance: float = 1e-8,
+    max_iterations: int = 60,
+    max_friction_iterations: int = 50,
+    initial_traction: tuple[np.ndarray, np.ndarray] | None = None,
+    initial_slip: np.ndarray | None = None,
+) -> TangSolution:
+    """Steady rolling with a friction law (:class:`~rigid_dynamics.contact.friction.FrictionLaw`) element-wise.
+
+    The static coefficient mu_s = mu(0, place) bounds adhesion in each element; an element in slip carries
+    |t| = mu(V |s|, place) p, with V |s| its local slip velocity (m/s). Coulomb's law (varying in place or not) is
+    one :func:`solve_tang`. A falling law is solved as CONTACT solves its steady state: the traction bound of the
+    slip elements is fixed, TANG solved, the bound updated from the new slip velocities, and so on (each solve
+    warm-started from the last), until the bound changes by less than ``tolerance`` times max mu_s p in an
+    iteration; the update is under-relaxed (halved) if the change grows. No friction memory (the steady law).
+
+    Args:
+        law: the FrictionLaw; ``place``: its variable at each element (ny, nx), rad or m (ignored when the law does
+            not vary).
+        rolling_speed_m_per_s: V > 0 (slip velocity = V times the dimensionless slip).
+        max_friction_iterations: outer iteration limit; not converged -> ``converged`` False.
+        Other arguments as :func:`solve_tang` (steady rolling only).
+    """
+    from rigid_dynamics.contact.friction import friction_coefficient
+
+    shape = (influence.ny, influence.nx)
+    record = law.record()
+    places = np.broadcast_to(np.asarray(place, float), shape)
+    coefficient = np.vectorize(lambda s, x: friction_coefficient(record, s, x), otypes=[float])
+    mu_s = coefficient(np.zeros(shape), places)
+    common = {"problem": "rolling", "tolerance": tolerance, "max_iterations": max_iterations}
+    start = {"initial_traction": initial_traction, "initial_slip": initial_slip} if initial_traction else {}
+    tang = solve_tang(influence, pressure_Pa, mu_s, rigid_slip_x, rigid_slip_y, **common, **start)
+    if law.is_coulomb or not tang.converged:
+        return tang
+    if not (math.isfinite(rolling_speed_m_per_s) and rolling_speed_m_per_s > 0):
+        raise ValueError(f"rolling_speed_m_per_s = {rolling_speed_m_per_s!r}: expected > 0 for a falling law")
+    p = np.where(pressure_Pa > 0, pressure_Pa, 0.0)
+    scale = float((mu_s * p).max()) or 1.0
+    mu_k = mu_s.copy()
+    relax, last_change, change = 1.0, math.inf, math.inf
+    lin = tang.linear_iterations
+    for outer in range(1, int(max_friction_iterations) + 1):
+        speed = rolling_speed_m_per_s * np.hypot(tang.slip_x, tang.slip_y)
+        target = np.where(tang.in_slip, coefficient(speed, places), mu_s)
+        change = float((np.abs(target - mu_k) * p).max()) / scale
+        if change <= max(tolerance, 1e-10) * 10:
+            return dataclasses.replace(tang, linear_iterations=lin, friction_iterations=outer, friction_change=change)
+        if change > last_change:
+            relax = max(0.5 * relax, 0.125)
+        last_change = change
+        mu_k = np.maximum(mu_k + relax * (target - mu_k), 1e-12)
+        tang = solve_tang(
+            influence, pressure_Pa, mu_s, rigid_slip_x, rigid_slip_y, kinetic_friction_coefficient=mu_k, **common,
+            initial_traction=(tang.traction_x_Pa, tang.traction_y_Pa), initial_slip=tang.in_slip,
+        )  # fmt: skip
+        lin += tang.linear_iterations
+        if not tang.converged:
+            break
+    return dataclasses.replace(
+        tang, converged=False, linear_iterations=lin, friction_iterations=outer, friction_change=change
+    )
