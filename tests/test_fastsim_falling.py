@@ -116,3 +116,28 @@ def test_bad_inputs_name_the_argument(kwargs, match):
     with pytest.raises(ValueError, match=match):
         fastsim_batch(A, B, FN, 0.0, 0.0, 0.0, shear_modulus_Pa=G, poisson_ratio=NU, friction_coefficient=EXPONENTIAL,
                       **kwargs)  # fmt: skip
+
+
+def test_static_fastsim_model_takes_the_material_law_at_the_patch_place():
+    """The registry's fastsim model with a material carrying a varying law: a patch whose contact angle sits at a
+    node gives the node's Coulomb result; a falling law gives fastsim_fields' result with that law."""
+    from dataclasses import replace
+
+    from rigid_dynamics.contact.registry import get_model
+    from rigid_dynamics.contact.types import ContactGeometry, Creepage
+    from rigid_dynamics.materials import Material
+
+    model = get_model("fastsim")
+    base = Material(G, NU, 0.3)
+    geometry = replace(ContactGeometry(1.0, 5.0, 1e-4), contact_angle_rad=0.4)
+    creep = Creepage(2e-3, 0.0, 0.0, SPEED)
+    law = friction.varying("surface_inclination", [0.2, 0.4], [friction.coulomb(0.4), friction.coulomb(0.1)])
+    got = model.solve(geometry, creep, base.with_friction(law))
+    want = model.solve(geometry, creep, Material(G, NU, 0.1))
+    assert got.creep_force_long_N == pytest.approx(want.creep_force_long_N, rel=1e-12)
+    falling = model.solve(geometry, creep, base.with_friction(EXPONENTIAL))
+    (fx, _, _, _), _ = fastsim_fields(
+        falling.semi_axis_long_m, falling.semi_axis_lat_m, falling.normal_force_N, 2e-3, 0.0, 0.0,
+        shear_modulus_Pa=G, poisson_ratio=NU, friction_coefficient=EXPONENTIAL, rolling_speed_m_per_s=SPEED,
+    )  # fmt: skip
+    assert falling.creep_force_long_N == pytest.approx(fx, rel=1e-12)

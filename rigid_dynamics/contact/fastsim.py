@@ -58,7 +58,14 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.contact.friction import FRICTION_COULOMB, FrictionLaw, FrictionRecord, friction_coefficient, uniform
+from rigid_dynamics.contact.friction import (
+    FRICTION_COULOMB,
+    FallingLaw,
+    FrictionLaw,
+    FrictionRecord,
+    friction_coefficient,
+    uniform,
+)
 from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
 from rigid_dynamics.contact.types import ContactFields
 
@@ -111,6 +118,22 @@ class PatchFriction(NamedTuple):
     place: float
     coefficient: float
     rolling_speed_m_per_s: float
+
+
+def law_at_place(law: FrictionLaw, place: float) -> FrictionLaw:
+    """The law ``law`` with its parameters at ``place`` (interpolated between its nodes as the compiled kernel does):
+    one law that varies nowhere, for a patch that has one place (the static FASTSIM model: its reference point).
+    """
+    if not law.varies:
+        return law
+    rec = law.record()
+    node = rec.node
+    i = int(np.clip(np.searchsorted(node, place, side="right") - 1, 0, max(len(node) - 2, 0)))
+    j = min(i + 1, len(node) - 1)
+    w = 0.0 if j == i else float(np.clip((place - node[i]) / (node[j] - node[i]), 0.0, 1.0))
+    fields = ("kinetic", "term_1", "half_velocity_1_m_per_s", "term_2", "half_velocity_2_m_per_s")
+    values = [float((1.0 - w) * getattr(rec, f)[i] + w * getattr(rec, f)[j]) for f in fields]
+    return FrictionLaw((FallingLaw(law.laws[0].law, *values),))
 
 
 def no_fields() -> StripFields:
