@@ -158,17 +158,33 @@ def default_model_options(method: str) -> dict | None:
     return {"element_size_m": CONTACT_ELEMENT_SIZE_M} if method == "bem" else None
 
 
-def sweep(method: str = "bem", steps=STEPS, model_options=None, kinematics: str = "deck", sides=None) -> list[dict]:
-    """Solve the A-2.2 steps; one dict per patch (keys ``COLUMNS``), CONTACT's values on the right wheel."""
+def sweep(
+    method: str = "bem",
+    steps=STEPS,
+    model_options=None,
+    kinematics: str = "deck",
+    sides=None,
+    material=None,
+    track_distance_m: float = 0.0,
+    patch_options: dict | None = None,
+) -> list[dict]:
+    """Solve the A-2.2 steps; one dict per patch (keys ``COLUMNS``), CONTACT's values on the right wheel.
+
+    ``material``: the pair's material (None: the deck's, :data:`MATERIAL`; another friction law for the friction
+    variants of the deck); ``track_distance_m``: the wheelset's position along the track (CONTACT's S_WS);
+    ``patch_options``: the case's patch options (A_SEP, D_SEP, D_COMB of another deck; None: the defaults).
+    """
     track = build_track(a22_case(0))
     rows = []
     options = {"model": default_model_options(method) if model_options is None else model_options}
     if sides is not None:
         options["sides"] = tuple(sides)
+    if patch_options is not None:
+        options["patch"] = dict(patch_options)
     reference = contact_reference()
     for step in steps:
-        case = a22_case(step, kinematics)
-        sol = solve_wheelset_case(case, MATERIAL, method, options, track=track)
+        case = dataclasses.replace(a22_case(step, kinematics), track_distance_m=track_distance_m)
+        sol = solve_wheelset_case(case, material or MATERIAL, method, options, track=track)
         main = {}
         for p in sol.patches:
             if p.side not in main or p.result.normal_force_N > main[p.side].result.normal_force_N:

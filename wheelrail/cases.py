@@ -9,7 +9,11 @@ A case file has the tables
   curvature, h = x^2/(2 R_long) + y^2/(2 R_lat)); or ``kind = "wheelset"`` with ``wheel_profile``,
   ``rail_profile``, ``lateral_shift_m``, ``yaw_rad``, ``gauge_m``, ``gauge_height_m``,
   ``flange_back_distance_m``, ``nominal_radius_m``, ``rail_inclination_rad``;
-* ``[loading]``: ``normal_force_N`` (quadric) or ``wheel_load_N`` (wheelset), or ``approach_m``;
+* ``[loading]``: ``normal_force_N`` (quadric) or ``wheel_load_N`` (wheelset), or ``approach_m``; a quadric case may
+  add ``longitudinal_force_N`` (the creep force on the wheel along x, N; CONTACT's F = 1): its longitudinal creepage
+  is then solved (``kinematics.creepage_long`` not given) and ``case.force_control`` in the JSON states the solved
+  creepage and the force residual; a wheelset case may add it too (the creep forces on its wheels summed along the
+  track's x): its pitch rate is then solved (``kinematics.pitch_rate_rad_per_s`` not given);
 * ``[kinematics]``: ``creepage_long``, ``creepage_lat``, ``spin_creepage_1_per_m``,
   ``rolling_speed_m_per_s`` (quadric); a wheelset case takes ``rolling_speed_m_per_s``, ``roll_rad``,
   ``pitch_rate_rad_per_s`` and ``wheel_rotation_rad`` (phi, the wheels' rotation angle: an irregularity centred
@@ -79,6 +83,7 @@ WHEELSET_GEOMETRY_KEYS = {
     "wheel_profile_mirror_z",
     "rail_profile_mirror_y",
     "rail_profile_mirror_z",
+    "track_distance_m",
 }
 QUADRIC_KINEMATICS_KEYS = {"creepage_long", "creepage_lat", "spin_creepage_1_per_m", "rolling_speed_m_per_s"}
 WHEELSET_KINEMATICS_KEYS = {"rolling_speed_m_per_s", "roll_rad", "pitch_rate_rad_per_s", "wheel_rotation_rad"}
@@ -111,6 +116,9 @@ class ContactCase:
         wheelset: the ``WheelsetCase`` of a wheelset case (None for a quadric case).
         solver_options: options passed to the contact model.
         name: case name (file stem unless given).
+        longitudinal_force_N: a quadric case's prescribed creep force on the wheel along x (N; CONTACT's F = 1):
+            its longitudinal creepage is solved (:func:`rigid_dynamics.contact.force_control.solve_for_force`);
+            None: the creepage as given.
     """
 
     kind: str
@@ -121,6 +129,7 @@ class ContactCase:
     wheelset: Any = None
     solver_options: dict = field(default_factory=dict)
     name: str = ""
+    longitudinal_force_N: float | None = None
 
 
 def read_material(table: dict, prefix: str = "material", friction: dict | None = None) -> Material:
@@ -202,7 +211,17 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
         check_keys(geometry_table, QUADRIC_GEOMETRY_KEYS | IRREGULARITY_KEYS, "geometry")
         radius_long = get_number(geometry_table, "radius_long_m", "geometry", positive=True)
         radius_lat = get_number(geometry_table, "radius_lat_m", "geometry", positive=True)
-        force, approach = _read_loading(get_table(doc, "loading"), "normal_force_N")
+        loading = dict(get_table(doc, "loading"))
+        longitudinal_force = None
+        if "longitudinal_force_N" in loading:
+            longitudinal_force = get_number(loading, "longitudinal_force_N", "loading")
+            del loading["longitudinal_force_N"]
+            if "creepage_long" in kinematics:
+                raise ConfigError(
+                    f"key 'kinematics.creepage_long' = {kinematics['creepage_long']!r}: not allowed with "
+                    "'loading.longitudinal_force_N' (the longitudinal creepage is solved for that force)"
+                )
+        force, approach = _read_loading(loading, "normal_force_N")
         check_keys(kinematics, QUADRIC_KINEMATICS_KEYS, "kinematics")
         creepage = Creepage(
             get_number(kinematics, "creepage_long", "kinematics", default=0.0),
@@ -224,16 +243,26 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
             geometry = _irregular_geometry(geometry_table, radius_long, radius_lat)
         else:
             geometry = ContactGeometry.quadric(radius_long, radius_lat, approach if approach is not None else 0.0)
-        return ContactCase("quadric", material, geometry, creepage, force, None, solver, name)
+        return ContactCase("quadric", material, geometry, creepage, force, None, solver, name, longitudinal_force)
     if kind == "wheelset":
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
         check_keys(kinematics, WHEELSET_KINEMATICS_KEYS, "kinematics")
-        force, approach = _read_loading(get_table(doc, "loading"), "wheel_load_N")
+        loading = dict(get_table(doc, "loading"))
+        longitudinal_force = None
+        if "longitudinal_force_N" in loading:
+            longitudinal_force = get_number(loading, "longitudinal_force_N", "loading")
+            del loading["longitudinal_force_N"]
+            if "pitch_rate_rad_per_s" in kinematics:
+                raise ConfigError(
+                    f"key 'kinematics.pitch_rate_rad_per_s' = {kinematics['pitch_rate_rad_per_s']!r}: not allowed "
+                    "with 'loading.longitudinal_force_N' (the pitch rate is solved for that force)"
+                )
+        force, approach = _read_loading(loading, "wheel_load_N")
         irregularities = dict(get_table(doc, "irregularities", required=False))
         if "wheel_slices_file" in irregularities:
             irregularities["wheel_slices_file"] = _slices_path(irregularities["wheel_slices_file"], base_dir)
         wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics, irregularities)
-        return ContactCase("wheelset", material, None, None, None, wheelset, solver, name)
+        return ContactCase("wheelset", material, None, None, None, wheelset, solver, name, longitudinal_force)
     raise ConfigError(f"key 'geometry.kind' = {kind!r}: expected 'quadric' or 'wheelset'")
 
 
@@ -600,27 +629,41 @@ def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> Ca
     setup_s = time.perf_counter() - prepare
     start = time.perf_counter()
     if case.kind == "quadric":
-        try:  # a model raises ValueError only for bad input (STYLE 12), e.g. a [solver] option
-            result = model.solve(
-                case.geometry,
-                case.creepage,
-                case.material,
-                normal_force_N=case.normal_force_N,
-                options=case.solver_options,
-            )
-        except ValueError as exc:
-            raise ConfigError(f"[solver]: {exc}") from None
+
+        def solve_at(creepage: Creepage) -> ContactResult:
+            try:  # a model raises ValueError only for bad input (STYLE 12), e.g. a [solver] option
+                return model.solve(
+                    case.geometry, creepage, case.material, normal_force_N=case.normal_force_N,
+                    options=case.solver_options,
+                )  # fmt: skip
+            except ValueError as exc:
+                raise ConfigError(f"[solver]: {exc}") from None
+
+        creepage, extra = case.creepage, {}
+        if case.longitudinal_force_N is not None:
+            creepage, extra = _force_controlled(case, solve_at)
+        result = solve_at(creepage)
+        success, message = result.success, result.message
+        if extra and extra["force_control"]["status"] != "ok":
+            success, message = False, f"force control: {extra['force_control']['message']}; {message}"
         return CaseSolution(
             method,
-            result.success,
-            result.message,
+            success,
+            message,
             time.perf_counter() - start,
-            [("single", case.geometry, case.creepage, result)],
+            [("single", case.geometry, creepage, result)],
+            extra,
             setup_s=setup_s,
         )
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case  # only a wheelset case needs the search
 
-    solution = solve_wheelset_case(case.wheelset, case.material, method, options=case.solver_options, progress=progress)
+    control = None
+    if case.longitudinal_force_N is not None:
+        solution, control = _force_controlled_wheelset(case, method, progress)
+    else:
+        solution = solve_wheelset_case(
+            case.wheelset, case.material, method, options=case.solver_options, progress=progress
+        )
     patches = [(p.side, p.geometry, p.creepage, p.result) for p in solution.patches]
     extra = {
         k: v
@@ -640,7 +683,96 @@ def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> Ca
         for p in solution.patches
     ]
     wall = time.perf_counter() - start
-    return CaseSolution(method, solution.success, solution.message, wall, patches, extra, setup_s=setup_s)
+    success, message = solution.success, solution.message
+    if control is not None:
+        extra["force_control"] = control
+        if control["status"] != "ok":
+            success, message = False, f"force control: {control['message']}; {message}"
+    return CaseSolution(method, success, message, wall, patches, extra, setup_s=setup_s)
+
+
+def _force_controlled(case: ContactCase, solve_at) -> tuple[Creepage, dict]:
+    """The creepage of a quadric case with ``longitudinal_force_N`` (CONTACT's F = 1) and the record of the solve:
+    Brent's method on the longitudinal creepage to a force residual of 1e-4 mu_s F_N (F_N of the zero-creepage
+    solve), the other creepages as given.
+    """
+    from rigid_dynamics.contact.force_control import solve_for_force
+
+    base = case.creepage
+    results: dict = {}
+
+    def force_of(xi: float) -> float:
+        result = solve_at(dataclasses.replace(base, longitudinal=xi))
+        results[xi] = result
+        return result.creep_force_long_N if result.success else math.nan
+
+    first = solve_at(dataclasses.replace(base, longitudinal=0.0))
+    mu_n = case.material.friction_coefficient * first.normal_force_N
+    if not (first.success and math.isfinite(mu_n) and mu_n > 0):
+        outcome = None
+    else:
+        outcome = solve_for_force(force_of, case.longitudinal_force_N, force_tolerance_N=1e-4 * mu_n)
+    record = {
+        "target_longitudinal_force_N": case.longitudinal_force_N,
+        "status": "not-converged" if outcome is None else outcome.status,
+        "solved_creepage_long": None if outcome is None else _number(outcome.creepage),
+        "longitudinal_force_N": None if outcome is None else _number(outcome.force_N),
+        "residual_N": None if outcome is None else _number(outcome.residual_N),
+        "force_tolerance_N": _number(1e-4 * mu_n),
+        "evaluations": 0 if outcome is None else outcome.evaluations,
+        "message": (f"the zero-creepage solve failed: {first.message}" if outcome is None else outcome.message),
+    }
+    xi = 0.0 if outcome is None or not math.isfinite(outcome.creepage) else outcome.creepage
+    return dataclasses.replace(base, longitudinal=xi), {"force_control": record}
+
+
+def _force_controlled_wheelset(case: ContactCase, method: str, progress=None):
+    """A wheelset case with ``longitudinal_force_N`` (CONTACT's F = 1 of its wheel-rail module): the pitch rate
+    solved so that the creep forces on the solved wheels sum to that force along the track's x (N, on the wheels).
+
+    The unknown is the wheelset's longitudinal creepage xi_ws = 1 - omega / omega_0, omega the wheels' spin rate and
+    omega_0 the free-rolling one (the zero-axle-moment spin rate of the case solved without the force): the pitch
+    rate is -omega_0 (1 - xi_ws). Brent's method to a residual of 1e-4 mu times the vertical load.
+    """
+    from rigid_dynamics.contact.force_control import solve_for_force
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    options = dict(case.solver_options)
+    free = solve_wheelset_case(case.wheelset, case.material, method, options=options, progress=progress)
+    omega_0 = free.spin_rate_rad_per_s
+    solutions: dict = {}
+
+    def force_of(xi: float):
+        wheelset = dataclasses.replace(case.wheelset, pitch_rate_rad_per_s=-omega_0 * (1.0 - xi))
+        solution = solve_wheelset_case(wheelset, case.material, method, options=options, progress=progress)
+        solutions[xi] = solution
+        if not solution.success:
+            return math.nan
+        return float(sum(p.force_main_N[0] for p in solution.patches if math.isfinite(p.result.normal_force_N)))
+
+    load = sum(free.wheel_vertical_load_N.values()) or float(case.wheelset.wheel_load_N or 0.0)
+    tolerance = 1e-4 * case.material.friction_coefficient * load
+    outcome = None
+    if free.success and math.isfinite(omega_0) and tolerance > 0:
+        # F_x on the wheels rises with xi_ws (traction): solve on -xi_ws, along which it falls
+        outcome = solve_for_force(lambda u: -force_of(-u), -case.longitudinal_force_N, force_tolerance_N=tolerance)
+    ok = outcome is not None and math.isfinite(outcome.creepage)
+    xi = -outcome.creepage if ok else 0.0
+    if xi not in solutions:
+        force_of(xi)
+    record = {
+        "target_longitudinal_force_N": case.longitudinal_force_N,
+        "status": "not-converged" if outcome is None else outcome.status,
+        "solved_creepage_long": _number(xi) if ok else None,
+        "free_rolling_spin_rate_rad_per_s": _number(omega_0),
+        "pitch_rate_rad_per_s": _number(-omega_0 * (1.0 - xi)) if ok else None,
+        "longitudinal_force_N": None if outcome is None else _number(-outcome.force_N),
+        "residual_N": None if outcome is None else _number(-outcome.residual_N),
+        "force_tolerance_N": _number(tolerance),
+        "evaluations": 1 + (0 if outcome is None else outcome.evaluations),
+        "message": f"the free-rolling solve failed: {free.message}" if outcome is None else outcome.message,
+    }
+    return solutions[xi], record
 
 
 def _number(value) -> float | None:
@@ -721,6 +853,9 @@ def solution_status(solution: CaseSolution) -> str:
     for patch in solution.patches:
         if patch[3].status not in OK_PATCH_STATUSES:
             return patch[3].status
+    control = solution.extra.get("force_control", {}).get("status", "ok")
+    if control != "ok":
+        return control  # the prescribed force was not reached: "not-attainable" or "not-converged"
     return "ok" if solution.success else "failed"
 
 

@@ -60,12 +60,13 @@ class FrictionRecord(NamedTuple):
     """A friction law as compiled kernels take it: one row per node (one node when nothing varies).
 
     Fields:
-        law_code: FRICTION_COULOMB, FRICTION_LINEAR, FRICTION_RATIONAL or FRICTION_EXPONENTIAL.
-        varies_code: VARIES_NOWHERE, VARIES_WITH_INCLINATION, VARIES_WITH_RAIL_LATERAL or VARIES_ALONG_TRACK.
-        node: (n,) the variable at the nodes, ascending (rad or m); (1,) zero when nothing varies.
-        kinetic: (n,) mu_k, the coefficient at large slip velocity.
-        term_1, half_velocity_1_m_per_s, term_2, half_velocity_2_m_per_s: (n,) f1, s1, f2, s2 of the falling law
-            (zero sizes for Coulomb).
+
+    * ``law_code``: FRICTION_COULOMB, FRICTION_LINEAR, FRICTION_RATIONAL or FRICTION_EXPONENTIAL;
+    * ``varies_code``: VARIES_NOWHERE, VARIES_WITH_INCLINATION, VARIES_WITH_RAIL_LATERAL or VARIES_ALONG_TRACK;
+    * ``node``: (n,) the variable at the nodes, ascending (rad or m); (1,) zero when nothing varies;
+    * ``kinetic``: (n,) mu_k, the coefficient at large slip velocity;
+    * ``term_1``, ``half_velocity_1_m_per_s``, ``term_2``, ``half_velocity_2_m_per_s``: (n,) f1, s1, f2, s2 of the
+      falling law (zero sizes for Coulomb).
     """
 
     law_code: int
@@ -298,7 +299,7 @@ TABLE_LAW_KEYS = {
 TABLE_LAW_KEYS["rational"] = TABLE_LAW_KEYS["exponential"] = TABLE_LAW_KEYS["linear"]
 OPTIONAL_TABLE_KEYS = {"term_2": 0.0, "half_velocity_2_m_per_s": 1.0}
 """Keys of a ``[friction]`` table per law (besides ``law``, ``varies_with`` and ``nodes_rad`` / ``nodes_m``), and the
-defaults of the optional ones. The names follow CONTACT v24.1's friction input (user guide, "friction law"):
+defaults of the optional ones. The names follow CONTACT v25.1's friction input (user guide, "friction law"):
 coefficient = FSTAT = FKIN (L = 0); kinetic, term_1, half_velocity_1, term_2, half_velocity_2 = FKIN, FLIN1, SABS1,
 FLIN2, SABS2 (L = 2, 3, 4; SABS in m/s here, mm/s in CONTACT); static, polach_a, polach_b = Polach's mu_0, A, B
 (L = 5: CONTACT's FSTAT, POLACH_A, POLACH_B with B in s/mm there)."""

@@ -74,7 +74,11 @@ DEFAULT_CASE_OPTIONS: dict = {
     "rolling_speed": "mean",  # creepages relative to the bodies' mean rolling speed ("mean", Kalker, CONTACT)
     # or to the wheelset centre's speed ("centre", eq 41); see _creepage
     "sides": SIDES,  # per-wheel kinematics: the wheels to solve (CONTACT's A-2.2 deck solves the right one)
+    "friction_place": "patch",  # a friction law varying in place: "patch" (one value at the patch's reference
+    # point, as CONTACT for a planar patch) or "element" (the rail's inclination / lateral coordinate under each
+    # element): friction_place_of
 }
+FRICTION_PLACES = ("patch", "element")
 COARSE_FORCE_TOLERANCE = 1e-3
 """The load tolerance of the coarse phase of a model with ``coarse_options`` (the FEA): the full solve's force
 differs from the coarse one by its discretisation error, several per cent on the A-2.2 patches, so balancing the
@@ -148,7 +152,33 @@ def case_options(method: str, check_model=None) -> dict:
                check=check_model),
         Option("rolling_speed", str, d["rolling_speed"], "creepages relative to", choices=("mean", "centre")),
         Option("sides", tuple, d["sides"], "per-wheel kinematics: the wheels solved"),
+        Option("friction_place", str, d["friction_place"], "where a friction law varying in place is evaluated",
+               choices=FRICTION_PLACES),
     )  # fmt: skip
+
+
+def friction_place_of(geometry: ContactGeometry, rail, side: str):
+    """The place function of a wheelset patch (``ContactGeometry.friction_place``): at a point (x, y) of the contact
+    plane, the rail surface under it (the same main-frame y) gives the surface inclination atan(-+ dN/dy) (N the
+    rail height, z down; - on the right rail, + on the left: the sign of the contact angle, positive towards the
+    gauge face, so that it equals ``contact_angle_rad`` where the rail's normal is the patch's) or the lateral
+    coordinate on the rail profile; "track_distance" is the patch's ``track_distance_m`` plus x along the track.
+    """
+    exact = getattr(rail, "exact", rail)
+    sign = -1.0 if side == "right" else 1.0
+    origin, frame = np.asarray(geometry.point_m, float), np.asarray(geometry.frame, float)
+
+    def place(varies_with: str, x_m, y_m):
+        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        points = origin + x_m[..., None] * frame[:, 0] + y_m[..., None] * frame[:, 1]
+        if varies_with == "track_distance":
+            return geometry.track_distance_m + points[..., 0]
+        values = rail.evaluate(points[..., 0], points[..., 1])
+        if varies_with == "surface_inclination":
+            return np.arctan(sign * np.asarray(values[2], float))
+        return np.asarray(exact.to_profile_coordinates(points[..., 1], np.asarray(values[0], float))[0], float)
+
+    return place
 
 
 @dataclass(frozen=True)
@@ -187,6 +217,8 @@ class WheelsetCase:
         wheel_irregularities_right, wheel_irregularities_left: out-of-roundness of each wheel, a tuple of
             rigid_dynamics.geometry wheel irregularities (``HarmonicOutOfRoundness``, ``WheelFlat``,
             ``MeasuredWheelIrregularity``: anything with ``evaluate(angle_rad, y_m)``); () is a round wheel.
+        track_distance_m: the wheelset's position along the track, m (CONTACT's S_WS): the place of a friction law
+            that varies along the track (every patch's ``track_distance_m``); moves nothing else.
     """
 
     wheel_profile: str
@@ -198,6 +230,7 @@ class WheelsetCase:
     flange_back_distance_m: float = 1.360
     nominal_radius_m: float = 0.46
     rail_inclination_rad: float = 0.0
+    track_distance_m: float = 0.0
     wheel_load_N: float | None = None
     approach_m: float | None = None
     rolling_speed_m_per_s: float = 1.0
@@ -533,6 +566,11 @@ class _Evaluator:
             options = self.model_options
             if self.estimates:
                 options = {**(options or {}), "estimate_grid_error": False}
+            if self.case.track_distance_m != 0.0:
+                geometry = dataclasses.replace(geometry, track_distance_m=float(self.case.track_distance_m))
+            if self.opts["friction_place"] == "element" and self.material.friction is not None:
+                rail = self.track.fast[side][1]
+                geometry = dataclasses.replace(geometry, friction_place=friction_place_of(geometry, rail, side))
             result = self.model.solve(geometry, creepage, self.material, normal_force_N=None, options=options)
             if not result.success:
                 failed.append(f"{side} patch {k}: {result.message}")

@@ -72,7 +72,7 @@ OPTIONS = declare(
     Option("shift_rotation_rad", float, 0.0, "shift problem: rigid rotation about the normal, rad"),
     Option("kinetic_friction_coefficient", float, None, "withdrawn: give a falling friction law ([friction])",
            minimum=0.0, exclusive_minimum=True, allow_none=True),
-    Option("max_friction_iterations", int, 50, "outer iterations of a falling friction law", minimum=1),
+    Option("max_friction_iterations", int, 100, "outer iterations of a falling friction law", minimum=1),
     Option("transient_steps", int, None, "transient problem: rolling steps of dx (None: nx)", minimum=1,
            allow_none=True),
 )  # fmt: skip
@@ -133,7 +133,7 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   coefficient for adhesion and slip (its input rejects FSTAT != FKIN), and friction that drops once an element
   slides is a falling law of the slip velocity: the material's friction law (``Material.friction``, a case's
   ``[friction]`` table), solved element-wise (:func:`~.tang.solve_tang_law`);
-* ``max_friction_iterations`` (int >= 1, default 50): outer iterations of a falling friction law (the traction
+* ``max_friction_iterations`` (int >= 1, default 100): outer iterations of a falling friction law (the traction
   bound of the slip elements updated from their slip velocities); the solution is "not-converged" beyond it.
 
 Friction: the material's law (:meth:`~rigid_dynamics.materials.Material.friction_law`) bounds the traction

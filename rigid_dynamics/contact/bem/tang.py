@@ -559,6 +559,11 @@ def solve_tang(
     return TangSolution(tx, ty, sx, sy, slip, it, lin_total, residual, converged)
 
 
+FRICTION_TOLERANCE = 1e-6
+"""The outer iteration of a falling law stops when the traction bound changes by less than max(10 tolerance, this)
+times max mu_s p (a finer bound changes the forces below the grid's own error by orders of magnitude)."""
+
+
 def solve_tang_law(
     influence: InfluenceGrid,
     pressure_Pa: np.ndarray,
@@ -570,7 +575,7 @@ def solve_tang_law(
     *,
     tolerance: float = 1e-8,
     max_iterations: int = 60,
-    max_friction_iterations: int = 50,
+    max_friction_iterations: int = 100,
     initial_traction: tuple[np.ndarray, np.ndarray] | None = None,
     initial_slip: np.ndarray | None = None,
 ) -> TangSolution:
@@ -580,15 +585,17 @@ def solve_tang_law(
     |t| = mu(V |s|, place) p, with V |s| its local slip velocity (m/s). Coulomb's law (varying in place or not) is
     one :func:`solve_tang`. A falling law is solved as CONTACT solves its steady state: the traction bound of the
     slip elements is fixed, TANG solved, the bound updated from the new slip velocities, and so on (each solve
-    warm-started from the last), until the bound changes by less than ``tolerance`` times max mu_s p in an
-    iteration; the update is under-relaxed (halved) if the change grows. No friction memory (the steady law).
+    warm-started from the last), until the bound changes by less than :data:`FRICTION_TOLERANCE` (or 10
+    ``tolerance``) times max mu_s p in an iteration; the update is under-relaxed (halved) if the change grows. No
+    friction memory (the steady law).
+
+    The other arguments are those of :func:`solve_tang` (steady rolling only).
 
     Args:
-        law: the FrictionLaw; ``place``: its variable at each element (ny, nx), rad or m (ignored when the law does
-            not vary).
+        law: the FrictionLaw.
+        place: the law's variable at each element (ny, nx), rad or m (ignored when the law does not vary).
         rolling_speed_m_per_s: V > 0 (slip velocity = V times the dimensionless slip).
         max_friction_iterations: outer iteration limit; not converged -> ``converged`` False.
-        Other arguments as :func:`solve_tang` (steady rolling only).
     """
     from rigid_dynamics.contact.friction import friction_coefficient
 
@@ -613,7 +620,7 @@ def solve_tang_law(
         speed = rolling_speed_m_per_s * np.hypot(tang.slip_x, tang.slip_y)
         target = np.where(tang.in_slip, coefficient(speed, places), mu_s)
         change = float((np.abs(target - mu_k) * p).max()) / scale
-        if change <= max(tolerance, 1e-10) * 10:
+        if change <= max(10.0 * tolerance, FRICTION_TOLERANCE):
             return dataclasses.replace(tang, linear_iterations=lin, friction_iterations=outer, friction_change=change)
         if change > last_change:
             relax = max(0.5 * relax, 0.125)
