@@ -156,3 +156,29 @@ def test_friction_table_coulomb_equals_material_coefficient():
 )  # fmt: skip
 def test_bad_friction_table_in_a_scene_exits_2(tmp_path, capsys, new, pattern):
     assert_bad_scene(tmp_path, capsys, "hunting-conical", "friction_coefficient = 0.3", new, pattern)
+
+
+def test_adhesion_events_on_synthetic_creep_curves():
+    """recorder.adhesion_events: a falling creep curve (maximum at xi = 0.01, then falling) gives the adhesion limit
+    at the maximum and the slide where |xi| reaches WHEEL_SLIDE_CREEPAGE; a saturating (Coulomb) curve gives none."""
+    from rigid_dynamics.wheelset.recorder import WHEEL_SLIDE_CREEPAGE, adhesion_events
+
+    t = np.linspace(0.0, 0.1, 101)
+    xi = t.copy()  # the creepage grows linearly, 0 to 0.1
+    falling = 0.4 * (xi / 0.01) * np.exp(1.0 - xi / 0.01) * 0.5 + 0.2 * np.minimum(xi / 0.01, 1.0)
+    saturating = 0.4 * np.minimum(xi / 0.01, 1.0)
+
+    def patches(ratio):
+        shape = (len(t), 2, 2)
+        normal = np.full(shape, np.nan)
+        normal[:, :, 0] = 1e5
+        tx, creep = np.full(shape, np.nan), np.full(shape, np.nan)
+        tx[:, :, 0] = -ratio[:, None] * 1e5
+        creep[:, :, 0] = xi[:, None]
+        return {"normal_force_N": normal, "creep_force_long_N": tx, "creepage_long": creep}
+
+    events = adhesion_events(t, patches(falling))
+    peak = float(t[int(np.argmax(falling))])
+    slide = float(t[int(np.argmax(xi >= WHEEL_SLIDE_CREEPAGE))])
+    assert ("adhesion-limit", "left", peak) in events and ("wheel-slide", "right", slide) in events
+    assert adhesion_events(t, patches(saturating)) == []

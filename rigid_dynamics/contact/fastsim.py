@@ -41,6 +41,18 @@ two such pairs advance together, the bound is compared squared so adhering eleme
 root). Both do the same IEEE arithmetic up to reordering and agree to ~1e-15 (tests/test_fastsim.py);
 the fast one is ~3x quicker (benchmarks/results/fastsim_grid.md).
 
+Friction (contact.friction; :class:`PatchFriction`): Coulomb's mu bounds every element by mu p. A falling law
+bounds an element that slides by mu at its own slip velocity V |s| (V the rolling speed, s the element's slip per
+rolling distance): with the trial traction t = p_prev - w dx and s = k (|t| - g), k = |(L1 t_x, L2 t_y)| / (|t| dx),
+the bound g solves g = p mu(V k (|t| - g)) (:func:`_falling_bound`), adhesion holding while |t| <= mu_s p,
+mu_s = mu(0): CONTACT's FASTSIM with falling friction written for the strip recursion (its friction memory not
+modelled). A law that varies in place is taken at the patch's place (one place per patch). Falling laws run the
+plain loop; Coulomb without fields the fast kernel (tests/test_fastsim_falling.py).
+
+The kernels take records (:class:`FastsimPatch`, :class:`FastsimGrid`, :class:`StripFields`, :class:`PatchFriction`
+and the flexibilities (L1, L2, L3)); the drivers :func:`fastsim_batch` and :func:`fastsim_fields` take arrays and
+keywords.
+
 Signs: Fx, Fy, Mz on the wheel, contact frame; Mz = sum (x p_y - y p_x) dA.
 
 Known limitation: the flexibilities are fitted to C11, C22, C23 only, so the simplified theory's
