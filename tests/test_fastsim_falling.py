@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from rigid_dynamics.contact import friction
-from rigid_dynamics.contact.fastsim import PatchFriction, _falling_bound, fastsim_batch, fastsim_fields
+from rigid_dynamics.contact.fastsim import FrictionAt, PatchFriction, _falling_bound, fastsim_batch, fastsim_fields
 
 G, NU = 82.0e9, 0.28
 A, B, FN = 6.0e-3, 4.0e-3, 80.0e3
@@ -85,7 +85,7 @@ def test_varying_law_at_a_node_is_the_node_law():
     way between two nodes, the interpolated mu."""
     law = friction.varying("surface_inclination", [0.3, 0.5], [friction.coulomb(0.4), friction.coulomb(0.1)])
     for place, mu in ((0.3, 0.4), (0.5, 0.1), (0.0, 0.4), (1.2, 0.1), (0.4, 0.25)):
-        got = _fx(0.01, law, place=place)[0]
+        got = _fx(0.01, FrictionAt(law, place))[0]
         assert got == pytest.approx(_fx(0.01, mu)[0], rel=1e-12, abs=1e-9)
 
 
@@ -107,12 +107,12 @@ def test_fields_of_a_falling_law_report_slip_velocity():
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"place": math.nan}, "place"),
         ({"rolling_speed_m_per_s": -1.0}, "rolling_speed_m_per_s"),
         ({"nz": 3}, "nz = 3: unknown option"),
     ],
 )
 def test_bad_inputs_name_the_argument(kwargs, match):
+    """Bad keywords raise ValueError naming the argument (and a place that is not finite, below)."""
     with pytest.raises(ValueError, match=match):
         fastsim_batch(A, B, FN, 0.0, 0.0, 0.0, shear_modulus_Pa=G, poisson_ratio=NU, friction_coefficient=EXPONENTIAL,
                       **kwargs)  # fmt: skip
@@ -141,3 +141,8 @@ def test_static_fastsim_model_takes_the_material_law_at_the_patch_place():
         shear_modulus_Pa=G, poisson_ratio=NU, friction_coefficient=EXPONENTIAL, rolling_speed_m_per_s=SPEED,
     )  # fmt: skip
     assert falling.creep_force_long_N == pytest.approx(fx, rel=1e-12)
+
+
+def test_a_place_that_is_not_finite_is_refused():
+    with pytest.raises(ValueError, match="place = nan: expected finite values"):
+        _fx(0.01, FrictionAt(EXPONENTIAL, math.nan))

@@ -132,6 +132,16 @@ class PatchFriction(NamedTuple):
     rolling_speed_m_per_s: float
 
 
+class FrictionAt(NamedTuple):
+    """A friction law at a place: ``friction_coefficient`` of :func:`fastsim_batch` / :func:`fastsim_fields` for a
+    law that varies in place; ``place`` (rad or m, the variable of the law's nodes) a number or an array (one per
+    patch).
+    """
+
+    law: FrictionLaw
+    place: object = 0.0
+
+
 def law_at_place(law: FrictionLaw, place: float) -> FrictionLaw:
     """The law ``law`` with its parameters at ``place`` (interpolated between its nodes as the compiled kernel does):
     one law that varies nowhere, for a patch that has one place (the static FASTSIM model: its reference point).
@@ -561,12 +571,14 @@ def _grid_options(options) -> tuple[FastsimGrid, str]:
     return FastsimGrid(int(opts["nx"]), int(opts["ny"]), traction_bound == "parabolic"), flexibility
 
 
-def _friction_arrays(friction, place, rolling_speed_m_per_s, shape):
-    """(record, place, mu_s, V) as flat arrays of ``shape``: ``friction`` a number or array (Coulomb) or a
-    contact.friction.FrictionLaw evaluated at ``place``.
+def _friction_arrays(friction, rolling_speed_m_per_s, shape):
+    """(record, place, mu_s, V) as flat arrays of ``shape``: ``friction`` a number or array (Coulomb), a
+    contact.friction.FrictionLaw (at place 0) or a :class:`FrictionAt`.
     """
     if isinstance(friction, FrictionLaw):
-        law = friction
+        friction = FrictionAt(friction)
+    if isinstance(friction, FrictionAt):
+        law, place = friction
         places = np.broadcast_to(np.asarray(place, dtype=float), shape).ravel().copy()
         if not np.all(np.isfinite(places)):
             raise ValueError(f"place = {place!r}: expected finite values")
@@ -587,7 +599,7 @@ def _friction_arrays(friction, place, rolling_speed_m_per_s, shape):
 def _prepare(patch: FastsimPatch, elastic, friction, options, coefficients):
     """Validated flat inputs of the drivers: (shape, :class:`FastsimPatch` of arrays, (L1, L2, L3) arrays,
     :class:`PatchFriction` of arrays, :class:`FastsimGrid`). ``elastic`` = (G, nu); ``friction`` = (friction
-    coefficient or law, place, rolling speed); ``options`` the grid keywords; ``coefficients`` the C_ij or None.
+    coefficient, law or FrictionAt; rolling speed); ``options`` the grid keywords; ``coefficients`` the C_ij or None.
     """
     shear_modulus_Pa, poisson_ratio = elastic
     grid, flexibility = _grid_options(options)
@@ -598,8 +610,8 @@ def _prepare(patch: FastsimPatch, elastic, friction, options, coefficients):
     a, b, fn, xi, eta, phi = (np.array(v.ravel(), dtype=float) for v in arrays)
     if not (np.all(np.isfinite(a)) and np.all(a > 0) and np.all(np.isfinite(b)) and np.all(b > 0)):
         raise ValueError("semi_axis_long_m, semi_axis_lat_m: expected finite values > 0")
-    law, place, speed = friction
-    patch_friction = _friction_arrays(law, place, speed, shape)
+    law, speed = friction
+    patch_friction = _friction_arrays(law, speed, shape)
     for name, v in (("normal_force_N", fn), ("longitudinal", xi), ("lateral", eta), ("spin_1_per_m", phi)):
         if not np.all(np.isfinite(v)):
             raise ValueError(f"{name}: expected finite values")
@@ -635,7 +647,6 @@ def fastsim_batch(
     shear_modulus_Pa: float,
     poisson_ratio: float,
     friction_coefficient,
-    place=0.0,
     rolling_speed_m_per_s=1.0,
     coefficients: CreepCoefficients | None = None,
     **grid,
@@ -648,9 +659,9 @@ def fastsim_batch(
         normal_force_N: N, N (patches with N <= 0 give zero forces).
         longitudinal: xi; lateral: eta; spin_1_per_m: phi (1/m).
         shear_modulus_Pa: G; poisson_ratio: nu (C_ij).
-        friction_coefficient: mu (scalar or array: Coulomb), or a contact.friction.FrictionLaw (falling and/or
-            varying: each element's bound is mu at its own slip velocity; the law's parameters at ``place``).
-        place: the patch's place in the variable of the law's nodes (rad or m; scalar or array).
+        friction_coefficient: mu (scalar or array: Coulomb), or a contact.friction.FrictionLaw (falling: each
+            element's bound is mu at its own slip velocity), or a :class:`FrictionAt` (a law that varies in place, at
+            the patches' places: its parameters there).
         rolling_speed_m_per_s: V, which turns the slip (per rolling distance) into the slip velocity of a falling law.
         coefficients: precomputed C_ij (else from Kalker's table).
         **grid: nx, ny (elements per strip and number of strips, default 20), traction_bound ("elliptic" or
@@ -664,7 +675,7 @@ def fastsim_batch(
     """
     patch = FastsimPatch(semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m)
     shape, patches, flex, friction, fgrid = _prepare(
-        patch, (shear_modulus_Pa, poisson_ratio), (friction_coefficient, place, rolling_speed_m_per_s), grid,
+        patch, (shear_modulus_Pa, poisson_ratio), (friction_coefficient, rolling_speed_m_per_s), grid,
         coefficients,
     )  # fmt: skip
     out = np.empty((patches.semi_axis_long_m.size, 4))
@@ -684,7 +695,6 @@ def fastsim_fields(
     poisson_ratio: float,
     friction_coefficient,
     rolling_speed_m_per_s: float = 1.0,
-    place: float = 0.0,
     **grid,
 ) -> tuple[tuple[float, float, float, float], ContactFields]:
     """FASTSIM for one patch with surface fields (arguments as :func:`fastsim_batch`, scalars).
@@ -702,7 +712,7 @@ def fastsim_fields(
     """
     patch = FastsimPatch(semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m)
     _, patches, flex, friction, fgrid = _prepare(
-        patch, (shear_modulus_Pa, poisson_ratio), (friction_coefficient, place, rolling_speed_m_per_s), grid, None
+        patch, (shear_modulus_Pa, poisson_ratio), (friction_coefficient, rolling_speed_m_per_s), grid, None
     )
     if patches.semi_axis_long_m.size != 1:
         raise ValueError("fastsim_fields: expected scalar inputs (one patch)")
