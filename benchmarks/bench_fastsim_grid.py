@@ -55,6 +55,7 @@ sys.path.insert(0, str(ROOT))
 
 from rigid_dynamics.contact import fastsim  # noqa: E402
 from rigid_dynamics.contact.fastsim import effective_flexibilities  # noqa: E402
+from rigid_dynamics.contact.friction import uniform  # noqa: E402
 from rigid_dynamics.contact.kalker import kalker_coefficients  # noqa: E402
 from rigid_dynamics.files import write_text  # noqa: E402  (atomic)
 
@@ -75,6 +76,8 @@ SCAN = range(4, 41)
 REF, CONVERGED = 200, 1600
 TOLERANCES = (0.01, 0.02)
 _DUMMY = np.zeros((1, 1))
+_COULOMB = uniform(0.0).record()
+"""Coulomb's record: the kernel then bounds by the coefficient it is given (PatchFriction.coefficient)."""
 
 
 def patch(xi, eta, phi, a=A, b=B, fn=FN, mu=MU):
@@ -87,9 +90,19 @@ def patch(xi, eta, phi, a=A, b=B, fn=FN, mu=MU):
     return (a, b, mu, fn, xi, eta, phi, *(float(np.ravel(v)[0]) for v in flex))
 
 
+@njit
+def _current_positional(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, px, py, sx, sy, store):
+    """The current ``fastsim._fastsim_one`` (records: FastsimPatch, PatchFriction, FastsimGrid, StripFields) behind
+    the positional signature the baselines before issue 26 have, so that both are timed and compared alike."""
+    return fastsim._fastsim_one(
+        fastsim.FastsimPatch(a, b, fn, xi, eta, phi), (l1, l2, l3), fastsim.PatchFriction(_COULOMB, 0.0, mu, 1.0),
+        fastsim.FastsimGrid(nx, ny, parabolic), fastsim.StripFields(px, py, sx, sy, store),
+    )  # fmt: skip
+
+
 def solve(args, nx, ny, kernel=None):
     """(Fx, Fy, Mz, slip fraction) of one patch."""
-    kernel = kernel or fastsim._fastsim_one
+    kernel = kernel or _current_positional
     return np.array(kernel(*args, nx, ny, False, _DUMMY, _DUMMY, _DUMMY, _DUMMY, False))
 
 
@@ -119,7 +132,7 @@ def _calls(kernel, reps, rows, nx, ny):
 
 def time_per_call_us(rows, nx, ny, kernel=None, budget_s=0.01, repeats=7):
     """Best-of-repeats wall time per kernel call (one patch), us."""
-    kernel = kernel or fastsim._fastsim_one
+    kernel = kernel or _current_positional
     rows = np.asarray(rows, dtype=float)
     _calls(kernel, 1, rows, nx, ny)
     t = time.perf_counter()
@@ -165,7 +178,7 @@ def speed(baseline):
                 diff = 0.0
                 for args in patches:
                     for parabolic in (False, True):
-                        new = np.array(fastsim._fastsim_one(*args, n, n, parabolic, *[_DUMMY] * 4, False))
+                        new = np.array(_current_positional(*args, n, n, parabolic, *[_DUMMY] * 4, False))
                         old = np.array(baseline._fastsim_one(*args, n, n, parabolic, *[_DUMMY] * 4, False))
                         f = math.hypot(old[0], old[1])
                         scale = np.array([f, f, f * args[0], 1.0])  # Mz against |F| a (pure creepage: Mz ~ 0)

@@ -17,11 +17,15 @@ import numpy as np
 import pytest
 
 from rigid_dynamics.contact.fastsim import (
+    FastsimGrid,
+    FastsimPatch,
     _fastsim_one,
     _fastsim_reference,
+    coulomb_friction,
     fastsim_batch,
     fastsim_fields,
     kalker_flexibilities,
+    no_fields,
 )
 from rigid_dynamics.contact.kalker import kalker_coefficients
 
@@ -248,7 +252,6 @@ def test_fast_kernel_equals_plain_strip_loop(parabolic):
     is not expected).
     """
     rng = np.random.default_rng(11)
-    d = np.zeros((1, 1))
     for _ in range(40):
         a, b = rng.uniform(2e-3, 10e-3, 2)
         fn, mu = rng.uniform(1e4, 1e5), rng.uniform(0.1, 0.5)
@@ -257,9 +260,9 @@ def test_fast_kernel_equals_plain_strip_loop(parabolic):
         phi = rng.uniform(-1, 1) * scale * 1e3 * rng.choice([0.0, 1.0])
         l1, l2, l3 = rng.uniform(0.5, 2.0, 3) * kalker_flexibilities(a, b, G, kalker_coefficients(a / b, NU))
         for nx, ny in [(1, 1), (1, 6), (7, 1), (5, 4), (13, 9), (20, 20), (8, 15)]:
-            args = (a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic)
-            fast = _fastsim_one(*args, d, d, d, d, False)
-            ref = _fastsim_reference(*args, d, d, d, d, False)
+            args = (FastsimPatch(a, b, fn, xi, eta, phi), (l1, l2, l3), coulomb_friction(mu))
+            fast = _fastsim_one(*args, FastsimGrid(nx, ny, parabolic), no_fields())
+            ref = _fastsim_reference(*args, FastsimGrid(nx, ny, parabolic), no_fields())
             np.testing.assert_allclose(fast[:2], ref[:2], rtol=1e-12, atol=1e-12 * mu * fn, err_msg=str(args))
             np.testing.assert_allclose(fast[2], ref[2], rtol=1e-12, atol=1e-12 * mu * fn * a, err_msg=str(args))
             assert fast[3] == ref[3], args

@@ -130,7 +130,7 @@ def test_loop_kpec_law_equals_contacts_kpec(contact_cases, case):
     cr = patch.creepage
     fn, _, _, fx, fy, _, area, pmax = _kpec_law(
         par, hertz_kalker_tables(tables_for(g, nu)), field, 0, (geo.approach_m, 1.0, 1.0, 0.0),
-        (cr.longitudinal, cr.lateral, cr.spin_1_per_m),
+        (cr.longitudinal, cr.lateral, cr.spin_1_per_m), material.friction_coefficient,
     )  # fmt: skip
     mu_fn = material.friction_coefficient * ref["fn_N"]
     diffs = {

@@ -89,6 +89,38 @@ def _resolve_irregularity_files(doc: dict, base_dir: Path | None) -> dict:
     return {**doc, "irregularities": table}
 
 
+def _friction_table(doc: dict):
+    """(the document without ``[friction]``, its FrictionLaw or None): the table of docs/files.md (the case files'
+    shape, rigid_dynamics.contact.friction.friction_law_from_table), which replaces
+    ``material.friction_coefficient`` (giving both is an error). The dynamics place a patch by its contact angle
+    (surface_inclination) or its track distance; rail_lateral is refused here.
+    """
+    from rigid_dynamics.contact.friction import friction_law_from_table
+
+    if "friction" not in doc:
+        return doc, None
+    table = doc["friction"]
+    material = doc.get("material", {})
+    if isinstance(material, dict) and "friction_coefficient" in material:
+        raise ConfigError(
+            f"key 'material.friction_coefficient' = {material['friction_coefficient']!r}: not allowed with a "
+            "[friction] table (it gives the friction law; remove one of the two)"
+        )
+    try:
+        law = friction_law_from_table(table)
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
+    if law.varies_with == "rail_lateral":
+        raise ConfigError(
+            "key 'friction.varies_with' = 'rail_lateral': not available in dynamics scenes (a patch is placed by its "
+            "contact angle or its track distance): expected 'none', 'surface_inclination' or 'track_distance'"
+        )
+    rest = {k: v for k, v in doc.items() if k != "friction"}
+    if isinstance(material, dict):
+        rest["material"] = {**material, "friction_coefficient": law.max_static}
+    return rest, law
+
+
 def parse_scene(doc: dict, base_dir: Path | None = None):
     """Validate a parsed scene document into a DynamicsScene (ConfigError on any problem).
 
@@ -108,7 +140,10 @@ def parse_scene(doc: dict, base_dir: Path | None = None):
             raise ConfigError(f"missing key {key!r}: expected a finite number (every scene states it)")
     _check_profiles(doc)
     doc = _resolve_irregularity_files(doc, base_dir)
+    doc, law = _friction_table(doc)
     scene = build_dataclass(DynamicsScene, doc)
+    if law is not None:
+        scene = dataclasses.replace(scene, material=scene.material.with_friction(law))
     from rigid_dynamics.wheelset.checks import SceneError, check_scene
 
     try:

@@ -41,6 +41,18 @@ two such pairs advance together, the bound is compared squared so adhering eleme
 root). Both do the same IEEE arithmetic up to reordering and agree to ~1e-15 (tests/test_fastsim.py);
 the fast one is ~3x quicker (benchmarks/results/fastsim_grid.md).
 
+Friction (contact.friction; :class:`PatchFriction`): Coulomb's mu bounds every element by mu p. A falling law
+bounds an element that slides by mu at its own slip velocity V |s| (V the rolling speed, s the element's slip per
+rolling distance): with the trial traction t = p_prev - w dx and s = k (|t| - g), k = |(L1 t_x, L2 t_y)| / (|t| dx),
+the bound g solves g = p mu(V k (|t| - g)) (:func:`_falling_bound`), adhesion holding while |t| <= mu_s p,
+mu_s = mu(0): CONTACT's FASTSIM with falling friction written for the strip recursion (its friction memory not
+modelled). A law that varies in place is taken at the patch's place (one place per patch). Falling laws run the
+plain loop; Coulomb without fields the fast kernel (tests/test_fastsim_falling.py).
+
+The kernels take records (:class:`FastsimPatch`, :class:`FastsimGrid`, :class:`StripFields`, :class:`PatchFriction`
+and the flexibilities (L1, L2, L3)); the drivers :func:`fastsim_batch` and :func:`fastsim_fields` take arrays and
+keywords.
+
 Signs: Fx, Fy, Mz on the wheel, contact frame; Mz = sum (x p_y - y p_x) dA.
 
 Known limitation: the flexibilities are fitted to C11, C22, C23 only, so the simplified theory's
@@ -53,10 +65,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from rigid_dynamics.contact.friction import (
+    FRICTION_COULOMB,
+    FallingLaw,
+    FrictionLaw,
+    FrictionRecord,
+    friction_coefficient,
+    uniform,
+)
 from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
 from rigid_dynamics.contact.types import ContactFields
 
@@ -64,33 +85,167 @@ TRACTION_BOUNDS = ("elliptic", "parabolic")
 FLEXIBILITIES = ("single", "three", "three-unblended")
 
 
+class FastsimPatch(NamedTuple):
+    """One elliptic patch as FASTSIM's kernels take it (floats; arrays of one length for the batch kernel).
+
+    Fields: semi-axes a (rolling direction) and b, m; normal force N, N; creepages xi, eta and spin phi, 1/m.
+    """
+
+    semi_axis_long_m: float
+    semi_axis_lat_m: float
+    normal_force_N: float
+    longitudinal: float
+    lateral: float
+    spin_1_per_m: float
+
+
+class FastsimGrid(NamedTuple):
+    """FASTSIM's discretisation: nx elements per strip, ny strips, the traction bound's shape (parabolic or not)."""
+
+    nx: int
+    ny: int
+    parabolic: bool
+
+
+class StripFields(NamedTuple):
+    """The strip fields (ny, nx) the plain loop fills when ``store``: tractions p_x, p_y (Pa), slip s_x, s_y (per
+    rolling distance, 1) at the element midpoints; (1, 1) arrays when not stored.
+    """
+
+    px: np.ndarray
+    py: np.ndarray
+    sx: np.ndarray
+    sy: np.ndarray
+    store: bool
+
+
+class PatchFriction(NamedTuple):
+    """The friction one FASTSIM patch sees: the law's record (contact.friction.FrictionRecord), the place of the
+    patch (the variable of its nodes, rad or m), the static coefficient there mu_s = mu(0) (the Coulomb bound and
+    the blending's mu), and the rolling speed V (m/s) that turns the slip s (per rolling distance) into the slip
+    velocity V |s| of a falling law. Floats for one patch; arrays (one per patch) for the batch kernel.
+    """
+
+    record: FrictionRecord
+    place: float
+    coefficient: float
+    rolling_speed_m_per_s: float
+
+
+class FrictionAt(NamedTuple):
+    """A friction law at a place: ``friction_coefficient`` of :func:`fastsim_batch` / :func:`fastsim_fields` for a
+    law that varies in place; ``place`` (rad or m, the variable of the law's nodes) a number or an array (one per
+    patch).
+    """
+
+    law: FrictionLaw
+    place: object = 0.0
+
+
+def law_at_place(law: FrictionLaw, place: float) -> FrictionLaw:
+    """The law ``law`` with its parameters at ``place`` (interpolated between its nodes as the compiled kernel does):
+    one law that varies nowhere, for a patch that has one place (the static FASTSIM model: its reference point).
+    """
+    if not law.varies:
+        return law
+    rec = law.record()
+    node = rec.node
+    i = int(np.clip(np.searchsorted(node, place, side="right") - 1, 0, max(len(node) - 2, 0)))
+    j = min(i + 1, len(node) - 1)
+    w = 0.0 if j == i else float(np.clip((place - node[i]) / (node[j] - node[i]), 0.0, 1.0))
+    fields = ("kinetic", "term_1", "half_velocity_1_m_per_s", "term_2", "half_velocity_2_m_per_s")
+    values = [float((1.0 - w) * getattr(rec, f)[i] + w * getattr(rec, f)[j]) for f in fields]
+    return FrictionLaw((FallingLaw(law.laws[0].law, *values),))
+
+
+def no_fields() -> StripFields:
+    """A :class:`StripFields` that stores nothing."""
+    d = np.zeros((1, 1))
+    return StripFields(d, d, d, d, False)
+
+
+def coulomb_friction(coefficient: float, rolling_speed_m_per_s: float = 1.0) -> PatchFriction:
+    """A :class:`PatchFriction` of Coulomb's law with ``coefficient`` (the record of contact.friction.uniform)."""
+    return PatchFriction(uniform(max(float(coefficient), 0.0)).record(), 0.0, float(coefficient), rolling_speed_m_per_s)
+
+
 @njit(cache=True)
-def _strip_constants(a, b, mu, fn, xi, eta, phi, l1, l2, l3, ny, parabolic):
+def _strip_constants(patch, mu, flex, ny, parabolic):
     """(strip width dy, traction bound at the centre g0, xi/L1, eta/L2, phi/L3) of both strip loops."""
+    a, b, fn = patch.semi_axis_long_m, patch.semi_axis_lat_m, patch.normal_force_N
+    l1, l2, l3 = flex
     dy = 2.0 * b / ny
     if parabolic:
         g0 = mu * 2.0 * fn / (math.pi * a * b)
     else:
         g0 = mu * 3.0 * fn / (2.0 * math.pi * a * b)
-    return dy, g0, xi / l1, eta / l2, phi / l3
+    return dy, g0, patch.longitudinal / l1, patch.lateral / l2, patch.spin_1_per_m / l3
 
 
 @njit(cache=True)
-def _fastsim_reference(
-    a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, px_out, py_out, sx_out, sy_out, store
-):
+def _falling_bound(friction, pressure, trial, slip_per_excess):
+    """The traction bound g of a sliding element under a falling law: the root of g = p mu(V k (|t| - g)) in
+    (0, |t|), with p the pressure (Pa), |t| = ``trial`` the trial traction's magnitude (Pa) and k =
+    ``slip_per_excess`` the slip per unit of traction excess, k = |(L1 t_x, L2 t_y)| / (|t| d) (1/Pa): the element's
+    slip is s = k (|t| - g), its slip velocity V s. Bracketed: g = 0 gives -p mu < 0, g = |t| gives |t| - p mu_s > 0
+    (the element slides). Regula falsi (Illinois) with bisection when it stalls, to 1e-13 |t|. When
+    p |dmu/ds| V k >= 1 the equation can have several roots (a steeply falling law on a fine grid); the bracket
+    returns one of them.
+    """
+    rec, place, speed = friction.record, friction.place, friction.rolling_speed_m_per_s
+    lo, hi = 0.0, trial
+    f_lo = -pressure * friction_coefficient(rec, speed * slip_per_excess * trial, place)
+    f_hi = trial - pressure * friction_coefficient(rec, 0.0, place)
+    side = 0
+    g = hi
+    for it in range(200):
+        if it % 3 == 2:
+            g = 0.5 * (lo + hi)
+        else:
+            g = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+            if not lo < g < hi:
+                g = 0.5 * (lo + hi)
+        f = g - pressure * friction_coefficient(rec, speed * slip_per_excess * (trial - g), place)
+        if f > 0.0:
+            hi, f_hi = g, f
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+        else:
+            lo, f_lo = g, f
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        if hi - lo <= 1e-13 * trial:
+            break
+    return g
+
+
+@njit(cache=True)
+def _fastsim_reference(patch, flex, friction, grid, fields):
     """FASTSIM for one patch, the plain strip loop (one strip, one element at a time, as in the module docstring).
 
-    Returns (Fx, Fy, Mz, slip_area_fraction) and fills the strip fields if store. Used by fastsim_fields and as the
-    reference that the fast kernel (_fastsim_one with store False) must reproduce to round-off (tests/test_fastsim.py).
+    ``patch`` (:class:`FastsimPatch`), ``flex`` = (L1, L2, L3) (m/Pa), ``friction`` (:class:`PatchFriction`),
+    ``grid`` (:class:`FastsimGrid`), ``fields`` (:class:`StripFields`). Returns (Fx, Fy, Mz, slip_area_fraction)
+    and fills the strip fields if fields.store. Coulomb's law: the bound is mu_s p everywhere (friction.coefficient;
+    the record is not read). A falling law: an element slides when |t| > mu_s p and then on the bound of
+    :func:`_falling_bound` (mu at its own slip velocity). Used by fastsim_fields, by every falling-law patch, and as
+    the reference that the fast kernel (_fastsim_one, Coulomb, no fields) must reproduce to round-off
+    (tests/test_fastsim.py).
     """
+    a, b, fn = patch.semi_axis_long_m, patch.semi_axis_lat_m, patch.normal_force_N
+    l1, l2, _ = flex
+    nx, ny, parabolic = grid.nx, grid.ny, grid.parabolic
+    store = fields.store
+    falling = friction.record.law_code != FRICTION_COULOMB
+    mu = friction.coefficient
     fx = 0.0
     fy = 0.0
     mz = 0.0
     n_slip = 0
     if fn <= 0.0 or a <= 0.0 or b <= 0.0:
         return fx, fy, mz, 0.0
-    dy, g0, cx, cy, cs = _strip_constants(a, b, mu, fn, xi, eta, phi, l1, l2, l3, ny, parabolic)
+    dy, g0, cx, cy, cs = _strip_constants(patch, mu, flex, ny, parabolic)
     for j in range(ny):
         y = -b + (j + 0.5) * dy
         ay = a * math.sqrt(max(0.0, 1.0 - (y / b) ** 2))
@@ -115,6 +270,9 @@ def _fastsim_reference(
                 g = g0 * math.sqrt(rho)
             tn = math.sqrt(tx * tx + ty * ty)
             if tn > g:
+                if falling and mu > 0.0:
+                    k_slip = math.sqrt((l1 * tx) ** 2 + (l2 * ty) ** 2) / (tn * d)
+                    g = _falling_bound(friction, g / mu, tn, k_slip)
                 s = g / tn
                 px = tx * s
                 py = ty * s
@@ -125,15 +283,15 @@ def _fastsim_reference(
                 py = ty
                 slipping = False
             if store:
-                px_out[j, k] = px
-                py_out[j, k] = py
+                fields.px[j, k] = px
+                fields.py[j, k] = py
                 if slipping:
                     # s = L (p - p_trial) / d per component (L1, L2 for x, y)
-                    sx_out[j, k] = l1 * (px - tx) / d
-                    sy_out[j, k] = l2 * (py - ty) / d
+                    fields.sx[j, k] = l1 * (px - tx) / d
+                    fields.sy[j, k] = l2 * (py - ty) / d
                 else:
-                    sx_out[j, k] = 0.0
-                    sy_out[j, k] = 0.0
+                    fields.sx[j, k] = 0.0
+                    fields.sy[j, k] = 0.0
             area = dx * dy
             fx += px * area
             fy += py * area
@@ -189,8 +347,9 @@ def _unit_element(st, x, wxad, wxbd, wyd, ey, inv_a2, g0sq, parabolic, pair):
 
 
 @njit(cache=True)
-def _fastsim_fast(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic):
-    """The strip loop of _fastsim_reference rearranged for speed (forces only; same results to round-off).
+def _fastsim_fast(patch, flex, mu, nx, ny, parabolic):
+    """The strip loop of _fastsim_reference rearranged for speed (Coulomb's law mu, forces only; same results to
+    round-off).
 
     * the strips at y and -y share a(y), dx, the element midpoints and the traction bound (computed once);
     * two such pairs are advanced together (four independent recurrences keep the divide/sqrt unit busy while a
@@ -200,13 +359,14 @@ def _fastsim_fast(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic):
     * traction sums per strip, times the element area dx dy once per strip.
     Plain IEEE arithmetic (no fastmath): contraction to FMA would give ~20 % but results that depend on the CPU.
     """
+    a, b, fn = patch.semi_axis_long_m, patch.semi_axis_lat_m, patch.normal_force_N
     fx = 0.0
     fy = 0.0
     mz = 0.0
     n_slip = 0
     if fn <= 0.0 or a <= 0.0 or b <= 0.0:
         return fx, fy, mz, 0.0
-    dy, g0, cx, cy, cs = _strip_constants(a, b, mu, fn, xi, eta, phi, l1, l2, l3, ny, parabolic)
+    dy, g0, cx, cy, cs = _strip_constants(patch, mu, flex, ny, parabolic)
     g0sq = g0 * g0
     inv_a2 = 1.0 / (a * a)
     dyb = 2.0 / ny
@@ -255,29 +415,38 @@ def _fastsim_fast(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic):
 
 
 @njit(cache=True)
-def _fastsim_one(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, px_out, py_out, sx_out, sy_out, store):
-    """FASTSIM for one patch. Returns (Fx, Fy, Mz, slip_area_fraction); fills the strip fields if store.
+def _fastsim_one(patch, flex, friction, grid, fields):
+    """FASTSIM for one patch (:class:`FastsimPatch`, flexibilities (L1, L2, L3), :class:`PatchFriction`,
+    :class:`FastsimGrid`, :class:`StripFields`). Returns (Fx, Fy, Mz, slip_area_fraction); fills the strip fields if
+    fields.store.
 
-    With store the plain loop (_fastsim_reference) runs; without, the fast kernel, specialised for the traction
-    bound (the two agree to round-off, ~1e-15 relative).
+    Coulomb's law without fields: the fast kernel, specialised for the traction bound; otherwise (fields, or a
+    falling law) the plain loop _fastsim_reference (the two agree to round-off, ~1e-15 relative, for Coulomb).
     """
-    if store:
-        return _fastsim_reference(
-            a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, px_out, py_out, sx_out, sy_out, store
-        )
-    if parabolic:
-        return _fastsim_fast(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, True)
-    return _fastsim_fast(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, False)
+    if fields.store or friction.record.law_code != FRICTION_COULOMB:
+        return _fastsim_reference(patch, flex, friction, grid, fields)
+    if grid.parabolic:
+        return _fastsim_fast(patch, flex, friction.coefficient, grid.nx, grid.ny, True)
+    return _fastsim_fast(patch, flex, friction.coefficient, grid.nx, grid.ny, False)
 
 
 @njit(cache=True)
-def _fastsim_many(a, b, mu, fn, xi, eta, phi, l1, l2, l3, nx, ny, parabolic, out):
-    dummy = np.zeros((1, 1))
-    for i in range(a.shape[0]):
-        r = _fastsim_one(
-            a[i], b[i], mu[i], fn[i], xi[i], eta[i], phi[i], l1[i], l2[i], l3[i], nx, ny, parabolic,
-            dummy, dummy, dummy, dummy, False,
+def _fastsim_many(patches, flex, friction, grid, out):
+    """:func:`_fastsim_one` over patches: ``patches`` a :class:`FastsimPatch` of (n,) arrays, flex (L1, L2, L3) of
+    (n,) arrays, ``friction`` a :class:`PatchFriction` whose place, coefficient and rolling speed are (n,) arrays;
+    out (n, 4).
+    """
+    fields = StripFields(np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), False)
+    l1, l2, l3 = flex
+    for i in range(patches.semi_axis_long_m.shape[0]):
+        patch = FastsimPatch(
+            patches.semi_axis_long_m[i], patches.semi_axis_lat_m[i], patches.normal_force_N[i],
+            patches.longitudinal[i], patches.lateral[i], patches.spin_1_per_m[i],
         )  # fmt: skip
+        one = PatchFriction(
+            friction.record, friction.place[i], friction.coefficient[i], friction.rolling_speed_m_per_s[i]
+        )
+        r = _fastsim_one(patch, (l1[i], l2[i], l3[i]), one, grid, fields)
         out[i, 0] = r[0]
         out[i, 1] = r[1]
         out[i, 2] = r[2]
@@ -378,38 +547,71 @@ class FastsimBatch:
     slip_fraction: np.ndarray
 
 
-def _prepare(
-    a,
-    b,
-    fn,
-    xi,
-    eta,
-    phi,
-    shear_modulus_Pa,
-    poisson_ratio,
-    friction_coefficient,
-    nx,
-    ny,
-    traction_bound,
-    flexibility,
-    coefficients,
-):
+GRID_DEFAULTS = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
+"""FASTSIM's discretisation options (keywords of :func:`fastsim_batch`, :func:`fastsim_fields`) and defaults."""
+
+
+def _grid_options(options) -> tuple[FastsimGrid, str]:
+    """(:class:`FastsimGrid`, flexibility) of the keyword options nx, ny, traction_bound, flexibility (validated)."""
+    unknown = sorted(set(options) - set(GRID_DEFAULTS))
+    if unknown:
+        raise ValueError(
+            f"{unknown[0]} = {options[unknown[0]]!r}: unknown option, expected one of {', '.join(GRID_DEFAULTS)}"
+        )
+    opts = {**GRID_DEFAULTS, **options}
+    traction_bound, flexibility = opts["traction_bound"], opts["flexibility"]
     if traction_bound not in TRACTION_BOUNDS:
         raise ValueError(f"traction_bound = {traction_bound!r}: expected one of {', '.join(TRACTION_BOUNDS)}")
     if flexibility not in FLEXIBILITIES:
         raise ValueError(f"flexibility = {flexibility!r}: expected one of {', '.join(FLEXIBILITIES)}")
-    for name, n in (("nx", nx), ("ny", ny)):
+    for name in ("nx", "ny"):
+        n = opts[name]
         if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 1:
             raise ValueError(f"{name} = {n!r}: expected an integer >= 1")
+    return FastsimGrid(int(opts["nx"]), int(opts["ny"]), traction_bound == "parabolic"), flexibility
+
+
+def _friction_arrays(friction, rolling_speed_m_per_s, shape):
+    """(record, place, mu_s, V) as flat arrays of ``shape``: ``friction`` a number or array (Coulomb), a
+    contact.friction.FrictionLaw (at place 0) or a :class:`FrictionAt`.
+    """
+    if isinstance(friction, FrictionLaw):
+        friction = FrictionAt(friction)
+    if isinstance(friction, FrictionAt):
+        law, place = friction
+        places = np.broadcast_to(np.asarray(place, dtype=float), shape).ravel().copy()
+        if not np.all(np.isfinite(places)):
+            raise ValueError(f"place = {place!r}: expected finite values")
+        record = law.record()
+        mu = np.array([friction_coefficient(record, 0.0, v) for v in places])
+    else:
+        mu = np.array(np.broadcast_to(np.asarray(friction, dtype=float), shape).ravel())
+        if not (np.all(np.isfinite(mu)) and np.all(mu >= 0)):
+            raise ValueError(f"friction_coefficient = {friction!r}: expected finite values >= 0")
+        record = uniform(0.0).record()
+        places = np.zeros(mu.shape)
+    speed = np.array(np.broadcast_to(np.asarray(rolling_speed_m_per_s, dtype=float), shape).ravel())
+    if not (np.all(np.isfinite(speed)) and np.all(speed >= 0)):
+        raise ValueError(f"rolling_speed_m_per_s = {rolling_speed_m_per_s!r}: expected finite values >= 0")
+    return PatchFriction(record, places, mu, speed)
+
+
+def _prepare(patch: FastsimPatch, elastic, friction, options, coefficients):
+    """Validated flat inputs of the drivers: (shape, :class:`FastsimPatch` of arrays, (L1, L2, L3) arrays,
+    :class:`PatchFriction` of arrays, :class:`FastsimGrid`). ``elastic`` = (G, nu); ``friction`` = (friction
+    coefficient, law or FrictionAt; rolling speed); ``options`` the grid keywords; ``coefficients`` the C_ij or None.
+    """
+    shear_modulus_Pa, poisson_ratio = elastic
+    grid, flexibility = _grid_options(options)
     if not (math.isfinite(shear_modulus_Pa) and shear_modulus_Pa > 0):
         raise ValueError(f"shear_modulus_Pa = {shear_modulus_Pa!r}: expected a finite number > 0")
-    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (a, b, fn, xi, eta, phi, friction_coefficient)))
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in patch))
     shape = arrays[0].shape
-    a, b, fn, xi, eta, phi, mu = (np.array(v.ravel(), dtype=float) for v in arrays)
+    a, b, fn, xi, eta, phi = (np.array(v.ravel(), dtype=float) for v in arrays)
     if not (np.all(np.isfinite(a)) and np.all(a > 0) and np.all(np.isfinite(b)) and np.all(b > 0)):
         raise ValueError("semi_axis_long_m, semi_axis_lat_m: expected finite values > 0")
-    if not (np.all(np.isfinite(mu)) and np.all(mu >= 0)):
-        raise ValueError(f"friction_coefficient = {friction_coefficient!r}: expected finite values >= 0")
+    law, speed = friction
+    patch_friction = _friction_arrays(law, speed, shape)
     for name, v in (("normal_force_N", fn), ("longitudinal", xi), ("lateral", eta), ("spin_1_per_m", phi)):
         if not np.all(np.isfinite(v)):
             raise ValueError(f"{name}: expected finite values")
@@ -426,12 +628,12 @@ def _prepare(
         eta,
         phi,
         shear_modulus_Pa=shear_modulus_Pa,
-        friction_coefficient=mu,
+        friction_coefficient=patch_friction.coefficient,
         coefficients=coef,
         flexibility=flexibility,
     )
-    l1, l2, l3 = (np.array(np.broadcast_to(v, a.shape), dtype=float) for v in (l1, l2, l3))
-    return shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3
+    flex = tuple(np.array(np.broadcast_to(v, a.shape), dtype=float) for v in (l1, l2, l3))
+    return shape, FastsimPatch(a, b, fn, xi, eta, phi), flex, patch_friction, grid
 
 
 def fastsim_batch(
@@ -445,11 +647,9 @@ def fastsim_batch(
     shear_modulus_Pa: float,
     poisson_ratio: float,
     friction_coefficient,
-    nx: int = 20,
-    ny: int = 20,
-    traction_bound: str = "elliptic",
-    flexibility: str = "three",
+    rolling_speed_m_per_s=1.0,
     coefficients: CreepCoefficients | None = None,
+    **grid,
 ) -> FastsimBatch:
     """FASTSIM creep forces and spin moment for many elliptic patches (compiled loop over patches).
 
@@ -458,11 +658,14 @@ def fastsim_batch(
         semi_axis_lat_m: b, m.
         normal_force_N: N, N (patches with N <= 0 give zero forces).
         longitudinal: xi; lateral: eta; spin_1_per_m: phi (1/m).
-        shear_modulus_Pa: G; poisson_ratio: nu (C_ij); friction_coefficient: mu (scalar or array).
-        nx, ny: elements per strip and number of strips.
-        traction_bound: "elliptic" or "parabolic".
-        flexibility: "single", "three" or "three-unblended".
+        shear_modulus_Pa: G; poisson_ratio: nu (C_ij).
+        friction_coefficient: mu (scalar or array: Coulomb), or a contact.friction.FrictionLaw (falling: each
+            element's bound is mu at its own slip velocity), or a :class:`FrictionAt` (a law that varies in place, at
+            the patches' places: its parameters there).
+        rolling_speed_m_per_s: V, which turns the slip (per rolling distance) into the slip velocity of a falling law.
         coefficients: precomputed C_ij (else from Kalker's table).
+        **grid: nx, ny (elements per strip and number of strips, default 20), traction_bound ("elliptic" or
+            "parabolic"), flexibility ("single", "three" or "three-unblended"); :data:`GRID_DEFAULTS`.
 
     Returns:
         :class:`FastsimBatch`.
@@ -470,12 +673,13 @@ def fastsim_batch(
     Raises:
         ValueError: bad option or input (the message names it).
     """
-    shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3 = _prepare(
-        semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m,
-        shear_modulus_Pa, poisson_ratio, friction_coefficient, nx, ny, traction_bound, flexibility, coefficients,
+    patch = FastsimPatch(semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m)
+    shape, patches, flex, friction, fgrid = _prepare(
+        patch, (shear_modulus_Pa, poisson_ratio), (friction_coefficient, rolling_speed_m_per_s), grid,
+        coefficients,
     )  # fmt: skip
-    out = np.empty((a.size, 4))
-    _fastsim_many(a, b, mu, fn, xi, eta, phi, l1, l2, l3, int(nx), int(ny), traction_bound == "parabolic", out)
+    out = np.empty((patches.semi_axis_long_m.size, 4))
+    _fastsim_many(patches, flex, friction, fgrid, out)
     return FastsimBatch(*(out[:, i].reshape(shape) for i in range(4)))
 
 
@@ -489,39 +693,44 @@ def fastsim_fields(
     *,
     shear_modulus_Pa: float,
     poisson_ratio: float,
-    friction_coefficient: float,
+    friction_coefficient,
     rolling_speed_m_per_s: float = 1.0,
-    nx: int = 20,
-    ny: int = 20,
-    traction_bound: str = "elliptic",
-    flexibility: str = "three",
+    **grid,
 ) -> tuple[tuple[float, float, float, float], ContactFields]:
-    """FASTSIM for one patch with surface fields.
+    """FASTSIM for one patch with surface fields (arguments as :func:`fastsim_batch`, scalars).
 
     The traction is computed on Kalker's strip grid (nx elements per strip) and resampled by
     linear interpolation along each strip onto a regular grid x_i = -a + (i + 1/2) 2a/nx (same
-    strips y_j), with zero traction at the leading edge and projected onto the traction bound
-    (interpolation between points on a concave bound can overshoot it); the slip flag and slip speed
-    (V |s|, m/s) are taken from the nearest strip element. The forces returned are those of the
-    strip grid (the resampled fields integrate to them only to O(dx)).
+    strips y_j), with zero traction at the leading edge and projected onto the traction bound mu_s p
+    (interpolation between points on a concave bound can overshoot it; a falling law's bound is lower in slip, so
+    the projection onto mu_s p is a bound, not the law); the slip flag and slip speed (V |s|, m/s) are taken from
+    the nearest strip element. The forces returned are those of the strip grid (the resampled fields integrate to
+    them only to O(dx)).
 
     Returns:
         ((Fx, Fy, Mz, slip_fraction), ContactFields) with fields[j, i] at (x_m[i], y_m[j]).
     """
-    shape, a, b, fn, xi, eta, phi, mu, l1, l2, l3 = _prepare(
-        semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m,
-        shear_modulus_Pa, poisson_ratio, friction_coefficient, nx, ny, traction_bound, flexibility, None,
-    )  # fmt: skip
-    if a.size != 1:
+    patch = FastsimPatch(semi_axis_long_m, semi_axis_lat_m, normal_force_N, longitudinal, lateral, spin_1_per_m)
+    _, patches, flex, friction, fgrid = _prepare(
+        patch, (shear_modulus_Pa, poisson_ratio), (friction_coefficient, rolling_speed_m_per_s), grid, None
+    )
+    if patches.semi_axis_long_m.size != 1:
         raise ValueError("fastsim_fields: expected scalar inputs (one patch)")
+    nx, ny = fgrid.nx, fgrid.ny
     px = np.zeros((ny, nx))
     py = np.zeros((ny, nx))
     sx = np.zeros((ny, nx))
     sy = np.zeros((ny, nx))
+    one = FastsimPatch(*(float(v[0]) for v in patches))
     res = _fastsim_one(
-        a[0], b[0], mu[0], fn[0], xi[0], eta[0], phi[0], l1[0], l2[0], l3[0], int(nx), int(ny),
-        traction_bound == "parabolic", px, py, sx, sy, True,
+        one,
+        (float(flex[0][0]), float(flex[1][0]), float(flex[2][0])),
+        PatchFriction(friction.record, float(friction.place[0]), float(friction.coefficient[0]),
+                      float(friction.rolling_speed_m_per_s[0])),
+        fgrid,
+        StripFields(px, py, sx, sy, True),
     )  # fmt: skip
+    a, b, fn, mu = patches.semi_axis_long_m, patches.semi_axis_lat_m, patches.normal_force_N, friction.coefficient
     a0, b0 = a[0], b[0]
     x_m = -a0 + (np.arange(nx) + 0.5) * 2.0 * a0 / nx
     y_m = -b0 + (np.arange(ny) + 0.5) * 2.0 * b0 / ny

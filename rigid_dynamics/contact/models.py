@@ -43,7 +43,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigid_dynamics.contact.fastsim import FLEXIBILITIES, TRACTION_BOUNDS, fastsim_batch, fastsim_fields
+from rigid_dynamics.contact.fastsim import (
+    FLEXIBILITIES,
+    TRACTION_BOUNDS,
+    fastsim_batch,
+    fastsim_fields,
+    law_at_place,
+)
 from rigid_dynamics.contact.hertz import HertzBatch, hertz_solve_batch
 from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
 from rigid_dynamics.contact.linear import linear_creep_forces
@@ -208,6 +214,22 @@ class HertzianModel:
         return _friction_bound(result, material, saturating=self.SATURATING)
 
 
+def _patch_place(geometry: ContactGeometry, material: Material) -> float:
+    """The place of a patch's reference point in the variable of the material's friction law (the contact angle,
+    the rail-profile lateral coordinate of the contact point, or the track distance; as the BEM's for a patch
+    without an element-wise place). Raises ValueError when the geometry has no such place.
+    """
+    varies_with = material.friction.varies_with
+    value = {
+        "surface_inclination": geometry.contact_angle_rad,
+        "rail_lateral": geometry.contact_point_rail_m[0],
+        "track_distance": geometry.track_distance_m,
+    }[varies_with]
+    if not math.isfinite(value):
+        raise ValueError(f"friction varies_with = {varies_with!r}: the patch has no such place ({value!r})")
+    return float(value)
+
+
 class HertzModel(HertzianModel):
     """Hertz normal contact only (seed eq 32-38); creep forces and spin moment 0.0."""
 
@@ -294,6 +316,8 @@ class FastsimModel(HertzianModel):
     OPTIONS_DEFAULTS = {"nx": 20, "ny": 20}
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+        if material.friction is not None and material.friction.varies:  # the law at the patch's reference point
+            material = material.with_friction(law_at_place(material.friction, _patch_place(geometry, material)))
         result = super().solve(geometry, creepage, material, normal_force_N=normal_force_N, options=options)
         estimate, tolerance = result.extra.get("discretisation_error_estimate"), result.extra.get("tolerance")
         if result.status == "ok" and estimate is not None and tolerance is not None and estimate > tolerance:
@@ -316,7 +340,7 @@ class FastsimModel(HertzianModel):
             creepage.spin_1_per_m,
             shear_modulus_Pa=material.shear_modulus_Pa,
             poisson_ratio=material.poisson_ratio,
-            friction_coefficient=material.friction_coefficient,
+            friction_coefficient=material.friction if material.friction is not None else material.friction_coefficient,
             rolling_speed_m_per_s=creepage.rolling_speed_m_per_s,
             nx=opts["nx"],
             ny=opts["ny"],
@@ -338,7 +362,7 @@ class FastsimModel(HertzianModel):
             creepage.spin_1_per_m,
             shear_modulus_Pa=material.shear_modulus_Pa,
             poisson_ratio=material.poisson_ratio,
-            friction_coefficient=material.friction_coefficient,
+            friction_coefficient=material.friction if material.friction is not None else material.friction_coefficient,
             rolling_speed_m_per_s=creepage.rolling_speed_m_per_s,
             nx=max(1, opts["nx"] // 2),
             ny=max(1, opts["ny"] // 2),

@@ -22,7 +22,21 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.contact.fastsim import _fastsim_one, flexibilities_one
+from rigid_dynamics.contact.fastsim import (
+    FastsimGrid,
+    FastsimPatch,
+    PatchFriction,
+    StripFields,
+    _fastsim_one,
+    flexibilities_one,
+)
+from rigid_dynamics.contact.friction import (
+    FRICTION_COULOMB,
+    VARIES_NOWHERE,
+    FrictionRecord,
+    friction_coefficient,
+    uniform,
+)
 from rigid_dynamics.contact.kpec import blended_flexibilities, fastsim_strips, flexibility_ellipse, kpec_pressure_into
 from rigid_dynamics.contact.linear import linear_one
 from rigid_dynamics.contact.vermeulen_johnson import saturate_one
@@ -110,7 +124,9 @@ KALKER_C11, KALKER_C22, KALKER_C23, KALKER_C33 = range(4)
 class HertzKalkerTables(NamedTuple):
     """:class:`TabulatedHertzKalker` as the compiled code reads it: ``hertz`` (rows :data:`HERTZ_P`, ...) on a
     uniform grid of ln(max(A, B)/min(A, B)) from ``log_ratio_start`` by ``log_ratio_step``; ``kalker`` (rows
-    :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b). Two arrays: the record is passed per patch.
+    :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b); and the run's friction law ``friction``
+    (contact.friction.FrictionRecord; one Coulomb law that varies nowhere: the parameter record's
+    ``friction_coefficient`` serves, as before the laws existed). The data of the compiled laws, passed per patch.
     """
 
     log_ratio_start: float
@@ -119,10 +135,14 @@ class HertzKalkerTables(NamedTuple):
     log_ab_start: float
     log_ab_step: float
     kalker: np.ndarray
+    friction: FrictionRecord
 
 
-def hertz_kalker_tables(tables) -> HertzKalkerTables:
-    """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`."""
+def hertz_kalker_tables(tables, friction=None) -> HertzKalkerTables:
+    """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker` and a contact.friction.FrictionLaw (None:
+    Coulomb with the parameter record's ``friction_coefficient``).
+    """
+    law = friction if friction is not None else uniform(0.0)
     return HertzKalkerTables(
         float(tables.log_r[0]),
         float(tables.log_r[1] - tables.log_r[0]),
@@ -130,6 +150,7 @@ def hertz_kalker_tables(tables) -> HertzKalkerTables:
         float(tables.log_ab[0]),
         float(tables.log_ab[1] - tables.log_ab[0]),
         np.ascontiguousarray(tables.c),
+        law.record(),
     )
 
 
@@ -170,26 +191,54 @@ def _hertz_kalker(par, tables, q, ca, cb):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _creep_law(par, code, dummy, patch, xi, eta, spin):
+def patch_friction(par, law, where):
+    """The friction of one patch (contact.fastsim.PatchFriction) at where = (place, rolling speed V, m/s): the law
+    ``law`` (a FrictionRecord) at the patch's place (the variable of its nodes), its static coefficient mu_s = mu(0)
+    there; a Coulomb law that varies nowhere: par.friction_coefficient.
+    """
+    place, speed = where
+    if law.law_code == FRICTION_COULOMB and law.varies_code == VARIES_NOWHERE:
+        return PatchFriction(law, place, par.friction_coefficient, speed)
+    return PatchFriction(law, place, friction_coefficient(law, 0.0, place), speed)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def mean_slip_coefficient(friction, xi, eta):
+    """The coefficient of an analytic law's patch: the law at the patch's mean rigid slip velocity
+    V sqrt(xi^2 + eta^2) (the spin's rigid slip averages to zero over the patch), at its place; Coulomb: mu_s.
+    """
+    if friction.record.law_code == FRICTION_COULOMB:
+        return friction.coefficient
+    speed = friction.rolling_speed_m_per_s * math.sqrt(xi * xi + eta * eta)
+    return friction_coefficient(friction.record, speed, friction.place)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _creep_law(par, code, dummy, patch, creep, friction):
     """(T_x, T_y, M_z) of the compiled creep law ``code`` (layout.LAW_CODES) on a Hertz patch
-    ``patch`` = (N, a, b, C11, C22, C23, C33) of :func:`_hertz_kalker`.
+    ``patch`` = (N, a, b, C11, C22, C23, C33) of :func:`_hertz_kalker`; creep = (xi, eta, phi); friction the
+    patch's (:func:`patch_friction`). FASTSIM bounds each element by mu at its own slip velocity; Vermeulen-Johnson
+    saturates at mu N with mu at the patch's mean slip velocity (:func:`mean_slip_coefficient`); the linear law has
+    no bound.
     """
     normal, sa, sb, c11, c22, c23, c33 = patch
+    xi, eta, spin = creep
     if code == LAW_HERTZ:
         return 0.0, 0.0, 0.0
     if code == LAW_FASTSIM:
         l1, l2, l3 = flexibilities_one(
-            sa, sb, normal, xi, eta, spin, par.shear_modulus_Pa, par.friction_coefficient, (c11, c22, c23),
+            sa, sb, normal, xi, eta, spin, par.shear_modulus_Pa, friction.coefficient, (c11, c22, c23),
             int(par.flexibility_code),
         )  # fmt: skip
         fs = _fastsim_one(
-            sa, sb, par.friction_coefficient, normal, xi, eta, spin, l1, l2, l3, int(par.fastsim_nx),
-            int(par.fastsim_ny), par.fastsim_parabolic > 0, dummy, dummy, dummy, dummy, False,
+            FastsimPatch(sa, sb, normal, xi, eta, spin), (l1, l2, l3), friction,
+            FastsimGrid(int(par.fastsim_nx), int(par.fastsim_ny), par.fastsim_parabolic > 0),
+            StripFields(dummy, dummy, dummy, dummy, False),
         )  # fmt: skip
         return fs[0], fs[1], fs[2]
     tx, ty, mz = linear_one(par.shear_modulus_Pa, sa, sb, c11, c22, c23, c33, xi, eta, spin)
     if code == LAW_VERMEULEN_JOHNSON:
-        tx, ty = saturate_one(tx, ty, par.friction_coefficient * normal)
+        tx, ty = saturate_one(tx, ty, mean_slip_coefficient(friction, xi, eta) * normal)
         mz = 0.0
     return tx, ty, mz
 
@@ -246,26 +295,31 @@ def _auto_choice(par, feats):
 
 
 @njit(cache=True, _nrt=False)
-def _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record):
+def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
     """The compiled contact law of one patch: (N, a, b, T_x, T_y, M_z, to_callback); to_callback: the patch is for
     the callback (``auto`` chose BEM, or its FASTSIM broke the friction bound as auto's does in contact.models).
+    geometry = (q, A, B); creep = (xi, eta, phi); where = (place, rolling speed) of the friction law
+    (:func:`patch_friction`; tables.friction).
 
     ``auto`` (par.model_code layout.LAW_AUTO): the features of contact.auto.patch_features that a quadric patch has
     (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
     are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
     rec[c] as layout.AUTO_PATCH_FIELDS.
     """
+    q, ca, cb = geometry
+    xi, eta, spin = creep
     patch = _hertz_kalker(par, tables, q, ca, cb)
     normal, sa, sb, c11, c22, c23, c33 = patch
     code = int(par.model_code)
+    friction = patch_friction(par, tables.friction, where)
     if code != LAW_AUTO:
-        tx, ty, mz = _creep_law(par, code, dummy, patch, xi, eta, spin)
+        tx, ty, mz = _creep_law(par, code, dummy, patch, creep, friction)
         return normal, sa, sb, tx, ty, mz, False
     ab = sa * sb
     gab = par.shear_modulus_Pa * ab
     gab15 = gab * math.sqrt(ab)
     t_lin = math.hypot(-gab * c11 * xi, -gab * c22 * eta - gab15 * c23 * spin)
-    mu_n = par.friction_coefficient * normal
+    mu_n = friction.coefficient * normal
     feats = (
         t_lin / (3.0 * mu_n) if mu_n > 0 else np.inf,
         gab15 * c23 * abs(spin) / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0,
@@ -277,7 +331,7 @@ def _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record):
     to_callback = False
     tx, ty, mz = 0.0, 0.0, 0.0
     if rung != AUTO_BEM:
-        tx, ty, mz = _creep_law(par, rung + LAW_LINEAR, dummy, patch, xi, eta, spin)
+        tx, ty, mz = _creep_law(par, rung + LAW_LINEAR, dummy, patch, creep, friction)
         if rung == AUTO_FASTSIM and math.hypot(tx, ty) > (1.0 + par.auto_friction_bound_tolerance) * mu_n:
             rung, to_callback = AUTO_BEM, True
     else:
@@ -326,10 +380,11 @@ def _quadric_field(par, field, c, geometry):
 
 
 @njit(cache=True, _nrt=False)
-def _kpec_law(par, tables, field, c, geometry, creep):
+def _kpec_law(par, tables, field, c, geometry, creep, mu):
     """CONTACT's KPEC + FASTSIM per strip (contact.kpec; the static semi_hertzian.KpecModel's steps) on candidate
     c's gap in ``field`` (compiled_patch.PatchScratch: sampled, else the quadric of geometry = (q, A, B, angle)
-    filled here), approach-driven: the gap already holds -q at the contact point. creep = (xi, eta, phi).
+    filled here), approach-driven: the gap already holds -q at the contact point. creep = (xi, eta, phi); mu the
+    patch's coefficient (compiled_rhs: the law at the patch's place and mean slip velocity, as the analytic laws).
     Kalker's C_ij of the flexibilities from the run's tables (relative error < 1e-7). Returns (N, a, b, T_x, T_y,
     M_z, area m^2, max pressure Pa); (a, b): the flexibilities' ellipse of the contact area; M_z about the contact
     point.
@@ -339,7 +394,6 @@ def _kpec_law(par, tables, field, c, geometry, creep):
     xs, ys, gap = field.xs[c], field.ys[c], field.gap[c]
     g_mod = par.shear_modulus_Pa
     nu = 1.0 - g_mod / par.contact_modulus_Pa
-    mu = par.friction_coefficient
     pressure, contact = field.pressure, field.contact
     # fn_kpec: CONTACT's F_N of the flexibilities, the pressure before the in-row gaps are cleared
     fn_kpec = kpec_pressure_into(gap, xs, ys, (g_mod, nu), (pressure, contact), (field.first, field.last))[0]
@@ -363,12 +417,14 @@ def _kpec_law(par, tables, field, c, geometry, creep):
 
 
 @njit(cache=True)
-def patch_forces(par, tables, q, ca, cb, xi, eta, spin):
+def patch_forces(par, tables, q, ca, cb, xi, eta, spin, where=(0.0, 1.0)):
     """One patch through the compiled law of par.model_code (not the callback): (N, T_x, T_y, M_z, a, b,
-    to_callback), for tests and inspection.
+    to_callback), for tests and inspection; where = (place, rolling speed m/s) of the friction law.
     """
     rec = np.zeros((1, N_FIELDS))
-    normal, sa, sb, tx, ty, mz, st = _law(par, tables, np.zeros((1, 1)), q, ca, cb, xi, eta, spin, rec, 0, False)
+    normal, sa, sb, tx, ty, mz, st = _law(
+        par, tables, np.zeros((1, 1)), (q, ca, cb), (xi, eta, spin), where, rec, 0, False
+    )
     return normal, tx, ty, mz, sa, sb, st
 
 

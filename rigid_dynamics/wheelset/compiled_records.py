@@ -116,6 +116,23 @@ def model_parameters(model_wheelset):
     return par
 
 
+def friction_law_of(material):
+    """The friction law of a material: ``material.friction_law()`` where the material carries one (a
+    contact.friction.FrictionLaw), else Coulomb with its ``friction_coefficient``. The compiled loop takes the
+    static inclination and the track distance as places; a law on the rail's lateral coordinate raises ValueError.
+    """
+    from rigid_dynamics.contact.friction import uniform
+
+    getter = getattr(material, "friction_law", None)
+    law = getter() if callable(getter) else uniform(material.friction_coefficient)
+    if law.varies_with == "rail_lateral":
+        raise ValueError(
+            "friction.varies_with = 'rail_lateral': not available in dynamics (the loop has the contact angle and "
+            "the track distance of a patch); expected 'surface_inclination' or 'track_distance'"
+        )
+    return law
+
+
 def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, python_geometry=False) -> PackedRun:
     """The :class:`PackedRun` of a WheelsetModel, its provider, the Hertz / Kalker tables and the contact model
     instance. ``options``: FASTSIM's (nx, ny, traction_bound, flexibility) for ``fastsim`` and ``auto``;
@@ -130,7 +147,8 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     par = model_parameters(m)
     par["shear_modulus_Pa"] = scene.material.shear_modulus_Pa
     par["contact_modulus_Pa"] = tables.e_star
-    par["friction_coefficient"] = scene.material.friction_coefficient
+    law = friction_law_of(scene.material)
+    par["friction_coefficient"] = law.max_static  # the coefficient of Coulomb's uniform law; else mu_s at most
     code = law_code(model)
     par["model_code"] = code
     par["z_ref_m"] = provider.z_ref if mode == GEOMETRY_TABLES else 0.0
@@ -144,7 +162,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     par["patch_sampled"] = 1.0 if scene.patch_geometry == "sampled" else 0.0
     if code == LAW_AUTO:
         auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
-    hk = hertz_kalker_tables(tables)
+    hk = hertz_kalker_tables(tables, law)
     if mode == GEOMETRY_TABLES:
         par["nominal_radius_m"] = provider.r0
         if provider.irregularities is not None:

@@ -32,7 +32,17 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, objmode
 
-from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_KPEC, LAW_LINEAR, _kpec_law, _law
+from rigid_dynamics.contact.friction import VARIES_ALONG_TRACK, VARIES_WITH_INCLINATION
+from rigid_dynamics.wheelset.compiled_laws import (
+    LAW_AUTO,
+    LAW_CALLBACK,
+    LAW_KPEC,
+    LAW_LINEAR,
+    _kpec_law,
+    _law,
+    mean_slip_coefficient,
+    patch_friction,
+)
 from rigid_dynamics.wheelset.compiled_motion import _assemble, _patch_creepages, _rotation
 from rigid_dynamics.wheelset.compiled_patch import patch_scratch, sample_candidates
 from rigid_dynamics.wheelset.compiled_search import search_geometry, search_geometry_on_track
@@ -220,6 +230,20 @@ def _served_law(par, rec, c, record):
     return LAW_AUTO
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _friction_place(varies_code, y, g):
+    """The place of a patch in the friction law's variable (contact.friction.VARIES_NAMES): the rail surface's
+    inclination at the contact point (the contact angle, rad, positive towards the gauge face), or the distance
+    along the track of the contact point (x of the centre plus the lever's x, m); 0 when the law varies nowhere.
+    (The rail profile's lateral coordinate is not available in the loop: compiled_records.pack rejects it.)
+    """
+    if varies_code == VARIES_WITH_INCLINATION:
+        return g[G_CONTACT_ANGLE]
+    if varies_code == VARIES_ALONG_TRACK:
+        return y[X] + g[G_LEVER]
+    return 0.0
+
+
 @njit(cache=True, _nrt=False)
 def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
     """d/dt of the full state into ``out`` from the candidate geometry cg (ncand, layout.N_GEO) (a candidate with
@@ -279,6 +303,7 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
         speed, xi, eta, spin = _patch_creepages(lever, n, oma, vxa, vy, vz, rail_vy[side], rail_vz[side], vel, ex, ey)
         if not speed > 0.0:
             return CREEPAGES_UNDEFINED
+        where = (_friction_place(tables.friction.varies_code, y, g), speed)
         if par.model_code == LAW_CALLBACK:
             normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(
                 t, y, c, side, g, (speed, xi, eta, spin), (ex, ey)
@@ -288,15 +313,18 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
                 return CALLBACK_FAILED
         elif par.model_code == LAW_KPEC:
             angle = g[G_ELLIPSE_ANGLE] if math.isfinite(g[G_ELLIPSE_ANGLE]) else 0.0
+            mu = mean_slip_coefficient(patch_friction(par, tables.friction, where), xi, eta)
             normal, sa, sb, tx, ty, mz, area, pmax = _kpec_law(
-                par, tables, field, c, (q, ca, cb, angle), (xi, eta, spin)
+                par, tables, field, c, (q, ca, cb, angle), (xi, eta, spin), mu
             )
             sampled = field.sampled[c] > 0.0
             geom = PATCH_SAMPLED if sampled else PATCH_ELLIPSE
             resid = field.residual[c] if sampled else math.nan
             law = LAW_KPEC
         else:
-            normal, sa, sb, tx, ty, mz, to_callback = _law(par, tables, dummy, q, ca, cb, xi, eta, spin, rec, c, record)
+            normal, sa, sb, tx, ty, mz, to_callback = _law(
+                par, tables, dummy, (q, ca, cb), (xi, eta, spin), where, rec, c, record
+            )
             # a compiled law sees the quadric: Hertz's ellipse, its area and max pressure
             area = math.pi * sa * sb
             pmax = 1.5 * normal / area if area > 0.0 else math.nan

@@ -259,3 +259,45 @@ class Recorder:
         system = self.model.track_system
         blocks = self.track_summary
         return system.summary_names, np.concatenate(blocks) if blocks else np.zeros((0, len(system.summary_names)))
+
+
+WHEEL_SLIDE_CREEPAGE = 0.05
+"""|xi| at which a wheel past its adhesion limit is said to slide (a definition: 5 % slip, beyond the creep-force
+maximum of the laws here, whose maxima lie below 1 % creepage at rolling speeds of 10-30 m/s)."""
+ADHESION_DROP = 0.01
+"""The fall of the adhesion ratio |T_x| / N below its maximum (relative) that marks the maximum as passed."""
+
+
+def adhesion_events(t: np.ndarray, patches: dict) -> list[tuple]:
+    """The adhesion limit and wheel slide of a driven or braked wheelset, per side, from the recorded samples.
+
+    Per side (both slots summed): the adhesion ratio f = |T_x| / N (longitudinal creep force over normal force) and
+    the longitudinal creepage xi of the patch with the larger normal force.
+
+    * ``"adhesion-limit"`` at the sample where f is largest, when later the creepage grows beyond its value there
+      while f falls by more than :data:`ADHESION_DROP` of it (the creep curve's maximum passed: the falling branch);
+    * ``"wheel-slide"`` at the first sample after that with |xi| >= :data:`WHEEL_SLIDE_CREEPAGE`.
+
+    Returns tuples (kind, side, time_s) as the recorder's events.
+    """
+    events: list[tuple] = []
+    if len(t) < 3:
+        return events
+    normal = np.nan_to_num(patches["normal_force_N"])
+    tx = np.nan_to_num(patches["creep_force_long_N"])
+    xi_all = np.nan_to_num(patches["creepage_long"])
+    for i, side in enumerate(SIDES):
+        n_side = normal[:, i, :].sum(axis=1)
+        ratio = np.where(n_side > 0.0, np.abs(tx[:, i, :].sum(axis=1)) / np.where(n_side > 0.0, n_side, 1.0), 0.0)
+        main = np.argmax(normal[:, i, :], axis=1)
+        xi = np.abs(xi_all[np.arange(len(t)), i, main])
+        peak = int(np.argmax(ratio))
+        later = np.arange(len(t)) > peak
+        past = later & (xi > xi[peak]) & (ratio < (1.0 - ADHESION_DROP) * ratio[peak])
+        if not np.any(past):
+            continue
+        events.append(("adhesion-limit", side, float(t[peak])))
+        sliding = later & (xi >= WHEEL_SLIDE_CREEPAGE)
+        if np.any(sliding):
+            events.append(("wheel-slide", side, float(t[int(np.argmax(sliding))])))
+    return events

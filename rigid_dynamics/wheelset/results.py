@@ -56,7 +56,9 @@ class SimulationResult:
         track_state_names: the names of ``track_states``' columns.
         track_full_states: every state of the elastic track at the output times (n, k) (the beam's modes and rail
             seats: track.BeamLayout); None for the rigid track.
-        events: tuples (kind, side, time_s): "wheel-lift", "contact-restored", "flange-contact".
+        events: tuples (kind, side, time_s): "wheel-lift", "contact-restored", "flange-contact"; with a traction or
+            braking torque "adhesion-limit" (the creep curve's maximum passed) and "wheel-slide"
+            (recorder.adhesion_events).
         rhs_evaluations, steps: counters. wall_time_s: wall time of the run (static equilibrium, integration,
             recording), s; loading the compiled code from numba's cache (once per process, ~0.1 s) is not counted.
         failure_time_s, failure_state: where the run ended abnormally (None when it did not).

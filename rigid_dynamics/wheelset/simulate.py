@@ -58,7 +58,7 @@ from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check,
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import ConicalProvider, TableProvider
-from rigid_dynamics.wheelset.recorder import NUMERICAL_ERRORS, Recorder, Stop
+from rigid_dynamics.wheelset.recorder import NUMERICAL_ERRORS, Recorder, Stop, adhesion_events
 from rigid_dynamics.wheelset.results import (
     STATUSES,
     SimulationResult,
@@ -311,7 +311,7 @@ def simulate(
         potential_energy_J=pot,
         work_contact_J=wc,
         work_exterior_J=we,
-        events=tuple(recorder.events),
+        events=tuple(sorted(recorder.events + _adhesion(scene, t, patches), key=lambda e: e[2])),
         rhs_evaluations=model.rhs_evaluations,
         steps=steps,
         wall_time_s=wall,
@@ -356,6 +356,15 @@ def _energy_check(result: SimulationResult, settings) -> SimulationResult:
         f"{ENERGY_TOLERANCE_RELATIVE:g}): {settings.method} at relative_tolerance {settings.relative_tolerance:g} "
         "is too loose for this run; tighten integrator.relative_tolerance",
     )
+
+
+def _adhesion(scene, t, patches) -> list[tuple]:
+    """The adhesion-limit and wheel-slide events (recorder.adhesion_events) of a driven or braked wheelset (scene
+    traction_torque_N_m != 0); none otherwise.
+    """
+    if scene.loads.traction_torque_N_m == 0.0 or patches is None or "creepage_long" not in patches:
+        return []
+    return adhesion_events(t, patches)
 
 
 def _limit_at_largest_force(model, t, states, patches, work_contact, work_exterior, track_states, start_limit):
