@@ -8,6 +8,14 @@ quasi-identical quadric cases being Hertz's; creep forces: the case's reference,
 elements with their uncertainty of 0.3-1.2 %; the large-spin case also against its converged F_y/(mu F_N) = -0.6254 from
 benchmarks/results/bem_rolling_coarse.md and CONTACT's -0.6215 quoted in issue 27), wall time (best of 3).
 
+Part 1b, the linear range against Kalker's exact theory (independent of our BEM): the quadric of the named creep
+cases (R 0.46 / 0.30 m, 10 kN) with one small creepage each (xi = 1e-5, eta = 1e-5, phi = 0.01 1/m: F near
+0.01 mu F_N, where the exact theory lies within about 0.4 % of its linear limit), against F = -G a b C11 xi,
+-G a b C22 eta, -G (ab)^1.5 C23 phi with Kalker's C_ij (Kalker 1990, Table E.3; rigid_dynamics.contact.kalker).
+The large-spin case's creep force at CONTACT's own 44 x 44 grid (examples/fastsim.inp, DX 0.4 mm, DY 0.2 mm,
+CONTACT's -0.6074 in fastsim.ref_out) and the creep-lat-spin case's bracket (the two slip points at 320 x 320, which
+converge from opposite sides) are printed below the table.
+
 Part 2, Manchester A-2.2 (kinematics "deck", right wheel) at CONTACT's 0.2 mm elements (option element_size_m):
 our estimate against the actual difference to CONTACT's finest run of the same step (benchmarks/results/
 contact_grid.md: 0.025 mm for the flange, 0.05 mm for the tread and the flange root).
@@ -48,6 +56,8 @@ CASES = (
     "large-spin",
 )
 LARGE_SPIN = {"converged": -0.6254, "CONTACT": -0.6215}
+CONTACT_44 = -0.6074  # CONTACT's examples/fastsim.ref_out, case 1 (exact theory on 44 x 44, DX 0.4 mm, DY 0.2 mm)
+LINEAR = (("linear-xi", (1e-5, 0.0, 0.0)), ("linear-eta", (0.0, 1e-5, 0.0)), ("linear-phi", (0.0, 0.0, 0.01)))
 # contact_grid.md: CONTACT's step (our a22_case(step - 1)) -> (case, DX mm, FN, FX, FS, PMAX MPa, area mm2)
 CONTACT_FINEST = {
     6: ("a22-tread", 0.05, 9787.0, -456.2, -2900.0, 730.6, 20.24),
@@ -108,6 +118,65 @@ def _quadric_row(name, options):
     return row
 
 
+def _linear_row(name, creepages, options):
+    from rigid_dynamics.contact.kalker import kalker_coefficients
+
+    material = Material(82e9, 0.28, 0.3)
+    geometry = ContactGeometry.quadric(0.46, 0.30)
+    force = 1e4
+    e_star = material.shear_modulus_Pa / (1 - material.poisson_ratio)
+    curvatures = (geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m)
+    a, b, *_ = hertz_ellipse(*curvatures, e_star, normal_force_N=force)
+    c = kalker_coefficients(a / b, material.poisson_ratio)
+    xi, eta, phi = creepages
+    g = material.shear_modulus_Pa
+    ref_fx = -g * a * b * float(c.c11) * xi
+    ref_fy = -g * a * b * float(c.c22) * eta - g * (a * b) ** 1.5 * float(c.c23) * phi
+    creepage = Creepage(xi, eta, phi, 10.0)
+    res, wall = _timed(lambda: BemModel().solve(geometry, creepage, material, normal_force_N=force, options=options))
+    scale = max(math.hypot(ref_fx, ref_fy), 0.01 * material.friction_coefficient * force)
+    grid = res.extra["grid_error"]
+    return {
+        "case": name,
+        "options": options,
+        "status": res.status,
+        "grid": f"{res.extra['nx']}x{res.extra['ny']}",
+        "refinements": grid["refinements"],
+        "wall_s": wall,
+        "estimate_largest": grid.get("largest_relative"),
+        "estimate": grid.get("relative"),
+        "kalker_force_N": [ref_fx, ref_fy],
+        "error": {
+            "creep_force_N": math.hypot(res.creep_force_long_N - ref_fx, res.creep_force_lat_N - ref_fy) / scale,
+            "max_pressure_Pa": None,
+            "contact_area_m2": None,
+        },
+    }
+
+
+def _contact_grid_spin():
+    """The large-spin case on CONTACT's 44 x 44 grid (margin 1.1) and creep-lat-spin's two-slip-point bracket."""
+    geometry, creepage, material, force, _ = _case("large-spin")
+    res = BemModel().solve(geometry, creepage, material, normal_force_N=force, options={"nx": 44, "ny": 44,
+                                                                                        "margin": 1.1})  # fmt: skip
+    spin = {
+        "fy_over_mu_fn": res.creep_force_lat_N / (material.friction_coefficient * force),
+        "estimate": res.extra["grid_error"]["relative"]["creep_force_N"],
+        "dx_m": res.extra["dx_m"],
+        "dy_m": res.extra["dy_m"],
+    }
+    geometry, creepage, material, force, _ = _case("creep-lat-spin")
+    bracket = {}
+    for point in ("centre", "midpoint"):
+        opts = {"nx": 320, "ny": 320, "rolling_slip_point": point, "estimate_grid_error": False}
+        bracket[point] = (
+            BemModel().solve(geometry, creepage, material, normal_force_N=force, options=opts).creep_force_lat_N
+        )
+    default = BemModel().solve(geometry, creepage, material, normal_force_N=force)
+    return spin, {**bracket, "default": default.creep_force_lat_N, "default_grid": default.extra["nx"],
+                  "default_estimate": default.extra["grid_error"]["relative"]["creep_force_N"]}  # fmt: skip
+
+
 def _a22_rows():
     from comparisons.manchester import MATERIAL, a22_case
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
@@ -153,6 +222,10 @@ def main():
     for name in CASES:
         quadric.append(_quadric_row(name, {}))
         quadric.append(_quadric_row(name, {"nx": 40, "ny": 40}))
+    for name, creepages in LINEAR:
+        quadric.append(_linear_row(name, creepages, {}))
+        quadric.append(_linear_row(name, creepages, {"nx": 40, "ny": 40}))
+    spin44, bracket = _contact_grid_spin()
     a22 = _a22_rows()
     machine = {
         "platform": platform.platform(),
@@ -162,11 +235,25 @@ def main():
         "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
     }
     out = ROOT / "benchmarks" / "results"
-    write_text(out / "bem_grid_error.json", json.dumps({"machine": machine, "quadric": quadric, "a22": a22}, indent=2))
+    write_text(
+        out / "bem_grid_error.json",
+        json.dumps(
+            {
+                "machine": machine,
+                "quadric": quadric,
+                "large_spin_44": spin44,
+                "creep_lat_spin_bracket": bracket,
+                "a22": a22,
+            },
+            indent=2,
+        ),
+    )
     lines = [
         "# The BEM's grid-error estimate and the cost of the default grid (benchmarks/bench_bem_grid_error.py)",
         "",
         __doc__.split("\n\n")[1].replace("\n", " "),
+        "",
+        __doc__.split("\n\n")[2].replace("\n", " "),
         "",
         f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs, one thread, Python {machine['python']}; "
         f"load average at end {machine['load_average_at_end']} (shared machine); {machine['date_utc']} UTC. "
@@ -195,11 +282,26 @@ def main():
         "CONTACT's -0.6215."
         for r in spin
     ]
+    lo, hi = sorted((abs(bracket["centre"]), abs(bracket["midpoint"])))
+    mid = 0.5 * (lo + hi)
+    lines += [
+        f"Large-spin on CONTACT's 44 x 44 grid (DX {1e3 * spin44['dx_m']:.2f} mm, DY {1e3 * spin44['dy_m']:.2f} mm): "
+        f"ours {spin44['fy_over_mu_fn']:.4f}, CONTACT's {CONTACT_44} (CONTACT takes the rolling slip elsewhere in "
+        f"the element); our estimate there {_pct(spin44['estimate'])}, CONTACT's own error at that grid against its "
+        f"-0.6215: {_pct(abs(CONTACT_44 / -0.6215 - 1))}, ours against the converged -0.6254: "
+        f"{_pct(abs(spin44['fy_over_mu_fn'] / -0.6254 - 1))}.",
+        f"creep-lat-spin at 320 x 320: F_y {bracket['centre']:.2f} N (element centre), {bracket['midpoint']:.2f} N "
+        f"(midpoint); the two slip points converge from opposite sides, so the limit lies in [{-hi:.1f}, {-lo:.1f}] N "
+        f"(mid {-mid:.1f} N +- {100 * (hi - lo) / (2 * mid):.1f} %); the named reference -322.93 N (Richardson of "
+        f"40/80/160, stated uncertainty 0.28 %) lies outside it. The default: {bracket['default']:.2f} N on "
+        f"{bracket['default_grid']} x {bracket['default_grid']}, estimate {_pct(bracket['default_estimate'])}, "
+        f"{_pct(abs(bracket['default'] / -mid - 1))} from the bracket's middle.",
+    ]
     default_ms = sum(r["wall_s"] for r in quadric if not r["options"])
     fixed_ms = sum(r["wall_s"] for r in quadric if r["options"])
     lines += [
         "",
-        f"Cost: the nine cases at the defaults take {1e3 * default_ms:.0f} ms in all against {1e3 * fixed_ms:.0f} ms "
+        f"Cost: the twelve cases at the defaults take {1e3 * default_ms:.0f} ms in all against {1e3 * fixed_ms:.0f} ms "
         f"on the 40 x 40 grid with its companions ({default_ms / fixed_ms:.1f}x).",
         "",
         "## Manchester A-2.2 at CONTACT's 0.2 mm elements (right wheel, deck kinematics)",
