@@ -246,6 +246,7 @@ def test_estimate_for_the_final_patches_only():
     assert later.status == direct.status == "warning"
     assert later.extra["grid_error"]["relative"] == pytest.approx(direct.extra["grid_error"]["relative"], rel=1e-9)
     assert later.creep_force_long_N == plain.creep_force_long_N
+    assert "not estimated" not in later.message and later.message == direct.message
 
     from comparisons.manchester import MATERIAL, a22_case
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case

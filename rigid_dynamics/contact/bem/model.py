@@ -356,7 +356,7 @@ class BemModel:
         if not opts["estimate_grid_error"]:
             if opts["extrapolate"]:
                 fine = self._extrapolated(geometry, creepage, material, normal_force_N, opts, fine, start)
-            return _without_grid_error(fine, "estimate_grid_error = false", time.perf_counter() - start)
+            return _without_grid_error(fine, NOT_ESTIMATED_REASON, time.perf_counter() - start)
         return self._estimate(geometry, creepage, material, normal_force_N, opts, fine, start, refine=True)
 
     def with_grid_error(
@@ -379,6 +379,8 @@ class BemModel:
         opts["warm_start"] = None
         if result.status == "no-contact" or not result.success or opts["extrapolate"]:
             return result
+        # the inner solve's "not estimated" note gives way to the estimate
+        result = dataclasses.replace(result, message=result.message.replace(_not_estimated_note(), ""))
         out = self._estimate(geometry, creepage, material, normal_force_N, opts, result, start, refine=False)
         return dataclasses.replace(out, wall_time_s=result.wall_time_s + time.perf_counter() - start)
 
@@ -865,12 +867,21 @@ def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
     }
 
 
+NOT_ESTIMATED_REASON = "estimate_grid_error = false"
+"""The reason a solve with ``estimate_grid_error = false`` gives for its missing estimate."""
+
+
+def _not_estimated_note(reason: str = NOT_ESTIMATED_REASON) -> str:
+    """The message part of a result whose grid error is not estimated (:func:`_without_grid_error`)."""
+    return f"; grid error not estimated ({reason})"
+
+
 def _without_grid_error(result: ContactResult, reason: str, wall_time_s: float) -> ContactResult:
     """``result`` marked as not estimated (``extra["grid_error"]["estimated"]`` False, the reason in the message)."""
     extra = dict(result.extra)
     extra["grid_error"] = {"estimated": False, "reason": reason}
     extra["grid_error_estimate"] = None
-    message = f"{result.message}; grid error not estimated ({reason})"
+    message = result.message + _not_estimated_note(reason)
     return dataclasses.replace(result, message=message, extra=extra, wall_time_s=wall_time_s)
 
 
