@@ -138,6 +138,21 @@ def modal_cutoff_check(status: str, message: str, scene, tolerance: float) -> tu
     )
 
 
+def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, str]:
+    """(status, message) with the BEM's grid judged: an "ok" run whose BEM patches were solved coarser than their
+    ``grid_tolerance`` asks (the largest force estimate of a solve above it) ends "warning", naming the estimate.
+    """
+    grid = (callback_stats or {}).get("bem_grid_error")
+    if status != "ok" or not grid or not grid["estimated"] or grid["largest_force"] <= grid["tolerance"]:
+        return status, message
+    return "warning", (
+        f"{message}; BEM grid-error estimate of the patch forces {grid['largest_force']:.3g} (t = {grid['t_s']:.6g} s) "
+        f"exceeds the BEM's grid_tolerance = {grid['tolerance']:g} (a sampled patch in the loop is solved on about "
+        "BEM_ELEMENTS = 40 elements across its sampled box, rigid_dynamics/wheelset/callback.py, not refined; "
+        'patch_geometry = "ellipse" solves the quadric on the BEM\'s refined default grid)'
+    )
+
+
 def _contact_grid_error(result) -> dict:
     """The contact grid's statement: the BEM's own estimate of every solve in the loop (callback.PatchCallback
     keeps the largest), or "not estimated" for the other models.
