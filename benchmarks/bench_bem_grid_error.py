@@ -8,6 +8,10 @@ quasi-identical quadric cases being Hertz's; creep forces: the case's reference,
 elements with their uncertainty of 0.3-1.2 %; the large-spin case also against its converged F_y/(mu F_N) = -0.6254 from
 benchmarks/results/bem_rolling_coarse.md and CONTACT's -0.6215 quoted in issue 27), wall time (best of 3).
 
+The column "vs CONTACT": the creep force against CONTACT's exact theory run here on the same cases (decks written for
+this project, 44/88/176 elements; its limit by first-order Richardson of its two finest grids, the extrapolation
+step as its uncertainty: comparisons/data/contact_quadric_creep/SOURCE.md).
+
 Part 1b, the linear range against Kalker's exact theory (independent of our BEM): the quadric of the named creep
 cases (R 0.46 / 0.30 m, 10 kN) with one small creepage each (xi = 1e-5, eta = 1e-5, phi = 0.01 1/m: F near
 0.01 mu F_N, where the exact theory lies within about 0.4 % of its linear limit), against F = -G a b C11 xi,
@@ -86,6 +90,28 @@ def _timed(fn, repeats=3):
     return result, best
 
 
+CONTACT_RUNS = ROOT / "comparisons" / "data" / "contact_quadric_creep" / "quadric_creep.csv"
+
+
+def _contact_limit(name):
+    """CONTACT's limit (F_x, F_y) and its uncertainty (N) from its two finest grids (first-order Richardson; the
+    extrapolation step as uncertainty; comparisons/data/contact_quadric_creep/SOURCE.md), or None."""
+    import csv
+
+    with CONTACT_RUNS.open() as handle:
+        rows = sorted((r for r in csv.DictReader(handle) if r["case"] == name), key=lambda r: int(r["mx"]))
+    if len(rows) < 2:
+        return None
+    coarse, fine = rows[-2], rows[-1]
+    ratio = int(fine["mx"]) / int(coarse["mx"])
+    limit, step = [], []
+    for key in ("fx_N", "fy_N"):
+        v_f, v_c = float(fine[key]), float(coarse[key])
+        limit.append(v_f + (v_f - v_c) / (ratio - 1))
+        step.append(abs(v_f - v_c) / (ratio - 1))
+    return limit, math.hypot(*step), [int(r["mx"]) for r in rows]
+
+
 def _quadric_row(name, options):
     geometry, creepage, material, force, ref = _case(name)
     e_star = material.shear_modulus_Pa / (1 - material.poisson_ratio)
@@ -111,6 +137,14 @@ def _quadric_row(name, options):
             "contact_area_m2": abs(res.contact_area_m2 / (math.pi * a * b) - 1),
         },
     }
+    contact = _contact_limit(name)
+    if contact is not None:
+        (c_fx, c_fy), unc, grids = contact
+        c_scale = max(math.hypot(c_fx, c_fy), 0.01 * mu_fn)
+        row["contact_limit_N"] = [c_fx, c_fy]
+        row["contact_grids"] = grids
+        row["contact_uncertainty"] = unc / c_scale
+        row["error_vs_contact"] = math.hypot(res.creep_force_long_N - c_fx, res.creep_force_lat_N - c_fy) / c_scale
     if name == "large-spin":
         ratio = res.creep_force_lat_N / mu_fn
         row["fy_over_mu_fn"] = ratio
@@ -255,13 +289,15 @@ def main():
         "",
         __doc__.split("\n\n")[2].replace("\n", " "),
         "",
+        __doc__.split("\n\n")[3].replace("\n", " "),
+        "",
         f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs, one thread, Python {machine['python']}; "
         f"load average at end {machine['load_average_at_end']} (shared machine); {machine['date_utc']} UTC. "
         "Each cell: estimate / actual error. Wall time best of 3 (NORM + TANG on the grid and its companions).",
         "",
-        "| case | options | status | grid | creep force est. / err. | max pressure est. / err. | area est. / err. | "
-        "wall ms |",
-        "|---|---|---|---|---|---|---|---|",
+        "| case | options | status | grid | creep force est. / err. | creep force err. vs CONTACT (its unc.) | "
+        "max pressure est. / err. | area est. / err. | wall ms |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in quadric:
         est = r["estimate"] or {}
@@ -273,6 +309,12 @@ def main():
         ]
         for key in ("creep_force_N", "max_pressure_Pa", "contact_area_m2"):
             cells.append(f"{_pct(est.get(key))} / {_pct(r['error'][key])}")
+            if key == "creep_force_N":
+                cells.append(
+                    f"{_pct(r['error_vs_contact'])} ({_pct(r['contact_uncertainty'])})"
+                    if "error_vs_contact" in r
+                    else "-"
+                )
         cells.append(f"{1e3 * r['wall_s']:.0f}")
         lines.append("| " + " | ".join(cells) + " |")
     spin = [r for r in quadric if r["case"] == "large-spin"]
