@@ -147,9 +147,9 @@ def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, 
         return status, message
     return "warning", (
         f"{message}; BEM grid-error estimate of the patch forces {grid['largest_force']:.3g} (t = {grid['t_s']:.6g} s) "
-        f"exceeds the BEM's grid_tolerance = {grid['tolerance']:g} (a sampled patch in the loop is solved on about "
-        "BEM_ELEMENTS = 40 elements across its sampled box, rigid_dynamics/wheelset/callback.py, not refined; "
-        'patch_geometry = "ellipse" solves the quadric on the BEM\'s refined default grid)'
+        f"exceeds the BEM's grid_tolerance = {grid['tolerance']:g} (the loop solves a sampled patch on about "
+        "BEM_ELEMENTS = 40 elements across its sampled box, rigid_dynamics/wheelset/callback.py, unrefined; an "
+        "ellipse patch on the BEM's default grid refined at most max_refinements times)"
     )
 
 
