@@ -176,9 +176,7 @@ def test_auto_choice_in_the_loop_is_the_documented_rule():
 
     scene = replace(SCENE, contact_model="auto", contact_tolerance=0.1, duration_s=0.05)
     result = simulate(scene, compiled=True)
-    # the unrefined 40 x 40 patches are coarser than the BEM's 2 % asks: the run says so (discretisation.py)
-    assert result.status == "warning" and result.compiled, result.message
-    assert "BEM grid-error estimate of the patch forces" in result.message
+    assert result.success and result.compiled, result.message
     rung = result.patches["auto_rung"]
     touching = np.isfinite(rung)
     assert np.any(touching)
