@@ -8,6 +8,18 @@ quasi-identical quadric cases being Hertz's; creep forces: the case's reference,
 elements with their uncertainty of 0.3-1.2 %; the large-spin case also against its converged F_y/(mu F_N) = -0.6254 from
 benchmarks/results/bem_rolling_coarse.md and CONTACT's -0.6215 quoted in issue 27), wall time (best of 3).
 
+The column "vs CONTACT": the creep force against CONTACT's exact theory run here on the same cases (decks written for
+this project, 44/88/176 elements; its limit by first-order Richardson of its two finest grids, the extrapolation
+step as its uncertainty: comparisons/data/contact_quadric_creep/SOURCE.md).
+
+Part 1b, the linear range against Kalker's exact theory (independent of our BEM): the quadric of the named creep
+cases (R 0.46 / 0.30 m, 10 kN) with one small creepage each (xi = 1e-5, eta = 1e-5, phi = 0.01 1/m: F near
+0.01 mu F_N, where the exact theory lies within about 0.4 % of its linear limit), against F = -G a b C11 xi,
+-G a b C22 eta, -G (ab)^1.5 C23 phi with Kalker's C_ij (Kalker 1990, Table E.3; rigid_dynamics.contact.kalker).
+The large-spin case's creep force at CONTACT's own 44 x 44 grid (examples/fastsim.inp, DX 0.4 mm, DY 0.2 mm,
+CONTACT's -0.6074 in fastsim.ref_out) and the creep-lat-spin case's bracket (the two slip points at 320 x 320, which
+converge from opposite sides) are printed below the table.
+
 Part 2, Manchester A-2.2 (kinematics "deck", right wheel) at CONTACT's 0.2 mm elements (option element_size_m):
 our estimate against the actual difference to CONTACT's finest run of the same step (benchmarks/results/
 contact_grid.md: 0.025 mm for the flange, 0.05 mm for the tread and the flange root).
@@ -48,6 +60,8 @@ CASES = (
     "large-spin",
 )
 LARGE_SPIN = {"converged": -0.6254, "CONTACT": -0.6215}
+CONTACT_44 = -0.6074  # CONTACT's examples/fastsim.ref_out, case 1 (exact theory on 44 x 44, DX 0.4 mm, DY 0.2 mm)
+LINEAR = (("linear-xi", (1e-5, 0.0, 0.0)), ("linear-eta", (0.0, 1e-5, 0.0)), ("linear-phi", (0.0, 0.0, 0.01)))
 # contact_grid.md: CONTACT's step (our a22_case(step - 1)) -> (case, DX mm, FN, FX, FS, PMAX MPa, area mm2)
 CONTACT_FINEST = {
     6: ("a22-tread", 0.05, 9787.0, -456.2, -2900.0, 730.6, 20.24),
@@ -76,6 +90,28 @@ def _timed(fn, repeats=3):
     return result, best
 
 
+CONTACT_RUNS = ROOT / "comparisons" / "data" / "contact_quadric_creep" / "quadric_creep.csv"
+
+
+def _contact_limit(name):
+    """CONTACT's limit (F_x, F_y) and its uncertainty (N) from its two finest grids (first-order Richardson; the
+    extrapolation step as uncertainty; comparisons/data/contact_quadric_creep/SOURCE.md), or None."""
+    import csv
+
+    with CONTACT_RUNS.open() as handle:
+        rows = sorted((r for r in csv.DictReader(handle) if r["case"] == name), key=lambda r: int(r["mx"]))
+    if len(rows) < 2:
+        return None
+    coarse, fine = rows[-2], rows[-1]
+    ratio = int(fine["mx"]) / int(coarse["mx"])
+    limit, step = [], []
+    for key in ("fx_N", "fy_N"):
+        v_f, v_c = float(fine[key]), float(coarse[key])
+        limit.append(v_f + (v_f - v_c) / (ratio - 1))
+        step.append(abs(v_f - v_c) / (ratio - 1))
+    return limit, math.hypot(*step), [int(r["mx"]) for r in rows]
+
+
 def _quadric_row(name, options):
     geometry, creepage, material, force, ref = _case(name)
     e_star = material.shear_modulus_Pa / (1 - material.poisson_ratio)
@@ -101,11 +137,78 @@ def _quadric_row(name, options):
             "contact_area_m2": abs(res.contact_area_m2 / (math.pi * a * b) - 1),
         },
     }
+    contact = _contact_limit(name)
+    if contact is not None:
+        (c_fx, c_fy), unc, grids = contact
+        c_scale = max(math.hypot(c_fx, c_fy), 0.01 * mu_fn)
+        row["contact_limit_N"] = [c_fx, c_fy]
+        row["contact_grids"] = grids
+        row["contact_uncertainty"] = unc / c_scale
+        row["error_vs_contact"] = math.hypot(res.creep_force_long_N - c_fx, res.creep_force_lat_N - c_fy) / c_scale
     if name == "large-spin":
         ratio = res.creep_force_lat_N / mu_fn
         row["fy_over_mu_fn"] = ratio
         row["error_vs"] = {k: abs(ratio / v - 1) for k, v in LARGE_SPIN.items()}
     return row
+
+
+def _linear_row(name, creepages, options):
+    from rigid_dynamics.contact.kalker import kalker_coefficients
+
+    material = Material(82e9, 0.28, 0.3)
+    geometry = ContactGeometry.quadric(0.46, 0.30)
+    force = 1e4
+    e_star = material.shear_modulus_Pa / (1 - material.poisson_ratio)
+    curvatures = (geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m)
+    a, b, *_ = hertz_ellipse(*curvatures, e_star, normal_force_N=force)
+    c = kalker_coefficients(a / b, material.poisson_ratio)
+    xi, eta, phi = creepages
+    g = material.shear_modulus_Pa
+    ref_fx = -g * a * b * float(c.c11) * xi
+    ref_fy = -g * a * b * float(c.c22) * eta - g * (a * b) ** 1.5 * float(c.c23) * phi
+    creepage = Creepage(xi, eta, phi, 10.0)
+    res, wall = _timed(lambda: BemModel().solve(geometry, creepage, material, normal_force_N=force, options=options))
+    scale = max(math.hypot(ref_fx, ref_fy), 0.01 * material.friction_coefficient * force)
+    grid = res.extra["grid_error"]
+    return {
+        "case": name,
+        "options": options,
+        "status": res.status,
+        "grid": f"{res.extra['nx']}x{res.extra['ny']}",
+        "refinements": grid["refinements"],
+        "wall_s": wall,
+        "estimate_largest": grid.get("largest_relative"),
+        "estimate": grid.get("relative"),
+        "kalker_force_N": [ref_fx, ref_fy],
+        "error": {
+            "creep_force_N": math.hypot(res.creep_force_long_N - ref_fx, res.creep_force_lat_N - ref_fy) / scale,
+            "max_pressure_Pa": None,
+            "contact_area_m2": None,
+        },
+    }
+
+
+def _contact_grid_spin():
+    """The large-spin case on CONTACT's 44 x 44 grid (margin 1.1) and creep-lat-spin's two-slip-point bracket."""
+    geometry, creepage, material, force, _ = _case("large-spin")
+    res = BemModel().solve(geometry, creepage, material, normal_force_N=force, options={"nx": 44, "ny": 44,
+                                                                                        "margin": 1.1})  # fmt: skip
+    spin = {
+        "fy_over_mu_fn": res.creep_force_lat_N / (material.friction_coefficient * force),
+        "estimate": res.extra["grid_error"]["relative"]["creep_force_N"],
+        "dx_m": res.extra["dx_m"],
+        "dy_m": res.extra["dy_m"],
+    }
+    geometry, creepage, material, force, _ = _case("creep-lat-spin")
+    bracket = {}
+    for point in ("centre", "midpoint"):
+        opts = {"nx": 320, "ny": 320, "rolling_slip_point": point, "estimate_grid_error": False}
+        bracket[point] = (
+            BemModel().solve(geometry, creepage, material, normal_force_N=force, options=opts).creep_force_lat_N
+        )
+    default = BemModel().solve(geometry, creepage, material, normal_force_N=force)
+    return spin, {**bracket, "default": default.creep_force_lat_N, "default_grid": default.extra["nx"],
+                  "default_estimate": default.extra["grid_error"]["relative"]["creep_force_N"]}  # fmt: skip
 
 
 def _a22_rows():
@@ -153,6 +256,10 @@ def main():
     for name in CASES:
         quadric.append(_quadric_row(name, {}))
         quadric.append(_quadric_row(name, {"nx": 40, "ny": 40}))
+    for name, creepages in LINEAR:
+        quadric.append(_linear_row(name, creepages, {}))
+        quadric.append(_linear_row(name, creepages, {"nx": 40, "ny": 40}))
+    spin44, bracket = _contact_grid_spin()
     a22 = _a22_rows()
     machine = {
         "platform": platform.platform(),
@@ -162,19 +269,35 @@ def main():
         "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
     }
     out = ROOT / "benchmarks" / "results"
-    write_text(out / "bem_grid_error.json", json.dumps({"machine": machine, "quadric": quadric, "a22": a22}, indent=2))
+    write_text(
+        out / "bem_grid_error.json",
+        json.dumps(
+            {
+                "machine": machine,
+                "quadric": quadric,
+                "large_spin_44": spin44,
+                "creep_lat_spin_bracket": bracket,
+                "a22": a22,
+            },
+            indent=2,
+        ),
+    )
     lines = [
         "# The BEM's grid-error estimate and the cost of the default grid (benchmarks/bench_bem_grid_error.py)",
         "",
         __doc__.split("\n\n")[1].replace("\n", " "),
         "",
+        __doc__.split("\n\n")[2].replace("\n", " "),
+        "",
+        __doc__.split("\n\n")[3].replace("\n", " "),
+        "",
         f"Machine: {machine['platform']}, {machine['cpu_count']} CPUs, one thread, Python {machine['python']}; "
         f"load average at end {machine['load_average_at_end']} (shared machine); {machine['date_utc']} UTC. "
         "Each cell: estimate / actual error. Wall time best of 3 (NORM + TANG on the grid and its companions).",
         "",
-        "| case | options | status | grid | creep force est. / err. | max pressure est. / err. | area est. / err. | "
-        "wall ms |",
-        "|---|---|---|---|---|---|---|---|",
+        "| case | options | status | grid | creep force est. / err. | creep force err. vs CONTACT (its unc.) | "
+        "max pressure est. / err. | area est. / err. | wall ms |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in quadric:
         est = r["estimate"] or {}
@@ -186,6 +309,12 @@ def main():
         ]
         for key in ("creep_force_N", "max_pressure_Pa", "contact_area_m2"):
             cells.append(f"{_pct(est.get(key))} / {_pct(r['error'][key])}")
+            if key == "creep_force_N":
+                cells.append(
+                    f"{_pct(r['error_vs_contact'])} ({_pct(r['contact_uncertainty'])})"
+                    if "error_vs_contact" in r
+                    else "-"
+                )
         cells.append(f"{1e3 * r['wall_s']:.0f}")
         lines.append("| " + " | ".join(cells) + " |")
     spin = [r for r in quadric if r["case"] == "large-spin"]
@@ -195,11 +324,27 @@ def main():
         "CONTACT's -0.6215."
         for r in spin
     ]
+    lo, hi = sorted((abs(bracket["centre"]), abs(bracket["midpoint"])))
+    spin_limit = _contact_limit("large-spin")[0][1] / (0.3 * 82000.0)
+    lat_limit = _contact_limit("creep-lat-spin")[0][1]
+    lines += [
+        f"Large-spin on CONTACT's 44 x 44 grid (DX {1e3 * spin44['dx_m']:.2f} mm, DY {1e3 * spin44['dy_m']:.2f} mm): "
+        f"ours {spin44['fy_over_mu_fn']:.4f}, CONTACT's {CONTACT_44} (CONTACT takes the rolling slip elsewhere in "
+        f"the element); our estimate there {_pct(spin44['estimate'])}; against CONTACT's limit {spin_limit:.4f} "
+        f"(-0.6209 on 176 x 176, extrapolated) CONTACT's own error at that grid is "
+        f"{_pct(abs(CONTACT_44 / spin_limit - 1))}, ours {_pct(abs(spin44['fy_over_mu_fn'] / spin_limit - 1))}.",
+        f"creep-lat-spin at 320 x 320: F_y {bracket['centre']:.2f} N (element centre), {bracket['midpoint']:.2f} N "
+        f"(midpoint); the two slip points converge from opposite sides, so the limit lies in [{-hi:.1f}, {-lo:.1f}] N; "
+        f"CONTACT's limit {lat_limit:.1f} N lies inside, the named reference -322.93 N (Richardson of 40/80/160, "
+        f"stated uncertainty 0.28 %) outside. The default: {bracket['default']:.2f} N on {bracket['default_grid']} x "
+        f"{bracket['default_grid']}, estimate {_pct(bracket['default_estimate'])}, "
+        f"{_pct(abs(bracket['default'] / lat_limit - 1))} from CONTACT's limit.",
+    ]
     default_ms = sum(r["wall_s"] for r in quadric if not r["options"])
     fixed_ms = sum(r["wall_s"] for r in quadric if r["options"])
     lines += [
         "",
-        f"Cost: the nine cases at the defaults take {1e3 * default_ms:.0f} ms in all against {1e3 * fixed_ms:.0f} ms "
+        f"Cost: the twelve cases at the defaults take {1e3 * default_ms:.0f} ms in all against {1e3 * fixed_ms:.0f} ms "
         f"on the 40 x 40 grid with its companions ({default_ms / fixed_ms:.1f}x).",
         "",
         "## Manchester A-2.2 at CONTACT's 0.2 mm elements (right wheel, deck kinematics)",

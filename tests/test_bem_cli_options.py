@@ -24,6 +24,17 @@ CASE = quadric_case(normal_force_N="1e5", creepage_long="0.0") + "[solver]\n"
         ),
         ("element_size_m = 0.001\nnx = 20", r"element_size_m = 0.001 together with nx: expected either"),
         ('norm_method = "fast"', r"norm_method' = 'fast': expected one of 'normcg', 'polonsky-keer'"),
+        # the grid-error options (issue 27)
+        ("grid_tolerance = 0.0", r"grid_tolerance' = 0.0: expected a finite number > 0"),
+        ("grid_tolerance = -0.02", r"grid_tolerance' = -0.02: expected a finite number > 0"),
+        ('grid_tolerance = "tight"', r"grid_tolerance' = 'tight': expected a finite number > 0"),
+        ("grid_tolerance = nan", r"grid_tolerance' = nan: expected a finite number"),
+        ("max_refinements = -1", r"max_refinements' = -1: expected an integer from 0 to 5"),
+        ("max_refinements = 6", r"max_refinements' = 6: expected an integer from 0 to 5"),
+        ("dx_m = 0.0", r"dx_m' = 0.0: expected a finite number > 0 and <= 0.1"),
+        ("dy_m = -1e-4\ndx_m = 1e-4", r"dy_m' = -0.0001: expected a finite number > 0 and <= 0.1"),
+        ("dy_m = 1e-4", r"option dy_m = 0.0001 without dx_m"),
+        ("dx_m = 1e-4\nnx = 20", r"option dx_m = 0.0001 together with nx"),
     ],
 )
 def test_bad_bem_solver_options(tmp_path, capsys, solver, pattern):

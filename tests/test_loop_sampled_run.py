@@ -35,7 +35,9 @@ def runs():
 
 def test_sampled_run_says_per_patch_that_the_geometry_was_sampled(runs):
     result = runs["sampled"]
-    assert result.status == "ok"
+    # the loop's sampled patches (about 40 elements across the sampled box) are coarser than the BEM's 2 % asks:
+    # the run says so (test_bem_runs_state_their_grid_error)
+    assert result.status == "warning" and "BEM grid-error estimate of the patch forces" in result.message
     touching = np.nan_to_num(result.patches["normal_force_N"]) > 0
     assert touching[:, 0, 0].all() and touching[:, 1, 0].all()  # the left flange root and the right tread
     assert np.all(result.patches["patch_geometry_code"][touching] == PATCH_SAMPLED)
@@ -155,3 +157,27 @@ def test_elastic_track_deflection_in_the_sampled_gap(monkeypatch):
     for candidate, field in seen:
         assert candidate == pytest.approx(8.0e-5, rel=0.01)
         assert field == pytest.approx(candidate, rel=1e-3)
+
+
+def test_bem_runs_state_their_grid_error(runs):
+    """A run whose patches the BEM served states the BEM's own grid-error estimate in summary.json
+    (``discretisation_errors.contact_grid``: the largest over its solves of each solve's companion-grid estimate,
+    tests/test_bem_grid_error.py checks that estimate against Kalker's and CONTACT's values) and in the printed lines;
+    every solve is estimated (regression of the bookkeeping). The sampled run's patches (about 40 elements across
+    the sampled box, not refined) exceed the BEM's 2 % and the run ends ``warning`` naming it; the ellipse run's
+    (the BEM's refined default grid) meet it and the run ends ``ok``."""
+    for geometry, result in runs.items():
+        summary = result.summary()
+        grid = summary["discretisation_errors"]["contact_grid"]
+        bem = summary["callback"]["bem_grid_error"]
+        assert grid["estimate"] is not None and grid["estimate"] > 0, grid
+        assert grid["estimate"] == bem["largest_force"] <= grid["largest_all_quantities"]
+        assert grid["solves_estimated"] > 0 and grid["solves_not_estimated"] == 0
+        assert 0 <= grid["solves_above_grid_tolerance"] <= grid["solves_estimated"]
+        assert grid["grid_tolerance"] == 0.02 and "companion grids" in grid["method"]
+        line = [text for text in patch_summary_lines(summary) if text.startswith("bem grid error: ")]
+        assert line and f"{100 * grid['estimate']:.2f} %" in line[0], line
+        coarse = grid["estimate"] > grid["grid_tolerance"]
+        assert coarse == (geometry == "sampled"), (geometry, grid)
+        assert result.status == ("warning" if coarse else "ok"), result.message
+        assert ("exceeds the BEM's grid_tolerance = 0.02" in result.message) == coarse

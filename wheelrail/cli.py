@@ -317,6 +317,13 @@ def patch_summary_lines(summary: dict) -> list[str]:
             f"bem: {bem['solves']} solves, {bem['warm_solves']} warm-started, {bem['iterations']} NORM + TANG "
             f"iterations; patch sampling {callback['sampling_seconds']:.3g} s of {callback['seconds']:.3g} s"
         )
+    grid = (summary.get("discretisation_errors") or {}).get("contact_grid") or {}
+    if grid.get("estimate") is not None:
+        lines.append(
+            f"bem grid error: largest estimate {100 * grid['estimate']:.2f} % of the patch forces (all quantities "
+            f"{100 * grid['largest_all_quantities']:.2f} %), {grid['solves_above_grid_tolerance']} of "
+            f"{grid['solves_estimated']} solves above grid_tolerance {grid['grid_tolerance']:g}"
+        )
     return lines
 
 

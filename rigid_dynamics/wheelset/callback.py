@@ -65,6 +65,8 @@ class PatchCallback:
         self.sampling_seconds = 0.0
         self.patches = "contact"
         self.former = None
+        self.grid_error = {"estimated": 0, "not_estimated": 0, "above_tolerance": 0, "largest_force": 0.0,
+                           "largest": 0.0, "tolerance": None, "t_s": None}  # fmt: skip
 
     @property
     def surfaces(self):
@@ -84,8 +86,29 @@ class PatchCallback:
             "sampled_patches": bool(self.sample),
             "sampling_seconds": float(self.sampling_seconds),
             "bem_warm_start": bool(self.bem and self.warm_start),
-            **({"bem": self.warm_counts()} if self.bem else {}),
+            **({"bem": self.warm_counts(), "bem_grid_error": dict(self.grid_error)} if self.bem else {}),
         }
+
+    def _record_grid_error(self, result, t_s: float) -> None:
+        """Keep the run's largest BEM grid-error estimate (bem.model.grid_error_estimate, every solve's own) of the
+        forces (normal and creep force, relative as the BEM states them) and of all its quantities, and count the
+        solves above their ``grid_tolerance`` and those not estimated (summary.json ``discretisation_errors``).
+        """
+        grid = (result.extra or {}).get("grid_error")
+        if grid is None or result.status == "no-contact":
+            return
+        if not grid.get("estimated"):
+            self.grid_error["not_estimated"] += 1
+            return
+        record = self.grid_error
+        record["estimated"] += 1
+        record["tolerance"] = grid["tolerance"]
+        rel = grid["relative"]
+        force = max(rel["normal_force_N"], rel["creep_force_N"])
+        if force > record["largest_force"]:
+            record["largest_force"], record["t_s"] = float(force), float(t_s)
+        record["largest"] = max(record["largest"], float(grid["largest_relative"]))
+        record["above_tolerance"] += int(grid["largest_relative"] > grid["tolerance"])
 
     def warm_counts(self) -> dict:
         """BEM solves, warm-started solves and NORM + TANG iterations over the run (all candidates)."""
@@ -139,6 +162,8 @@ class PatchCallback:
             return _FAILED
         finally:
             self.seconds += time.perf_counter() - start
+        if self.bem:
+            self._record_grid_error(result, t)
         if not result.success and result.status != "no-contact":
             self.message = f"contact model {result.method!r} failed at t = {t:.6g} s: {result.status}: {result.message}"
             return _FAILED

@@ -40,8 +40,10 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 (the numbers are there, but the step is too coarse to trust them), or when a run of scipy's methods (no force
 error estimate) reaches the end with an energy balance above :data:`ENERGY_TOLERANCE_RELATIVE` (a tolerance too
 loose for the run), or when the beam's modal cut-off error (discretisation.modal_cutoff_check, a measured rule)
-exceeds ``force_tolerance``; and ``"ok"`` when it reaches the end without any of these. Events (wheel lift, contact
-restored, flange contact onset) are detected on the output samples, so their times are known to one output step.
+exceeds ``force_tolerance``, or when a BEM patch's own grid-error estimate of its forces exceeds the BEM's
+``grid_tolerance`` (discretisation.contact_grid_check); and ``"ok"`` when it reaches the end without any of these.
+Events (wheel lift, contact restored, flange contact onset) are detected on the output samples, so their times are
+known to one output step.
 """
 
 from __future__ import annotations
@@ -53,7 +55,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from rigid_dynamics.wheelset.discretisation import modal_cutoff_check
+from rigid_dynamics.wheelset.discretisation import contact_grid_check, modal_cutoff_check
 from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_compiled, run_scipy
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
@@ -333,6 +335,7 @@ def simulate(
     if not checked and status == "ok":
         result = _energy_check(result, settings)
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
+    status, message = contact_grid_check(status, message, result.callback_stats)
     return result if status == result.status else replace(result, status=status, message=message)
 
 

@@ -54,7 +54,7 @@ OPTIONS = declare(
            maximum=0.1, exclusive_minimum=True, allow_none=True),
     Option("grid_tolerance", float, 0.02, "accepted estimated relative grid error of forces, max pressure and area",
            minimum=0.0, exclusive_minimum=True),
-    Option("max_refinements", int, 2, "halvings of the default grid's elements while the estimate exceeds "
+    Option("max_refinements", int, 3, "halvings of the default grid's elements while the estimate exceeds "
            "grid_tolerance", minimum=0, maximum=5),
     Option("estimate_grid_error", bool, True, "estimate the grid error (false: for the inner solves of an "
            "iteration whose final patches are estimated by with_grid_error)"),
@@ -87,7 +87,7 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
 * ``dx_m``, ``dy_m`` (float > 0 or None): rectangular elements of these sides (CONTACT's DX and DY; ``dy_m``
   None: ``dx_m``) instead of ``nx``, ``ny``, placed as for ``element_size_m`` (not together with it, nor with
   ``nx``, ``ny``);
-* ``grid_tolerance`` (float > 0, default 0.02) and ``max_refinements`` (int >= 0, default 2): every solution
+* ``grid_tolerance`` (float > 0, default 0.02) and ``max_refinements`` (int >= 0, default 3): every solution
   carries an estimate of its discretisation error (``extra["grid_error"]``, :func:`grid_error_estimate`) from two
   companion solutions over the same potential area with elements twice and four times as large. When neither
   ``nx``/``ny`` nor an element size is given, the grid starts at the default counts and its elements are halved
@@ -387,7 +387,7 @@ class BemModel:
         if not opts["estimate_grid_error"]:
             if opts["extrapolate"]:
                 fine = self._extrapolated(geometry, creepage, material, normal_force_N, opts, fine, start)
-            return _without_grid_error(fine, "estimate_grid_error = false", time.perf_counter() - start)
+            return _without_grid_error(fine, NOT_ESTIMATED_REASON, time.perf_counter() - start)
         return self._estimate(geometry, creepage, material, normal_force_N, opts, fine, start, refine=True)
 
     def with_grid_error(
@@ -410,6 +410,8 @@ class BemModel:
         opts["warm_start"] = None
         if result.status == "no-contact" or not result.success or opts["extrapolate"]:
             return result
+        # the inner solve's "not estimated" note gives way to the estimate
+        result = dataclasses.replace(result, message=result.message.replace(_not_estimated_note(), ""))
         out = self._estimate(geometry, creepage, material, normal_force_N, opts, result, start, refine=False)
         return dataclasses.replace(out, wall_time_s=result.wall_time_s + time.perf_counter() - start)
 
@@ -806,23 +808,35 @@ GRID_ERROR_QUANTITIES = (
 """The quantities whose relative grid-error estimate is held against ``grid_tolerance`` (key, words)."""
 
 
-def _smooth_error(fine: float, coarse: float, coarsest: float | None) -> float:
-    """Estimated error of ``fine`` from the values on elements 1, 2 and 4 times as large (first order assumed).
+GRID_ERROR_MIN_ORDER = 0.6
+"""The smallest convergence order the estimate extrapolates with (:func:`_smooth_error`): a slower observed
+contraction is treated as this order (the estimate at most |d1|/(sqrt 2 - 1) = 2.4 |d1|)."""
 
-    Differences d1 = v_h - v_2h, d2 = v_2h - v_4h. Monotone and contracting at an observed order between 0 and 3
-    (d1 d2 > 0, |d1| < |d2| <= 8 |d1|): |d1|, the Richardson error of a first-order method (steady rolling's
-    upwind slip and the element-count area are first order; for the second-order normal problem this
-    overestimates by about 3; observed orders above 1 on coarse grids were measured to be pre-asymptotic on the
-    large-spin case, whose order tends to 1.0: benchmarks/results/bem_rolling_coarse.md). Otherwise (oscillating
-    differences, or a d1 that is small by chance beside a large d2, as on coarse grids where the contact's edge
-    jumps between elements) the bound max(|d1|, |d2|/2); without v_4h, |d1|.
+
+def _smooth_error(fine: float, coarse: float, coarsest: float | None) -> float:
+    """Estimated error of ``fine`` from the values on elements 1, 2 and 4 times as large.
+
+    Differences d1 = v_h - v_2h, d2 = v_2h - v_4h, observed order p = log2(|d2|/|d1|) when they have one sign.
+
+    * 0 < p < 1 (slower than first order): |d1|/(2^p - 1), Richardson's error at the observed order (p at least
+      :data:`GRID_ERROR_MIN_ORDER`);
+    * otherwise the bound max(|d1|, |d2|/2): Richardson's error |d1| of a first-order method (steady rolling's
+      upwind slip and the element-count area are first order), or half the coarse pair's difference when that is
+      larger (observed orders above 1 on coarse grids are pre-asymptotic: the large-spin case's order tends to 1.0,
+      benchmarks/results/bem_rolling_coarse.md; the linear-range creep cases jump from 20 to 40 elements and move
+      little from 40 to 80, where |d1| alone was measured to be a third of the error against Kalker's exact
+      coefficients: benchmarks/results/bem_grid_error.md), or for oscillating differences; for the second-order
+      normal problem this overestimates by 2-4.
+
+    Without v_4h, |d1|.
     """
     d1 = fine - coarse
     if coarsest is None:
         return abs(d1)
     d2 = coarse - coarsest
-    if d1 * d2 > 0 and abs(d1) < abs(d2) <= 8.0 * abs(d1):
-        return abs(d1)
+    if d1 * d2 > 0 and abs(d1) < abs(d2) < 2.0 * abs(d1):
+        order = math.log2(abs(d2) / abs(d1))
+        return abs(d1) / (2.0 ** max(order, GRID_ERROR_MIN_ORDER) - 1.0)
     return max(abs(d1), abs(d2) / 2.0)
 
 
@@ -887,12 +901,21 @@ def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
     }
 
 
+NOT_ESTIMATED_REASON = "estimate_grid_error = false"
+"""The reason a solve with ``estimate_grid_error = false`` gives for its missing estimate."""
+
+
+def _not_estimated_note(reason: str = NOT_ESTIMATED_REASON) -> str:
+    """The message part of a result whose grid error is not estimated (:func:`_without_grid_error`)."""
+    return f"; grid error not estimated ({reason})"
+
+
 def _without_grid_error(result: ContactResult, reason: str, wall_time_s: float) -> ContactResult:
     """``result`` marked as not estimated (``extra["grid_error"]["estimated"]`` False, the reason in the message)."""
     extra = dict(result.extra)
     extra["grid_error"] = {"estimated": False, "reason": reason}
     extra["grid_error_estimate"] = None
-    message = f"{result.message}; grid error not estimated ({reason})"
+    message = result.message + _not_estimated_note(reason)
     return dataclasses.replace(result, message=message, extra=extra, wall_time_s=wall_time_s)
 
 
