@@ -98,15 +98,8 @@ def test_the_loop_detector_finds_a_loop():
     assert _cycles({"a": {"b"}, "b": set()}) == []
 
 
-LONG_SIGNATURES_ALLOWED = {
-    # FASTSIM's kernels: the friction helper of issue 25 is converting them to records (contact/fastsim.py); remove
-    # each name here when its signature takes at most 12 parameters.
-    "rigid_dynamics/contact/fastsim.py": {
-        "_fastsim_reference", "_fastsim_fast", "_fastsim_one", "_fastsim_many", "_prepare", "fastsim_batch",
-        "fastsim_fields",
-    },
-}  # fmt: skip
-"""Functions allowed more than MAX_PARAMETERS parameters, by file: none outside FASTSIM's kernels."""
+LONG_SIGNATURES_ALLOWED: dict[str, set[str]] = {}
+"""Functions allowed more than MAX_PARAMETERS parameters, by file: none."""
 
 
 def _parameter_count(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
