@@ -78,3 +78,37 @@ def test_contact_json_imports_no_heavy_module(method):
     code, _, imported = done.stdout.strip().partition(" ")
     assert code == "0", done.stdout
     assert imported == "", f"heavy modules imported by wheelrail contact --json: {imported}"
+
+
+NO_KERNEL_METHODS = ("hertz",)
+"""Methods whose ``wheelrail contact <quadric case>`` run needs no compiled kernel: they must not import numba
+(its import and CPU target cost 0.6-0.8 s CPU, benchmarks/results/startup.md; the Hertz loops run as Python for one
+patch)."""
+
+
+@pytest.mark.parametrize("method", NO_KERNEL_METHODS)
+def test_contact_json_without_kernels_imports_no_numba(method):
+    """``wheelrail contact hertz-quadric --method hertz --json`` imports neither numba nor llvmlite, nor any of
+    ``CONTACT_HEAVY``."""
+    heavy = CONTACT_HEAVY | {"numba", "llvmlite"}
+    extra = f', "--method", "{method}"'
+    done = subprocess.run(
+        [sys.executable, "-c", CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(heavy))],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    code, _, imported = done.stdout.strip().partition(" ")
+    assert code == "0", done.stdout
+    assert imported == "", f"modules imported by wheelrail contact --method {method} --json: {imported}"
+
+
+def test_fastsim_choices_written_in_models_agree_with_fastsim():
+    """models.py writes FASTSIM's option choices itself (so that it need not import the FASTSIM kernels); they are
+    fastsim.py's."""
+    from rigid_dynamics.contact import fastsim, models
+
+    assert models.TRACTION_BOUNDS == fastsim.TRACTION_BOUNDS
+    assert models.FLEXIBILITIES == fastsim.FLEXIBILITIES

@@ -55,8 +55,8 @@ import math
 import numpy as np
 from numba import njit
 
+from rigid_dynamics.contact._hertz_kernels import _kdbc, _shape
 from rigid_dynamics.contact.fastrip import _circle_integral
-from rigid_dynamics.contact.hertz import _kdbc, _shape
 from rigid_dynamics.contact.kalker import _coefficients_many
 
 KP_THRESHOLD_FACTOR = 0.5

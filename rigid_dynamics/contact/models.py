@@ -43,14 +43,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigid_dynamics.contact.fastsim import FLEXIBILITIES, TRACTION_BOUNDS, fastsim_batch, fastsim_fields
 from rigid_dynamics.contact.hertz import HertzBatch, hertz_solve_batch
-from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
-from rigid_dynamics.contact.linear import linear_creep_forces
 from rigid_dynamics.contact.options import Option, OptionError, declare, validate_options
 from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
-from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
 from rigid_dynamics.materials import Material
+
+TRACTION_BOUNDS = ("elliptic", "parabolic")
+FLEXIBILITIES = ("single", "three", "three-unblended")
+"""FASTSIM's choices, as rigid_dynamics.contact.fastsim declares them (tests/test_import_hygiene.py checks that they
+agree): written here so that this module, and a command using Hertz, linear or Vermeulen-Johnson, does not import
+the FASTSIM kernels. The compiled models' modules are imported inside the functions that use them."""
 
 
 def _options(options: Mapping | None, declared: Mapping[str, Option], model: str) -> dict:
@@ -221,6 +223,8 @@ class HertzModel(HertzianModel):
 
 def _linear_forces(hertz, creepage, material):
     """Kalker's linear-theory (Fx, Fy, Mz) on the Hertz ellipse of one patch (eq 50-52)."""
+    from rigid_dynamics.contact.linear import linear_creep_forces
+
     return linear_creep_forces(
         hertz.semi_axis_long_m,
         hertz.semi_axis_lat_m,
@@ -254,6 +258,8 @@ class VermeulenJohnsonModel(HertzianModel):
     SATURATING = True
 
     def tangential(self, hertz, creepage, material, opts):
+        from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+
         tx, ty, _ = _linear_forces(hertz, creepage, material)
         fx, fy = vermeulen_johnson_saturation(tx, ty, hertz.normal_force_N, material.friction_coefficient)
         return {"creep_force_long_N": float(fx), "creep_force_lat_N": float(fy), "spin_moment_Nm": None}, {}
@@ -307,6 +313,8 @@ class FastsimModel(HertzianModel):
         return result
 
     def tangential(self, hertz, creepage, material, opts):
+        from rigid_dynamics.contact.fastsim import fastsim_fields
+
         (fx, fy, mz, slip_fraction), fields = fastsim_fields(
             float(hertz.semi_axis_long_m),
             float(hertz.semi_axis_lat_m),
@@ -531,6 +539,11 @@ def solve_batch(
     """
     if method not in BATCH_METHODS:
         raise ValueError(f"method = {method!r}: expected one of {', '.join(BATCH_METHODS)}")
+    from rigid_dynamics.contact.fastsim import fastsim_batch
+    from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+    from rigid_dynamics.contact.linear import linear_creep_forces
+    from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+
     fastsim_options = {k: v for k, v in FastsimModel.OPTIONS.items() if k != "fields"}
     declared = {"fastsim": fastsim_options, "auto": {"tolerance": AutoModel.OPTIONS["tolerance"], **fastsim_options}}
     opts = _options(options, declared.get(method, {}), method)
