@@ -44,10 +44,11 @@ The residual is evaluated to ~1e-15 relative, so the converged semi-axes carry t
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 
 import numpy as np
+
+from rigid_dynamics.contact.lazy_kernels import run_as_python
 
 _SERIES_LIMIT = 0.1
 _N_SERIES = 24
@@ -70,10 +71,6 @@ _B_SERIES = 0.5 * math.pi * _C[:_N_SERIES] * (_C[:_N_SERIES] - _C[1 : _N_SERIES 
 _C_SERIES = 0.5 * math.pi * _C[1 : _N_SERIES + 1] * (2.0 * _C[2 : _N_SERIES + 2] - _C[1 : _N_SERIES + 1])
 
 
-PYTHON_BATCH_LIMIT = 8
-"""Batches up to this size run as Python when numba is not imported yet (see the module's docstring)."""
-
-
 def _ellipkm1(p):
     """K from scipy's ``ellipkm1`` (K of parameter 1 - p), for the Python path (compiled: _hertz_kernels)."""
     from scipy.special import ellipkm1
@@ -90,7 +87,7 @@ def _ellipe(m):
 
 def _kernels(n: int):
     """The compiled kernels' module, or None where a batch of ``n`` runs as Python (numba not imported, n small)."""
-    if n <= PYTHON_BATCH_LIMIT and "numba" not in sys.modules:
+    if run_as_python(n):
         return None
     from rigid_dynamics.contact import _hertz_kernels
 

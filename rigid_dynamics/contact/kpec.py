@@ -55,9 +55,9 @@ import math
 import numpy as np
 from numba import njit
 
+from rigid_dynamics.contact._analytic_kernels import _coefficients_many
 from rigid_dynamics.contact._hertz_kernels import _kdbc, _shape
 from rigid_dynamics.contact.fastrip import _circle_integral
-from rigid_dynamics.contact.kalker import _coefficients_many
 
 KP_THRESHOLD_FACTOR = 0.5
 """Kik-Piotrowski's virtual-penetration factor of the equivalent-ellipse step (CONTACT: 0.5)."""
