@@ -113,3 +113,34 @@ def test_fastsim_choices_written_in_models_agree_with_fastsim():
 
     assert models.TRACTION_BOUNDS == fastsim.TRACTION_BOUNDS
     assert models.FLEXIBILITIES == fastsim.FLEXIBILITIES
+
+
+AUTO_ANALYTIC_CODE = """
+import contextlib, io, json, sys
+from pathlib import Path
+from wheelrail.cli import main
+text = Path("wheelrail/cases/hertz-quadric.toml").read_text()
+for old, new in (("spin_creepage_1_per_m = 0.1", "spin_creepage_1_per_m = 0.0"), ("creepage_long = 0.001",
+                 "creepage_long = 0.0001"), ("creepage_lat = -0.0005", "creepage_lat = -0.00005")):
+    assert old in text, old
+    text = text.replace(old, new)
+Path(sys.argv[1]).write_text(text)
+out = io.StringIO()
+with contextlib.redirect_stdout(out):
+    code = main(["contact", sys.argv[1], "--json"])
+print(code, json.loads(out.getvalue())["patches"][0]["model"], "numba" in sys.modules)
+"""
+
+
+def test_auto_choosing_an_analytic_model_imports_no_numba(tmp_path):
+    """``wheelrail contact <quadric case> --json`` whose ``auto`` choice is the linear theory (hertz-quadric with a
+    tenth of its creepages and no spin) warms up only the chosen model and imports no numba."""
+    done = subprocess.run(
+        [sys.executable, "-c", AUTO_ANALYTIC_CODE, str(tmp_path / "small-creep.toml")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0", "linear", "False"], done.stdout

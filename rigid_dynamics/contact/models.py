@@ -416,22 +416,38 @@ class AutoModel:
         ),
     )
 
-    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+    def _choose(self, geometry, creepage, material, normal_force_N, opts):
+        """(hertz, why, features, choice, thresholds' data); hertz None (and the rest None) without contact."""
         from rigid_dynamics.contact.auto import choose_rung, load_thresholds, patch_features
 
+        hertz, why = _hertz(geometry, material, normal_force_N)
+        if hertz is None:
+            return hertz, why, None, None, None
+        features = patch_features(geometry, creepage, material, hertz)
+        fs_opts = {**FastsimModel.OPTIONS_DEFAULTS, **((opts["model_options"] or {}).get("fastsim") or {})}
+        data = load_thresholds()
+        choice = choose_rung(features, opts["tolerance"], fastsim_grid=(fs_opts["nx"], fs_opts["ny"]), data=data)
+        return hertz, why, features, choice, data
+
+    def chosen_model(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> str:
+        """The model :meth:`solve` would run for this patch ("hertz" without contact), without running it: the
+        contact command warms up only that model's kernels (a chosen rung whose result is not ok falls back to bem
+        inside the solve).
+        """
+        opts = _options(options, self.OPTIONS, self.name)
+        hertz, _, _, choice, _ = self._choose(geometry, creepage, material, normal_force_N, opts)
+        return "hertz" if hertz is None else choice["model"]
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
         start = time.perf_counter()
         opts = _options(options, self.OPTIONS, self.name)
         tol = opts["tolerance"]
         per_model = dict(opts["model_options"] or {})
-        hertz, why = _hertz(geometry, material, normal_force_N)
+        hertz, why, features, choice, data = self._choose(geometry, creepage, material, normal_force_N, opts)
         if hertz is None:
             result = _base_result(self.name, geometry, creepage, None, why, start)
             result.extra["selected_model"] = "hertz"
             return result
-        features = patch_features(geometry, creepage, material, hertz)
-        fs_opts = {**FastsimModel.OPTIONS_DEFAULTS, **(per_model.get("fastsim") or {})}
-        data = load_thresholds()
-        choice = choose_rung(features, tol, fastsim_grid=(fs_opts["nx"], fs_opts["ny"]), data=data)
         record = {
             "selected_model": choice["model"],
             "selection_reason": choice["reason"],
