@@ -220,9 +220,12 @@ def test_seed_equations_34_to_38_as_printed(A, B):
 
 def test_regression_python_path_gives_the_compiled_bits():
     """Regression (two code paths of ours, not physics): hertz.py's loops run as Python (a small batch before numba
-    is imported, e.g. ``wheelrail contact --method hertz``) and compiled by numba (_hertz_kernels) give the same bits,
-    over curvature ratios 1 to 2e4 (both branches of K, D, B, C), both axis orders, force and approach control."""
-    from rigid_dynamics.contact import _hertz_kernels, hertz
+    is imported, e.g. ``wheelrail contact --method hertz``) and compiled by numba (hertz.compiled_kernels) give the
+    same bits, over curvature ratios 1 to 2e4 (both branches of K, D, B, C), both axis orders, force and approach
+    control."""
+    from rigid_dynamics.contact import hertz
+
+    compiled = hertz.compiled_kernels()
 
     rng = np.random.default_rng(7)
     ratio = np.concatenate([[1.0, 1.0 + 1e-9, 1.05, 1.2, 3.0, 100.0, 2e4], np.exp(rng.uniform(0.0, 9.9, 120))])
@@ -233,15 +236,15 @@ def test_regression_python_path_gives_the_compiled_bits():
     load = rng.uniform(-1e3, 2e5, ratio.size)
     for force_control, values in ((True, load), (False, np.abs(load) * 1e-10)):
         runs = []
-        for kernel in (hertz._hertz_many, _hertz_kernels._hertz_many):
+        for kernel in (hertz._hertz_many, compiled["_hertz_many"]):
             out = np.empty((ratio.size, 7))
             it = np.empty(ratio.size, dtype=np.int64)
             ok = np.empty(ratio.size, dtype=np.bool_)
             kernel(curv_a, curv_b, values, force_control, E_STAR, 1e-14, 60, out, it, ok)
             runs.append((out, it, ok))
-        for python, compiled in zip(*runs, strict=True):
-            np.testing.assert_array_equal(python, compiled)
-    for kernel in (hertz._kdbc_many, _hertz_kernels._kdbc_many):
+        for python_values, compiled_values in zip(*runs, strict=True):
+            np.testing.assert_array_equal(python_values, compiled_values)
+    for kernel in (hertz._kdbc_many, compiled["_kdbc_many"]):
         out = np.empty((ratio.size, 4))
         kernel(1.0 / ratio, out)
         runs.append(out)

@@ -1,10 +1,11 @@
 """Regression tests (two code paths of ours, not physics): the loops of kalker.py, linear.py and
 vermeulen_johnson.py run as Python (a small batch before numba is imported, e.g. ``wheelrail contact --method
-linear``) and as their numba-compiled copies (rigid_dynamics/contact/_analytic_kernels.py) give the same bits."""
+linear``) and as their numba-compiled copies (each module's ``compiled_kernels()``, lazy_kernels.py) give the same
+bits."""
 
 import numpy as np
 
-from rigid_dynamics.contact import _analytic_kernels, kalker, linear, vermeulen_johnson
+from rigid_dynamics.contact import kalker, linear, vermeulen_johnson
 
 
 def _inputs(n=300, seed=3):
@@ -18,8 +19,8 @@ def test_kalker_coefficients_and_asymptotes_same_bits():
     """Both branches: inside Kalker's table (PCHIP) and outside it (slender asymptotes blended at the edge)."""
     _, ratio, nu = _inputs()
     for python, compiled in (
-        (kalker._coefficients_many, _analytic_kernels._coefficients_many),
-        (kalker._asymptotes_many, _analytic_kernels._asymptotes_many),
+        (kalker._coefficients_many, kalker.compiled_kernels()["_coefficients_many"]),
+        (kalker._asymptotes_many, kalker.compiled_kernels()["_asymptotes_many"]),
     ):
         out_python, out_compiled = np.empty((ratio.size, 4)), np.empty((ratio.size, 4))
         python(ratio, nu, out_python)
@@ -37,14 +38,14 @@ def test_linear_and_saturation_same_bits():
     kalker._coefficients_many(ratio, nu, coef)
     creep = [rng.uniform(-1e-2, 1e-2, n), rng.uniform(-1e-2, 1e-2, n), rng.uniform(-1.0, 1.0, n)]
     outs = []
-    for kernel in (linear._linear_many, _analytic_kernels._linear_many):
+    for kernel in (linear._linear_many, linear.compiled_kernels()["_linear_many"]):
         out = np.empty((3, n))
         kernel(8.2e10, a, b, tuple(np.ascontiguousarray(coef[:, i]) for i in range(4)), *creep, out)
         outs.append(out)
     np.testing.assert_array_equal(*outs)
     limit = np.concatenate([[0.0], rng.uniform(0.0, 2.0, n - 1)]) * np.hypot(outs[0][0], outs[0][1])
     sat = []
-    for kernel in (vermeulen_johnson._saturate_many, _analytic_kernels._saturate_many):
+    for kernel in (vermeulen_johnson._saturate_many, vermeulen_johnson.compiled_kernels()["_saturate_many"]):
         out = np.empty((2, n))
         kernel(outs[0][0], outs[0][1], limit, out)
         sat.append(out)
@@ -58,4 +59,4 @@ def test_public_compiled_laws_are_the_compiled_copies():
 
     assert isinstance(linear.linear_one, CPUDispatcher)
     assert isinstance(vermeulen_johnson.saturate_one, CPUDispatcher)
-    assert linear.linear_one is _analytic_kernels.linear_one
+    assert linear.linear_one is linear.compiled_kernels()["_linear_one"]

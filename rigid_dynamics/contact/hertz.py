@@ -31,8 +31,8 @@ To keep full precision for every ratio from 1 (A = B) to beyond 1e4 (b/a ~ 4e-3)
 * otherwise K comes from ``scipy.special.ellipkm1(p)`` (accurate as p -> 0, slender ellipses)
   and E from ``scipy.special.ellipe(m)``.
 
-The loops below are plain Python. rigid_dynamics/contact/_hertz_kernels.py compiles the same functions with
-numba (scipy's two functions then called through ``scipy.special.cython_special``): a batch of 10,000 costs well
+The loops below are plain Python; :func:`compiled_kernels` compiles the same functions with numba (scipy's two
+functions then called through ``scipy.special.cython_special``): a batch of 10,000 costs well
 under 1 us per patch there. A small batch in a process that has not imported numba runs the same source as Python
 (scipy's ufuncs: the same compiled functions), so that a command solving one Hertz patch never pays numba's start-up
 (about 0.6-0.8 s CPU, benchmarks/results/startup.md); both paths give the same bits (tests/test_hertz.py).
@@ -48,7 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigid_dynamics.contact.lazy_kernels import run_as_python
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 _SERIES_LIMIT = 0.1
 _N_SERIES = 24
@@ -72,26 +72,47 @@ _C_SERIES = 0.5 * math.pi * _C[1 : _N_SERIES + 1] * (2.0 * _C[2 : _N_SERIES + 2]
 
 
 def _ellipkm1(p):
-    """K from scipy's ``ellipkm1`` (K of parameter 1 - p), for the Python path (compiled: _hertz_kernels)."""
+    """K from scipy's ``ellipkm1`` (K of parameter 1 - p), for the Python path (compiled: compiled_kernels)."""
     from scipy.special import ellipkm1
 
     return float(ellipkm1(p))
 
 
 def _ellipe(m):
-    """E from scipy's ``ellipe`` (E of parameter m), for the Python path (compiled: _hertz_kernels)."""
+    """E from scipy's ``ellipe`` (E of parameter m), for the Python path (compiled: compiled_kernels)."""
     from scipy.special import ellipe
 
     return float(ellipe(m))
 
 
-def _kernels(n: int):
-    """The compiled kernels' module, or None where a batch of ``n`` runs as Python (numba not imported, n small)."""
-    if run_as_python(n):
-        return None
-    from rigid_dynamics.contact import _hertz_kernels
+def _scipy_externals() -> dict:
+    """Scipy's ``ellipkm1``/``ellipe`` for compiled code (``scipy.special.cython_special``), registered as named
+    external symbols so that the compiled copies can be cached on disk.
+    """
+    import llvmlite.binding as llvm
+    from numba import types
+    from numba.extending import get_cython_function_address
 
-    return _hertz_kernels
+    for name in ("ellipkm1", "ellipe"):
+        llvm.add_symbol(f"wheelrail_scipy_{name}", get_cython_function_address("scipy.special.cython_special", name))
+    signature = types.float64(types.float64)
+    return {
+        "_ellipkm1": types.ExternalFunction("wheelrail_scipy_ellipkm1", signature),
+        "_ellipe": types.ExternalFunction("wheelrail_scipy_ellipe", signature),
+    }
+
+
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of this module's loops (``_kdbc``, ``_shape``, ``_kdbc_many``, ``_shape_many``,
+    ``_hertz_many``; lazy_kernels.compiled_copies; imports numba).
+    """
+    names = ("_kdbc", "_shape", "_kdbc_many", "_shape_many", "_hertz_many")
+    return compiled_copies(__name__, names, replacements=_scipy_externals)
+
+
+def _kernels(n: int):
+    """The compiled copies, or None where a batch of ``n`` runs as Python (numba not imported, n small)."""
+    return None if run_as_python(n) else compiled_kernels()
 
 
 def _kdbc(p):
@@ -215,7 +236,7 @@ def elliptic_kdbc(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     p = np.asarray(p, dtype=float)
     out = np.empty((p.size, 4))
     kernels = _kernels(p.size)
-    (_kdbc_many if kernels is None else kernels._kdbc_many)(np.array(p.ravel(), dtype=float), out)
+    (_kdbc_many if kernels is None else kernels["_kdbc_many"])(np.array(p.ravel(), dtype=float), out)
     return tuple(out[:, i].reshape(p.shape) for i in range(4))
 
 
@@ -246,7 +267,7 @@ def ellipse_shape_from_curvature_ratio(
     it = np.empty(flat.size, dtype=np.int64)
     ok = np.empty(flat.size, dtype=np.bool_)
     kernels = _kernels(flat.size)
-    (_shape_many if kernels is None else kernels._shape_many)(flat, rtol, max_iterations, p, it, ok)
+    (_shape_many if kernels is None else kernels["_shape_many"])(flat, rtol, max_iterations, p, it, ok)
     return p.reshape(r.shape), np.asarray(it.max() if it.size else 0), ok.reshape(r.shape)
 
 
@@ -346,7 +367,7 @@ def hertz_solve_batch(
     it = np.empty(n, dtype=np.int64)
     ok = np.empty(n, dtype=np.bool_)
     kernels = _kernels(n)
-    (_hertz_many if kernels is None else kernels._hertz_many)(
+    (_hertz_many if kernels is None else kernels["_hertz_many"])(
         np.array(A.ravel(), dtype=float),
         np.array(B.ravel(), dtype=float),
         np.array(load.ravel(), dtype=float),

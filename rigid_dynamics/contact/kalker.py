@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigid_dynamics.contact.lazy_kernels import run_as_python
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 _DATA_FILE = Path(__file__).resolve().parent / "data" / "kalker_creep_coefficients.csv"
 COEFFICIENT_NAMES = ("C11", "C22", "C23", "C33")
@@ -230,11 +230,11 @@ def _asymptotes_many(a_over_b, nu, out):
         _asymptote_one(a_over_b[i], nu[i], out[i])
 
 
-def _compiled():
-    """The compiled copies of this module's loops (rigid_dynamics/contact/_analytic_kernels.py)."""
-    from rigid_dynamics.contact import _analytic_kernels
-
-    return _analytic_kernels
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of this module's loops (``_table_one``, ``_asymptote_one``,
+    ``_coefficients_many``, ``_asymptotes_many``; lazy_kernels.compiled_copies; imports numba).
+    """
+    return compiled_copies(__name__, ("_table_one", "_asymptote_one", "_coefficients_many", "_asymptotes_many"))
 
 
 def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
@@ -246,7 +246,7 @@ def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
     a_over_b = np.atleast_1d(np.asarray(a_over_b, dtype=float))
     nu = np.broadcast_to(np.asarray(poisson_ratio, dtype=float), a_over_b.shape)
     out = np.empty((a_over_b.size, 4))
-    (_asymptotes_many if run_as_python(out.shape[0]) else _compiled()._asymptotes_many)(
+    (_asymptotes_many if run_as_python(out.shape[0]) else compiled_kernels()["_asymptotes_many"])(
         np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out
     )
     return out.reshape(a_over_b.shape + (4,))
@@ -282,7 +282,7 @@ def kalker_coefficients(a_over_b, poisson_ratio) -> CreepCoefficients:
     if not (np.all(np.isfinite(nu)) and np.all((nu > -1.0) & (nu <= 0.5))):
         raise ValueError(f"poisson_ratio = {poisson_ratio!r}: expected values in (-1, 0.5]")
     out = np.empty((a_over_b.size, 4))
-    (_coefficients_many if run_as_python(out.shape[0]) else _compiled()._coefficients_many)(
+    (_coefficients_many if run_as_python(out.shape[0]) else compiled_kernels()["_coefficients_many"])(
         np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out
     )
     return CreepCoefficients(*(out[:, i].reshape(shape) for i in range(4)))

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
-from rigid_dynamics.contact.lazy_kernels import run_as_python
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 
 def _linear_one(shear_modulus_Pa, a, b, c11, c22, c23, c33, xi, eta, phi):
@@ -41,18 +41,18 @@ def _linear_many(shear_modulus_Pa, a, b, c, xi, eta, phi, out):
         )
 
 
-def _compiled_many():
-    from rigid_dynamics.contact._analytic_kernels import _linear_many as compiled
-
-    return compiled
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of ``_linear_one`` (inlined, no NRT: the compiled dynamics loop's law) and
+    ``_linear_many`` (lazy_kernels.compiled_copies; imports numba).
+    """
+    inline = {"_nrt": False, "inline": "always"}
+    return compiled_copies(__name__, ("_linear_one", "_linear_many"), options={"_linear_one": inline})
 
 
 def __getattr__(name):
     """``linear_one``: the compiled copy of :func:`_linear_one` (imports numba when first asked for)."""
     if name == "linear_one":
-        from rigid_dynamics.contact._analytic_kernels import linear_one
-
-        return linear_one
+        return compiled_kernels()["_linear_one"]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -93,6 +93,6 @@ def linear_creep_forces(
         np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float).ravel() for v in (c.c11, c.c22, c.c23, c.c33)
     )
     out = np.empty((3, flat[0].size))
-    kernel = _linear_many if run_as_python(out.shape[1]) else _compiled_many()
+    kernel = _linear_many if run_as_python(out.shape[1]) else compiled_kernels()["_linear_many"]
     kernel(float(shear_modulus_Pa), flat[0], flat[1], coef, flat[2], flat[3], flat[4], out)
     return out[0].reshape(a.shape), out[1].reshape(a.shape), out[2].reshape(a.shape)

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from rigid_dynamics.contact.lazy_kernels import run_as_python
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 
 def _saturate_one(tx, ty, limit):
@@ -43,18 +43,18 @@ def _saturate_many(tx, ty, limit, out):
         out[0, k], out[1, k] = _saturate_one(tx[k], ty[k], limit[k])
 
 
-def _compiled_many():
-    from rigid_dynamics.contact._analytic_kernels import _saturate_many as compiled
-
-    return compiled
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of ``_saturate_one`` (inlined, no NRT: the compiled dynamics loop's law) and
+    ``_saturate_many`` (lazy_kernels.compiled_copies; imports numba).
+    """
+    inline = {"_nrt": False, "inline": "always"}
+    return compiled_copies(__name__, ("_saturate_one", "_saturate_many"), options={"_saturate_one": inline})
 
 
 def __getattr__(name):
     """``saturate_one``: the compiled copy of :func:`_saturate_one` (imports numba when first asked for)."""
     if name == "saturate_one":
-        from rigid_dynamics.contact._analytic_kernels import saturate_one
-
-        return saturate_one
+        return compiled_kernels()["_saturate_one"]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -82,6 +82,6 @@ def vermeulen_johnson_saturation(
         raise ValueError("normal_force_N and friction_coefficient: expected values >= 0")
     shape = tx.shape
     out = np.empty((2, tx.size))
-    kernel = _saturate_many if run_as_python(out.shape[1]) else _compiled_many()
+    kernel = _saturate_many if run_as_python(out.shape[1]) else compiled_kernels()["_saturate_many"]
     kernel(*(np.ascontiguousarray(v, dtype=float).ravel() for v in (tx, ty, f * n)), out)
     return out[0].reshape(shape), out[1].reshape(shape)
