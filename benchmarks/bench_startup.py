@@ -28,6 +28,9 @@ COMMANDS = {
     "contact hertz-quadric --method hertz --json": [
         "-m", "wheelrail.cli", "contact", "hertz-quadric", "--method", "hertz", "--json",
     ],
+    "contact hertz-quadric --method linear --json": [
+        "-m", "wheelrail.cli", "contact", "hertz-quadric", "--method", "linear", "--json",
+    ],
     "contact hertz-quadric --method bem --json": [
         "-m", "wheelrail.cli", "contact", "hertz-quadric", "--method", "bem", "--json",
     ],

@@ -216,3 +216,65 @@ def test_seed_equations_34_to_38_as_printed(A, B):
     if A > B:
         literal_force, _, _ = eq36_37(1 / (1 - m2))
         assert abs(literal_force / force - 1) > 0.1
+
+
+def test_regression_python_path_gives_the_compiled_bits():
+    """Regression (two code paths of ours, not physics): hertz.py's loops run as Python (a small batch before numba
+    is imported, e.g. ``wheelrail contact --method hertz``) and compiled by numba (hertz.compiled_kernels) give the
+    same bits, over curvature ratios 1 to 2e4 (both branches of K, D, B, C), both axis orders, force and approach
+    control."""
+    from rigid_dynamics.contact import hertz
+
+    compiled = hertz.compiled_kernels()
+
+    rng = np.random.default_rng(7)
+    ratio = np.concatenate([[1.0, 1.0 + 1e-9, 1.05, 1.2, 3.0, 100.0, 2e4], np.exp(rng.uniform(0.0, 9.9, 120))])
+    curv_a = rng.uniform(1.0, 200.0, ratio.size)
+    curv_b = curv_a * ratio
+    swap = rng.random(ratio.size) < 0.5
+    curv_a, curv_b = np.where(swap, curv_b, curv_a), np.where(swap, curv_a, curv_b)
+    load = rng.uniform(-1e3, 2e5, ratio.size)
+    for force_control, values in ((True, load), (False, np.abs(load) * 1e-10)):
+        runs = []
+        for kernel in (hertz._hertz_many, compiled["_hertz_many"]):
+            out = np.empty((ratio.size, 7))
+            it = np.empty(ratio.size, dtype=np.int64)
+            ok = np.empty(ratio.size, dtype=np.bool_)
+            kernel(curv_a, curv_b, values, force_control, E_STAR, 1e-14, 60, out, it, ok)
+            runs.append((out, it, ok))
+        for python_values, compiled_values in zip(*runs, strict=True):
+            np.testing.assert_array_equal(python_values, compiled_values)
+    for kernel in (hertz._kdbc_many, compiled["_kdbc_many"]):
+        out = np.empty((ratio.size, 4))
+        kernel(1.0 / ratio, out)
+        runs.append(out)
+    np.testing.assert_array_equal(runs[-2], runs[-1])
+
+
+def test_small_batch_before_numba_runs_as_python():
+    """A one-patch solve in a fresh process (the ``--method hertz`` command's path) does not import numba, and
+    matches the compiled batch's bits once numba is loaded (regression between our two paths)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import sys\n"
+        "from rigid_dynamics.contact.hertz import hertz_solve_batch\n"
+        "h = hertz_solve_batch(3.1, 27.5, normal_force_N=1.2e5, shear_modulus_Pa=82e9, poisson_ratio=0.28)\n"
+        "print('numba' in sys.modules, repr(float(h.max_pressure_Pa)), repr(float(h.semi_axis_lat_m)))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    imported, p0, b = done.stdout.split()
+    assert imported == "False"
+    batch = hertz_solve_batch(
+        np.full(20, 3.1), np.full(20, 27.5), normal_force_N=1.2e5, shear_modulus_Pa=82e9, poisson_ratio=0.28
+    )
+    assert float(p0) == float(batch.max_pressure_Pa[0]) and float(b) == float(batch.semi_axis_lat_m[0])

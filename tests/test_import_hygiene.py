@@ -78,3 +78,69 @@ def test_contact_json_imports_no_heavy_module(method):
     code, _, imported = done.stdout.strip().partition(" ")
     assert code == "0", done.stdout
     assert imported == "", f"heavy modules imported by wheelrail contact --json: {imported}"
+
+
+NO_KERNEL_METHODS = {"hertz": "0", "linear": "1", "vermeulen-johnson": "0"}
+"""Methods whose ``wheelrail contact <quadric case>`` run needs no compiled kernel, with the command's exit status
+(linear: 1, its ``warning`` -- full adhesion past the friction bound on this case): they must not import numba
+(its import and CPU target cost 0.6-0.8 s CPU, benchmarks/results/startup.md; the loops of hertz.py, kalker.py,
+linear.py and vermeulen_johnson.py run as Python for one patch, rigid_dynamics/contact/lazy_kernels.py)."""
+
+
+@pytest.mark.parametrize("method", NO_KERNEL_METHODS)
+def test_contact_json_without_kernels_imports_no_numba(method):
+    """``wheelrail contact hertz-quadric --method <hertz, linear, vermeulen-johnson> --json`` imports neither numba
+    nor llvmlite, nor any of ``CONTACT_HEAVY``."""
+    heavy = CONTACT_HEAVY | {"numba", "llvmlite"}
+    extra = f', "--method", "{method}"'
+    done = subprocess.run(
+        [sys.executable, "-c", CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(heavy))],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    code, _, imported = done.stdout.strip().partition(" ")
+    assert code == NO_KERNEL_METHODS[method], done.stdout
+    assert imported == "", f"modules imported by wheelrail contact --method {method} --json: {imported}"
+
+
+def test_fastsim_choices_written_in_models_agree_with_fastsim():
+    """models.py writes FASTSIM's option choices itself (so that it need not import the FASTSIM kernels); they are
+    fastsim.py's."""
+    from rigid_dynamics.contact import fastsim, models
+
+    assert models.TRACTION_BOUNDS == fastsim.TRACTION_BOUNDS
+    assert models.FLEXIBILITIES == fastsim.FLEXIBILITIES
+
+
+AUTO_ANALYTIC_CODE = """
+import contextlib, io, json, sys
+from pathlib import Path
+from wheelrail.cli import main
+text = Path("wheelrail/cases/hertz-quadric.toml").read_text()
+for old, new in (("spin_creepage_1_per_m = 0.1", "spin_creepage_1_per_m = 0.0"), ("creepage_long = 0.001",
+                 "creepage_long = 0.0001"), ("creepage_lat = -0.0005", "creepage_lat = -0.00005")):
+    assert old in text, old
+    text = text.replace(old, new)
+Path(sys.argv[1]).write_text(text)
+out = io.StringIO()
+with contextlib.redirect_stdout(out):
+    code = main(["contact", sys.argv[1], "--json"])
+print(code, json.loads(out.getvalue())["patches"][0]["model"], "numba" in sys.modules)
+"""
+
+
+def test_auto_choosing_an_analytic_model_imports_no_numba(tmp_path):
+    """``wheelrail contact <quadric case> --json`` whose ``auto`` choice is the linear theory (hertz-quadric with a
+    tenth of its creepages and no spin) warms up only the chosen model and imports no numba."""
+    done = subprocess.run(
+        [sys.executable, "-c", AUTO_ANALYTIC_CODE, str(tmp_path / "small-creep.toml")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0", "linear", "False"], done.stdout

@@ -590,16 +590,21 @@ class CaseSolution:
 
 WARM_UP_OPTIONS = {"hertz": None, "linear": None, "vermeulen-johnson": None, "fastsim": None, "bem": {"nx": 8, "ny": 8}}
 """Models whose numba kernels :func:`solve_case` compiles (or loads from the cache) on a small patch before its
-clock starts, with the options of that small solve. ``auto`` warms up every rung it may choose (bem, its fallback,
-included); ``fea`` has no numba kernels (DOLFINx caches its compiled forms itself)."""
+clock starts, with the options of that small solve. ``auto`` warms up Hertz and the model it chooses on a quadric
+case, and every rung it may choose (bem, its fallback, included) on a wheelset case; ``fea`` has no numba kernels
+(DOLFINx caches its compiled forms itself)."""
 
 
-def warm_up(method: str, material: Material) -> float:
-    """Solve a small quadric patch with ``method`` so that its compiled kernels are loaded; returns the time, s."""
+def warm_up(method: str, material: Material, models: tuple[str, ...] | None = None) -> float:
+    """Solve a small quadric patch with ``method`` so that its compiled kernels are loaded; returns the time, s.
+
+    ``models``: the models to warm up instead of ``method`` (``auto`` on a quadric patch: the one it chooses).
+    """
     from rigid_dynamics.contact.registry import get_model
 
     start = time.perf_counter()
     names = ("hertz", "linear", "vermeulen-johnson", "fastsim", "bem") if method == "auto" else (method,)
+    names = names if models is None else models
     geometry = ContactGeometry.quadric(0.46, 0.3)
     for name in names:
         if name in WARM_UP_OPTIONS:
@@ -608,6 +613,22 @@ def warm_up(method: str, material: Material) -> float:
                     geometry, Creepage(1e-3, 1e-3, 0.1), material, normal_force_N=1e4, options=WARM_UP_OPTIONS[name]
                 )
     return time.perf_counter() - start
+
+
+def _auto_choice(model, case: ContactCase) -> tuple[str, ...] | None:
+    """("hertz", the model ``auto`` chooses) for a quadric case, so that only its kernels are warmed up (a case that
+    ``auto`` serves by an analytic model then loads no numba); None (warm up every rung) for a wheelset case or
+    when the choice fails (the solve reports why).
+    """
+    if case.kind != "quadric":
+        return None
+    try:
+        chosen = model.chosen_model(
+            case.geometry, case.creepage, case.material, normal_force_N=case.normal_force_N, options=case.solver_options
+        )
+    except Exception:  # the solve itself reports bad options or input
+        return None
+    return ("hertz", chosen)
 
 
 def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> CaseSolution:
@@ -626,7 +647,7 @@ def solve_case(case: ContactCase | str | Path, method: str, progress=None) -> Ca
         case = load_case(case)
     prepare = time.perf_counter()
     model = get_model(method)
-    warm_up(method, case.material)
+    warm_up(method, case.material, _auto_choice(model, case) if method == "auto" else None)
     setup_s = time.perf_counter() - prepare
     start = time.perf_counter()
     if case.kind == "quadric":

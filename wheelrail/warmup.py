@@ -27,6 +27,10 @@ def warm_up_all(stream=sys.stderr) -> dict[str, float]:
     for method in WARM_UP_OPTIONS:
         print(f"setup: compiling the {method} contact kernels ...", file=stream, flush=True)
         timings[f"contact {method}"] = warm_up(method, STEEL)
+    print("setup: compiling the batched Hertz / Kalker / linear / Vermeulen-Johnson loops ...", file=stream, flush=True)
+    start = time.perf_counter()
+    _warm_up_batches()
+    timings["contact batches"] = time.perf_counter() - start
     for name, path in embedded_scenes().items():
         scene = load_scene(path)
         # every scene: the adaptive methods call the same compiled right-hand side (with the given geometry of the
@@ -60,6 +64,25 @@ def warm_up_all(stream=sys.stderr) -> dict[str, float]:
     total = time.perf_counter() - start_all
     print(f"setup: numba kernels ready in {total:.0f} s (cached on disk for every later run)", file=stream, flush=True)
     return timings
+
+
+def _warm_up_batches() -> None:
+    """The compiled copies of the analytic models' loops (a one-patch solve runs them as Python, lazy_kernels.py)."""
+    import numpy as np
+
+    from rigid_dynamics.contact.hertz import hertz_solve_batch
+    from rigid_dynamics.contact.lazy_kernels import PYTHON_BATCH_LIMIT
+    from rigid_dynamics.contact.linear import linear_creep_forces
+    from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+
+    n = PYTHON_BATCH_LIMIT + 1
+    hertz = hertz_solve_batch(
+        np.full(n, 2.0), np.full(n, 3.0), normal_force_N=1e4, shear_modulus_Pa=8e10, poisson_ratio=0.3
+    )
+    fx, fy, _ = linear_creep_forces(
+        hertz.semi_axis_long_m, hertz.semi_axis_lat_m, 1e-3, 1e-3, 0.1, shear_modulus_Pa=8e10, poisson_ratio=0.3
+    )
+    vermeulen_johnson_saturation(fx, fy, hertz.normal_force_N, 0.3)
 
 
 if __name__ == "__main__":

@@ -31,8 +31,11 @@ To keep full precision for every ratio from 1 (A = B) to beyond 1e4 (b/a ~ 4e-3)
 * otherwise K comes from ``scipy.special.ellipkm1(p)`` (accurate as p -> 0, slender ellipses)
   and E from ``scipy.special.ellipe(m)``.
 
-Both scipy functions are called from numba-compiled loops (through ``scipy.special.cython_special``),
-so a batch of 1 costs a few microseconds and a batch of 10,000 well under 1 us per patch.
+The loops below are plain Python; :func:`compiled_kernels` compiles the same functions with numba (scipy's two
+functions then called through ``scipy.special.cython_special``): a batch of 10,000 costs well
+under 1 us per patch there. A small batch in a process that has not imported numba runs the same source as Python
+(scipy's ufuncs: the same compiled functions), so that a command solving one Hertz patch never pays numba's start-up
+(about 0.6-0.8 s CPU, benchmarks/results/startup.md); both paths give the same bits (tests/test_hertz.py).
 
 The residual is evaluated to ~1e-15 relative, so the converged semi-axes carry that accuracy
 (the tests compare with an independent quadrature of Hertz's potential integrals to 1e-8).
@@ -43,10 +46,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import llvmlite.binding as llvm
 import numpy as np
-from numba import njit, types
-from numba.extending import get_cython_function_address
+
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 _SERIES_LIMIT = 0.1
 _N_SERIES = 24
@@ -69,15 +71,50 @@ _B_SERIES = 0.5 * math.pi * _C[:_N_SERIES] * (_C[:_N_SERIES] - _C[1 : _N_SERIES 
 _C_SERIES = 0.5 * math.pi * _C[1 : _N_SERIES + 1] * (2.0 * _C[2 : _N_SERIES + 2] - _C[1 : _N_SERIES + 1])
 
 
-# scipy's complete elliptic integrals, called from compiled code (scipy.special.cython_special)
-# (registered as named external symbols so that the compiled kernels can be cached on disk)
-for _name in ("ellipkm1", "ellipe"):
-    llvm.add_symbol(f"wheelrail_scipy_{_name}", get_cython_function_address("scipy.special.cython_special", _name))
-_ellipkm1 = types.ExternalFunction("wheelrail_scipy_ellipkm1", types.float64(types.float64))
-_ellipe = types.ExternalFunction("wheelrail_scipy_ellipe", types.float64(types.float64))
+def _ellipkm1(p):
+    """K from scipy's ``ellipkm1`` (K of parameter 1 - p), for the Python path (compiled: compiled_kernels)."""
+    from scipy.special import ellipkm1
+
+    return float(ellipkm1(p))
 
 
-@njit(cache=True)
+def _ellipe(m):
+    """E from scipy's ``ellipe`` (E of parameter m), for the Python path (compiled: compiled_kernels)."""
+    from scipy.special import ellipe
+
+    return float(ellipe(m))
+
+
+def _scipy_externals() -> dict:
+    """Scipy's ``ellipkm1``/``ellipe`` for compiled code (``scipy.special.cython_special``), registered as named
+    external symbols so that the compiled copies can be cached on disk.
+    """
+    import llvmlite.binding as llvm
+    from numba import types
+    from numba.extending import get_cython_function_address
+
+    for name in ("ellipkm1", "ellipe"):
+        llvm.add_symbol(f"wheelrail_scipy_{name}", get_cython_function_address("scipy.special.cython_special", name))
+    signature = types.float64(types.float64)
+    return {
+        "_ellipkm1": types.ExternalFunction("wheelrail_scipy_ellipkm1", signature),
+        "_ellipe": types.ExternalFunction("wheelrail_scipy_ellipe", signature),
+    }
+
+
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of this module's loops (``_kdbc``, ``_shape``, ``_kdbc_many``, ``_shape_many``,
+    ``_hertz_many``; lazy_kernels.compiled_copies; imports numba).
+    """
+    names = ("_kdbc", "_shape", "_kdbc_many", "_shape_many", "_hertz_many")
+    return compiled_copies(__name__, names, replacements=_scipy_externals)
+
+
+def _kernels(n: int):
+    """The compiled copies, or None where a batch of ``n`` runs as Python (numba not imported, n small)."""
+    return None if run_as_python(n) else compiled_kernels()
+
+
 def _kdbc(p):
     """(K, D, B, C) of parameter m = 1 - p for one p in (0, 1] (see :func:`elliptic_kdbc`)."""
     m = 1.0 - p
@@ -97,7 +134,6 @@ def _kdbc(p):
     return k, d, b, (d - b) / m
 
 
-@njit(cache=True)
 def _shape(r, rtol, max_iterations):
     """Safeguarded Newton for s = ln p with B(m)/(p D(m)) = r; returns (p, iterations, converged)."""
     if r == 1.0:
@@ -132,7 +168,6 @@ def _shape(r, rtol, max_iterations):
     return math.exp(s), max_iterations, False
 
 
-@njit(cache=True)
 def _kdbc_many(p, out):
     for i in range(p.shape[0]):
         k, d, b, c = _kdbc(p[i])
@@ -142,7 +177,6 @@ def _kdbc_many(p, out):
         out[i, 3] = c
 
 
-@njit(cache=True)
 def _shape_many(r, rtol, max_iterations, p_out, it_out, ok_out):
     for i in range(r.shape[0]):
         p, it, ok = _shape(r[i], rtol, max_iterations)
@@ -151,7 +185,6 @@ def _shape_many(r, rtol, max_iterations, p_out, it_out, ok_out):
         ok_out[i] = ok
 
 
-@njit(cache=True)
 def _hertz_many(curv_long, curv_lat, load, force_control, e_star, rtol, max_iterations, out, it_out, ok_out):
     """out[:, :] = (a, b, q, N, p0, m, major_along_x) per patch (zeros where load <= 0)."""
     for i in range(curv_long.shape[0]):
@@ -202,7 +235,8 @@ def elliptic_kdbc(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     """
     p = np.asarray(p, dtype=float)
     out = np.empty((p.size, 4))
-    _kdbc_many(np.array(p.ravel(), dtype=float), out)
+    kernels = _kernels(p.size)
+    (_kdbc_many if kernels is None else kernels["_kdbc_many"])(np.array(p.ravel(), dtype=float), out)
     return tuple(out[:, i].reshape(p.shape) for i in range(4))
 
 
@@ -232,7 +266,8 @@ def ellipse_shape_from_curvature_ratio(
     p = np.empty(flat.size)
     it = np.empty(flat.size, dtype=np.int64)
     ok = np.empty(flat.size, dtype=np.bool_)
-    _shape_many(flat, rtol, max_iterations, p, it, ok)
+    kernels = _kernels(flat.size)
+    (_shape_many if kernels is None else kernels["_shape_many"])(flat, rtol, max_iterations, p, it, ok)
     return p.reshape(r.shape), np.asarray(it.max() if it.size else 0), ok.reshape(r.shape)
 
 
@@ -331,7 +366,8 @@ def hertz_solve_batch(
     out = np.empty((n, 7))
     it = np.empty(n, dtype=np.int64)
     ok = np.empty(n, dtype=np.bool_)
-    _hertz_many(
+    kernels = _kernels(n)
+    (_hertz_many if kernels is None else kernels["_hertz_many"])(
         np.array(A.ravel(), dtype=float),
         np.array(B.ravel(), dtype=float),
         np.array(load.ravel(), dtype=float),

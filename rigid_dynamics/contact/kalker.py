@@ -49,7 +49,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numba import njit
+
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 _DATA_FILE = Path(__file__).resolve().parent / "data" / "kalker_creep_coefficients.csv"
 COEFFICIENT_NAMES = ("C11", "C22", "C23", "C33")
@@ -163,7 +164,6 @@ _NU0, _NU1, _NU2 = TABLE_POISSON_RATIOS
 _LOG4 = math.log(4.0)
 
 
-@njit(cache=True)
 def _table_one(log_r, nu, out):
     """Interpolated table at ln(a/b) inside the table: PCHIP in ln(a/b), quadratic of 1/C in nu."""
     i = np.searchsorted(_PP_X, log_r) - 1
@@ -182,7 +182,6 @@ def _table_one(log_r, nu, out):
         out[c] = 1.0 / inv
 
 
-@njit(cache=True)
 def _asymptote_one(a_over_b, nu, out):
     """Kalker's slender-ellipse asymptotes (module docstring); C33 = nan for b/a -> 0."""
     if a_over_b <= 1.0:
@@ -202,7 +201,6 @@ def _asymptote_one(a_over_b, nu, out):
         out[3] = math.nan
 
 
-@njit(cache=True)
 def _coefficients_many(a_over_b, nu, out):
     edge = np.empty(4)
     asym_edge = np.empty(4)
@@ -227,10 +225,16 @@ def _coefficients_many(a_over_b, nu, out):
                 out[i, c] = asym[c] * (1.0 + (edge[c] / asym_edge[c] - 1.0) * g_frac)
 
 
-@njit(cache=True)
 def _asymptotes_many(a_over_b, nu, out):
     for i in range(a_over_b.shape[0]):
         _asymptote_one(a_over_b[i], nu[i], out[i])
+
+
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of this module's loops (``_table_one``, ``_asymptote_one``,
+    ``_coefficients_many``, ``_asymptotes_many``; lazy_kernels.compiled_copies; imports numba).
+    """
+    return compiled_copies(__name__, ("_table_one", "_asymptote_one", "_coefficients_many", "_asymptotes_many"))
 
 
 def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
@@ -242,7 +246,9 @@ def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
     a_over_b = np.atleast_1d(np.asarray(a_over_b, dtype=float))
     nu = np.broadcast_to(np.asarray(poisson_ratio, dtype=float), a_over_b.shape)
     out = np.empty((a_over_b.size, 4))
-    _asymptotes_many(np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out)
+    (_asymptotes_many if run_as_python(out.shape[0]) else compiled_kernels()["_asymptotes_many"])(
+        np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out
+    )
     return out.reshape(a_over_b.shape + (4,))
 
 
@@ -276,5 +282,7 @@ def kalker_coefficients(a_over_b, poisson_ratio) -> CreepCoefficients:
     if not (np.all(np.isfinite(nu)) and np.all((nu > -1.0) & (nu <= 0.5))):
         raise ValueError(f"poisson_ratio = {poisson_ratio!r}: expected values in (-1, 0.5]")
     out = np.empty((a_over_b.size, 4))
-    _coefficients_many(np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out)
+    (_coefficients_many if run_as_python(out.shape[0]) else compiled_kernels()["_coefficients_many"])(
+        np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out
+    )
     return CreepCoefficients(*(out[:, i].reshape(shape) for i in range(4)))

@@ -55,9 +55,13 @@ import math
 import numpy as np
 from numba import njit
 
+from rigid_dynamics.contact import hertz, kalker
 from rigid_dynamics.contact.fastrip import _circle_integral
-from rigid_dynamics.contact.hertz import _kdbc, _shape
-from rigid_dynamics.contact.kalker import _coefficients_many
+
+# the compiled copies of Hertz's and Kalker's loops (lazy_kernels.py), called from this module's kernels
+_kdbc = hertz.compiled_kernels()["_kdbc"]
+_shape = hertz.compiled_kernels()["_shape"]
+_coefficients_many = kalker.compiled_kernels()["_coefficients_many"]
 
 KP_THRESHOLD_FACTOR = 0.5
 """Kik-Piotrowski's virtual-penetration factor of the equivalent-ellipse step (CONTACT: 0.5)."""

@@ -17,15 +17,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def linear_one(shear_modulus_Pa, a, b, c11, c22, c23, c33, xi, eta, phi):
+def _linear_one(shear_modulus_Pa, a, b, c11, c22, c23, c33, xi, eta, phi):
     """(Fx, Fy, Mz) of the linear theory (eq 50-52) for one patch: the one implementation (the batch
-    :func:`linear_creep_forces` and the compiled dynamics loop call it).
+    :func:`linear_creep_forces` and the compiled dynamics loop call it; ``linear_one`` is its compiled copy).
     """
     ab = a * b
     g_ab = shear_modulus_Pa * ab
@@ -33,14 +32,28 @@ def linear_one(shear_modulus_Pa, a, b, c11, c22, c23, c33, xi, eta, phi):
     return -g_ab * c11 * xi, -g_ab * c22 * eta - g_ab15 * c23 * phi, g_ab15 * c23 * eta - g_ab * ab * c33 * phi
 
 
-@njit(cache=True)
 def _linear_many(shear_modulus_Pa, a, b, c, xi, eta, phi, out):
-    """:func:`linear_one` over flat arrays; c = (C11, C22, C23, C33) arrays; out (3, n)."""
+    """:func:`_linear_one` over flat arrays; c = (C11, C22, C23, C33) arrays; out (3, n)."""
     c11, c22, c23, c33 = c
     for k in range(a.shape[0]):
-        out[0, k], out[1, k], out[2, k] = linear_one(
+        out[0, k], out[1, k], out[2, k] = _linear_one(
             shear_modulus_Pa, a[k], b[k], c11[k], c22[k], c23[k], c33[k], xi[k], eta[k], phi[k]
         )
+
+
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of ``_linear_one`` (inlined, no NRT: the compiled dynamics loop's law) and
+    ``_linear_many`` (lazy_kernels.compiled_copies; imports numba).
+    """
+    inline = {"_nrt": False, "inline": "always"}
+    return compiled_copies(__name__, ("_linear_one", "_linear_many"), options={"_linear_one": inline})
+
+
+def __getattr__(name):
+    """``linear_one``: the compiled copy of :func:`_linear_one` (imports numba when first asked for)."""
+    if name == "linear_one":
+        return compiled_kernels()["_linear_one"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def linear_creep_forces(
@@ -80,5 +93,6 @@ def linear_creep_forces(
         np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float).ravel() for v in (c.c11, c.c22, c.c23, c.c33)
     )
     out = np.empty((3, flat[0].size))
-    _linear_many(float(shear_modulus_Pa), flat[0], flat[1], coef, flat[2], flat[3], flat[4], out)
+    kernel = _linear_many if run_as_python(out.shape[1]) else compiled_kernels()["_linear_many"]
+    kernel(float(shear_modulus_Pa), flat[0], flat[1], coef, flat[2], flat[3], flat[4], out)
     return out[0].reshape(a.shape), out[1].reshape(a.shape), out[2].reshape(a.shape)

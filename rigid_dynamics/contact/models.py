@@ -43,20 +43,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rigid_dynamics.contact.fastsim import (
-    FLEXIBILITIES,
-    TRACTION_BOUNDS,
-    fastsim_batch,
-    fastsim_fields,
-    law_at_place,
-)
 from rigid_dynamics.contact.hertz import HertzBatch, hertz_solve_batch
-from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
-from rigid_dynamics.contact.linear import linear_creep_forces
 from rigid_dynamics.contact.options import Option, OptionError, declare, validate_options
 from rigid_dynamics.contact.types import ContactGeometry, ContactResult, Creepage
-from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
 from rigid_dynamics.materials import Material
+
+TRACTION_BOUNDS = ("elliptic", "parabolic")
+FLEXIBILITIES = ("single", "three", "three-unblended")
+"""FASTSIM's choices, as rigid_dynamics.contact.fastsim declares them (tests/test_import_hygiene.py checks that they
+agree): written here so that this module, and a command using Hertz, linear or Vermeulen-Johnson, does not import
+the FASTSIM kernels. The compiled models' modules are imported inside the functions that use them."""
 
 
 def _options(options: Mapping | None, declared: Mapping[str, Option], model: str) -> dict:
@@ -243,6 +239,8 @@ class HertzModel(HertzianModel):
 
 def _linear_forces(hertz, creepage, material):
     """Kalker's linear-theory (Fx, Fy, Mz) on the Hertz ellipse of one patch (eq 50-52)."""
+    from rigid_dynamics.contact.linear import linear_creep_forces
+
     return linear_creep_forces(
         hertz.semi_axis_long_m,
         hertz.semi_axis_lat_m,
@@ -276,6 +274,8 @@ class VermeulenJohnsonModel(HertzianModel):
     SATURATING = True
 
     def tangential(self, hertz, creepage, material, opts):
+        from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+
         tx, ty, _ = _linear_forces(hertz, creepage, material)
         fx, fy = vermeulen_johnson_saturation(tx, ty, hertz.normal_force_N, material.friction_coefficient)
         return {"creep_force_long_N": float(fx), "creep_force_lat_N": float(fy), "spin_moment_Nm": None}, {}
@@ -317,6 +317,8 @@ class FastsimModel(HertzianModel):
 
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
         if material.friction is not None and material.friction.varies:  # the law at the patch's reference point
+            from rigid_dynamics.contact.fastsim import law_at_place
+
             material = material.with_friction(law_at_place(material.friction, _patch_place(geometry, material)))
         result = super().solve(geometry, creepage, material, normal_force_N=normal_force_N, options=options)
         estimate, tolerance = result.extra.get("discretisation_error_estimate"), result.extra.get("tolerance")
@@ -331,6 +333,8 @@ class FastsimModel(HertzianModel):
         return result
 
     def tangential(self, hertz, creepage, material, opts):
+        from rigid_dynamics.contact.fastsim import fastsim_fields
+
         (fx, fy, mz, slip_fraction), fields = fastsim_fields(
             float(hertz.semi_axis_long_m),
             float(hertz.semi_axis_lat_m),
@@ -432,22 +436,38 @@ class AutoModel:
         ),
     )
 
-    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
+    def _choose(self, geometry, creepage, material, normal_force_N, opts):
+        """(hertz, why, features, choice, thresholds' data); hertz None (and the rest None) without contact."""
         from rigid_dynamics.contact.auto import choose_rung, load_thresholds, patch_features
 
+        hertz, why = _hertz(geometry, material, normal_force_N)
+        if hertz is None:
+            return hertz, why, None, None, None
+        features = patch_features(geometry, creepage, material, hertz)
+        fs_opts = {**FastsimModel.OPTIONS_DEFAULTS, **((opts["model_options"] or {}).get("fastsim") or {})}
+        data = load_thresholds()
+        choice = choose_rung(features, opts["tolerance"], fastsim_grid=(fs_opts["nx"], fs_opts["ny"]), data=data)
+        return hertz, why, features, choice, data
+
+    def chosen_model(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> str:
+        """The model :meth:`solve` would run for this patch ("hertz" without contact), without running it: the
+        contact command warms up only that model's kernels (a chosen rung whose result is not ok falls back to bem
+        inside the solve).
+        """
+        opts = _options(options, self.OPTIONS, self.name)
+        hertz, _, _, choice, _ = self._choose(geometry, creepage, material, normal_force_N, opts)
+        return "hertz" if hertz is None else choice["model"]
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None) -> ContactResult:
         start = time.perf_counter()
         opts = _options(options, self.OPTIONS, self.name)
         tol = opts["tolerance"]
         per_model = dict(opts["model_options"] or {})
-        hertz, why = _hertz(geometry, material, normal_force_N)
+        hertz, why, features, choice, data = self._choose(geometry, creepage, material, normal_force_N, opts)
         if hertz is None:
             result = _base_result(self.name, geometry, creepage, None, why, start)
             result.extra["selected_model"] = "hertz"
             return result
-        features = patch_features(geometry, creepage, material, hertz)
-        fs_opts = {**FastsimModel.OPTIONS_DEFAULTS, **(per_model.get("fastsim") or {})}
-        data = load_thresholds()
-        choice = choose_rung(features, tol, fastsim_grid=(fs_opts["nx"], fs_opts["ny"]), data=data)
         record = {
             "selected_model": choice["model"],
             "selection_reason": choice["reason"],
@@ -555,6 +575,11 @@ def solve_batch(
     """
     if method not in BATCH_METHODS:
         raise ValueError(f"method = {method!r}: expected one of {', '.join(BATCH_METHODS)}")
+    from rigid_dynamics.contact.fastsim import fastsim_batch
+    from rigid_dynamics.contact.kalker import CreepCoefficients, kalker_coefficients
+    from rigid_dynamics.contact.linear import linear_creep_forces
+    from rigid_dynamics.contact.vermeulen_johnson import vermeulen_johnson_saturation
+
     fastsim_options = {k: v for k, v in FastsimModel.OPTIONS.items() if k != "fields"}
     declared = {"fastsim": fastsim_options, "auto": {"tolerance": AutoModel.OPTIONS["tolerance"], **fastsim_options}}
     opts = _options(options, declared.get(method, {}), method)

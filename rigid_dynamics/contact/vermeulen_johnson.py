@@ -19,28 +19,43 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def saturate_one(tx, ty, limit):
+def _saturate_one(tx, ty, limit):
     """(T_bar_x, T_bar_y) of linear forces (tx, ty) under the limit f N (eq 53-58) for one patch: the one
-    implementation (the batch :func:`vermeulen_johnson_saturation` and the compiled dynamics loop call it).
+    implementation (the batch :func:`vermeulen_johnson_saturation` and the compiled dynamics loop call it;
+    ``saturate_one`` is its compiled copy).
     """
     tt = math.hypot(tx, ty)
     if tt > 0.0:
         wprime = tt / (3.0 * limit) if limit > 0 else np.inf
         one = max(1.0 - wprime, 0.0)
-        scale = limit * (1.0 - one**3) / tt
+        scale = limit * (1.0 - one * (one * one)) / tt  # one**3 as numba compiles it (same bits as Python)
         return tx * scale, ty * scale
     return tx, ty
 
 
-@njit(cache=True)
 def _saturate_many(tx, ty, limit, out):
-    """:func:`saturate_one` over flat arrays into out (2, n)."""
+    """:func:`_saturate_one` over flat arrays into out (2, n)."""
     for k in range(tx.shape[0]):
-        out[0, k], out[1, k] = saturate_one(tx[k], ty[k], limit[k])
+        out[0, k], out[1, k] = _saturate_one(tx[k], ty[k], limit[k])
+
+
+def compiled_kernels() -> dict:
+    """Name -> numba-compiled copy of ``_saturate_one`` (inlined, no NRT: the compiled dynamics loop's law) and
+    ``_saturate_many`` (lazy_kernels.compiled_copies; imports numba).
+    """
+    inline = {"_nrt": False, "inline": "always"}
+    return compiled_copies(__name__, ("_saturate_one", "_saturate_many"), options={"_saturate_one": inline})
+
+
+def __getattr__(name):
+    """``saturate_one``: the compiled copy of :func:`_saturate_one` (imports numba when first asked for)."""
+    if name == "saturate_one":
+        return compiled_kernels()["_saturate_one"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def vermeulen_johnson_saturation(
@@ -67,5 +82,6 @@ def vermeulen_johnson_saturation(
         raise ValueError("normal_force_N and friction_coefficient: expected values >= 0")
     shape = tx.shape
     out = np.empty((2, tx.size))
-    _saturate_many(*(np.ascontiguousarray(v, dtype=float).ravel() for v in (tx, ty, f * n)), out)
+    kernel = _saturate_many if run_as_python(out.shape[1]) else compiled_kernels()["_saturate_many"]
+    kernel(*(np.ascontiguousarray(v, dtype=float).ravel() for v in (tx, ty, f * n)), out)
     return out[0].reshape(shape), out[1].reshape(shape)
