@@ -35,9 +35,14 @@ def runs():
 
 def test_sampled_run_says_per_patch_that_the_geometry_was_sampled(runs):
     result = runs["sampled"]
-    # the loop's sampled patches (about 40 elements across the sampled box) are coarser than the BEM's 2 % asks:
-    # the run says so (test_bem_runs_state_their_grid_error)
-    assert result.status == "warning" and "BEM grid-error estimate of the patch forces" in result.message
+    # every BEM solve of the loop states its grid error, and the run's status follows the largest force estimate
+    # against grid_tolerance (test_bem_runs_state_their_grid_error); with the formed patches this short run's
+    # force estimate is about 0.9 % (below the 2 %), its max-pressure/area estimate about 6 %
+    grid = result.callback_stats["bem_grid_error"]
+    assert grid["estimated"] == result.callback_stats["solves"] and grid["not_estimated"] == 0
+    above = grid["largest_force"] > grid["tolerance"]
+    assert (result.status == "warning") == above
+    assert ("BEM grid-error estimate of the patch forces" in result.message) == above
     touching = np.nan_to_num(result.patches["normal_force_N"]) > 0
     assert touching[:, 0, 0].all() and touching[:, 1, 0].all()  # the left flange root and the right tread
     assert np.all(result.patches["patch_geometry_code"][touching] == PATCH_SAMPLED)
