@@ -53,7 +53,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from rigid_dynamics.wheelset.discretisation import modal_cutoff_check
+from rigid_dynamics.wheelset.discretisation import companion_check, companion_errors, modal_cutoff_check
 from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_compiled, run_scipy
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
@@ -333,7 +333,9 @@ def simulate(
     if not checked and status == "ok":
         result = _energy_check(result, settings)
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
-    return result if status == result.status else replace(result, status=status, message=message)
+    companions = companion_errors(result, provider)
+    status, message = companion_check(status, message, companions, settings.force_tolerance)
+    return replace(result, status=status, message=message, companion_errors=companions)
 
 
 ENERGY_TOLERANCE_RELATIVE = 0.01
