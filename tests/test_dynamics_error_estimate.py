@@ -109,8 +109,8 @@ def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_p
     stated = own.summary()["discretisation_errors"]
     assert stated["step"]["estimate"] < shipped.integrator.force_tolerance
     assert 0 < stated["modal_cutoff"]["estimate"] <= 0.01
-    assert stated["contact_grid"]["estimate"] is None and "not estimated" in stated["contact_grid"]["method"]
-    assert stated["geometry_tables"]["estimate"] is None
+    assert stated["contact_grid"]["estimate"] < shipped.integrator.force_tolerance  # FASTSIM's companion
+    assert stated["geometry_tables"]["estimate"] is None  # the 3-D search: no tables
 
 
 def test_failure_within_the_start_limit_is_judged_at_the_impact():
@@ -261,7 +261,7 @@ def test_cli_run_reports_the_warning(tmp_path, capsys):
 
     text = embedded_scenes()["wheel-flat"].read_text()
     for old, new in (
-        ("fixed_step_s = 2.5e-5", "fixed_step_s = 1.0e-3"),
+        ("fixed_step_s = 6.25e-6", "fixed_step_s = 1.0e-3"),
         ("duration_s = 0.4", "duration_s = 0.25"),
         ('model = "beam"', 'model = "rigid"'),
     ):

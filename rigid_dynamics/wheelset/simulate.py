@@ -153,6 +153,7 @@ def simulate(
     provider=None,
     contact_model=None,
     compiled: bool | None = None,
+    companions: bool = True,
 ) -> SimulationResult:
     """Run a scene and return its :class:`SimulationResult` (never raises for numerical trouble).
 
@@ -164,6 +165,8 @@ def simulate(
         contact_model: optional model instance or registered name overriding ``scene.contact_model``.
         compiled: use the compiled loop (rigid_dynamics.wheelset.compiled_loop) when it supports the run
             (None: whenever it does; False: never; True: required, ValueError if unsupported).
+        companions: state the discretisation errors by companion evaluations (discretisation.companion_errors;
+            False inside a companion run).
 
     Raises:
         ValueError: the scene cannot be set up (unknown model, provider that cannot serve it).
@@ -333,6 +336,8 @@ def simulate(
     if not checked and status == "ok":
         result = _energy_check(result, settings)
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
+    if not companions:
+        return result if status == result.status else replace(result, status=status, message=message)
     companions = companion_errors(result, provider)
     status, message = companion_check(status, message, companions, settings.force_tolerance)
     return replace(result, status=status, message=message, companion_errors=companions)
