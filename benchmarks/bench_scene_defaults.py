@@ -9,10 +9,11 @@ is timed here.
 
 Measured per scene: wall time of the default and of the reference run, status, the stated errors, and the largest
 difference of the settled peaks (normal, longitudinal and lateral creep force per wheel) relative to the static
-wheel load and relative to the reference peak itself.
+wheel load and relative to the reference peak itself (peak magnitudes: an oscillating force's signed peak may flip
+sign between runs at equal size).
 
 Run: ``.venv/bin/python benchmarks/bench_scene_defaults.py [scene ...]`` (a subset replaces those scenes' records;
-the machine line is the last run's); writes
+the machine line is the last run's; ``--render`` rewrites the .md from the .json); writes
 benchmarks/results/scene_defaults_error.json and scene_defaults_error.md.
 """
 
@@ -73,6 +74,31 @@ def wheelflat_reference() -> dict:
     raise SystemExit("wheelflat_cutoff.md: no 20000 Hz row")
 
 
+def compare(record) -> None:
+    """The largest difference of the settled peak magnitudes (a peak is the signed value of largest magnitude: an
+    oscillating force's peak may take either sign at equal size), relative to the static load and to the peak."""
+    load, ref_peaks = record["static_wheel_load_N"], record["reference_peaks"]
+    diffs = {
+        k: (abs(abs(v) - abs(ref_peaks[k])) / load, abs(abs(v) - abs(ref_peaks[k])) / max(abs(ref_peaks[k]), 1e-9))
+        for k, v in record["peaks"].items()
+        if v is not None and ref_peaks.get(k) is not None
+    }
+    record["worst_of_static_load"] = max(d[0] for d in diffs.values())
+    record["worst_key"] = max(diffs, key=lambda k: diffs[k][0])
+    record["worst_of_own_peak"] = max(d[1] for d in diffs.values())
+    record["worst_own_key"] = max(diffs, key=lambda k: diffs[k][1])
+
+
+def rerender() -> None:
+    """Rewrite the .md from the .json (the comparison recomputed from the stored peaks)."""
+    data = json.loads(OUT.with_suffix(".json").read_text(encoding="utf-8"))
+    for record in data["records"]:
+        record.setdefault("static_wheel_load_N", load_scene(record["scene"]).static_wheel_load_N)
+        compare(record)
+    write_text(OUT.with_suffix(".json"), json.dumps(data, indent=1))
+    write_text(OUT.with_suffix(".md"), render(data["machine"], data["records"]))
+
+
 def run(scene):
     start = time.perf_counter()
     result = simulate(scene)
@@ -99,17 +125,9 @@ def main(names) -> None:
         else:
             ref, ref_wall = run(reference(scene))
             ref_peaks, ref_status = peaks(ref.summary()), ref.status
-        load = scene.static_wheel_load_N
-        diffs = {
-            k: (abs(v - ref_peaks[k]) / load, abs(v - ref_peaks[k]) / max(abs(ref_peaks[k]), 1e-9))
-            for k, v in record["peaks"].items()
-            if v is not None and ref_peaks.get(k) is not None
-        }
         record.update(reference_status=ref_status, reference_wall_s=ref_wall, reference_peaks=ref_peaks)
-        record["worst_of_static_load"] = max(d[0] for d in diffs.values())
-        record["worst_key"] = max(diffs, key=lambda k: diffs[k][0])
-        record["worst_of_own_peak"] = max(d[1] for d in diffs.values())
-        record["worst_own_key"] = max(diffs, key=lambda k: diffs[k][1])
+        record["static_wheel_load_N"] = scene.static_wheel_load_N
+        compare(record)
         records.append(record)
         print(name, record["status"], f"{wall:.1f} s", record["worst_of_static_load"], record["stated"], flush=True)
     previous = OUT.with_suffix(".json")
@@ -160,6 +178,9 @@ def render(machine, records) -> str:
 
 
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--render"]:
+        rerender()
+        raise SystemExit(0)
     chosen = sys.argv[1:] or SCENES
     unknown = sorted(set(chosen) - set(SCENES))
     if unknown:
