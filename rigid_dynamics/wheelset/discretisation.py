@@ -41,6 +41,9 @@ beam runs say "not estimated".
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -265,7 +268,22 @@ def contact_grid_error(result) -> dict:
     }
 
 
-def geometry_error(result, provider=None) -> dict:
+class Companions(NamedTuple):
+    """What the companions need from the run (simulate.py builds it; this module does not import simulate).
+
+    Attributes:
+        provider: the run's contact-geometry provider.
+        model_for: provider -> a WheelsetModel of the run's scene and contact law on that provider (compiled
+            geometry).
+        rerun: scene -> the SimulationResult of that scene with the run's provider and law, without companions.
+    """
+
+    provider: object
+    model_for: Callable
+    rerun: Callable
+
+
+def geometry_error(result, companions: Companions) -> dict:
     """The statement of the geometry tables' error against the 3-D search (module docstring)."""
     if "table" not in str(result.provider):
         return {"estimate": None, "method": f"none: provider {result.provider} (no tables)"}
@@ -274,20 +292,17 @@ def geometry_error(result, provider=None) -> dict:
     if not len(k):
         return {"estimate": None, "method": "not estimated (no settled sample)"}
     from rigid_dynamics.wheelset.providers import SearchProvider
-    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
-    from rigid_dynamics.wheelset.wheelset_model import ContactFailure, WheelsetModel
+    from rigid_dynamics.wheelset.wheelset_model import ContactFailure
 
     try:
         if scene.irregularities.joint_dip_angle_rad > 0 or scene.track.is_conical:
             return {"estimate": None, "method": "not estimated (the 3-D search does not serve this geometry)"}
-        law = get_contact_model(scene.contact_model)
-        options = model_options(getattr(law, "name", ""), scene)
-        tables = WheelsetModel(scene, provider or build_provider(scene), law, options, python_geometry=False)
+        tables = companions.model_for(companions.provider)
         key = (scene.wheelset, scene.track, scene.irregularities)
         if key not in _SEARCH_PROVIDERS:  # its surfaces cost about 0.5 s: kept for further runs in the process
             _SEARCH_PROVIDERS.clear()
             _SEARCH_PROVIDERS[key] = SearchProvider(*key)
-        search = WheelsetModel(scene, _SEARCH_PROVIDERS[key], law, options)
+        search = companions.model_for(_SEARCH_PROVIDERS[key])
         diff = np.zeros(3)
         for i in k:
             track = result.track_full_states[i] if result.track_full_states is not None else None
@@ -320,23 +335,19 @@ SCIPY_COMPANION_FACTOR = 10.0
 """The scipy methods' step companion runs at this multiple of both tolerances."""
 
 
-def scipy_step_error(result, provider=None) -> dict:
+def scipy_step_error(result, companions: Companions) -> dict:
     """The step error of a run by scipy's adaptive methods (no per-step force estimate): a companion run at
     SCIPY_COMPANION_FACTOR times both tolerances (about 0.6x the run's steps for RK45), the largest difference of the
     per-wheel contact forces at the settled output samples divided by (factor - 1) (the global error taken
     proportional to the tolerance), relative to the static wheel load.
     """
-    from dataclasses import replace
-
-    from rigid_dynamics.wheelset.simulate import simulate
-
     scene = result.scene
     integ = scene.integrator
     f = SCIPY_COMPANION_FACTOR
     loose = replace(
         integ, relative_tolerance=integ.relative_tolerance * f, absolute_tolerance=integ.absolute_tolerance * f
     )
-    companion = simulate(replace(scene, integrator=loose), provider=provider, companions=False)
+    companion = companions.rerun(replace(scene, integrator=loose))
     n = min(len(companion.t), len(result.t))
     if companion.status not in ("ok", "warning") or n == 0 or not np.allclose(companion.t[:n], result.t[:n]):
         return {
@@ -356,15 +367,15 @@ def scipy_step_error(result, provider=None) -> dict:
     }
 
 
-def companion_errors(result, provider=None) -> dict:
+def companion_errors(result, companions: Companions) -> dict:
     """The companions' statements of a finished run: {"contact_grid": ..., "geometry_tables": ...} and, for scipy's
     methods, {"step": ...}.
     """
     if result.scene is None or not len(result.t):
         return {}
-    out = {"contact_grid": contact_grid_error(result), "geometry_tables": geometry_error(result, provider)}
+    out = {"contact_grid": contact_grid_error(result), "geometry_tables": geometry_error(result, companions)}
     if result.force_error_estimate is None and result.status in ("ok", "warning"):
-        out["step"] = scipy_step_error(result, provider)
+        out["step"] = scipy_step_error(result, companions)
     return out
 
 

@@ -53,7 +53,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from rigid_dynamics.wheelset.discretisation import companion_check, companion_errors, modal_cutoff_check
+from rigid_dynamics.wheelset.discretisation import Companions, companion_check, companion_errors, modal_cutoff_check
 from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_compiled, run_scipy
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
@@ -338,9 +338,16 @@ def simulate(
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
     if not companions:
         return result if status == result.status else replace(result, status=status, message=message)
-    companions = companion_errors(result, provider)
-    status, message = companion_check(status, message, companions, settings.force_tolerance)
-    return replace(result, status=status, message=message, companion_errors=companions)
+    stated = companion_errors(
+        result,
+        Companions(
+            provider,
+            lambda p: WheelsetModel(scene, p, model_obj, options, python_geometry=False),
+            lambda s: simulate(s, provider=provider, contact_model=model_obj, compiled=compiled, companions=False),
+        ),
+    )
+    status, message = companion_check(status, message, stated, settings.force_tolerance)
+    return replace(result, status=status, message=message, companion_errors=stated)
 
 
 ENERGY_TOLERANCE_RELATIVE = 0.01
@@ -438,7 +445,8 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
             f"tighten relative_tolerance = {settings.relative_tolerance:g} / absolute_tolerance = "
             f"{settings.absolute_tolerance:g}"
         )
-    half = simulate(replace(scene, integrator=finer), provider=provider, contact_model=model_obj, compiled=compiled)
+    finer_scene = replace(scene, integrator=finer)
+    half = simulate(finer_scene, provider=provider, contact_model=model_obj, compiled=compiled, companions=False)
     total = {
         "wall_time_s": result.wall_time_s + half.wall_time_s,
         "rhs_evaluations": result.rhs_evaluations + half.rhs_evaluations,
