@@ -103,15 +103,14 @@ def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_p
     assert result.status == "step-unstable" and not result.success
     assert "stability limit" in result.message and "5 ms" in result.message
     own = simulate(replace(shipped, duration_s=0.03))
-    # the step passes; the run ends "warning" for the beam's modal cut-off alone (5 kHz: the lateral peaks 12 % off,
-    # benchmarks/results/wheelflat_cutoff.md), which the summary states next to the step's estimate
-    assert own.status == "warning" and "force error estimate" not in own.message, own.message
-    assert "modal cut-off error estimate" in own.message and "cutoff_frequency_Hz = 5000" in own.message
+    # the step passes, and so does the beam's modal cut-off at the shipped 15 kHz (the rule's 0.99 %; at 5 kHz it
+    # was 12 %, benchmarks/results/wheelflat_cutoff.md), which the summary states next to the step's estimate
+    assert own.status == "ok", own.message
     stated = own.summary()["discretisation_errors"]
     assert stated["step"]["estimate"] < shipped.integrator.force_tolerance
-    assert stated["modal_cutoff"]["estimate"] > 0.1 and stated["modal_cutoff"]["component"] == "lateral_creep_force"
-    assert stated["contact_grid"]["estimate"] is None and "not estimated" in stated["contact_grid"]["method"]
-    assert stated["geometry_tables"]["estimate"] is None
+    assert 0 < stated["modal_cutoff"]["estimate"] <= 0.01
+    assert stated["contact_grid"]["estimate"] < shipped.integrator.force_tolerance  # FASTSIM's companion
+    assert stated["geometry_tables"]["estimate"] is None  # the 3-D search: no tables
 
 
 def test_failure_within_the_start_limit_is_judged_at_the_impact():
@@ -262,7 +261,7 @@ def test_cli_run_reports_the_warning(tmp_path, capsys):
 
     text = embedded_scenes()["wheel-flat"].read_text()
     for old, new in (
-        ("fixed_step_s = 2.5e-5", "fixed_step_s = 1.0e-3"),
+        ("fixed_step_s = 6.25e-6", "fixed_step_s = 1.0e-3"),
         ("duration_s = 0.4", "duration_s = 0.25"),
         ('model = "beam"', 'model = "rigid"'),
     ):

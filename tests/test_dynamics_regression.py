@@ -99,7 +99,14 @@ def _run(name):
     from rigid_dynamics.wheelset import simulate
 
     args, compiled = CASES[name]
-    return simulate(_scene(*args), compiled=compiled)
+    scene = _scene(*args)
+    if args[0] == "wheel-flat":  # the data were written at the scene's earlier 5 kHz cut-off and 25 us step
+        scene = replace(
+            scene,
+            track_dynamics=replace(scene.track_dynamics, cutoff_frequency_Hz=5000.0),
+            integrator=replace(scene.integrator, fixed_step_s=2.5e-5),
+        )
+    return simulate(scene, compiled=compiled)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

@@ -284,6 +284,10 @@ def cmd_run(args) -> int:
         f"in {summary['wall_time_s']:.3g} s (real-time factor {summary['real_time_factor']:.3g}); "
         f"start-up {timing['startup_s']:.2g} s, set-up and compiled-code loading {timing['setup_s']:.2g} s"
     )
+    if summary.get("discretisation_errors"):
+        from rigid_dynamics.wheelset.discretisation import describe
+
+        _print(describe(summary["discretisation_errors"]))
     for line in patch_summary_lines(summary):
         _print(line)
     _print(f"output written to {out_dir}")

@@ -25,7 +25,8 @@ lateral coordinate on the rail profile, or the distance along the track) and int
 held constant beyond the end nodes (as CONTACT's V = 1, 2 inputs are).
 
 The records are NamedTuples of float64 arrays and integers, so a compiled kernel takes them whole
-(:func:`friction_coefficient`).
+(:func:`friction_coefficient`, numba's compiled copy of :func:`_friction_coefficient`, made when first asked for:
+a command that only reads a law does not import numba, rigid_dynamics.contact.lazy_kernels).
 """
 
 from __future__ import annotations
@@ -36,7 +37,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+
+from rigid_dynamics.contact.lazy_kernels import compiled_copies, run_as_python
 
 # --- codes ---------------------------------------------------------------------------------------------------------
 FRICTION_COULOMB, FRICTION_LINEAR, FRICTION_RATIONAL, FRICTION_EXPONENTIAL = range(4)
@@ -230,7 +232,7 @@ class FrictionLaw:
 
         ``place`` is the variable the nodes are given in (ignored when nothing varies).
         """
-        return float(friction_coefficient(self.record(), abs(slip_velocity_m_per_s), place))
+        return _evaluate(self.record(), abs(slip_velocity_m_per_s), place)
 
     def static_coefficient(self, place: float = 0.0) -> float:
         """The static coefficient mu_s = mu(0) at ``place``."""
@@ -247,8 +249,7 @@ def varying(varies_with: str, nodes: Sequence[float], laws: Sequence[FallingLaw]
     return FrictionLaw(tuple(laws), varies_with, tuple(float(v) for v in nodes))
 
 
-# --- the compiled kernels ------------------------------------------------------------------------------------------
-@njit(cache=True)
+# --- the kernels (plain Python, compiled by numba on demand) ----------------------------------------------------
 def _law_value(law_code, kinetic, term_1, half_1, term_2, half_2, slip_velocity):
     """mu(s) of one node's law at the slip velocity s >= 0 (m/s); see the module text for the forms."""
     if law_code == FRICTION_LINEAR:
@@ -265,8 +266,7 @@ def _law_value(law_code, kinetic, term_1, half_1, term_2, half_2, slip_velocity)
     return kinetic
 
 
-@njit(cache=True)
-def friction_coefficient(record, slip_velocity_m_per_s, place):
+def _friction_coefficient(record, slip_velocity_m_per_s, place):
     """The coefficient mu of ``record`` (a :class:`FrictionRecord`) at slip velocity s >= 0 (m/s) and at ``place``.
 
     ``place`` is the variable of the nodes (rad or m); the parameters are interpolated linearly between nodes and
@@ -369,3 +369,23 @@ def friction_law_from_table(table: dict, prefix: str = "friction") -> FrictionLa
 
 def _is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def compiled_kernels() -> dict:
+    """Numba's compiled copies of the kernels (rigid_dynamics.contact.lazy_kernels.compiled_copies)."""
+    return compiled_copies(__name__, ("_law_value", "_friction_coefficient"))
+
+
+def _evaluate(record: FrictionRecord, slip_velocity_m_per_s: float, place: float) -> float:
+    """The coefficient by the Python kernel before numba is loaded, else by the compiled one (same bits)."""
+    kernel = _friction_coefficient if run_as_python(1) else compiled_kernels()["_friction_coefficient"]
+    return float(kernel(record, slip_velocity_m_per_s, place))
+
+
+def __getattr__(name):
+    """``friction_coefficient``: the compiled copy of :func:`_friction_coefficient` (imports numba when first asked
+    for).
+    """
+    if name == "friction_coefficient":
+        return compiled_kernels()["_friction_coefficient"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -74,6 +74,8 @@ class SimulationResult:
             (:func:`_half_step_check`; compiled DP54/BS32 runs: from a run at a tenth of both tolerances); None
             otherwise.
         scene: the scene that ran.
+        companion_errors: the contact grid's and the geometry tables' error statements of the run's companions
+            (discretisation.companion_errors); None before they are computed.
         callback_stats: runs with a contact model solved through the callback (callback.PatchCallback): its solves,
             seconds, the seconds spent sampling patches and the BEM warm start's counts; None otherwise.
     """
@@ -105,6 +107,7 @@ class SimulationResult:
     track_state_names: tuple = ()
     track_full_states: np.ndarray | None = field(default=None, repr=False)
     callback_stats: dict | None = None
+    companion_errors: dict | None = field(default=None, repr=False)
 
     @property
     def success(self) -> bool:

@@ -55,7 +55,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from rigid_dynamics.wheelset.discretisation import contact_grid_check, modal_cutoff_check
+from rigid_dynamics.wheelset.discretisation import (
+    Companions,
+    companion_check,
+    companion_errors,
+    contact_grid_check,
+    modal_cutoff_check,
+)
 from rigid_dynamics.wheelset.drivers import ADAPTIVE_METHODS, force_error_check, run_compiled, run_scipy
 from rigid_dynamics.wheelset.equilibrium import elastic_start, initial_state
 from rigid_dynamics.wheelset.parameters import DynamicsScene
@@ -155,6 +161,7 @@ def simulate(
     provider=None,
     contact_model=None,
     compiled: bool | None = None,
+    companions: bool = True,
 ) -> SimulationResult:
     """Run a scene and return its :class:`SimulationResult` (never raises for numerical trouble).
 
@@ -166,6 +173,8 @@ def simulate(
         contact_model: optional model instance or registered name overriding ``scene.contact_model``.
         compiled: use the compiled loop (rigid_dynamics.wheelset.compiled_loop) when it supports the run
             (None: whenever it does; False: never; True: required, ValueError if unsupported).
+        companions: state the discretisation errors by companion evaluations (discretisation.companion_errors;
+            False inside a companion run).
 
     Raises:
         ValueError: the scene cannot be set up (unknown model, provider that cannot serve it).
@@ -336,7 +345,18 @@ def simulate(
         result = _energy_check(result, settings)
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
     status, message = contact_grid_check(status, message, result.callback_stats)
-    return result if status == result.status else replace(result, status=status, message=message)
+    if not companions:
+        return result if status == result.status else replace(result, status=status, message=message)
+    stated = companion_errors(
+        result,
+        Companions(
+            provider,
+            lambda p: WheelsetModel(scene, p, model_obj, options, python_geometry=False),
+            lambda s: simulate(s, provider=provider, contact_model=model_obj, compiled=compiled, companions=False),
+        ),
+    )
+    status, message = companion_check(status, message, stated, settings.force_tolerance)
+    return replace(result, status=status, message=message, companion_errors=stated)
 
 
 ENERGY_TOLERANCE_RELATIVE = 0.01
@@ -443,7 +463,8 @@ def _half_step_check(result: SimulationResult, provider, model_obj, compiled) ->
             f"tighten relative_tolerance = {settings.relative_tolerance:g} / absolute_tolerance = "
             f"{settings.absolute_tolerance:g}"
         )
-    half = simulate(replace(scene, integrator=finer), provider=provider, contact_model=model_obj, compiled=compiled)
+    finer_scene = replace(scene, integrator=finer)
+    half = simulate(finer_scene, provider=provider, contact_model=model_obj, compiled=compiled, companions=False)
     total = {
         "wall_time_s": result.wall_time_s + half.wall_time_s,
         "rhs_evaluations": result.rhs_evaluations + half.rhs_evaluations,
