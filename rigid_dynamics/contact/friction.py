@@ -64,8 +64,8 @@ class FrictionRecord(NamedTuple):
         varies_code: VARIES_NOWHERE, VARIES_WITH_INCLINATION, VARIES_WITH_RAIL_LATERAL or VARIES_ALONG_TRACK.
         node: (n,) the variable at the nodes, ascending (rad or m); (1,) zero when nothing varies.
         kinetic: (n,) mu_k, the coefficient at large slip velocity.
-        term_1, half_velocity_1_m_per_s, term_2, half_velocity_2_m_per_s: (n,) f1, s1, f2, s2 of the falling law
-            (zero sizes for Coulomb).
+        term_1, half_velocity_1_m_per_s, term_2, half_velocity_2_m_per_s: (n,) f1, s1, f2, s2 of the falling law,
+        zero sizes for Coulomb.
     """
 
     law_code: int
