@@ -53,6 +53,17 @@ def test_estimate_adds_the_block_size_error_to_force_approach_and_pressure_only(
     )
 
 
+def test_approach_control_takes_the_pressure_block_error_as_a_third_of_the_force_s():
+    """Hertz at a fixed patch shape: N ~ q^(3/2), p ~ q^(1/2), so dp/p = dN/(3 N); the two blocks' coarse-mesh
+    pressures (which differ by mesh scatter, here 10 %) are not used under approach control."""
+    levels = [{"normal_force": 100.0, "max_pressure": 1.0}, {"normal_force": 100.0, "max_pressure": 1.0}]
+    block = {"normal_force": 102.0, "max_pressure": 1.1}
+    force = estimate(levels, block, approach_control=True)["block_size_relative_error"]["normal_force"]
+    out = estimate(levels, block, approach_control=True)["block_size_relative_error"]["max_pressure"]
+    assert out == pytest.approx(force / 3.0)
+    assert estimate(levels, block)["block_size_relative_error"]["max_pressure"] == pytest.approx(0.1 / (1 - 2**-0.75))
+
+
 def test_richardson_needs_two_levels():
     with pytest.raises(ValueError, match="at least two levels"):
         richardson_error([1.0])
