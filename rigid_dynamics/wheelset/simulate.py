@@ -192,7 +192,7 @@ def simulate(
     packed = model.packed
     if use_compiled:
         # the compiled code (from numba's cache) is loaded before the clock starts
-        load(packed, PAIRS[settings.method][0] if embedded else None)
+        load(packed)
     start = time.perf_counter()
     recorder = Recorder(model, scene)
     status, message, fail_t, fail_state = "ok", "", None, None
