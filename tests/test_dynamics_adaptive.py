@@ -104,9 +104,10 @@ def test_tableaux_satisfy_the_order_conditions():
     assert _order_conditions(RK4_A, RK4_B_HAT, 4) != []  # the embedded solution is of order 3 only
     for j in range(7):
         assert sum(Fraction(v) for v in DP54_P[j]) == (Fraction(DP54_A[-1][j]) if j < 6 else 0)
-    for name, ((a, d, c, e, p, _), _) in TABLEAUX.items():
+    for name, ((a, d, c, e, p, _, b_hat_num, b_hat_den), _) in TABLEAUX.items():
         a = a / d[:, None]
         assert np.allclose(a.sum(axis=1), c) and abs(e.sum()) < 1e-15, name
+        assert np.allclose(a[-1] - b_hat_num / b_hat_den, e), name
         assert np.allclose(p.sum(axis=1), np.append(a[-1, :-1], 0.0)), name  # y(theta = 1) = y_new
     rk4 = TABLEAUX["RK4"][0]
     assert rk4.d.tolist() == [1, 2, 2, 1, 6] and rk4.a[-1].tolist() == [1, 2, 2, 1, 0]

@@ -108,7 +108,9 @@ class Tableau(NamedTuple):
     """An explicit Runge-Kutta method as the compiled loop takes it (:func:`_tableau`): A (s, s) whose last row is
     the propagated weights b, each row i as ``a[i] / d[i]`` (the stage's state is y + (h / d_i) sum_j a_ij k_j;
     d = 1 for the pairs, RK4's rows as integers over their common denominator), the nodes c, the error weights
-    e = b - b_hat, the dense output P (s, 4), and k = the order of the error estimate + 1 (the controller's exponent).
+    e = b - b_hat, the dense output P (s, 4), k = the order of the error estimate + 1 (the controller's exponent),
+    and b_hat once more as each weight's numerator over its denominator (the embedded solution of the force error
+    estimate, y + h sum_j (n_j k_j) / d_j: RK4's y + h (k1/6 + k2/3 + k3/3 + k5/6) as the formula is written).
     """
 
     a: np.ndarray
@@ -117,6 +119,8 @@ class Tableau(NamedTuple):
     e: np.ndarray
     p: np.ndarray
     k_order: float
+    b_hat_num: np.ndarray
+    b_hat_den: np.ndarray
 
 
 class StepControl(NamedTuple):
@@ -239,6 +243,8 @@ def _tableau(a_rows, b_hat, k_order, p_rows=None, integer_rows=False):
         np.array([float(v) for v in e]),
         np.array([[float(F(v)) for v in row] for row in p_rows]),
         float(k_order),
+        np.array([float(F(v).numerator) for v in b_hat]),
+        np.array([float(F(v).denominator) for v in b_hat]),
     )
 
 
@@ -332,7 +338,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     Carried between calls (the driver keeps ``carried``, :class:`Carried`, and ``events``, :class:`EventLog`).
     Returns an :class:`Outcome`.
     """
-    a, d, cc, e, p, k_order = tableau
+    a, d, cc, e, p, k_order, b_hat_num, b_hat_den = tableau
     rtol, atol, weight, h_min, h_max, event_tol, max_steps, controller, check_every = control
     fixed = controller == FIXED_STEP
     out_times, states, recs, errs = outputs
@@ -345,7 +351,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     nst = y.shape[0]
     ns = a.shape[0]
     y = y.copy()
-    y_new, ys, err, scratch = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
+    y_new, ys, scratch = np.empty(nst), np.empty(nst), np.empty(nst)
     rec_end = np.empty((ncand + 2, N_FIELDS))
     mask1, gap1 = np.empty(ncand, np.int64), np.empty(ncand)
     mask_t, gap_t = np.empty(ncand, np.int64), np.empty(ncand)
@@ -414,17 +420,18 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         if failed == 0:
             for i in range(nst):
                 y_new[i] = ys[i]  # the last row of A is b
+        if failed == 0 and not fixed:
             total, wsum = 0.0, 0.0
             for i in range(nst):
                 acc = 0.0
                 for s in range(ns):
                     acc += e[s] * kst[s, i]
-                err[i] = h * acc
+                err = h * acc
                 if weight[i] > 0.0:
                     sc = atol[i] + (rtol * max(abs(y[i]), abs(y_new[i])) if weight[i] > 1.0 else 0.0)
-                    total += (err[i] / sc) ** 2
+                    total += (err / sc) ** 2
                     wsum += 1.0
-            norm = math.sqrt(total / wsum) if not fixed else 0.0
+            norm = math.sqrt(total / wsum)
             if not np.isfinite(norm):
                 failed = 1
         if failed != 0:
@@ -522,13 +529,17 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                 return _outcome(BLOW_UP, t, y, h, accepted, rejected, k_out, evals, located, BLOW_UP)
         # force error estimate of a step with output samples (and of the fixed step every check_every steps): the
         # per-wheel contact forces at the propagated solution against those at the embedded lower-order one,
-        # y_new - err; a sample carries the largest since the previous sample
+        # y + h sum_j b_hat_j k_j; a sample carries the largest since the previous sample
         k_first = k_out
         sample = k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny
         if sample or (fixed and check_every > 0 and (accepted + 1) % check_every == 0):
             side_forces(rec_end, sides, f4)
             for i in range(nst):
-                ys[i] = y_new[i] - err[i]
+                acc = 0.0
+                for j in range(ns):
+                    if b_hat_num[j] != 0.0:
+                        acc += b_hat_num[j] * kst[j, i] / b_hat_den[j]
+                ys[i] = y[i] + h * acc
             st = _rhs(t_new, ys, run, ws, True, False, scratch)
             evals += 1
             estimate = np.inf
