@@ -397,9 +397,14 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             return _outcome(UNDERFLOW, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
         # the fixed step's times are t0 + n h (no sum of rounded steps), the controlled steps' t + h
         t_new = t0 + (accepted + 1) * h if fixed else t + h
-        mem_save[:, :, :] = mem
-        n_mem_save[:] = n_mem
-        # the stages; the last one is f(t + h, y_new) (FSAL), evaluated with its record and the lateral scan
+        # a step that ends on or past a sample (and the fixed step every check_every steps) has a force error estimate
+        sample = k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny
+        check = sample or (fixed and check_every > 0 and (accepted + 1) % check_every == 0)
+        if not fixed:  # (the fixed step is never retried: no memory to restore)
+            mem_save[:, :, :] = mem
+            n_mem_save[:] = n_mem
+        # the stages; the last one is f(t + h, y_new) (FSAL), evaluated with the lateral scan and with its record
+        # (the fixed step's only when it is checked: its record serves the estimate and the sample)
         failed = 0
         for s in range(1, ns):
             for i in range(nst):
@@ -409,7 +414,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                         acc += a[s, j] * kst[j, i]
                 ys[i] = y[i] + (h / d[s]) * acc
             last = s == ns - 1
-            st = _rhs(t_new if last else t + cc[s] * h, ys, run, ws, last, last, kst[s])
+            st = _rhs(t_new if last else t + cc[s] * h, ys, run, ws, last and (check or not fixed), last, kst[s])
             evals += 1
             if st == CALLBACK_FAILED or (st != 0 and fixed):
                 # the contact model behind the callback failed (not a matter of the step), or a fixed step's stage
@@ -452,17 +457,19 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             continue
         # accepted by the error control; the memory of the step's end (the last stage's scan) is what the next step
         # starts from: evaluations off the step's path (location, output samples) restore it
-        mem_end[:, :, :] = mem
-        n_mem_end[:] = n_mem
-        for i in range(ncand + 2):
-            for f in range(N_FIELDS):
-                rec_end[i, f] = rec[i, f]
-        _contact_mask(rec, ncand, mask1, gap1)
+        if check or not fixed:
+            for i in range(ncand + 2):
+                for f in range(N_FIELDS):
+                    rec_end[i, f] = rec[i, f]
         switched = False
-        for c in range(ncand):
-            if mask1[c] != mask0[c]:
-                switched = True
-        if switched and not fixed and h > event_tol and not event_t == event_t:
+        if not fixed:
+            mem_end[:, :, :] = mem
+            n_mem_end[:] = n_mem
+            _contact_mask(rec, ncand, mask1, gap1)
+            for c in range(ncand):
+                if mask1[c] != mask0[c]:
+                    switched = True
+        if switched and h > event_tol and not event_t == event_t:
             # locate the earliest switch on the dense output: [lo, hi] with the start's set at lo, another at hi
             lo, hi = 0.0, 1.0
             for c in range(ncand):
@@ -531,8 +538,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         # per-wheel contact forces at the propagated solution against those at the embedded lower-order one,
         # y + h sum_j b_hat_j k_j; a sample carries the largest since the previous sample
         k_first = k_out
-        sample = k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny
-        if sample or (fixed and check_every > 0 and (accepted + 1) % check_every == 0):
+        if check:
             side_forces(rec_end, sides, f4)
             for i in range(nst):
                 acc = 0.0
@@ -548,12 +554,9 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                 estimate = force_difference(f4, f3)
             if not pending >= estimate:  # also when pending is NaN
                 pending = estimate
-            if fixed:
-                # RK4 keeps the memory this evaluation leaves, as the fixed-step loop before it did (the regression
+            if not fixed:
+                # (RK4 keeps the memory this evaluation leaves, as the fixed-step loop before it did: the regression
                 # references hold it; the memory of the step's end instead moves corrugation's states by 1e-8)
-                mem_end[:, :, :] = mem
-                n_mem_end[:] = n_mem
-            else:
                 mem[:, :, :] = mem_end
                 n_mem[:] = n_mem_end
         # the output samples within (t, t_new]: dense output and a right-hand side with record there
@@ -581,20 +584,21 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                     )
             if abs(states[k_out - 1, Y]) > ymax:
                 return _outcome(DERAILED, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, DERAILED)
-        mem[:, :, :] = mem_end
-        n_mem[:] = n_mem_end
-        switched = False
-        for c in range(ncand):
-            if mask1[c] != mask0[c]:
-                switched = True
-        if switched and n_ev[0] < ev_t.shape[0]:
-            ev_t[n_ev[0]] = event_t if event_t == event_t else t_new
+        if not fixed:
+            mem[:, :, :] = mem_end
+            n_mem[:] = n_mem_end
+            switched = False
             for c in range(ncand):
-                ev_mask[n_ev[0], c] = mask1[c]
-            n_ev[0] += 1
-        event_t = np.nan
-        for c in range(ncand):
-            mask0[c], gap0[c] = mask1[c], gap1[c]
+                if mask1[c] != mask0[c]:
+                    switched = True
+            if switched and n_ev[0] < ev_t.shape[0]:
+                ev_t[n_ev[0]] = event_t if event_t == event_t else t_new
+                for c in range(ncand):
+                    ev_mask[n_ev[0], c] = mask1[c]
+                n_ev[0] += 1
+            event_t = np.nan
+            for c in range(ncand):
+                mask0[c], gap0[c] = mask1[c], gap1[c]
         for i in range(nst):
             kst[0, i] = kst[ns - 1, i]
             y[i] = y_new[i]
