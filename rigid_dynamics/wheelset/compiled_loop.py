@@ -320,6 +320,34 @@ def _dense(y, h, kst, p, theta, out):
 
 
 @njit(cache=True, _nrt=False)
+def _combine(weights, kst, s, out):
+    """The sum over the first s stages of w_j k_j into ``out``, per state, the terms added in the order of j (w_j = 0
+    skipped).
+    """
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    for j in range(s):
+        w = weights[j]
+        if w != 0.0:
+            for i in range(out.shape[0]):
+                out[i] += w * kst[j, i]
+
+
+@njit(cache=True, _nrt=False)
+def _combine_fractions(numerators, denominators, kst, out):
+    """The sum over the stages of (n_j k_j) / d_j into ``out``, per state, the terms added in the order of j (n_j = 0
+    skipped).
+    """
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    for j in range(kst.shape[0]):
+        w, dj = numerators[j], denominators[j]
+        if w != 0.0:
+            for i in range(out.shape[0]):
+                out[i] += w * kst[j, i] / dj
+
+
+@njit(cache=True, _nrt=False)
 def _contact_mask(rec, ncand, mask, gap):
     """Which candidates are in contact (normal force > 0) and their approach q (NaN: absent), from a record."""
     for c in range(ncand):
@@ -351,7 +379,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     nst = y.shape[0]
     ns = a.shape[0]
     y = y.copy()
-    y_new, ys, scratch = np.empty(nst), np.empty(nst), np.empty(nst)
+    y_new, ys, scratch, combined, stage = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
     rec_end = np.empty((ncand + 2, N_FIELDS))
     mask1, gap1 = np.empty(ncand, np.int64), np.empty(ncand)
     mask_t, gap_t = np.empty(ncand, np.int64), np.empty(ncand)
@@ -407,14 +435,17 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         # (the fixed step's only when it is checked: its record serves the estimate and the sample)
         failed = 0
         for s in range(1, ns):
+            _combine(a[s], kst, s, combined)
+            hd = h / d[s]
             for i in range(nst):
-                acc = 0.0
-                for j in range(s):
-                    if a[s, j] != 0.0:
-                        acc += a[s, j] * kst[j, i]
-                ys[i] = y[i] + (h / d[s]) * acc
+                ys[i] = y[i] + hd * combined[i]
             last = s == ns - 1
-            st = _rhs(t_new if last else t + cc[s] * h, ys, run, ws, last and (check or not fixed), last, kst[s])
+            if last:
+                st = _rhs(t_new, ys, run, ws, check or not fixed, True, stage)
+            else:
+                st = _rhs(t + cc[s] * h, ys, run, ws, False, False, stage)
+            for i in range(nst):
+                kst[s, i] = stage[i]
             evals += 1
             if st == CALLBACK_FAILED or (st != 0 and fixed):
                 # the contact model behind the callback failed (not a matter of the step), or a fixed step's stage
@@ -540,12 +571,9 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         k_first = k_out
         if check:
             side_forces(rec_end, sides, f4)
+            _combine_fractions(b_hat_num, b_hat_den, kst, combined)
             for i in range(nst):
-                acc = 0.0
-                for j in range(ns):
-                    if b_hat_num[j] != 0.0:
-                        acc += b_hat_num[j] * kst[j, i] / b_hat_den[j]
-                ys[i] = y[i] + h * acc
+                ys[i] = y[i] + h * combined[i]
             st = _rhs(t_new, ys, run, ws, True, False, scratch)
             evals += 1
             estimate = np.inf
