@@ -336,7 +336,7 @@ def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -
 
 
 def patch_tables(model, block, sides, slots) -> dict:
-    """The compiled loops' records of a block of output samples (n, candidates + 2, layout.N_FIELDS) as the
+    """The compiled loop's records of a block of output samples (n, candidates + 2, layout.N_FIELDS) as the
     recorder's per-patch tables: field -> (n, 2 sides, MAX_SLOTS), NaN where no candidate sits (PATCH_FIELDS, and
     AUTO_PATCH_FIELDS for ``auto``).
     """

@@ -1,10 +1,10 @@
 """Running a wheelset scene: provider and model selection, the start, the choice of driver, the result.
 
-Where the parts live: the drivers (scipy's adaptive methods, RK4 on the Python right-hand side, the compiled RK4
-loop) in drivers.py; the output samples, events and anomaly checks in recorder.py; the start (static equilibrium,
-free rolling, elastic track at rest) in equilibrium.py; :class:`SimulationResult`, its summary and the time-series
-files in results.py. This module re-exports the public names of those (``SimulationResult``, ``STATUSES``,
-``save_timeseries``, ``timeseries_arrays``, ``dominant_wavelength_m``, ``initial_state``).
+Where the parts live: the drivers (scipy's adaptive methods and RK4 on the Python right-hand side, the compiled
+loop for RK4, DP54 and BS32) in drivers.py; the output samples, events and anomaly checks in recorder.py; the start
+(static equilibrium, free rolling, elastic track at rest) in equilibrium.py; :class:`SimulationResult`, its summary
+and the time-series files in results.py. This module re-exports the public names of those (``SimulationResult``,
+``STATUSES``, ``save_timeseries``, ``timeseries_arrays``, ``dominant_wavelength_m``, ``initial_state``).
 
 ``simulate(scene, progress=None) -> SimulationResult``. The adaptive methods are scipy's
 ``OdeSolver`` classes (RK45, DOP853, Radau, BDF, LSODA) stepped one step at a time, so that the run
