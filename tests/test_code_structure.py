@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -296,3 +297,69 @@ def test_contact_package_auto_rungs_match_the_compiled_order():
 
     assert [r.replace("-", "_") for r in AUTO_RUNGS[: len(layout.AUTO_RUNG_NAMES)]] == list(layout.AUTO_RUNG_NAMES)
     assert tuple(FEATURES) == layout.AUTO_FEATURE_NAMES
+
+
+WALK_HEADER = "The walk from a scene's `contact_model` to the compiled law"
+
+
+def _readme_walk() -> tuple[str, list[list[str]]]:
+    """The README's walk: its header line and, per numbered item, the backticked names in it (first: its file)."""
+    text = (ROOT / "README.md").read_text()
+    assert WALK_HEADER in text, "README.md's development section lost the walk"
+    header, rest = text.split(WALK_HEADER, 1)[1].split("\n", 1)
+    block = rest.strip("\n").split("\n\n", 1)[0]
+    items = re.split(r"^\d+\. ", block, flags=re.M)[1:]
+    return header, [re.findall(r"`([^`]+)`", " ".join(item.split())) for item in items]
+
+
+def test_readme_walk_names_files_that_exist():
+    """Regression of the README against the code: the walk from a scene's ``contact_model`` to the compiled law
+    names at most 8 files (its header says how many), one per step, each a file of ``rigid_dynamics``; every
+    identifier in the code it quotes (``law_code(model)``, ``compiled_laws._kpec_law``) is defined or used in one of
+    the files it names (or in the scene reader it names)."""
+    header, items = _readme_walk()
+    files = [names[0] for names in items]
+    assert all(f.endswith(".py") for f in files), files
+    assert len(set(files)) == len(files) <= 8
+    assert f"{len(files)} files" in header
+    sources = {f: (PACKAGE / f).read_text() for f in files if (PACKAGE / f).is_file()}
+    assert sorted(sources) == sorted(files), "a file the walk names does not exist"
+    quoted = {n for names in items for n in names[1:] if n.endswith(".py")}
+    for path in quoted:
+        assert (PACKAGE / path).is_file() or (ROOT / path).is_file(), path
+    text = "\n".join(sources.values()) + (ROOT / "wheelrail" / "scenes.py").read_text()
+    quoted_code = [re.sub(r'"[^"]*"', "", n) for names in items for n in names[1:] if not n.endswith(".py")]
+    identifiers = {word for code in quoted_code for word in re.findall(r"[A-Za-z_]\w*", code)}
+    assert len(identifiers) > 20
+    missing = sorted(n for n in identifiers if not re.search(rf"\b{n}\b", text))
+    assert missing == []
+
+
+def test_every_scene_contact_model_resolves_through_the_walk():
+    """Regression of the README against the code: each shipped scene's ``contact_model`` resolves through the files
+    of the walk: its class lives in a walk file, it declares a compiled law (not the callback), and the law's scalar
+    kernel (contact/<law>.py, which compiled_laws.py imports) is among the kernels the walk's last step names."""
+    import inspect
+    import tomllib
+
+    from rigid_dynamics.contact.registry import get_model
+    from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK, LAW_CODES
+    from rigid_dynamics.wheelset.compiled_records import law_code
+
+    _, items = _readme_walk()
+    files = {names[0] for names in items}
+    kernels = {n for n in items[-1] if n.endswith(".py")}
+    laws_source = (PACKAGE / "wheelset" / "compiled_laws.py").read_text()
+    scenes = sorted((ROOT / "wheelrail" / "scenes").glob("*.toml"))
+    assert scenes
+    for path in scenes:
+        name = tomllib.loads(path.read_text())["contact_model"]
+        model = get_model(name)
+        module_file = Path(inspect.getsourcefile(type(model))).resolve().relative_to(PACKAGE).as_posix()
+        assert module_file in files, (path.name, name, module_file)
+        code = law_code(model)
+        assert code != LAW_CALLBACK and LAW_CODES[model.compiled_law] == code, (path.name, name)
+        if model.compiled_law != "hertz":  # hertz has no creep force: the walk ends in compiled_laws.py
+            kernel = f"contact/{model.compiled_law.replace('-', '_')}.py"
+            assert kernel in kernels, (path.name, kernel)
+            assert f"from rigid_dynamics.{kernel[:-3].replace('/', '.')} import" in laws_source, kernel

@@ -17,7 +17,17 @@ import pytest
 from hardening_helpers import assert_bad_scene
 
 from rigid_dynamics.wheelset import build_provider, compiled_loop, simulate
-from rigid_dynamics.wheelset.compiled_loop import BS32_A, BS32_B_HAT, DP54_A, DP54_B_HAT, DP54_P, PAIRS
+from rigid_dynamics.wheelset.compiled_loop import (
+    BS32_A,
+    BS32_B_HAT,
+    DP54_A,
+    DP54_B_HAT,
+    DP54_P,
+    PAIRS,
+    RK4_A,
+    RK4_B_HAT,
+    TABLEAUX,
+)
 from rigid_dynamics.wheelset.parameters import IntegratorSettings
 from wheelrail.scenes import load_scene
 
@@ -79,19 +89,29 @@ def _order_conditions(rows, weights, order):
 
 
 def test_tableaux_satisfy_the_order_conditions():
-    """DP54: b of order 5 and b_hat of order 4; BS32: b of order 3 and b_hat of order 2 (exact arithmetic); both
-    first-same-as-last; the dense output of DP54 reproduces b at theta = 1 and has the consistency sum 1."""
+    """DP54: b of order 5 and b_hat of order 4; BS32: b of order 3 and b_hat of order 2; RK4: b of order 4 and its
+    embedded b_hat (with k5 = f(t + h, y4)) of order 3 (exact arithmetic); all first-same-as-last; the dense output
+    of DP54 reproduces b at theta = 1 and has the consistency sum 1; every tableau's rows over their divisors sum to
+    its nodes, and RK4's rows are the classical formula's integers over 2, 2, 1, 6."""
     assert _order_conditions(DP54_A, DP54_A[-1] + (0,), 5) == []
     assert _order_conditions(DP54_A, DP54_B_HAT, 4) == []
     assert _order_conditions(DP54_A, DP54_B_HAT, 5) != []  # the embedded solution is of order 4 only
     assert _order_conditions(BS32_A, BS32_A[-1] + (0,), 3) == []
     assert _order_conditions(BS32_A, BS32_B_HAT, 2) == []
     assert "b.c^2 = 1/3" in _order_conditions(BS32_A, BS32_B_HAT, 3)  # order 2 only
+    assert _order_conditions(RK4_A, RK4_A[-1] + (0,), 4) == []
+    assert _order_conditions(RK4_A, RK4_B_HAT, 3) == []
+    assert _order_conditions(RK4_A, RK4_B_HAT, 4) != []  # the embedded solution is of order 3 only
     for j in range(7):
         assert sum(Fraction(v) for v in DP54_P[j]) == (Fraction(DP54_A[-1][j]) if j < 6 else 0)
-    for name, ((a, c, e, p, _), _) in PAIRS.items():
+    for name, ((a, d, c, e, p, _, b_hat_num, b_hat_den), _) in TABLEAUX.items():
+        a = a / d[:, None]
         assert np.allclose(a.sum(axis=1), c) and abs(e.sum()) < 1e-15, name
+        assert np.allclose(a[-1] - b_hat_num / b_hat_den, e), name
         assert np.allclose(p.sum(axis=1), np.append(a[-1, :-1], 0.0)), name  # y(theta = 1) = y_new
+    rk4 = TABLEAUX["RK4"][0]
+    assert rk4.d.tolist() == [1, 2, 2, 1, 6] and rk4.a[-1].tolist() == [1, 2, 2, 1, 0]
+    assert (PAIRS["DP54"][0].d == 1).all() and (PAIRS["BS32"][0].d == 1).all()
 
 
 def _hunting(method, duration_s=1.8, **changes):

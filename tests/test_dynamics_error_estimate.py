@@ -1,9 +1,9 @@
 """Fixed-step RK4 runs carry a force error estimate and end with status "warning" above the scene's tolerance;
 runs start in a consistent rolling equilibrium; summary peaks are taken after the settling distance.
 
-The estimate (compiled_loop.rk4_run, drivers.run_scipy with its RK4 solver) is the contact-force difference between
-RK4 and the third-order formula embedded in its stages, y4 - y3 = h/6 (k4 - k5) (Hairer, Norsett & Wanner, Solving
-ODEs I, II.4).
+The estimate (compiled_loop.embedded_run with RK4's tableau, drivers.run_scipy with its RK4 solver) is the
+contact-force difference between RK4 and the third-order formula embedded in its stages, y4 - y3 = h/6 (k4 - k5)
+(Hairer, Norsett & Wanner, Solving ODEs I, II.4).
 Checked here: its observed order (4, the local error of a third-order formula) on a smooth scene; the steps the issue
 names are flagged (wheel-flat at 5 ms, polygonal-wheel at 1 ms) and each embedded scene at its own step is not;
 the Python RK4 path gives the same estimate as the compiled one (a regression test of two of our own paths).

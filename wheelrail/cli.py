@@ -336,9 +336,12 @@ def _progress_bar(quiet: bool, label: str):
     """A tqdm bar driven by fraction callbacks (off when quiet or not on a terminal), and the check for a swallowed
     termination at every report (:func:`_check_terminated`).
     """
+    try:
+        from tqdm import tqdm
+    except ImportError:  # the progress extra not installed: no bar
+        quiet = True
     if quiet or not sys.stderr.isatty():
         return lambda fraction: _check_terminated(), lambda: None
-    from tqdm import tqdm
 
     bar = tqdm(total=1000, desc=label, unit="‰", leave=False, mininterval=0.5, delay=2.0)
     state = {"last": 0}

@@ -57,11 +57,29 @@ def _check_models(models, allowed) -> list[str]:
     return models
 
 
-def _bar(total: int, label: str):
-    """A tqdm bar on a terminal (None elsewhere) and a callback advancing it."""
-    from tqdm import tqdm
+class _NoBar:
+    """Stands in for a tqdm bar off a terminal or without tqdm (the ``progress`` extra)."""
 
-    bar = tqdm(total=total, desc=label, unit="run", leave=False, disable=not sys.stderr.isatty())
+    n = 0
+
+    def set_postfix_str(self, text, refresh=True):
+        pass
+
+    def update(self, n):
+        self.n += n
+
+    def close(self):
+        pass
+
+
+def _bar(total: int, label: str):
+    """A tqdm bar on a terminal (a silent stand-in elsewhere, or without tqdm) and a callback advancing it."""
+    try:
+        from tqdm import tqdm
+    except ImportError:  # the progress extra not installed: no bar
+        bar = _NoBar()
+    else:
+        bar = tqdm(total=total, desc=label, unit="run", leave=False, disable=not sys.stderr.isatty())
 
     def update(done: int, total: int, text: str) -> None:
         bar.set_postfix_str(text[:40], refresh=False)

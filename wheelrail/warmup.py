@@ -33,8 +33,8 @@ def warm_up_all(stream=sys.stderr) -> dict[str, float]:
     timings["contact batches"] = time.perf_counter() - start
     for name, path in embedded_scenes().items():
         scene = load_scene(path)
-        # every scene: the adaptive methods call the same compiled right-hand side (with the given geometry of the
-        # conical provider) as the RK4 loop
+        # every scene: scipy's methods call the same compiled right-hand side (with the given geometry of the
+        # conical provider) as the compiled loop, whose one compilation serves RK4, DP54 and BS32 (the same types)
         step = scene.integrator.fixed_step_s
         short = dataclasses.replace(scene, duration_s=2 * step)
         print(f"setup: compiling the dynamics kernels of scene {name} (up to a minute) ...", file=stream, flush=True)
@@ -44,23 +44,6 @@ def warm_up_all(stream=sys.stderr) -> dict[str, float]:
         except Exception as exc:  # never fail the setup: the scene then compiles on its first run
             print(f"setup: warning: scene {name} not compiled ({type(exc).__name__}: {exc})", file=stream, flush=True)
         timings[f"scene {name}"] = time.perf_counter() - start
-        if "adaptive" not in timings:
-            # the embedded pairs' loop (compiled_loop.embedded_run): one compilation serves DP54 and BS32 on
-            # tables and on the 3-D search (the same argument types)
-            print(
-                "setup: compiling the error-controlled (DP54/BS32) loop (up to two minutes) ...",
-                file=stream,
-                flush=True,
-            )
-            start = time.perf_counter()
-            pair = dataclasses.replace(short, integrator=dataclasses.replace(short.integrator, method="DP54"))
-            try:
-                simulate(pair)
-            except Exception as exc:  # never fail the setup
-                print(
-                    f"setup: warning: the DP54 loop not compiled ({type(exc).__name__}: {exc})", file=stream, flush=True
-                )
-            timings["adaptive"] = time.perf_counter() - start
     total = time.perf_counter() - start_all
     print(f"setup: numba kernels ready in {total:.0f} s (cached on disk for every later run)", file=stream, flush=True)
     return timings

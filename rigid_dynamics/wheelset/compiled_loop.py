@@ -1,12 +1,13 @@
-"""The compiled loops: embedded Runge-Kutta pairs with step-size control, dense output at the output times and
-contact onset/loss located within the step (:func:`embedded_run`), and the fixed-step RK4 (:func:`rk4_run`). Both
-take records (:class:`Tableau`, :class:`StepControl`, :class:`Outputs`, :class:`Carried`, :class:`EventLog`,
-compiled_records.PackedRun) and return an :class:`Outcome`; drivers.py calls them in chunks.
+"""The compiled loop (:func:`embedded_run`), one for every method: an explicit Runge-Kutta tableau, first-same-as-last,
+with either step-size control (the embedded pairs: dense output at the output times, contact onset/loss located
+within the step) or a fixed step (RK4). It takes records (:class:`Tableau`, :class:`StepControl`, :class:`Outputs`,
+:class:`Carried`, :class:`EventLog`, compiled_records.PackedRun) and returns an :class:`Outcome`; drivers.run_compiled
+calls it in chunks.
 
-The right-hand side is compiled_rhs._rhs, called exactly as rk4_run below calls it (tables or the compiled
-3-D search; the lateral scan ``full`` at each step's first stage, which for these FSAL pairs is the previous
-step's last stage, and at the recorded samples). Two pairs (Butcher tableaux below, module constants with their
-sources; tests/test_dynamics_adaptive.py checks their order conditions and observed orders):
+The right-hand side is compiled_rhs._rhs (tables or the compiled 3-D search; the lateral scan ``full`` at each step's
+first stage, which for these FSAL tableaux is the previous step's last stage, and at the recorded samples). The
+methods (:data:`TABLEAUX`; Butcher tableaux below, module constants with their sources;
+tests/test_dynamics_adaptive.py checks their order conditions and observed orders):
 
 * ``DP54``: Dormand & Prince, "A family of embedded Runge-Kutta formulae", J. Comput. Appl. Math. 6 (1980) 19-26
   (the 5th-order solution is propagated, the 4th-order one estimates the error; 6 new right-hand sides per step,
@@ -15,7 +16,16 @@ sources; tests/test_dynamics_adaptive.py checks their order conditions and obser
   as scipy's RK45 uses them);
 * ``BS32``: Bogacki & Shampine, "A 3(2) pair of Runge-Kutta formulas", Appl. Math. Lett. 2 (1989) 321-325
   (3 new right-hand sides per step, first-same-as-last), dense output by cubic Hermite interpolation between the
-  step's ends (order 3).
+  step's ends (order 3);
+* ``RK4``: the classical Runge-Kutta method of order 4 with a fixed step (:data:`FIXED_STEP`), written
+  first-same-as-last with a fifth stage k5 = f(t + h, y4), the next step's k1 (4 new right-hand sides per step, as
+  the classical method), its rows as integers over their common denominator, y4 = y + h/6 (k1 + 2 k2 + 2 k3 + k4)
+  as the formula is written. Its embedded third-order formula y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) (Hairer,
+  Norsett & Wanner I, II.4) is the error indicator, not a step control: the force error estimate (the per-wheel
+  contact forces at y4 and y3, drivers.force_error_check) every ``check_every`` steps and at every sample, a sample
+  carrying the largest since the previous one. The step's times are t0 + n h; nothing is rejected or located (a
+  failed stage or a non-finite state ends the run with its status); the samples lie on step ends (multiples of the
+  step).
 
 Step control (Hairer, Norsett & Wanner I, II.4): the error of a step is err = h sum_i e_i k_i (e = b - b_hat), its
 size the root-mean-square over the mechanical and track states of err_j / (atol_j + rtol max(|y_j|, |y_new_j|))
@@ -46,7 +56,11 @@ the other side. The located times and the contact set after each switch go to th
 
 The search memory (compiled_search: the warm starts of the contact points) is saved at each step's start and
 restored when the step is rejected, and after every evaluation off the step's path (output samples, event
-location), so that an accepted step sees the memory of the previous step's end, as in rk4_run.
+location, the force error estimate's state), so that an accepted step sees the memory of the previous step's end.
+One exception, kept from the former RK4 loop: RK4's next step starts from the memory its force error estimate's
+evaluation (at y3) leaves. The search's warm start moves its converged contact points slightly: restoring the
+step-end memory there moves the states of corrugation (elastic track, 3-D search) by 9.5e-9 of their block's
+magnitude, beyond tests/test_dynamics_regression.py's 1e-10, so the references' behaviour is kept.
 
 Status codes: layout.STATUS (0 ok, 1 blow-up, 2 force anomaly, 3 derailed, 4 creepages undefined, 5 callback
 failed, 6 step-size underflow).
@@ -92,21 +106,28 @@ STEPS_PER_CALL = 2000
 
 class Tableau(NamedTuple):
     """An explicit Runge-Kutta method as the compiled loop takes it (:func:`_tableau`): A (s, s) whose last row is
-    the propagated weights b, the nodes c, the error weights e = b - b_hat, the dense output P (s, 4), and k = the
-    order of the error estimate + 1 (the controller's exponent).
+    the propagated weights b, each row i as ``a[i] / d[i]`` (the stage's state is y + (h / d_i) sum_j a_ij k_j;
+    d = 1 for the pairs, RK4's rows as integers over their common denominator), the nodes c, the error weights
+    e = b - b_hat, the dense output P (s, 4), k = the order of the error estimate + 1 (the controller's exponent),
+    and b_hat once more as each weight's numerator over its denominator (the embedded solution of the force error
+    estimate, y + h sum_j (n_j k_j) / d_j: RK4's y + h (k1/6 + k2/3 + k3/3 + k5/6) as the formula is written).
     """
 
     a: np.ndarray
+    d: np.ndarray
     c: np.ndarray
     e: np.ndarray
     p: np.ndarray
     k_order: float
+    b_hat_num: np.ndarray
+    b_hat_den: np.ndarray
 
 
 class StepControl(NamedTuple):
     """Step-size control of :func:`embedded_run`: rtol, atol per state, the weight per state (0 not controlled,
-    1 atol alone, 2 atol + rtol |y|), the smallest and largest step, the event location's time tolerance (s) and the
-    accepted steps per call.
+    1 atol alone, 2 atol + rtol |y|), the smallest and largest step, the event location's time tolerance (s), the
+    accepted steps per call, the controller (:data:`PI_CONTROL` or :data:`FIXED_STEP`) and, for the fixed step, the
+    steps between force error checks (0: at the output samples only).
     """
 
     rtol: float
@@ -116,12 +137,19 @@ class StepControl(NamedTuple):
     h_max: float
     event_tol: float
     max_steps: int
+    controller: int
+    check_every: int
+
+
+PI_CONTROL, FIXED_STEP = range(2)
+"""The controllers of :func:`embedded_run`: the PI step-size control with rejections and located contact switches
+(the embedded pairs), or the fixed step (RK4: the step never changes, nothing is rejected or located; its error
+estimate is the force error check's)."""
 
 
 class Outputs(NamedTuple):
-    """Where a compiled loop records its samples: the output times (embedded pairs; RK4 records every
-    ``out_every`` steps), the states, the patch records (samples, candidates + 2, layout.N_FIELDS) and the force
-    error estimates (N).
+    """Where the compiled loop records its samples: the output times (for the fixed step, multiples of the step),
+    the states, the patch records (samples, candidates + 2, layout.N_FIELDS) and the force error estimates (N).
     """
 
     times: np.ndarray
@@ -185,10 +213,12 @@ def _outcome(status, t, y, h, accepted, rejected, k_out, evaluations, located, l
     )  # fmt: skip
 
 
-def _tableau(a_rows, b_hat, k_order, p_rows=None):
+def _tableau(a_rows, b_hat, k_order, p_rows=None, integer_rows=False):
     """The :class:`Tableau` of an FSAL pair from its rows of A (the last row is b), the embedded weights b_hat, k (the
     order of the error estimate + 1) and the dense-output matrix P (coefficients of theta, theta^2, theta^3,
-    theta^4; None: cubic Hermite between the step's ends, exact in Fractions).
+    theta^4; None: cubic Hermite between the step's ends, exact in Fractions). ``integer_rows``: each row of A as
+    integers over its common denominator d_i (RK4: y + h/6 (k1 + 2 k2 + 2 k3 + k4) as the formula is written);
+    else d = 1 and the rows as their fractions' floats.
     """
     s = len(a_rows)
     a = [[F(0)] * s for _ in range(s)]
@@ -196,6 +226,7 @@ def _tableau(a_rows, b_hat, k_order, p_rows=None):
         for j, v in enumerate(row):
             a[i][j] = F(v)
     b = a[s - 1]
+    d = [math.lcm(*(v.denominator for v in row)) if integer_rows else 1 for row in a]
     c = [sum(row, F(0)) for row in a]
     e = [b[j] - F(b_hat[j]) for j in range(s)]
     if p_rows is None:
@@ -204,13 +235,16 @@ def _tableau(a_rows, b_hat, k_order, p_rows=None):
         p_rows = [[0, 3 * b[j], -2 * b[j], 0] for j in range(s)]
         p_rows[0] = [p_rows[0][0] + 1, p_rows[0][1] - 2, p_rows[0][2] + 1, 0]
         p_rows[s - 1] = [p_rows[s - 1][0], p_rows[s - 1][1] - 1, p_rows[s - 1][2] + 1, 0]
-    as_float = np.array([[float(v) for v in row] for row in a])
+    as_float = np.array([[float(v * d[i]) for v in row] for i, row in enumerate(a)])
     return Tableau(
         as_float,
+        np.array([float(v) for v in d]),
         np.array([float(v) for v in c]),
         np.array([float(v) for v in e]),
         np.array([[float(F(v)) for v in row] for row in p_rows]),
         float(k_order),
+        np.array([float(F(v).numerator) for v in b_hat]),
+        np.array([float(F(v).denominator) for v in b_hat]),
     )
 
 
@@ -243,12 +277,24 @@ BS32_A = ((), (F(1, 2),), (0, F(3, 4)), (F(2, 9), F(1, 3), F(4, 9)))
 BS32_B_HAT = (F(7, 24), F(1, 4), F(1, 3), F(1, 8))
 """Bogacki-Shampine 3(2): the embedded 2nd-order weights."""
 
+RK4_A = ((), (F(1, 2),), (0, F(1, 2)), (0, 0, 1), (F(1, 6), F(1, 3), F(1, 3), F(1, 6)))
+"""The classical Runge-Kutta method of order 4, written first-same-as-last: its four stages and a fifth, the
+derivative at the step's end k5 = f(t + h, y4) (the next step's k1), whose row of A is RK4's weights b."""
+RK4_B_HAT = (F(1, 6), F(1, 3), F(1, 3), 0, F(1, 6))
+"""The third-order formula embedded in RK4's stages with k5: y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6), so
+y4 - y3 = h/6 (k4 - k5) (Hairer, Norsett & Wanner, Solving ODEs I, 2nd ed., II.4, embedded formulas of order 4(3)):
+the force error estimate's second state (drivers.force_error_check)."""
+
 PAIRS = {
     # name: (tableau, new right-hand sides per step)
     "DP54": (_tableau(DP54_A, DP54_B_HAT, 5, DP54_P), 6),
     "BS32": (_tableau(BS32_A, BS32_B_HAT, 3), 3),
 }
-"""The embedded pairs by the scene's ``[integrator] method``."""
+"""The embedded pairs by the scene's ``[integrator] method`` (PI step-size control)."""
+
+TABLEAUX = {**PAIRS, "RK4": (_tableau(RK4_A, RK4_B_HAT, 4, integer_rows=True), 4)}
+"""Every method of the compiled loop: the embedded pairs and RK4 (fixed step, :data:`FIXED_STEP`; its dense output
+the cubic Hermite between the step's ends, as drivers.RK4's)."""
 
 SCIPY_EQUIVALENT = {"DP54": "RK45", "BS32": "RK23"}
 """The same pairs in scipy (the Python path, for scenes the compiled loop cannot run): RK45 is Dormand-Prince 5(4)
@@ -274,6 +320,34 @@ def _dense(y, h, kst, p, theta, out):
 
 
 @njit(cache=True, _nrt=False)
+def _combine(weights, kst, s, out):
+    """The sum over the first s stages of w_j k_j into ``out``, per state, the terms added in the order of j (w_j = 0
+    skipped).
+    """
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    for j in range(s):
+        w = weights[j]
+        if w != 0.0:
+            for i in range(out.shape[0]):
+                out[i] += w * kst[j, i]
+
+
+@njit(cache=True, _nrt=False)
+def _combine_fractions(numerators, denominators, kst, out):
+    """The sum over the stages of (n_j k_j) / d_j into ``out``, per state, the terms added in the order of j (n_j = 0
+    skipped).
+    """
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    for j in range(kst.shape[0]):
+        w, dj = numerators[j], denominators[j]
+        if w != 0.0:
+            for i in range(out.shape[0]):
+                out[i] += w * kst[j, i] / dj
+
+
+@njit(cache=True, _nrt=False)
 def _contact_mask(rec, ncand, mask, gap):
     """Which candidates are in contact (normal force > 0) and their approach q (NaN: absent), from a record."""
     for c in range(ncand):
@@ -283,16 +357,18 @@ def _contact_mask(rec, ncand, mask, gap):
 
 @njit(cache=True)
 def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried, events):
-    """Advance from (t0, y) with the embedded pair ``tableau`` (:class:`Tableau`) under the step-size control
+    """Advance from (t0, y) with the method ``tableau`` (:class:`Tableau`, :data:`TABLEAUX`) under the control
     ``control`` (:class:`StepControl`) until t_end or ``control.max_steps`` accepted steps; record the samples at
-    outputs.times[k_out:] (dense output, then a right-hand side with record at the interpolated state) into
-    ``outputs``. ``run``: compiled_records.PackedRun. Module docstring for the control and the events.
+    outputs.times[k_out:] (dense output, then a right-hand side with record at the interpolated state; a sample on
+    the step's end takes the step's last stage) into ``outputs``. ``run``: compiled_records.PackedRun. Module
+    docstring for the control, the fixed step and the events.
 
     Carried between calls (the driver keeps ``carried``, :class:`Carried`, and ``events``, :class:`EventLog`).
     Returns an :class:`Outcome`.
     """
-    a, cc, e, p, k_order = tableau
-    rtol, atol, weight, h_min, h_max, event_tol, max_steps = control
+    a, d, cc, e, p, k_order, b_hat_num, b_hat_den = tableau
+    rtol, atol, weight, h_min, h_max, event_tol, max_steps, controller, check_every = control
+    fixed = controller == FIXED_STEP
     out_times, states, recs, errs = outputs
     carry, kst, mask0, gap0 = carried
     ev_t, ev_mask, n_ev = events
@@ -303,19 +379,19 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     nst = y.shape[0]
     ns = a.shape[0]
     y = y.copy()
-    y_new, ys, err, scratch = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
+    y_new, ys, scratch, combined, stage = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
     rec_end = np.empty((ncand + 2, N_FIELDS))
     mask1, gap1 = np.empty(ncand, np.int64), np.empty(ncand)
     mask_t, gap_t = np.empty(ncand, np.int64), np.empty(ncand)
     gap_lo, gap_hi = np.empty(ncand), np.empty(ncand)
     f4, f3 = np.empty((2, 3)), np.empty((2, 3))
-    force_err = np.nan
     mem, n_mem = run.search.mem, run.search.n_mem
     mem_save, n_mem_save = mem.copy(), n_mem.copy()
     mem_end, n_mem_end = mem.copy(), n_mem.copy()
     fmax, ymax = par.max_force_N, par.max_lateral_m
     t = t0
     evals, accepted, rejected, located, last_fail = 0, 0, 0, 0, 0
+    pending = np.nan  # the largest force error estimate since the last sample (NaN: none)
     if carry[STARTED] == 0.0:
         st = _rhs(t, y, run, ws, True, True, kst[0])
         evals += 1
@@ -333,33 +409,46 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     after_reject = False
     h_event = np.nan  # the controller's step before a step was cut short to end at a switch
     event_t = np.nan  # the located switch that the step being retried is to end just after
+    norm = 0.0
     while accepted < max_steps and t < t_end - tiny:
-        h = min(h, h_max)
-        if k_out < out_times.shape[0]:
-            # end the step on the next output time when that shortens it by less than one stage's worth: the
-            # sample then needs no right-hand side of its own
-            d = out_times[k_out] - t
-            if d < h and d > h * (1.0 - 1.0 / (ns - 1)):
-                h = d
-        if t + 1.01 * h >= t_end:
-            h = t_end - t
+        if not fixed:
+            h = min(h, h_max)
+            if k_out < out_times.shape[0]:
+                # end the step on the next output time when that shortens it by less than one stage's worth: the
+                # sample then needs no right-hand side of its own
+                gap = out_times[k_out] - t
+                if gap < h and gap > h * (1.0 - 1.0 / (ns - 1)):
+                    h = gap
+            if t + 1.01 * h >= t_end:
+                h = t_end - t
         if not h >= h_min:
             return _outcome(UNDERFLOW, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
-        mem_save[:, :, :] = mem
-        n_mem_save[:] = n_mem
-        # the stages; the last one is f(t + h, y_new) (FSAL), evaluated with its record and the lateral scan
+        # the fixed step's times are t0 + n h (no sum of rounded steps), the controlled steps' t + h
+        t_new = t0 + (accepted + 1) * h if fixed else t + h
+        # a step that ends on or past a sample (and the fixed step every check_every steps) has a force error estimate
+        sample = k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny
+        check = sample or (fixed and check_every > 0 and (accepted + 1) % check_every == 0)
+        if not fixed:  # (the fixed step is never retried: no memory to restore)
+            mem_save[:, :, :] = mem
+            n_mem_save[:] = n_mem
+        # the stages; the last one is f(t + h, y_new) (FSAL), evaluated with the lateral scan and with its record
+        # (the fixed step's only when it is checked: its record serves the estimate and the sample)
         failed = 0
         for s in range(1, ns):
+            _combine(a[s], kst, s, combined)
+            hd = h / d[s]
             for i in range(nst):
-                acc = 0.0
-                for j in range(s):
-                    if a[s, j] != 0.0:
-                        acc += a[s, j] * kst[j, i]
-                ys[i] = y[i] + h * acc
+                ys[i] = y[i] + hd * combined[i]
             last = s == ns - 1
-            st = _rhs(t + cc[s] * h, ys, run, ws, last, last, kst[s])
+            if last:
+                st = _rhs(t_new, ys, run, ws, check or not fixed, True, stage)
+            else:
+                st = _rhs(t + cc[s] * h, ys, run, ws, False, False, stage)
+            for i in range(nst):
+                kst[s, i] = stage[i]
             evals += 1
-            if st == CALLBACK_FAILED:  # the contact model behind the callback failed: not a matter of the step
+            if st == CALLBACK_FAILED or (st != 0 and fixed):
+                # the contact model behind the callback failed (not a matter of the step), or a fixed step's stage
                 return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
             if st != 0:
                 failed = st
@@ -367,15 +456,16 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         if failed == 0:
             for i in range(nst):
                 y_new[i] = ys[i]  # the last row of A is b
+        if failed == 0 and not fixed:
             total, wsum = 0.0, 0.0
             for i in range(nst):
                 acc = 0.0
                 for s in range(ns):
                     acc += e[s] * kst[s, i]
-                err[i] = h * acc
+                err = h * acc
                 if weight[i] > 0.0:
                     sc = atol[i] + (rtol * max(abs(y[i]), abs(y_new[i])) if weight[i] > 1.0 else 0.0)
-                    total += (err[i] / sc) ** 2
+                    total += (err / sc) ** 2
                     wsum += 1.0
             norm = math.sqrt(total / wsum)
             if not np.isfinite(norm):
@@ -398,16 +488,18 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             continue
         # accepted by the error control; the memory of the step's end (the last stage's scan) is what the next step
         # starts from: evaluations off the step's path (location, output samples) restore it
-        mem_end[:, :, :] = mem
-        n_mem_end[:] = n_mem
-        for i in range(ncand + 2):
-            for f in range(N_FIELDS):
-                rec_end[i, f] = rec[i, f]
-        _contact_mask(rec, ncand, mask1, gap1)
+        if check or not fixed:
+            for i in range(ncand + 2):
+                for f in range(N_FIELDS):
+                    rec_end[i, f] = rec[i, f]
         switched = False
-        for c in range(ncand):
-            if mask1[c] != mask0[c]:
-                switched = True
+        if not fixed:
+            mem_end[:, :, :] = mem
+            n_mem_end[:] = n_mem
+            _contact_mask(rec, ncand, mask1, gap1)
+            for c in range(ncand):
+                if mask1[c] != mask0[c]:
+                    switched = True
         if switched and h > event_tol and not event_t == event_t:
             # locate the earliest switch on the dense output: [lo, hi] with the start's set at lo, another at hi
             lo, hi = 0.0, 1.0
@@ -473,22 +565,28 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         for i in range(nst):
             if not np.isfinite(y_new[i]):
                 return _outcome(BLOW_UP, t, y, h, accepted, rejected, k_out, evals, located, BLOW_UP)
-        t_new = t + h
-        # force error estimate of a step with output samples (as rk4_run's): the per-wheel contact forces at the
-        # propagated solution against those at the embedded lower-order one, y_new - err
+        # force error estimate of a step with output samples (and of the fixed step every check_every steps): the
+        # per-wheel contact forces at the propagated solution against those at the embedded lower-order one,
+        # y + h sum_j b_hat_j k_j; a sample carries the largest since the previous sample
         k_first = k_out
-        if k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny:
+        if check:
             side_forces(rec_end, sides, f4)
+            _combine_fractions(b_hat_num, b_hat_den, kst, combined)
             for i in range(nst):
-                ys[i] = y_new[i] - err[i]
+                ys[i] = y[i] + h * combined[i]
             st = _rhs(t_new, ys, run, ws, True, False, scratch)
             evals += 1
-            force_err = np.inf
+            estimate = np.inf
             if st == 0:
                 side_forces(rec, sides, f3)
-                force_err = force_difference(f4, f3)
-            mem[:, :, :] = mem_end
-            n_mem[:] = n_mem_end
+                estimate = force_difference(f4, f3)
+            if not pending >= estimate:  # also when pending is NaN
+                pending = estimate
+            if not fixed:
+                # (RK4 keeps the memory this evaluation leaves, as the fixed-step loop before it did: the regression
+                # references hold it; the memory of the step's end instead moves corrugation's states by 1e-8)
+                mem[:, :, :] = mem_end
+                n_mem[:] = n_mem_end
         # the output samples within (t, t_new]: dense output and a right-hand side with record there
         while k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny:
             theta = (out_times[k_out] - t) / h
@@ -504,7 +602,8 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                 states[k_out, :] = ys
                 recs[k_out, :, :] = rec
             side_forces(recs[k_out], sides, f4)
-            errs[k_out] = force_err if k_out == k_first else np.nan
+            errs[k_out] = pending if k_out == k_first else np.nan
+            pending = np.nan
             k_out += 1
             for sd in range(2):
                 if f4[sd, NORMAL_FORCE] > fmax:
@@ -513,25 +612,28 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                     )
             if abs(states[k_out - 1, Y]) > ymax:
                 return _outcome(DERAILED, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, DERAILED)
-        mem[:, :, :] = mem_end
-        n_mem[:] = n_mem_end
-        switched = False
-        for c in range(ncand):
-            if mask1[c] != mask0[c]:
-                switched = True
-        if switched and n_ev[0] < ev_t.shape[0]:
-            ev_t[n_ev[0]] = event_t if event_t == event_t else t_new
+        if not fixed:
+            mem[:, :, :] = mem_end
+            n_mem[:] = n_mem_end
+            switched = False
             for c in range(ncand):
-                ev_mask[n_ev[0], c] = mask1[c]
-            n_ev[0] += 1
-        event_t = np.nan
-        for c in range(ncand):
-            mask0[c], gap0[c] = mask1[c], gap1[c]
+                if mask1[c] != mask0[c]:
+                    switched = True
+            if switched and n_ev[0] < ev_t.shape[0]:
+                ev_t[n_ev[0]] = event_t if event_t == event_t else t_new
+                for c in range(ncand):
+                    ev_mask[n_ev[0], c] = mask1[c]
+                n_ev[0] += 1
+            event_t = np.nan
+            for c in range(ncand):
+                mask0[c], gap0[c] = mask1[c], gap1[c]
         for i in range(nst):
             kst[0, i] = kst[ns - 1, i]
             y[i] = y_new[i]
         t = t_new
         accepted += 1
+        if fixed:
+            continue
         norm = max(norm, 1e-4)
         factor = 0.9 * norm ** (-0.7 / k_order) * err_prev ** (0.4 / k_order)
         factor = min(max(factor, 0.2), 1.0 if after_reject else 10.0)
@@ -544,107 +646,3 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             h_event = np.nan
         after_reject = False
     return _outcome(OK, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
-
-
-@njit(cache=True)
-def rk4_run(y, t0, h, steps, run, outputs, out_start):
-    """Advance ``steps`` = (n_steps, out_every, check_every) RK4 steps of size h from (t0, y); record every
-    ``out_every`` steps into ``outputs`` (:class:`Outputs`; its times are not read) from index ``out_start``.
-    ``run``: compiled_records.PackedRun (tables or the 3-D search, whose memory carries over between calls; the
-    lateral scan runs at each step's first stage and at the recorded samples). Returns an :class:`Outcome` (its
-    ``accepted``: the steps done; h, rejected, located and last_failure unused).
-
-    Error estimate (into errs, N, per recorded sample): at every recorded sample and every ``check_every`` steps
-    the step that ends there is also advanced by the third-order formula embedded in the classical RK4 stages and
-    the derivative at the step's end, k5 = f(t + h, y4) (which is the next step's k1): y3 = y + h (k1/6 + k2/3 +
-    k3/3 + k5/6), so y4 - y3 = h/6 (k4 - k5) (Hairer, Norsett & Wanner, Solving ODEs I, 2nd ed., section II.4,
-    "embedded formulas" of order 4(3)). The estimate is the largest difference of the per-wheel contact forces
-    (normal, longitudinal and lateral creep force) at y4 and y3: the force error of one step of the third-order
-    formula, an upper estimate of RK4's own (one extra right-hand side per check; two between recorded samples).
-    A sample carries the largest estimate of the checks since the previous sample (inf when the third-order
-    state's right-hand side failed).
-    """
-    n_steps, out_every, check_every = steps
-    _, states, recs, errs = outputs
-    par, sides = run.par, run.sides
-    ncand = sides.shape[0]
-    ws = workspace(run, np.empty((ncand + 2, N_FIELDS)))
-    rec = ws.rec
-    nst = y.shape[0]
-    y = y.copy()
-    k1, k2, k3, k4 = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
-    k5, k6 = np.empty(nst), np.empty(nst)
-    ys, y_new = np.empty(nst), np.empty(nst)
-    f4, f3 = np.empty((2, 3)), np.empty((2, 3))
-    pending = np.nan
-    t = t0
-    k_out = out_start
-    evals = 0
-    fmax, ymax = par.max_force_N, par.max_lateral_m
-    have_k1 = False  # k1 of the next step is the recorded sample's derivative (same t and y)
-    for step in range(n_steps):
-        if not have_k1:
-            st = _rhs(t, y, run, ws, False, True, k1)
-            evals += 1
-            if st != 0:
-                return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
-        have_k1 = False
-        for i in range(nst):
-            ys[i] = y[i] + 0.5 * h * k1[i]
-        st = _rhs(t + 0.5 * h, ys, run, ws, False, False, k2)
-        if st != 0:
-            return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
-        for i in range(nst):
-            ys[i] = y[i] + 0.5 * h * k2[i]
-        st = _rhs(t + 0.5 * h, ys, run, ws, False, False, k3)
-        if st != 0:
-            return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
-        for i in range(nst):
-            ys[i] = y[i] + h * k3[i]
-        st = _rhs(t + h, ys, run, ws, False, False, k4)
-        evals += 3
-        if st != 0:
-            return _outcome(st, t, y, h, step, 0, k_out, evals, 0, st)
-        finite = True
-        for i in range(nst):
-            y_new[i] = y[i] + (h / 6.0) * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            if not np.isfinite(y_new[i]):
-                finite = False
-        if not finite:
-            return _outcome(BLOW_UP, t, y, h, step, 0, k_out, evals, 0, BLOW_UP)
-        y, y_new = y_new, y  # y_new now holds the step's start
-        t = t0 + (step + 1) * h
-        output = (step + 1) % out_every == 0 and k_out < states.shape[0]
-        if output or (step + 1) % check_every == 0:
-            st = _rhs(t, y, run, ws, True, True, k5)
-            evals += 1
-            if st != 0:
-                return _outcome(st, t, y, h, step + 1, 0, k_out, evals, 0, st)
-            if output:
-                states[k_out, :] = y
-                recs[k_out, :, :] = rec
-            side_forces(rec, sides, f4)
-            # the embedded third-order solution and its contact forces
-            for i in range(nst):
-                ys[i] = y_new[i] + h * (k1[i] / 6.0 + k2[i] / 3.0 + k3[i] / 3.0 + k5[i] / 6.0)
-            st = _rhs(t, ys, run, ws, True, False, k6)
-            evals += 1
-            worst = np.inf
-            if st == 0:
-                side_forces(rec, sides, f3)
-                worst = force_difference(f4, f3)
-            if not pending >= worst:  # also when pending is NaN
-                pending = worst
-            for i in range(nst):
-                k1[i] = k5[i]
-            have_k1 = True
-            if output:
-                errs[k_out] = pending
-                pending = np.nan
-                k_out += 1
-                for sd in range(2):
-                    if f4[sd, NORMAL_FORCE] > fmax:
-                        return _outcome(FORCE_ANOMALY, t, y, h, step + 1, 0, k_out, evals, 0, FORCE_ANOMALY)
-                if abs(y[Y]) > ymax:
-                    return _outcome(DERAILED, t, y, h, step + 1, 0, k_out, evals, 0, DERAILED)
-    return _outcome(OK, t, y, h, n_steps, 0, k_out, evals, 0, OK)

@@ -79,10 +79,9 @@ def supported(scene, provider) -> bool:
     compiled (tables or search). Any contact model: the compiled laws inline, ``auto``'s choice inline, the others
     (bem, fea, user models) through the callback.
     """
-    from rigid_dynamics.wheelset.compiled_loop import PAIRS
+    from rigid_dynamics.wheelset.compiled_loop import TABLEAUX
 
-    method = scene.integrator.method
-    return (method == "RK4" or method in PAIRS) and geometry_mode(provider) != GEOMETRY_GIVEN
+    return scene.integrator.method in TABLEAUX and geometry_mode(provider) != GEOMETRY_GIVEN
 
 
 def model_parameters(model_wheelset):
@@ -179,30 +178,30 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     return PackedRun(par, hk, sides, slots, mode, no_table_geometry(slots), no_search_args())
 
 
-def load(run: PackedRun, tableau=None) -> None:
-    """Load (from numba's cache, or compile) the compiled loop and rhs_once for the types of ``run``: zero steps,
-    and one right-hand side at the zero state (no wheel near a rail there: no candidate enters the search memory,
-    whose warm starts are its only state). ``tableau``: an embedded pair's (compiled_loop.PAIRS); None: RK4.
+def load(run: PackedRun) -> None:
+    """Load (from numba's cache, or compile) the compiled loop and rhs_once for the types of ``run``: zero steps
+    (one compilation serves every tableau and controller of compiled_loop.TABLEAUX: the same argument types), and
+    one right-hand side at the zero state (no wheel near a rail there: no candidate enters the search memory, whose
+    warm starts are its only state).
     """
     from rigid_dynamics.wheelset.compiled_loop import (
+        PI_CONTROL,
+        TABLEAUX,
         Carried,
         EventLog,
         Outputs,
         StepControl,
         embedded_run,
-        rk4_run,
     )
     from rigid_dynamics.wheelset.compiled_rhs import rhs_once
 
     y = np.zeros(n_states(int(run.par["track_positions"])))
     ncand = len(run.sides)
     outputs = Outputs(np.zeros(0), np.zeros((0, len(y))), np.zeros((0, ncand + 2, N_FIELDS)), np.zeros(0))
-    if tableau is None:
-        rk4_run(y, 0.0, 1e-3, (0, 1, 1), run, outputs, 0)
-    else:
-        control = StepControl(1e-6, np.ones(len(y)), np.ones(len(y)), 1e-10, 1e-3, 1e-6, 0)
-        carried = Carried(np.array([1e-4, 1.0]), np.zeros((len(tableau.a), len(y))), np.zeros(ncand, np.int64),
-                          np.zeros(ncand))  # fmt: skip
-        events = EventLog(np.zeros(0), np.zeros((0, ncand), np.int64), np.zeros(1, np.int64))
-        embedded_run(y, 0.0, 0.0, 1e-3, tableau, control, run, outputs, 0, carried, events)
+    tableau = TABLEAUX["RK4"][0]
+    control = StepControl(1e-6, np.ones(len(y)), np.ones(len(y)), 1e-10, 1e-3, 1e-6, 0, PI_CONTROL, 0)
+    carried = Carried(np.array([1e-4, 1.0]), np.zeros((len(tableau.a), len(y))), np.zeros(ncand, np.int64),
+                      np.zeros(ncand))  # fmt: skip
+    events = EventLog(np.zeros(0), np.zeros((0, ncand), np.int64), np.zeros(1, np.int64))
+    embedded_run(y, 0.0, 0.0, 1e-3, tableau, control, run, outputs, 0, carried, events)
     rhs_once(0.0, y, run, np.zeros(len(y)), np.zeros((ncand + 2, N_FIELDS)))

@@ -1,4 +1,4 @@
-"""Compiled (numba) 3-D contact search for the compiled RK4 loop: the patches of both wheels at one pose.
+"""Compiled (numba) 3-D contact search for the compiled loop: the patches of both wheels at one pose.
 
 The same search as rigid_dynamics.contact.search.search_side with the SearchProvider of providers/search.py, on the
 same surfaces (the TabulatedWheel/TabulatedRail stand-ins: Hermite tables of the ideal profiles plus the closed-

@@ -1,8 +1,8 @@
 """The integrators over the right-hand side: scipy's adaptive ``OdeSolver`` methods stepped one step at a time
 (:func:`run_scipy`, with the Jacobian of :func:`state_jacobian` for Radau and BDF, and the fixed-step RK4 as one more
-``OdeSolver``, :func:`_rk4_class`) and the compiled loop (:func:`run_compiled`: RK4, or the embedded pairs
-DP54/BS32 with step-size control of compiled_loop.py, :func:`run_embedded`), with the force error estimate and its
-check (:func:`force_error_check`). Run statuses of the compiled codes: layout.STATUS.
+``OdeSolver``, :func:`_rk4_class`) and the compiled loop (:func:`run_compiled`: one loop for the embedded pairs
+DP54/BS32 with step-size control and RK4 with its fixed step, compiled_loop.py), with the force error estimate and
+its check (:func:`force_error_check`). Run statuses of the compiled codes: layout.STATUS.
 """
 
 from __future__ import annotations
@@ -50,10 +50,10 @@ def force_error_check(errors: np.ndarray, t: np.ndarray, settled: np.ndarray, se
     full-run peaks are not converged.
 
     The estimate is the contact-force difference between RK4 and its embedded third-order solution over the step
-    ending at each recorded sample (compiled_loop.rk4_run, :func:`run_scipy`). On the embedded scenes it separates the
-    steps whose force results move by more than a few per cent of the static load from those that do not, where the
-    contact-passage time against the step misses the creep-force bias of polygonal-wheel at 1 ms and step doubling
-    underestimates it (benchmarks/results/step_sensitivity.md).
+    ending at each recorded sample (compiled_loop.embedded_run, :func:`run_scipy`). On the embedded scenes it
+    separates the steps whose force results move by more than a few per cent of the static load from those that do
+    not, where the contact-passage time against the step misses the creep-force bias of polygonal-wheel at 1 ms and
+    step doubling underestimates it (benchmarks/results/step_sensitivity.md).
     """
 
     def worst(mask):
@@ -262,7 +262,7 @@ def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -
     (:class:`RK4`, fixed step). The samples at ``out_times`` come from the step's dense output (the step's end
     itself when a sample falls on it).
 
-    RK4 also estimates its force error (as compiled_loop.rk4_run): every :func:`steps_between_checks` steps and at
+    RK4 also estimates its force error (as compiled_loop.embedded_run): every :func:`steps_between_checks` steps and at
     a sample on the step's end, the contact forces at the propagated and at the embedded third-order state
     (:func:`_force_error`, two extra contact evaluations); a sample on the step's end carries the estimate of that
     step, other samples the largest of the checks since the previous sample. Samples are recorded (and checked for
@@ -336,7 +336,7 @@ def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -
 
 
 def patch_tables(model, block, sides, slots) -> dict:
-    """The compiled loops' records of a block of output samples (n, candidates + 2, layout.N_FIELDS) as the
+    """The compiled loop's records of a block of output samples (n, candidates + 2, layout.N_FIELDS) as the
     recorder's per-patch tables: field -> (n, 2 sides, MAX_SLOTS), NaN where no candidate sits (PATCH_FIELDS, and
     AUTO_PATCH_FIELDS for ``auto``).
     """
@@ -382,45 +382,6 @@ def _append_samples(model, recorder, outputs, k_out, k_new, times):
     )
 
 
-def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
-    """RK4 in the compiled loop (compiled_loop.rk4_run), in chunks so that wall time and progress are watched; the
-    embedded pairs with step-size control (``method`` "DP54" or "BS32") in :func:`run_embedded`.
-    """
-    from rigid_dynamics.wheelset.compiled_loop import PAIRS, Outputs, rk4_run
-    from rigid_dynamics.wheelset.compiled_rhs import use_callback
-
-    if settings.method in PAIRS:
-        return run_embedded(model, y0, duration, settings, recorder, report, start)
-    run = model.packed
-    use_callback(model.callback)
-    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
-    h = duration / n_steps
-    out_every = max(1, int(round(settings.output_step_s / h)))
-    check_every = steps_between_checks(settings, h)
-    n_out = n_steps // out_every
-    ncand = len(run.sides)
-    outputs = Outputs(
-        np.zeros(0), np.zeros((n_out, len(y0))), np.zeros((n_out, ncand + 2, N_FIELDS)), np.full(n_out, np.nan)
-    )
-    y, t, done, k_out = y0.copy(), 0.0, 0, 0
-    chunk = max(out_every, (2000 // out_every) * out_every)
-    while done < n_steps:
-        todo = min(chunk, n_steps - done)
-        outcome = rk4_run(y, t, h, (todo, out_every, check_every), run, outputs, k_out)
-        model.rhs_evaluations += outcome.evaluations
-        if outcome.k_out > k_out:
-            times = (done // out_every + np.arange(1, outcome.k_out - k_out + 1)) * out_every * h
-            _append_samples(model, recorder, outputs, k_out, outcome.k_out, times)
-        k_out = outcome.k_out
-        if outcome.status != 0:
-            raise _stop_from_status(model, outcome.status, outcome.t, outcome.y, "RK4", done + outcome.accepted)
-        done += todo
-        y, t = outcome.y, outcome.t
-        _watch(model, settings, start, t, y, done)
-        report(t)
-    return n_steps
-
-
 FORCE_CHECK_INTERVAL_S = 1e-3
 """Largest simulated time between two force error checks of an RK4 run, s: with sparse output (say 10 ms) a
 wheel-flat impact (about 3 ms at 60 km/h) still meets a check."""
@@ -432,12 +393,19 @@ def steps_between_checks(settings, step_s: float) -> int:
     return max(1, min(out_every, int(round(FORCE_CHECK_INTERVAL_S / step_s))))
 
 
-def step_control(settings, scene, max_steps: int):
-    """The compiled_loop.StepControl of an embedded pair's run: atol per state (:func:`tolerances`) and its
+def step_control(settings, scene, max_steps: int, check_every: int = 0):
+    """The compiled_loop.StepControl of a run: for an embedded pair, atol per state (:func:`tolerances`) and its
     weights (positions by atol alone: their values carry offsets, x and the spin angle grow along the track, z is
-    about r0; the rates by atol + rtol |y|; the work integrals, diagnostics, not controlled).
+    about r0; the rates by atol + rtol |y|; the work integrals, diagnostics, not controlled); for RK4 the fixed step
+    with a force error check every ``check_every`` steps.
     """
-    from rigid_dynamics.wheelset.compiled_loop import EVENT_TIME_TOLERANCE_S, MIN_STEP_S, StepControl
+    from rigid_dynamics.wheelset.compiled_loop import (
+        EVENT_TIME_TOLERANCE_S,
+        FIXED_STEP,
+        MIN_STEP_S,
+        PI_CONTROL,
+        StepControl,
+    )
     from rigid_dynamics.wheelset.state import track_positions
 
     atol = tolerances(settings, scene)
@@ -445,9 +413,11 @@ def step_control(settings, scene, max_steps: int):
     weight[POSITIONS] = 1.0  # 1: atol alone
     weight[track_positions(len(atol))] = 1.0  # (absent on the rigid track)
     weight[WORK] = 0.0  # diagnostics, not in the right-hand side
+    controller = FIXED_STEP if settings.method == "RK4" else PI_CONTROL
     return StepControl(
-        settings.relative_tolerance, atol, weight, MIN_STEP_S, settings.max_step_s, EVENT_TIME_TOLERANCE_S, max_steps
-    )
+        settings.relative_tolerance, atol, weight, MIN_STEP_S, settings.max_step_s, EVENT_TIME_TOLERANCE_S, max_steps,
+        controller, check_every,
+    )  # fmt: skip
 
 
 def initial_step(rhs, y0, control, k_order) -> float:
@@ -492,18 +462,34 @@ def side_events(events, sides):
     return found
 
 
-def run_embedded(model, y0, duration, settings, recorder, report, start) -> int:
-    """An embedded pair with step-size control in the compiled loop (compiled_loop.embedded_run), in calls of
-    compiled_loop.STEPS_PER_CALL accepted steps so that wall time, budget and progress are watched. Records the
-    samples at the output times (multiples of output_step_s, and the end); the wheel-lift and contact-restored
-    events are the located switches (their times within compiled_loop.EVENT_TIME_TOLERANCE_S), not the samples'.
-    Sets ``model.adaptive_stats``. Returns the accepted steps.
+def _fixed_step_plan(settings, duration):
+    """RK4's step h (``fixed_step_s`` shortened to divide the run into whole steps), its output times (every
+    ``out_every`` steps: multiples of h, the last sample at or before the end), the steps between force error checks
+    and the steps per call of the compiled loop (a multiple of both, about 2000).
+    """
+    n_steps = max(1, int(math.ceil(duration / settings.fixed_step_s - 1e-9)))
+    h = duration / n_steps
+    out_every = max(1, int(round(settings.output_step_s / h)))
+    check_every = steps_between_checks(settings, h)
+    period = math.lcm(out_every, check_every)
+    out_times = np.arange(1, n_steps // out_every + 1) * out_every * h
+    return h, out_times, check_every, max(period, (2000 // period) * period)
+
+
+def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
+    """The compiled loop (compiled_loop.embedded_run) for every method of compiled_loop.TABLEAUX: the embedded pairs
+    DP54/BS32 with step-size control, in calls of compiled_loop.STEPS_PER_CALL accepted steps, and RK4 with its
+    fixed step (:func:`_fixed_step_plan`), so that wall time, budget and progress are watched between calls.
+    Records the samples at the output times (the pairs: multiples of output_step_s, and the end; RK4: every
+    ``out_every`` steps); for the pairs the wheel-lift and contact-restored events are the located switches (their
+    times within compiled_loop.EVENT_TIME_TOLERANCE_S), not the samples', and ``model.adaptive_stats`` is set.
+    Returns the accepted steps.
     """
     from rigid_dynamics.wheelset.compiled_loop import (
         MAX_EVENTS,
         MIN_STEP_S,
-        PAIRS,
         STEPS_PER_CALL,
+        TABLEAUX,
         Carried,
         EventLog,
         Outputs,
@@ -513,13 +499,18 @@ def run_embedded(model, y0, duration, settings, recorder, report, start) -> int:
 
     scene, run = model.scene, model.packed
     use_callback(model.callback)
-    tableau, _ = PAIRS[settings.method]
-    control = step_control(settings, scene, STEPS_PER_CALL)
+    tableau, _ = TABLEAUX[settings.method]
+    fixed = settings.method == "RK4"
     ncand = len(run.sides)
-    n_out = int(math.floor(duration / settings.output_step_s + 1e-9))
-    out_times = settings.output_step_s * np.arange(1, n_out + 1)
-    if len(out_times) == 0 or out_times[-1] < duration - 1e-12:
-        out_times = np.append(out_times, duration)
+    if fixed:
+        h, out_times, check_every, per_call = _fixed_step_plan(settings, duration)
+        control = step_control(settings, scene, per_call, check_every)
+    else:
+        control = step_control(settings, scene, STEPS_PER_CALL)
+        n_out = int(math.floor(duration / settings.output_step_s + 1e-9))
+        out_times = settings.output_step_s * np.arange(1, n_out + 1)
+        if len(out_times) == 0 or out_times[-1] < duration - 1e-12:
+            out_times = np.append(out_times, duration)
     outputs = Outputs(
         out_times,
         np.zeros((len(out_times), len(y0))),
@@ -533,18 +524,22 @@ def run_embedded(model, y0, duration, settings, recorder, report, start) -> int:
         status = rhs_once(t, y, run, out, rec)
         return out if status == 0 else np.full(len(y), np.nan)
 
-    h = initial_step(rhs, y0, control, tableau.k_order)
-    model.rhs_evaluations += 2
+    if not fixed:
+        h = initial_step(rhs, y0, control, tableau.k_order)
+        model.rhs_evaluations += 2
     carried = Carried(np.array([1e-4, 0.0]), np.zeros((len(tableau.a), len(y0))), np.zeros(ncand, np.int64),
                       np.zeros(ncand))  # fmt: skip
-    events = EventLog(np.zeros(MAX_EVENTS), np.zeros((MAX_EVENTS, ncand), np.int64), np.zeros(1, np.int64))
+    n_events = 0 if fixed else MAX_EVENTS  # RK4 locates no switch: its events are the samples' (recorder.py)
+    events = EventLog(np.zeros(n_events), np.zeros((n_events, ncand), np.int64), np.zeros(1, np.int64))
     stats = {"accepted_steps": 0, "rejected_steps": 0, "located_switches": 0}
-    model.adaptive_stats = stats
+    if not fixed:
+        model.adaptive_stats = stats
     y, t, k_out = y0.copy(), 0.0, 0
 
     def events_to_recorder():
-        kept = [ev for ev in recorder.events if ev[0] not in ("wheel-lift", "contact-restored")]
-        recorder.events[:] = sorted(kept + side_events(events, run.sides), key=lambda ev: ev[2])
+        if not fixed:
+            kept = [ev for ev in recorder.events if ev[0] not in ("wheel-lift", "contact-restored")]
+            recorder.events[:] = sorted(kept + side_events(events, run.sides), key=lambda ev: ev[2])
 
     while True:
         outcome = embedded_run(y, t, duration, h, tableau, control, run, outputs, k_out, carried, events)

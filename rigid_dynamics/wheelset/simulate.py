@@ -1,10 +1,10 @@
 """Running a wheelset scene: provider and model selection, the start, the choice of driver, the result.
 
-Where the parts live: the drivers (scipy's adaptive methods, RK4 on the Python right-hand side, the compiled RK4
-loop) in drivers.py; the output samples, events and anomaly checks in recorder.py; the start (static equilibrium,
-free rolling, elastic track at rest) in equilibrium.py; :class:`SimulationResult`, its summary and the time-series
-files in results.py. This module re-exports the public names of those (``SimulationResult``, ``STATUSES``,
-``save_timeseries``, ``timeseries_arrays``, ``dominant_wavelength_m``, ``initial_state``).
+Where the parts live: the drivers (scipy's adaptive methods and RK4 on the Python right-hand side, the compiled
+loop for RK4, DP54 and BS32) in drivers.py; the output samples, events and anomaly checks in recorder.py; the start
+(static equilibrium, free rolling, elastic track at rest) in equilibrium.py; :class:`SimulationResult`, its summary
+and the time-series files in results.py. This module re-exports the public names of those (``SimulationResult``,
+``STATUSES``, ``save_timeseries``, ``timeseries_arrays``, ``dominant_wavelength_m``, ``initial_state``).
 
 ``simulate(scene, progress=None) -> SimulationResult``. The adaptive methods are scipy's
 ``OdeSolver`` classes (RK45, DOP853, Radau, BDF, LSODA) stepped one step at a time, so that the run
@@ -41,9 +41,11 @@ Safety (a run never hangs and never writes NaN silently): the run ends with a st
 error estimate) reaches the end with an energy balance above :data:`ENERGY_TOLERANCE_RELATIVE` (a tolerance too
 loose for the run), or when the beam's modal cut-off error (discretisation.modal_cutoff_check, a measured rule)
 exceeds ``force_tolerance``, or when a BEM patch's own grid-error estimate of its forces exceeds the BEM's
-``grid_tolerance`` (discretisation.contact_grid_check); and ``"ok"`` when it reaches the end without any of these.
-Events (wheel lift, contact restored, flange contact onset) are detected on the output samples, so their times are
-known to one output step.
+``grid_tolerance`` (discretisation.contact_grid_check), or when a companion estimate (the contact grid, the geometry
+tables, scipy's step: discretisation.companion_check) exceeds ``force_tolerance``; and ``"ok"`` when it reaches the
+end without any of these (one function judges a run's step or tolerances this way: :func:`judge_step`; the
+companions follow it). Events (wheel lift, contact restored, flange contact onset, adhesion limit and wheel slide) are
+detected on the output samples, so their times are known to one output step.
 """
 
 from __future__ import annotations
@@ -52,6 +54,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -203,7 +206,7 @@ def simulate(
     packed = model.packed
     if use_compiled:
         # the compiled code (from numba's cache) is loaded before the clock starts
-        load(packed, PAIRS[settings.method][0] if embedded else None)
+        load(packed)
     start = time.perf_counter()
     recorder = Recorder(model, scene)
     status, message, fail_t, fail_state = "ok", "", None, None
@@ -286,31 +289,16 @@ def simulate(
     wall = time.perf_counter() - start
     t, states, patches, forces, kin, pot, wc, we, errors, track_full = recorder.arrays()
     track_names, track_states = recorder.summary_arrays()
-    fixed_step = settings.method == "RK4"
-    checked = fixed_step or (use_compiled and embedded)  # runs with a force error estimate at their samples
-    if checked:
-        errors = errors / scene.static_wheel_load_N
-        if status == "ok":
-            settled = states[:, 0] - states[0, 0] >= scene.settling_distance_m if len(t) else np.zeros(0, bool)
-            status, message = force_error_check(errors, t, settled, settings, message)
-        if (
-            ok and fixed_step
-        ):  # the step against RK4's stability limit at the start (stability.py): numerical failures named so
-            try:
-                probe = model
-                if use_compiled and search_in_python:
-                    probe = WheelsetModel(scene, provider, model_obj, options, python_geometry=True)
-                    probe.frame_x0, probe.track_rest = model.frame_x0, model.track_rest
-                limit = rk4_stable_step(lambda y: probe.derivative(0.0, y), full0, jac=probe.state_jacobian)
-            except (ContactFailure, *NUMERICAL_ERRORS):
-                limit = None
-            if limit is not None and status in NUMERICAL_LOOKING and not settings.fixed_step_s > limit.max_step_s:
-                limit = _limit_at_largest_force(probe, t, states, patches, wc, we, track_full, limit)
-            if limit is not None:
-                status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit)
-    cache = getattr(provider, "cache", None)  # the contact tables' disk cache (providers/table_cache.py)
-    if cache is not None and cache.note:
-        message = f"{message}; {cache.note}"
+    checked = settings.method == "RK4" or (use_compiled and embedded)  # a force error estimate at the samples
+
+    def probe():
+        # the Python face of the right-hand side at the run's start, for RK4's stability limit (stability.py)
+        if use_compiled and search_in_python:
+            python = WheelsetModel(scene, provider, model_obj, options, python_geometry=True)
+            python.frame_x0, python.track_rest = model.frame_x0, model.track_rest
+            return python
+        return model
+
     result = SimulationResult(
         status=status,
         message=message,
@@ -332,31 +320,83 @@ def simulate(
         contact_model=getattr(model_obj, "name", type(model_obj).__name__),
         method=settings.method,
         compiled=use_compiled,
-        force_error_estimate=errors if checked else None,
+        force_error_estimate=errors / scene.static_wheel_load_N if checked else None,
         scene=scene,
         track_states=track_states,
         track_state_names=tuple(track_names or ()),
         track_full_states=track_full,
         callback_stats=model.callback.stats() if model.callback is not None else None,
     )
+    result = judge_step(result, _Rerun(provider, model_obj, compiled), probe if ok else None, full0)
+    if companions:  # the discretisations the step's judgement cannot see (discretisation.companion_errors)
+        stated = companion_errors(
+            result,
+            Companions(
+                provider,
+                lambda p: WheelsetModel(scene, p, model_obj, options, python_geometry=False),
+                lambda s: simulate(s, provider=provider, contact_model=model_obj, compiled=compiled, companions=False),
+            ),
+        )
+        status, message = companion_check(result.status, result.message, stated, settings.force_tolerance)
+        result = replace(result, status=status, message=message, companion_errors=stated)
+    cache = getattr(provider, "cache", None)  # the contact tables' disk cache (providers/table_cache.py)
+    if cache is not None and cache.note:
+        result = replace(result, message=f"{result.message}; {cache.note}")
+    return result
+
+
+class _Rerun(NamedTuple):
+    """What a second run of the same scene (the half-step check) takes: the provider, the contact model and
+    ``compiled`` as :func:`simulate` was called.
+    """
+
+    provider: object
+    model_obj: object
+    compiled: bool | None
+
+
+def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray) -> SimulationResult:
+    """The one judgement of a run's step (RK4) or tolerances (every other method), after the run, in this order:
+
+    1. a run with a force error estimate (RK4, the compiled pairs) that reached its end: the estimate after the
+       settling distance against ``force_tolerance`` (drivers.force_error_check, "warning" above it);
+    2. RK4 from a consistent start (``probe``: a callable giving the model whose Jacobian is linearised; None when
+       the start was not consistent): the step against RK4's stability limit at the start, or at the recorded state
+       of the largest contact force when the run failed within the start's limit (:func:`_limit_at_largest_force`);
+       a numerical-looking failure beyond the limit becomes "step-unstable" (stability.judge_fixed_step);
+    3. a run with a force error estimate in which a wheel lifted after the settling distance: the run again at half
+       the step or a tenth of the tolerances (:func:`_half_step_check`);
+    4. scipy's methods (no force error estimate): the energy balance (:func:`_energy_check`);
+    5. the beam's modal cut-off error (discretisation.modal_cutoff_check);
+    6. the BEM patches' own grid-error estimates (discretisation.contact_grid_check).
+    """
+    scene = result.scene
+    settings = scene.integrator
+    status, message = result.status, result.message
+    t, states = result.t, result.states
+    checked = result.force_error_estimate is not None
+    if checked and status == "ok":
+        settled = states[:, 0] - states[0, 0] >= scene.settling_distance_m if len(t) else np.zeros(0, bool)
+        status, message = force_error_check(result.force_error_estimate, t, settled, settings, message)
+    if settings.method == "RK4" and probe is not None:
+        try:
+            model = probe()
+            limit = rk4_stable_step(lambda y: model.derivative(0.0, y), full0, jac=model.state_jacobian)
+        except (ContactFailure, *NUMERICAL_ERRORS):
+            limit = None
+        if limit is not None and status in NUMERICAL_LOOKING and not settings.fixed_step_s > limit.max_step_s:
+            limit = _limit_at_largest_force(model, result, limit)
+        if limit is not None:
+            status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit)
+    if (status, message) != (result.status, result.message):
+        result = replace(result, status=status, message=message)
     if checked and status == "ok" and settings.lift_half_step_check and _lifted_after_settling(result):
-        result = _half_step_check(result, provider, model_obj, compiled)
-    if not checked and status == "ok":
+        result = _half_step_check(result, *rerun)
+    if not checked and result.status == "ok":
         result = _energy_check(result, settings)
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
     status, message = contact_grid_check(status, message, result.callback_stats)
-    if not companions:
-        return result if status == result.status else replace(result, status=status, message=message)
-    stated = companion_errors(
-        result,
-        Companions(
-            provider,
-            lambda p: WheelsetModel(scene, p, model_obj, options, python_geometry=False),
-            lambda s: simulate(s, provider=provider, contact_model=model_obj, compiled=compiled, companions=False),
-        ),
-    )
-    status, message = companion_check(status, message, stated, settings.force_tolerance)
-    return replace(result, status=status, message=message, companion_errors=stated)
+    return result if status == result.status else replace(result, status=status, message=message)
 
 
 ENERGY_TOLERANCE_RELATIVE = 0.01
@@ -390,7 +430,7 @@ def _adhesion(scene, t, patches) -> list[tuple]:
     return adhesion_events(t, patches)
 
 
-def _limit_at_largest_force(model, t, states, patches, work_contact, work_exterior, track_states, start_limit):
+def _limit_at_largest_force(model, result: SimulationResult, start_limit):
     """RK4's stability limit at the recorded state of the largest contact force, if smaller than ``start_limit``.
 
     A fixed-step run that failed (blow-up, force anomaly, derailment, solver failure) with a step within the limit
@@ -400,6 +440,8 @@ def _limit_at_largest_force(model, t, states, patches, work_contact, work_exteri
     of the largest normal force recorded before the failure is a state the run visited; beyond the limit there the
     failure is the integrator's too. Returns ``start_limit`` when that limit is not smaller or cannot be computed.
     """
+    t, states, patches = result.t, result.states, result.patches
+    work_contact, work_exterior, track_states = result.work_contact_J, result.work_exterior_J, result.track_full_states
     normal = np.nan_to_num(patches["normal_force_N"], nan=0.0).sum(axis=2).max(axis=1) if len(t) else np.zeros(0)
     finite = np.isfinite(normal) & np.all(np.isfinite(states), axis=1)
     if not np.any(finite):
