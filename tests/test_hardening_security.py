@@ -35,7 +35,9 @@ def test_local_dask_cluster_runs_no_code_for_another_local_process(tmp_path):
             {"address": address, "security": Security.temporary()},  # TLS with credentials the cluster never made
         ]
         for attempt in attempts:
-            with pytest.raises((OSError, TypeError, ValueError)):
+            # refused by an error of distributed's (OSError/TypeError/ValueError; in a long test session its loop
+            # runner's own AssertionError): what matters is that no code ran (the marker below)
+            with pytest.raises((OSError, TypeError, ValueError, AssertionError)):
                 with Client(attempt.pop("address"), timeout="3s", set_as_default=False, **attempt) as intruder:
                     intruder.run_on_scheduler(payload)
     assert not marker.exists()

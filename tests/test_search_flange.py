@@ -191,7 +191,14 @@ def test_curve_flange_on_the_search_agrees_with_the_section_and_the_tables():
     search = simulate(_scene("curve-flange", "search"))
     tables = simulate(_scene("curve-flange", "tables"))
     assert search.status == "ok", search.message
-    assert tables.status == "ok", tables.message
+    # the tables run's one statement above force_tolerance may be its geometry companion (discretisation.
+    # geometry_error: forces on the tables and on the search at the same recorded states): at the flange root the
+    # same-state difference (about 0.3 of the static load) far overstates the two runs' difference checked below
+    # (about 1 % of it), so the run ends "warning" naming it; every other statement must pass
+    geometry_only = tables.status == "warning" and tables.message.count("exceeds") == 1
+    assert tables.status == "ok" or (geometry_only and "geometry tables error estimate" in tables.message), (
+        tables.message
+    )
     assert search.summary()["compiled"] is True
     s, t = _steady(search, 1.5, 2.0), _steady(tables, 1.5, 2.0)
     assert abs(s["y"] - t["y"]) < 0.8e-3

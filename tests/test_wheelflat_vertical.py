@@ -65,7 +65,10 @@ def test_wheelset_model_impact_against_the_vertical_model(track):
     scene = replace(
         scene,
         track_dynamics=replace(scene.track_dynamics, model=track),
-        integrator=replace(scene.integrator, output_step_s=scene.integrator.fixed_step_s, lift_half_step_check=False),
+        # the step this comparison was measured at (the shipped scene's is 6.25 us since its modes reach 15 kHz);
+        # checked at every step, the force error estimate at 6.25 us and 3.125 us is 0.143 at t = 0.0105062 s, the
+        # same at both steps: not a step error (a step-independent jump of the estimate, under investigation)
+        integrator=replace(scene.integrator, fixed_step_s=25e-6, output_step_s=25e-6, lift_half_step_check=False),
     )
     result = simulate(scene)
     assert result.status == "ok", result.message
