@@ -213,15 +213,7 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
         radius_long = get_number(geometry_table, "radius_long_m", "geometry", positive=True)
         radius_lat = get_number(geometry_table, "radius_lat_m", "geometry", positive=True)
         loading = dict(get_table(doc, "loading"))
-        longitudinal_force = None
-        if "longitudinal_force_N" in loading:
-            longitudinal_force = get_number(loading, "longitudinal_force_N", "loading")
-            del loading["longitudinal_force_N"]
-            if "creepage_long" in kinematics:
-                raise ConfigError(
-                    f"key 'kinematics.creepage_long' = {kinematics['creepage_long']!r}: not allowed with "
-                    "'loading.longitudinal_force_N' (the longitudinal creepage is solved for that force)"
-                )
+        longitudinal_force = _longitudinal_force(loading, kinematics, "creepage_long", "the longitudinal creepage")
         force, approach = _read_loading(loading, "normal_force_N")
         check_keys(kinematics, QUADRIC_KINEMATICS_KEYS, "kinematics")
         creepage = Creepage(
@@ -249,15 +241,7 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
         check_keys(geometry_table, WHEELSET_GEOMETRY_KEYS, "geometry")
         check_keys(kinematics, WHEELSET_KINEMATICS_KEYS, "kinematics")
         loading = dict(get_table(doc, "loading"))
-        longitudinal_force = None
-        if "longitudinal_force_N" in loading:
-            longitudinal_force = get_number(loading, "longitudinal_force_N", "loading")
-            del loading["longitudinal_force_N"]
-            if "pitch_rate_rad_per_s" in kinematics:
-                raise ConfigError(
-                    f"key 'kinematics.pitch_rate_rad_per_s' = {kinematics['pitch_rate_rad_per_s']!r}: not allowed "
-                    "with 'loading.longitudinal_force_N' (the pitch rate is solved for that force)"
-                )
+        longitudinal_force = _longitudinal_force(loading, kinematics, "pitch_rate_rad_per_s", "the pitch rate")
         force, approach = _read_loading(loading, "wheel_load_N")
         irregularities = dict(get_table(doc, "irregularities", required=False))
         if "wheel_slices_file" in irregularities:
@@ -265,6 +249,22 @@ def parse_case(doc: dict, name: str = "", base_dir: Path | None = None) -> Conta
         wheelset = _build_wheelset_case(geometry_table, force, approach, kinematics, irregularities)
         return ContactCase("wheelset", material, None, None, None, wheelset, solver, name, longitudinal_force)
     raise ConfigError(f"key 'geometry.kind' = {kind!r}: expected 'quadric' or 'wheelset'")
+
+
+def _longitudinal_force(loading: dict, kinematics: dict, solved_key: str, solved: str) -> float | None:
+    """``loading.longitudinal_force_N`` taken out of ``loading`` (None when absent); the kinematics key it solves
+    (``solved_key``, described as ``solved``) may not be given with it.
+    """
+    if "longitudinal_force_N" not in loading:
+        return None
+    force = get_number(loading, "longitudinal_force_N", "loading")
+    del loading["longitudinal_force_N"]
+    if solved_key in kinematics:
+        raise ConfigError(
+            f"key 'kinematics.{solved_key}' = {kinematics[solved_key]!r}: not allowed with "
+            f"'loading.longitudinal_force_N' ({solved} is solved for that force)"
+        )
+    return force
 
 
 def _slices_path(value, base_dir: Path | None) -> str:
