@@ -288,10 +288,46 @@ def cmd_run(args) -> int:
         from rigid_dynamics.wheelset.discretisation import describe
 
         _print(describe(summary["discretisation_errors"]))
-    for line in patch_summary_lines(summary):
+    for line in patch_summary_lines(summary) + event_lines(summary):
         _print(line)
     _print(f"output written to {out_dir}")
     return EXIT_OK if summary.get("success", summary["status"] == "ok") and summary["status"] == "ok" else EXIT_FAILED
+
+
+EVENTS_PRINTED = 12
+"""The events a run prints (the first ones; summary.json holds all)."""
+
+
+def event_lines(summary: dict) -> list[str]:
+    """The run's events (SimulationResult.events, in time order) as one line, e.g. "events: adhesion-limit left at
+    0.045 s, wheel-slide left at 0.059 s", the first :data:`EVENTS_PRINTED` with the count of the rest; and the
+    traction controller's last sample, if the scene has one.
+    """
+    lines = []
+    events = summary.get("events") or []
+    if events:
+        shown = ", ".join(
+            f"{e['kind']} {e['side']}" + (f" at {e['time_s']:.4g} s" if e.get("time_s") is not None else "")
+            for e in events[:EVENTS_PRINTED]
+        )
+        more = len(events) - EVENTS_PRINTED
+        lines.append(f"events: {shown}" + (f" and {more} more (summary.json)" if more > 0 else ""))
+    traction = summary.get("traction")
+    if traction:
+        last = traction["last_sample"]
+        demand = (
+            f"force {traction['force_demand_N']:g} N"
+            if traction["mode"] == "force"
+            else f"adhesion {traction['adhesion_demand']:g} of the normal force"
+        )
+        names = ("traction_torque_N_m", "traction_demand_N", "traction_measured_force_N")
+        numbers = [last.get(name) for name in names]
+        if all(v is not None for v in numbers):
+            lines.append(
+                f"traction controller ({demand}): at the end torque {numbers[0]:.5g} N m, demand {numbers[1]:.5g} N, "
+                f"longitudinal creep force {numbers[2]:.5g} N"
+            )
+    return lines
 
 
 def patch_summary_lines(summary: dict) -> list[str]:

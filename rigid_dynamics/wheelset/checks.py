@@ -33,6 +33,7 @@ def check_scene(scene: DynamicsScene) -> None:
     """
     from rigid_dynamics.contact.registry import MODELS
 
+    _check_traction(scene)
     if isinstance(scene.contact_model, str) and scene.contact_model not in MODELS:
         raise SceneError("contact_model", scene.contact_model, "one of " + ", ".join(MODELS))
     track, irr = scene.track, scene.irregularities
@@ -71,3 +72,27 @@ def check_scene(scene: DynamicsScene) -> None:
                 f"an amplitude < r0 / n^2 = {limit:.4g} m for polygon_order n = {n} and r0 = {r0:g} m (beyond it "
                 "the wheel is no longer convex, or no longer round at all)",
             )
+
+
+TRACTION_METHODS = ("RK4", "DP54", "BS32")
+"""Integrator methods that run the traction controller (the compiled loop's, stopped at each sample)."""
+
+
+def _check_traction(scene: DynamicsScene) -> None:
+    """A [traction] controller sets the torque: no constant torque beside it, a method of the compiled loop."""
+    control = scene.traction
+    if not control.active:
+        return
+    if scene.loads.traction_torque_N_m != 0.0:
+        raise SceneError(
+            "loads.traction_torque_N_m",
+            scene.loads.traction_torque_N_m,
+            f"0 with traction.mode = {control.mode!r} (the controller sets the torque; remove one of the two)",
+        )
+    if scene.integrator.method not in TRACTION_METHODS:
+        raise SceneError(
+            "integrator.method",
+            scene.integrator.method,
+            f"one of {', '.join(TRACTION_METHODS)} with traction.mode = {control.mode!r} (the controller runs in "
+            "the compiled loop, sampled at the output times)",
+        )

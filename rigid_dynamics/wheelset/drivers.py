@@ -18,8 +18,10 @@ from rigid_dynamics.wheelset.equilibrium import contact_force_sums
 from rigid_dynamics.wheelset.layout import (
     AUTO_PATCH_FIELDS,
     CALLBACK_FAILED,
+    CREEP_FORCE_LONG,
     MAX_SLOTS,
     N_FIELDS,
+    NORMAL_FORCE,
     PATCH_FIELDS,
     UNDERFLOW,
     status_name,
@@ -476,6 +478,14 @@ def _fixed_step_plan(settings, duration):
     return h, out_times, check_every, max(period, (2000 // period) * period)
 
 
+def _longitudinal_sums(rec: np.ndarray, ncand: int) -> tuple[float, float]:
+    """(total longitudinal creep force, total normal force) of the candidates of one record (ncand + 2,
+    layout.N_FIELDS), N: what the traction controller measures (traction.py).
+    """
+    block = rec[:ncand]
+    return float(np.nansum(block[:, CREEP_FORCE_LONG])), float(np.nansum(block[:, NORMAL_FORCE]))
+
+
 def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
     """The compiled loop (compiled_loop.embedded_run) for every method of compiled_loop.TABLEAUX: the embedded pairs
     DP54/BS32 with step-size control, in calls of compiled_loop.STEPS_PER_CALL accepted steps, and RK4 with its
@@ -488,6 +498,7 @@ def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
     from rigid_dynamics.wheelset.compiled_loop import (
         MAX_EVENTS,
         MIN_STEP_S,
+        STARTED,
         STEPS_PER_CALL,
         TABLEAUX,
         Carried,
@@ -535,6 +546,14 @@ def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
     if not fixed:
         model.adaptive_stats = stats
     y, t, k_out = y0.copy(), 0.0, 0
+    traction = getattr(model, "traction", None)
+    if traction is not None:
+        # the controller samples at the output times: each call of the loop ends on the next one (RK4: per_call
+        # is the steps between samples), and the torque is set from the sample's record (traction.py)
+        rhs(0.0, y0)
+        run.par["torque_N_m"] = traction.update(0.0, *_longitudinal_sums(rec, ncand))
+        if fixed:
+            control = control._replace(max_steps=max(1, int(round(out_times[0] / h))))
 
     def events_to_recorder():
         if not fixed:
@@ -542,7 +561,8 @@ def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
             recorder.events[:] = sorted(kept + side_events(events, run.sides), key=lambda ev: ev[2])
 
     while True:
-        outcome = embedded_run(y, t, duration, h, tableau, control, run, outputs, k_out, carried, events)
+        t_end = duration if traction is None or fixed else float(out_times[min(k_out, len(out_times) - 1)])
+        outcome = embedded_run(y, t, t_end, h, tableau, control, run, outputs, k_out, carried, events)
         model.rhs_evaluations += outcome.evaluations
         stats["accepted_steps"] += outcome.accepted
         stats["rejected_steps"] += outcome.rejected
@@ -569,6 +589,9 @@ def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
                 model, outcome.status, outcome.t, outcome.y, settings.method, stats["accepted_steps"], why
             )
         y, t, h = outcome.y, outcome.t, outcome.h
+        if traction is not None and k_out > 0 and abs(out_times[k_out - 1] - t) <= 1e-12 * max(1.0, duration):
+            run.par["torque_N_m"] = traction.update(t, *_longitudinal_sums(outputs.recs[k_out - 1], ncand))
+            carried.control[STARTED] = 0.0  # the first stage f(t, y) again, with the new torque
         if t >= duration - 1e-12 * max(1.0, duration):
             break
         try:

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, fields
 from rigid_dynamics.materials import STEEL, Material
 from rigid_dynamics.wheelset.fields import check_finite
 from rigid_dynamics.wheelset.track import TrackDynamics
+from rigid_dynamics.wheelset.traction import TractionControl
 
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
 """Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
@@ -500,6 +501,8 @@ class DynamicsScene:
     Attributes:
         name: scene name. description: one line for listings.
         wheelset, suspension, loads, track, irregularities, integrator, initial: nested parameters.
+        traction: the traction or braking controller (traction.TractionControl; mode "none": the constant
+            loads.traction_torque_N_m).
         material: elastic constants and friction of the wheel-rail pair.
         speed_m_per_s: V, forward speed of the suspension frame and initial speed of the wheelset, m/s.
         duration_s: simulated time, s.
@@ -546,6 +549,7 @@ class DynamicsScene:
     settling_distance_m: float = 10.0
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
+    traction: TractionControl = field(default_factory=TractionControl)
 
     def __post_init__(self) -> None:
         check_finite(
@@ -576,6 +580,7 @@ class DynamicsScene:
             ("material", Material),
             ("integrator", IntegratorSettings),
             ("initial", InitialConditions),
+            ("traction", TractionControl),
         ):
             if not isinstance(getattr(self, name), cls):
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected a {cls.__name__}")

@@ -76,6 +76,9 @@ class SimulationResult:
         scene: the scene that ran.
         companion_errors: the contact grid's and the geometry tables' error statements of the run's companions
             (discretisation.companion_errors); None before they are computed.
+        traction: runs with a [traction] controller: traction.TRACTION_SERIES -> (n,) at the output times (the torque
+            held from each sample on, N m; the demand and the measured total longitudinal creep force, N); None
+            otherwise.
         callback_stats: runs with a contact model solved through the callback (callback.PatchCallback): its solves,
             seconds, the seconds spent sampling patches and the BEM warm start's counts; None otherwise.
     """
@@ -108,6 +111,7 @@ class SimulationResult:
     track_full_states: np.ndarray | None = field(default=None, repr=False)
     callback_stats: dict | None = None
     companion_errors: dict | None = field(default=None, repr=False)
+    traction: dict | None = None
 
     @property
     def success(self) -> bool:
@@ -281,7 +285,17 @@ class SimulationResult:
             **self._auto_summary(),
             "patch_summary": self.patch_summary(),
             "callback": self.callback_stats,
+            "traction": self._traction_summary(num),
         }
+
+    def _traction_summary(self, num) -> dict | None:
+        """The traction controller's mode and demand, and its last sample (torque, demand, measured force)."""
+        if self.traction is None or self.scene is None:
+            return None
+        control = self.scene.traction
+        last = {name: num(values[-1]) if len(values) else None for name, values in self.traction.items()}
+        return {"mode": control.mode, "force_demand_N": control.force_demand_N,
+                "adhesion_demand": control.adhesion_demand, "last_sample": last}  # fmt: skip
 
     def patch_summary(self) -> dict:
         """Per patch slot in contact (``"left tread"``, ``"right second"``, ...): which geometry the model saw
@@ -461,6 +475,8 @@ def timeseries_arrays(result: SimulationResult) -> dict[str, np.ndarray]:
     if result.track_states is not None:
         arrays["track_states"] = result.track_states
         arrays["track_state_names"] = np.array(result.track_state_names)
+    for name, values in (result.traction or {}).items():
+        arrays[name] = values
     for name, values in result.patches.items():
         arrays[f"patch_{name}"] = values
     if "auto_rung" in result.patches:

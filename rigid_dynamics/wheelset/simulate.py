@@ -78,6 +78,7 @@ from rigid_dynamics.wheelset.results import (
     timeseries_arrays,
 )
 from rigid_dynamics.wheelset.stability import NUMERICAL_LOOKING, judge_fixed_step, rk4_stable_step
+from rigid_dynamics.wheelset.traction import TractionController
 from rigid_dynamics.wheelset.wheelset_model import ContactFailure, WheelsetModel
 
 __all__ = [
@@ -200,7 +201,14 @@ def simulate(
     # the compiled 3-D search tracks its contact points between RK4 stages: outside the compiled loop (and for the
     # finite-difference Jacobian of the stability check) the contact package's search gives the geometry
     search_in_python = geometry_mode(provider) == GEOMETRY_SEARCH
+    if scene.traction.active and not use_compiled:
+        raise ValueError(
+            f"traction.mode = {scene.traction.mode!r}: the traction controller runs in the compiled loop only "
+            "(method RK4, DP54 or BS32 with a TableProvider or a SearchProvider on tabulated surfaces)"
+        )
     model = WheelsetModel(scene, provider, model_obj, options, python_geometry=search_in_python and not use_compiled)
+    traction = scene.traction
+    model.traction = TractionController(traction, scene.wheelset.nominal_radius_m) if traction.active else None
     settings = scene.integrator
     duration = scene.duration_s
     packed = model.packed
@@ -326,6 +334,7 @@ def simulate(
         track_state_names=tuple(track_names or ()),
         track_full_states=track_full,
         callback_stats=model.callback.stats() if model.callback is not None else None,
+        traction=model.traction.series(t) if model.traction is not None else None,
     )
     result = judge_step(result, _Rerun(provider, model_obj, compiled), probe if ok else None, full0)
     if companions:  # the discretisations the step's judgement cannot see (discretisation.companion_errors)
@@ -423,9 +432,10 @@ def _energy_check(result: SimulationResult, settings) -> SimulationResult:
 
 def _adhesion(scene, t, patches) -> list[tuple]:
     """The adhesion-limit and wheel-slide events (recorder.adhesion_events) of a driven or braked wheelset (scene
-    traction_torque_N_m != 0); none otherwise.
+    traction_torque_N_m != 0 or a [traction] controller); none otherwise.
     """
-    if scene.loads.traction_torque_N_m == 0.0 or patches is None or "creepage_long" not in patches:
+    driven = scene.loads.traction_torque_N_m != 0.0 or scene.traction.active
+    if not driven or patches is None or "creepage_long" not in patches:
         return []
     return adhesion_events(t, patches)
 
