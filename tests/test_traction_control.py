@@ -114,6 +114,28 @@ def test_adhesion_limit_then_slide(limited):
     assert {e["kind"] for e in summary["events"]} >= {"adhesion-limit", "wheel-slide"}
 
 
+def test_slip_protection_holds_the_slip_limit():
+    """slip_limit = 0.01 (beyond the creep curve's maximum): past the adhesion limit the wheels are held at
+    |xi| = 0.01 (within 3e-3 of it over the last 50 ms), no wheel slide;
+    the force on the falling branch, below the maximum."""
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.scenes import load_scene
+
+    scene = load_scene("traction-adhesion")
+    result = simulate(replace(scene, duration_s=0.3, traction=replace(scene.traction, slip_limit=0.01)))
+    assert result.status == "ok", result.message
+    kinds = {kind for kind, _, _ in result.events}
+    assert "adhesion-limit" in kinds and "wheel-slide" not in kinds
+    late = result.t >= 0.25
+    xi = np.abs(result.patches["creepage_long"][:, :, 0])
+    deviation = np.max(np.abs(xi[late].max(axis=1) - 0.01)) / 0.01
+    print(f"slip held at 0.01 to {deviation:.3g} (relative) over 0.25-0.3 s; overshoot {xi.max() / 0.01 - 1:.3g}")
+    assert deviation < 3e-3
+    ratio = _total(result, "creep_force_long_N") / _total(result, "normal_force_N")
+    assert ratio[-1] < np.max(ratio)
+    assert np.all(result.traction["traction_torque_N_m"] < scene.traction.torque_limit_N_m)
+
+
 def test_cli_prints_the_events(tmp_path, capsys):
     """``wheelrail run`` prints the events it writes to summary.json, and the controller's last sample."""
     import json

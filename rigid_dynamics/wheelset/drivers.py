@@ -19,6 +19,7 @@ from rigid_dynamics.wheelset.layout import (
     AUTO_PATCH_FIELDS,
     CALLBACK_FAILED,
     CREEP_FORCE_LONG,
+    CREEPAGE_LONG,
     MAX_SLOTS,
     N_FIELDS,
     NORMAL_FORCE,
@@ -478,12 +479,14 @@ def _fixed_step_plan(settings, duration):
     return h, out_times, check_every, max(period, (2000 // period) * period)
 
 
-def _longitudinal_sums(rec: np.ndarray, ncand: int) -> tuple[float, float]:
-    """(total longitudinal creep force, total normal force) of the candidates of one record (ncand + 2,
-    layout.N_FIELDS), N: what the traction controller measures (traction.py).
+def _longitudinal_sums(rec: np.ndarray, ncand: int) -> tuple[float, float, float]:
+    """(total longitudinal creep force, N; total normal force, N; the largest |xi| of the candidates in contact) of
+    one record (ncand + 2, layout.N_FIELDS): what the traction controller measures (traction.py).
     """
     block = rec[:ncand]
-    return float(np.nansum(block[:, CREEP_FORCE_LONG])), float(np.nansum(block[:, NORMAL_FORCE]))
+    touching = block[:, NORMAL_FORCE] > 0.0
+    creepage = float(np.max(np.abs(block[touching, CREEPAGE_LONG]))) if np.any(touching) else 0.0
+    return float(np.nansum(block[:, CREEP_FORCE_LONG])), float(np.nansum(block[:, NORMAL_FORCE])), creepage
 
 
 def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:

@@ -28,10 +28,23 @@ Beyond the adhesion limit no torque holds the demand: on a falling creep curve t
 the error grows, the torque runs to its limit and the wheel slides; the run's events (recorder.adhesion_events)
 mark the adhesion limit and the wheel slide.
 
+With slip protection (``slip_limit`` = xi_max > 0) the error is the smaller, in the demand's direction, of the
+force error and a creepage error that vanishes at the slip limit::
+
+    e_k = sgn(D_k) min(sgn(D_k) (D_k - F_k), |D_k| (1 - |xi_k| / xi_max))
+
+(|xi_k| the largest longitudinal creepage of the patches in contact): below the limit and short of the demand the
+controller raises the torque as before; a demand the adhesion cannot give no longer runs the wheel into a slide but
+holds it at |xi| = xi_max (the creep controller of a wheel-slide protection or anti-slip system), on the falling
+branch of the creep curve if xi_max lies beyond its maximum.
+
 The plant seen by the controller is fast: the wheelset's spin against its creep stiffness settles in
 J_a V / (k r_0^2) (0.5 ms for 112 kg m^2, 20 m/s, k = 2.2e7 N per unit creepage for the axle), so at a 1 ms sample
 the measured force is close to T_(k-1) / r_0 and the proportional loop is stable for K_p < r_0; the integral's time
-constant is about r_0 / K_i (23 ms for K_i = 20 m/s).
+constant is about (r_0 + K_p) / K_i (28 ms for K_i = 20 m/s). On the creepage error of the slip protection the
+torque changes by K_p |D| / xi_max per unit creepage, whose loop through the wheel's spin
+(dxi/dt = r_0 (T - r_0 F) / (V J_a)) is stable at the sample dt while K_p |D| r_0 dt / (xi_max V J_a) < 2 (0.16 for
+80 kN, xi_max = 0.01, dt = 1 ms).
 """
 
 from __future__ import annotations
@@ -60,6 +73,8 @@ class TractionControl:
         integral_gain_m_per_s: K_i >= 0, N m of torque per N of force error and second (m/s).
         torque_limit_N_m: T_max > 0, the largest axle torque of the drive or brake, N m.
         ramp_time_s: the demand rises linearly from zero over this time, s (0: a step at t = 0).
+        slip_limit: xi_max, the longitudinal creepage the slip protection holds the wheels to, in (0, 1)
+            (0: no slip protection).
     """
 
     mode: str = "none"
@@ -69,12 +84,13 @@ class TractionControl:
     integral_gain_m_per_s: float = 20.0
     torque_limit_N_m: float = 50.0e3
     ramp_time_s: float = 0.0
+    slip_limit: float = 0.0
 
     def __post_init__(self) -> None:
         if self.mode not in TRACTION_MODES:
             raise ValueError(f"mode = {self.mode!r}: expected one of {', '.join(TRACTION_MODES)}")
         for name in ("force_demand_N", "adhesion_demand", "proportional_gain_m", "integral_gain_m_per_s",
-                     "torque_limit_N_m", "ramp_time_s"):  # fmt: skip
+                     "torque_limit_N_m", "ramp_time_s", "slip_limit"):  # fmt: skip
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f"{name} = {value!r}: expected a finite number")
@@ -83,6 +99,8 @@ class TractionControl:
                 raise ValueError(f"{name} = {getattr(self, name)!r}: expected a number >= 0")
         if not self.torque_limit_N_m > 0.0:
             raise ValueError(f"torque_limit_N_m = {self.torque_limit_N_m!r}: expected a number > 0 (N m)")
+        if not 0.0 <= self.slip_limit < 1.0:
+            raise ValueError(f"slip_limit = {self.slip_limit!r}: expected a creepage in (0, 1), or 0 for none")
         if abs(self.adhesion_demand) > 1.0:
             raise ValueError(f"adhesion_demand = {self.adhesion_demand!r}: expected a ratio T_x / N within [-1, 1]")
         if self.mode == "force" and self.force_demand_N == 0.0:
@@ -121,8 +139,10 @@ class TractionController:
         ramp = 1.0 if c.ramp_time_s == 0.0 else min(1.0, t / c.ramp_time_s)
         return ramp * (c.force_demand_N if c.mode == "force" else c.adhesion_demand * normal_force_N)
 
-    def update(self, t: float, creep_force_N: float, normal_force_N: float) -> float:
-        """The torque (N m) from the sample at t: measured total longitudinal creep force and normal force, N."""
+    def update(self, t: float, creep_force_N: float, normal_force_N: float, creepage: float = 0.0) -> float:
+        """The torque (N m) from the sample at t: measured total longitudinal creep force and normal force (N), and
+        the largest |xi| of the patches in contact (for the slip protection).
+        """
         c = self.control
         if self.last is not None:
             t_last, e_last, saturated = self.last
@@ -130,6 +150,9 @@ class TractionController:
                 self.integral += c.integral_gain_m_per_s * (t - t_last) * e_last
         demand = self.demand_N(t, normal_force_N)
         error = demand - creep_force_N
+        if c.slip_limit > 0.0 and demand != 0.0:
+            sign = math.copysign(1.0, demand)
+            error = sign * min(sign * error, abs(demand) * (1.0 - abs(creepage) / c.slip_limit))
         u = self.radius * demand + c.proportional_gain_m * error + self.integral
         torque = min(max(u, -c.torque_limit_N_m), c.torque_limit_N_m)
         saturated = 0 if torque == u else (1 if u > 0 else -1)
