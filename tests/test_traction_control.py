@@ -136,6 +136,31 @@ def test_slip_protection_holds_the_slip_limit():
     assert np.all(result.traction["traction_torque_N_m"] < scene.traction.torque_limit_N_m)
 
 
+def test_dp54_runs_the_controller_as_rk4(limited):
+    """Regression of the two integrators of the compiled loop under the controller (DP54 stops at each sample as RK4
+    does): the same events and the peak adhesion ratio to 1e-4."""
+    from rigid_dynamics.wheelset import simulate
+
+    scene = limited.scene
+    dp54 = simulate(replace(scene, integrator=replace(scene.integrator, method="DP54")), companions=False)
+    assert dp54.status == "ok", dp54.message
+    assert dp54.events == limited.events
+
+    def peak(result):
+        return np.max(_total(result, "creep_force_long_N") / _total(result, "normal_force_N"))
+
+    assert peak(dp54) == pytest.approx(peak(limited), abs=1e-4)
+
+
+def test_the_python_path_refuses_the_controller():
+    """compiled = False: the controller runs in the compiled loop only; a ValueError naming the key."""
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.scenes import load_scene
+
+    with pytest.raises(ValueError, match=r"traction\.mode = 'adhesion': the traction controller runs in the compiled"):
+        simulate(replace(load_scene("traction-adhesion"), duration_s=0.01), compiled=False)
+
+
 def test_cli_prints_the_events(tmp_path, capsys):
     """``wheelrail run`` prints the events it writes to summary.json, and the controller's last sample."""
     import json
