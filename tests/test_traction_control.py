@@ -64,6 +64,22 @@ def test_force_demand_is_held(held):
     assert not [e for e in held.events if e[0] in ("adhesion-limit", "wheel-slide")]
 
 
+def test_braking_adhesion_demand_is_held():
+    """A braking adhesion demand of -0.3 (below mu_0 = 0.4): the ratio of the total longitudinal creep force to the
+    total normal force holds -0.3 within 1e-4 over the last 50 ms, the torque brakes (< 0), no adhesion event."""
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.scenes import load_scene
+
+    scene = load_scene("traction-adhesion")
+    result = simulate(replace(scene, duration_s=0.3, traction=replace(scene.traction, adhesion_demand=-0.3)))
+    assert result.status == "ok", result.message
+    late = result.t >= 0.25
+    ratio = _total(result, "creep_force_long_N") / _total(result, "normal_force_N")
+    assert np.max(np.abs(ratio[late] + 0.3)) < 1e-4
+    assert np.all(result.traction["traction_torque_N_m"][late] < 0.0)
+    assert not [e for e in result.events if e[0] in ("adhesion-limit", "wheel-slide")]
+
+
 def test_steady_creepage_is_the_static_root(held):
     """The creepage the controller settles at is where the static FASTSIM of both recorded patches (same grid
     20 x 20, same Polach law at the rolling speed) gives the demanded force. The two wheels' creepages differ by
