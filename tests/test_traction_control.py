@@ -190,6 +190,8 @@ def test_cli_prints_the_events(tmp_path, capsys):
     assert len(summary["events"]) == line.count(" at ")
     arrays = np.load(tmp_path / "run" / "timeseries.npz")
     assert arrays["traction_torque_N_m"].shape == arrays["t"].shape
+    header = (tmp_path / "run" / "timeseries.csv").read_text().splitlines()[0].split(",")
+    assert {"traction_torque_N_m", "traction_demand_N", "traction_measured_force_N"} <= set(header)
 
 
 def test_pi_law_on_a_static_plant():

@@ -85,6 +85,8 @@ def result_columns(result) -> dict[str, np.ndarray]:
     if track is not None:  # what the run recorded of the elastic track (its track_state_names), after the others
         for k, name in enumerate(result.track_state_names):
             columns[name] = np.asarray(track, float)[:, k]
+    for name, values in (getattr(result, "traction", None) or {}).items():  # the traction controller's samples
+        columns[name] = np.asarray(values, float)
     return columns
 
 
