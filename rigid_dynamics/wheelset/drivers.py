@@ -554,8 +554,9 @@ def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
         # the controller samples at the output times: each call of the loop ends on the next one (RK4: per_call
         # is the steps between samples), and the torque is set from the sample's record (traction.py)
         rhs(0.0, y0)
+        model.rhs_evaluations += 1
         run.par["torque_N_m"] = traction.update(0.0, *_longitudinal_sums(rec, ncand))
-        if fixed:
+        if fixed and len(out_times):  # (a run shorter than one output step has no sample after t = 0)
             control = control._replace(max_steps=max(1, int(round(out_times[0] / h))))
 
     def events_to_recorder():
