@@ -154,7 +154,9 @@ class CreepSensitivities:
             "message": self.message,
             "jacobian": table(self.jacobian),
             "error_estimate": table(self.error_estimate),
-            "steps": {c: (None if not math.isfinite(h) else float(h)) for c, h in zip(COLUMNS, self.steps, strict=True)},
+            "steps": {
+                c: (None if not math.isfinite(h) else float(h)) for c, h in zip(COLUMNS, self.steps, strict=True)
+            },
             "coefficients": {k: (None if not math.isfinite(v) else v) for k, v in coef._asdict().items()},
             "solves": self.solves,
             "wall_time_s": self.wall_time_s,
@@ -203,7 +205,10 @@ def creep_sensitivities(
         chosen = base.extra.get("selected_model", "auto")
         per_model = dict((point.options or {}).get("model_options") or {})
         if chosen == "bem":
-            per_model["bem"] = {"grid_tolerance": (point.options or {}).get("tolerance", 0.05), **(per_model.get("bem") or {})}
+            per_model["bem"] = {
+                "grid_tolerance": (point.options or {}).get("tolerance", 0.05),
+                **(per_model.get("bem") or {}),
+            }
         out = creep_sensitivities(
             chosen, point._replace(options=per_model.get(chosen)), relative_step=relative_step, method=method
         )
@@ -403,9 +408,10 @@ def _differences(rung, point: OperatingPoint, base: ContactResult, relative_step
             jac[:, j] = (pair[0] - pair[1]) / (2.0 * factor * steps[j])
         estimates.append(jac)
     jac, error = estimates[0], np.abs(estimates[0] - estimates[1])
-    message = (f"central differences, steps {relative_step:g} x the creepage scale (xi* {steps[XI] / relative_step:.3g}, "
-               f"eta* {steps[ETA] / relative_step:.3g}, phi* {steps[PHI] / relative_step:.3g} 1/m) and "
-               f"{relative_step:g} x N; error estimated against twice the steps")  # fmt: skip
+    scale = steps / relative_step
+    message = (f"central differences, steps {relative_step:g} x the creepage scale (xi* {scale[XI]:.3g}, "
+               f"eta* {scale[ETA]:.3g}, phi* {scale[PHI]:.3g} 1/m) and {relative_step:g} x N; error estimated "
+               "against twice the steps")  # fmt: skip
     if base.status != "ok":
         message += f"; the base solve: {base.status}: {base.message}"
     return CreepSensitivities(
