@@ -179,12 +179,16 @@ def creep_sensitivities(
     *,
     relative_step: float = DEFAULT_RELATIVE_STEP,
     method: str | None = None,
+    estimate_error: bool = True,
+    normal: bool = True,
 ) -> CreepSensitivities:
     """d(Fx, Fy, Mz)/d(xi, eta, phi, N) of ``model`` (a registered name or a ContactModel) at ``point``.
 
     Analytic for hertz, linear and vermeulen-johnson; central differences with steps from the creepage scale for
     every other rung, with their error estimated from a second step (module docstring). ``method``: force
-    "central-difference" (e.g. to check an analytic rung), else None.
+    "central-difference" (e.g. to check an analytic rung), else None. ``estimate_error`` False: one step only (half
+    the solves; ``error_estimate`` NaN); ``normal`` False: no dF/dN column by differences (NaN; a third fewer
+    solves), for a caller that needs the creepage columns alone (the wheelset's Jacobian).
 
     Raises:
         ValueError: bad model name, ``relative_step`` not in (0, 0.1], ``method`` unknown, or bad input of the
@@ -210,7 +214,12 @@ def creep_sensitivities(
                 **(per_model.get("bem") or {}),
             }
         out = creep_sensitivities(
-            chosen, point._replace(options=per_model.get(chosen)), relative_step=relative_step, method=method
+            chosen,
+            point._replace(options=per_model.get(chosen)),
+            relative_step=relative_step,
+            method=method,
+            estimate_error=estimate_error,
+            normal=normal,
         )
         return replace(out, message=f"auto chose {chosen}: {out.message}", wall_time_s=time.perf_counter() - start)
     if base.status == "no-contact" or not base.success:
@@ -223,7 +232,7 @@ def creep_sensitivities(
     if method == "analytic":
         raise ValueError(f"method = 'analytic': the rung {rung.name!r} has no closed form (one of "
                          f"{', '.join(ANALYTIC_RUNGS)} has)")  # fmt: skip
-    return _differences(rung, point, base, relative_step, start)
+    return _differences(rung, point, base, (relative_step, estimate_error, normal), start)
 
 
 def _failed(name: str, base: ContactResult, material: Material, message: str, start: float) -> CreepSensitivities:
@@ -382,7 +391,9 @@ def _shifted(point: OperatingPoint, column: int, step: float) -> OperatingPoint:
     return point._replace(creepage=Creepage(*values, c.rolling_speed_m_per_s))
 
 
-def _differences(rung, point: OperatingPoint, base: ContactResult, relative_step: float, start) -> CreepSensitivities:
+def _differences(rung, point: OperatingPoint, base: ContactResult, how: tuple, start) -> CreepSensitivities:
+    """Central differences; ``how`` = (relative_step, estimate_error, normal) of :func:`creep_sensitivities`."""
+    relative_step, estimate_error, normal = how
     a, b = base.semi_axis_long_m, base.semi_axis_lat_m
     if not (a and b and a > 0 and b > 0):
         a, b = _hertz_axes(point)
@@ -390,9 +401,9 @@ def _differences(rung, point: OperatingPoint, base: ContactResult, relative_step
     opts = _fixed_grid_options(rung, point.options, base)
     solves = 1
     estimates = []
-    for factor in (1.0, 2.0):
-        jac = np.empty((3, 4))
-        for j in range(4):
+    for factor in (1.0, 2.0) if estimate_error else (1.0,):
+        jac = np.full((3, 4), np.nan)
+        for j in range(4) if normal else range(3):
             pair = []
             for sign in (1.0, -1.0):
                 shifted = _shifted(point, j, sign * factor * steps[j])
@@ -407,11 +418,12 @@ def _differences(rung, point: OperatingPoint, base: ContactResult, relative_step
                 pair.append(_forces(r))
             jac[:, j] = (pair[0] - pair[1]) / (2.0 * factor * steps[j])
         estimates.append(jac)
-    jac, error = estimates[0], np.abs(estimates[0] - estimates[1])
+    jac = estimates[0]
+    error = np.abs(estimates[0] - estimates[1]) if estimate_error else np.full((3, 4), np.nan)
     scale = steps / relative_step
     message = (f"central differences, steps {relative_step:g} x the creepage scale (xi* {scale[XI]:.3g}, "
-               f"eta* {scale[ETA]:.3g}, phi* {scale[PHI]:.3g} 1/m) and {relative_step:g} x N; error estimated "
-               "against twice the steps")  # fmt: skip
+               f"eta* {scale[ETA]:.3g}, phi* {scale[PHI]:.3g} 1/m) and {relative_step:g} x N; error "
+               + ("estimated against twice the steps" if estimate_error else "not estimated"))  # fmt: skip
     if base.status != "ok":
         message += f"; the base solve: {base.status}: {base.message}"
     return CreepSensitivities(
