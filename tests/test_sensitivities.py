@@ -162,7 +162,7 @@ DIFFERENCE_RUNGS = {
 @pytest.mark.parametrize("name", list(DIFFERENCE_RUNGS))
 @pytest.mark.parametrize("where", ["zero", "mid"])
 def test_difference_rungs_consistent_with_a_third_of_the_step(name, where):
-    """Regression/consistency: the sensitivities (steps 1e-3 x the creepage scale) against the rung's own central
+    """Regression/consistency: the sensitivities (steps 1e-4 x the creepage scale, the BEM 1e-3) against the rung's own central
     differences at a third of those steps; they agree within 3 x the stated error estimate plus 1e-3 of the row's
     largest entry (the rounding of the perturbed solves).
     """

@@ -28,7 +28,8 @@ sensitivities come by differences below.
 models; ``auto``: the rung it chose at the operating point): J[:, j] = (F(x + h_j) - F(x - h_j)) / (2 h_j), with
 the step chosen from the creepage scale of the patch, the creepage at which the linear force reaches 3 mu N (where
 Vermeulen-Johnson saturates): xi* = 3 mu N / (G a b C11), eta* = 3 mu N / (G a b C22), phi* = 3 mu N / (G (ab)^1.5
-C23), and h_j = ``relative_step`` x (that scale) (default 1e-3; the normal force: ``relative_step`` x N). The
+C23), and h_j = ``relative_step`` x (that scale) (default 1e-4, the BEM 1e-3: :data:`DEFAULT_RELATIVE_STEP`,
+:data:`ITERATIVE_RELATIVE_STEPS`; the normal force: ``relative_step`` x N). The
 semi-axes are the base solution's, else Hertz's. The error of each entry is estimated by repeating with twice the
 steps: ``error_estimate`` = |J(h) - J(2h)|, which for a smooth force is three times J(h)'s own O(h^2) error (so
 conservative) and also shows the noise of a grid law whose slip front jumps from element to element and of an
@@ -63,8 +64,15 @@ FX, FY, MZ = range(3)
 XI, ETA, PHI, NORMAL = range(4)
 
 ANALYTIC_RUNGS = ("hertz", "linear", "vermeulen-johnson")
-DEFAULT_RELATIVE_STEP = 1e-3
-"""Central-difference step as a fraction of the patch's creepage scale (module docstring)."""
+DEFAULT_RELATIVE_STEP = 1e-4
+"""Central-difference step as a fraction of the patch's creepage scale (module docstring), for the rungs that solve
+without iterating (FASTSIM, FaStrip, KPEC under approach control): small enough that a step seldom straddles an
+element's switch between adhesion and slip (FASTSIM's force is piecewise smooth in the creepages: at 1e-3 the
+wheelset Jacobian's FASTSIM columns differed by 0.15 % from the compiled law's own derivative, at 1e-4 by 2e-8,
+benchmarks/results/creep_jacobian.md)."""
+ITERATIVE_RELATIVE_STEPS = {"bem": 1e-3, "fea": 1e-2}
+"""The step of the rungs that iterate to a tolerance: the BEM's relative tolerance 1e-6 makes a difference quotient
+with a step of 1e-3 x the creepage scale noisy at about 1e-6 / 1e-3 of the force's scale (an FEA solve more)."""
 
 
 class LinearCreepCoefficients(NamedTuple):
@@ -177,7 +185,7 @@ def creep_sensitivities(
     model,
     point: OperatingPoint,
     *,
-    relative_step: float = DEFAULT_RELATIVE_STEP,
+    relative_step: float | None = None,
     method: str | None = None,
     estimate_error: bool = True,
     normal: bool = True,
@@ -185,7 +193,9 @@ def creep_sensitivities(
     """d(Fx, Fy, Mz)/d(xi, eta, phi, N) of ``model`` (a registered name or a ContactModel) at ``point``.
 
     Analytic for hertz, linear and vermeulen-johnson; central differences with steps from the creepage scale for
-    every other rung, with their error estimated from a second step (module docstring). ``method``: force
+    every other rung, with their error estimated from a second step (module docstring). ``relative_step``: the
+    steps as a fraction of the creepage scale (None: :data:`ITERATIVE_RELATIVE_STEPS` for an iterative rung, else
+    :data:`DEFAULT_RELATIVE_STEP`). ``method``: force
     "central-difference" (e.g. to check an analytic rung), else None. ``estimate_error`` False: one step only (half
     the solves; ``error_estimate`` NaN); ``normal`` False: no dF/dN column by differences (NaN; a third fewer
     solves), for a caller that needs the creepage columns alone (the wheelset's Jacobian).
@@ -196,7 +206,9 @@ def creep_sensitivities(
     """
     from rigid_dynamics.contact.registry import get_model
 
-    if not (isinstance(relative_step, (int, float)) and math.isfinite(relative_step) and 0 < relative_step <= 0.1):
+    if relative_step is not None and not (
+        isinstance(relative_step, (int, float)) and math.isfinite(relative_step) and 0 < relative_step <= 0.1
+    ):
         raise ValueError(f"relative_step = {relative_step!r}: expected a number in (0, 0.1]")
     if method not in (None, "analytic", "central-difference"):
         raise ValueError(f"method = {method!r}: expected None, 'analytic' or 'central-difference'")
@@ -232,6 +244,8 @@ def creep_sensitivities(
     if method == "analytic":
         raise ValueError(f"method = 'analytic': the rung {rung.name!r} has no closed form (one of "
                          f"{', '.join(ANALYTIC_RUNGS)} has)")  # fmt: skip
+    if relative_step is None:
+        relative_step = ITERATIVE_RELATIVE_STEPS.get(rung.name, DEFAULT_RELATIVE_STEP)
     return _differences(rung, point, base, (relative_step, estimate_error, normal), start)
 
 

@@ -125,10 +125,10 @@ def _check_supported(model) -> None:
                          "straight track")  # fmt: skip
 
 
-def creep_velocity_columns(model, t: float, state: np.ndarray, relative_step: float = 1e-3) -> CreepColumns:
+def creep_velocity_columns(model, t: float, state: np.ndarray, relative_step: float | None = None) -> CreepColumns:
     """The velocity columns of ``model``'s Jacobian at the full ``state`` (module docstring), with the sensitivities
     of the model's own rung and options at each patch (central differences with ``relative_step`` x the creepage
-    scale where the rung has no closed form, one step, no dF/dN).
+    scale where the rung has no closed form, None: the rung's default; one step, no dF/dN).
 
     Raises:
         ValueError: elastic track or curve (module docstring); a patch whose sensitivities failed (its message).
