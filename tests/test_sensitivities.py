@@ -162,9 +162,9 @@ DIFFERENCE_RUNGS = {
 @pytest.mark.parametrize("name", list(DIFFERENCE_RUNGS))
 @pytest.mark.parametrize("where", ["zero", "mid"])
 def test_difference_rungs_consistent_with_a_third_of_the_step(name, where):
-    """Regression/consistency: the sensitivities (steps 1e-4 x the creepage scale, the BEM 1e-3) against the rung's own central
-    differences at a third of those steps; they agree within 3 x the stated error estimate plus 1e-3 of the row's
-    largest entry (the rounding of the perturbed solves).
+    """Regression/consistency: the sensitivities (steps 1e-4 x the creepage scale, the BEM 1e-3) against the rung's
+    own central differences at a third of those steps; they agree within 3 x the stated error estimate plus 1e-3 of
+    the row's largest entry (the rounding of the perturbed solves).
     """
     options = DIFFERENCE_RUNGS[name]
     point = OperatingPoint(OVAL, POINTS[where], MAT, LOAD_N, options)
@@ -224,3 +224,38 @@ def test_analytic_asked_of_a_difference_rung_raises():
         creep_sensitivities("nope", OperatingPoint(OVAL, POINTS["mid"], MAT, LOAD_N))
     with pytest.raises(ValueError, match="row = 'fx'"):
         creep_sensitivities("linear", OperatingPoint(OVAL, POINTS["mid"], MAT, LOAD_N)).d("fx", "lateral")
+
+
+def test_cli_contact_sensitivities_json_is_the_api(capsys):
+    import json
+
+    from wheelrail.cases import load_case
+    from wheelrail.cli import main
+
+    assert main(["contact", "hertz-quadric", "--method", "vermeulen-johnson", "--sensitivities", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    patch = record["patches"][0]
+    case = load_case("hertz-quadric")
+    point = OperatingPoint(case.geometry, case.creepage, case.material, patch["normal_force_N"], case.solver_options)
+    api = creep_sensitivities("vermeulen-johnson", point)
+    assert patch["sensitivities"]["kind"] == "analytic" and record["status"] == "ok"
+    for i, row in enumerate(ROWS):
+        for k, column in enumerate(COLUMNS):
+            value = patch["sensitivities"]["jacobian"][row][column]
+            assert (value is None and math.isnan(api.jacobian[i, k])) or value == pytest.approx(api.jacobian[i, k])
+
+
+def test_cli_contact_sensitivities_table(capsys):
+    from wheelrail.cli import main
+
+    assert main(["contact", "hertz-quadric", "--method", "fastsim", "--sensitivities"]) == 0
+    out = capsys.readouterr().out
+    assert "sensitivities   d/dxi [N]" in out and "single: fastsim central-difference (ok)" in out
+
+
+def test_cli_contact_sensitivities_refuse_fea(capsys):
+    from wheelrail.cli import main
+
+    assert main(["contact", "hertz-quadric", "--method", "fea", "--sensitivities"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wheelrail: error: --sensitivities with --method 'fea'") and err.count("\n") == 1
