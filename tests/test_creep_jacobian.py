@@ -80,3 +80,30 @@ def test_elastic_track_is_refused(scene_and_provider):
     model = WheelsetModel(scene, provider, get_contact_model("linear"), None)
     with pytest.raises(ValueError, match="the elastic track"):
         creep_velocity_columns(model, 0.0, model.full_state(initial_state(scene)[:12]))
+
+
+def test_implicit_methods_take_the_sensitivity_columns_for_a_called_back_rung_only(scene_and_provider):
+    from rigid_dynamics.wheelset.drivers import sensitivity_velocity_columns
+
+    scene, provider = scene_and_provider
+    for name, expected in (("linear", False), ("fastsim", False), ("bem", True)):
+        sc = dataclasses.replace(scene, contact_model=name)
+        model = WheelsetModel(sc, provider, get_contact_model(name), model_options(name, sc))
+        assert (sensitivity_velocity_columns(model) is not None) == expected, name
+
+
+def test_state_jacobian_with_given_velocity_columns_and_its_fallback(scene_and_provider):
+    """drivers.state_jacobian with the sensitivity columns (here of the linear rung, whose differences are exact to
+    3e-8) agrees with its all-difference Jacobian; a velocity-column function that raises leaves the differences."""
+    from rigid_dynamics.wheelset.drivers import state_jacobian
+
+    model, full = _model_at_creeping_state(*scene_and_provider, "linear")
+    plain = state_jacobian(model.derivative)(0.0, full)
+    given = state_jacobian(model.derivative, lambda t, y: creep_velocity_columns(model, t, y).columns)(0.0, full)
+    assert relative_difference(given[:, 6:12], plain[:, 6:12]) < 1e-5
+    np.testing.assert_array_equal(given[:, :6], plain[:, :6])
+
+    def refuse(t, y):
+        raise ValueError("no sensitivities here")
+
+    np.testing.assert_array_equal(state_jacobian(model.derivative, refuse)(0.0, full), plain)
