@@ -76,13 +76,14 @@ def main() -> None:
     a, b = (np.array(r["final_state"]) for r in runs)
     scale = runs[0]["atol"] + runs[0]["rtol"] * np.maximum(np.abs(a), np.abs(b))
     spread = float(np.max(np.abs(a - b) / scale))
-    result = {"machine": machine, "duration_s": DURATION_S, "runs": runs, "final_state_difference_in_tolerances": spread}
+    result = {"machine": machine, "duration_s": DURATION_S, "runs": runs}
+    result["final_state_difference_in_tolerances"] = spread
     out_dir = ROOT / "benchmarks" / "results"
     atomic_write(out_dir / "radau_bem_jacobian.json", lambda p: p.write_text(json.dumps(result, indent=2) + "\n"))
     lines = [
         "# Radau with the BEM: velocity columns by differences or from the creep sensitivities",
         "",
-        "Written by `benchmarks/bench_radau_bem_jacobian.py` (hunting-conical, `contact_model = \"bem\"`, Radau, "
+        'Written by `benchmarks/bench_radau_bem_jacobian.py` (hunting-conical, `contact_model = "bem"`, Radau, '
         f"{DURATION_S} s).",
         f"Machine: {machine['platform']}, {machine['processor']}, os.cpu_count() = {machine['cpu_count']}, "
         f"Python {machine['python']}; {machine['note']}.",
