@@ -69,7 +69,7 @@ DEFAULT_RELATIVE_STEP = 1e-4
 without iterating (FASTSIM, FaStrip, KPEC under approach control): small enough that a step seldom straddles an
 element's switch between adhesion and slip (FASTSIM's force is piecewise smooth in the creepages: at 1e-3 the
 wheelset Jacobian's FASTSIM columns differed by 0.15 % from the compiled law's own derivative, at 1e-4 by 2e-8,
-benchmarks/results/creep_jacobian.md)."""
+benchmarks/results/creep_sensitivities.md)."""
 ITERATIVE_RELATIVE_STEPS = {"bem": 1e-3, "fea": 1e-2}
 """The step of the rungs that iterate to a tolerance: the BEM's relative tolerance 1e-6 makes a difference quotient
 with a step of 1e-3 x the creepage scale noisy at about 1e-6 / 1e-3 of the force's scale (an FEA solve more)."""

@@ -20,9 +20,10 @@ Kalker by tables, compiled_laws) and the Python rung that gives S_p (the table i
 below). Only the straight rigid track (the elastic track's rail velocities and a curve's frame enter the
 creepages as further terms): elsewhere :func:`creep_velocity_columns` raises ValueError.
 
-benchmarks/bench_creep_jacobian.py measures it against the finite-difference columns (accuracy and time per
-rung); tests/test_creep_jacobian.py checks the assembly against the model's right-hand side and the columns against
-differences.
+Used by Radau and BDF for a rung the loop calls back (drivers.sensitivity_velocity_columns: the BEM's differences
+are noise there); benchmarks/bench_creep_sensitivities.py measures the columns against differences (accuracy and
+time per rung), bench_radau_bem_jacobian.py a Radau run with each; tests/test_creep_jacobian.py checks the assembly
+against the model's right-hand side and the columns against differences.
 """
 
 from __future__ import annotations

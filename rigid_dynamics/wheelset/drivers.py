@@ -278,8 +278,8 @@ def sensitivity_velocity_columns(model) -> Callable | None:
 
     Measured (benchmarks/results/creep_sensitivities.md, radau_bem_jacobian.md): the BEM's velocity columns by
     forward differences at sqrt(eps) are 150 % off (its tolerance and warm starts), from the sensitivities 0.5 %;
-    Radau on hunting-conical with the BEM for 0.01 s took 297 right-hand sides and 131 s with the differences, 111
-    and 82 s with the sensitivity columns.
+    Radau on hunting-conical with the BEM for 0.01 s took 297 right-hand sides and 165 s with the differences, 112
+    and 72 s with the sensitivity columns (final states within 12 x the tolerance: the BEM's noise).
     """
     from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK
     from rigid_dynamics.wheelset.compiled_records import law_code
