@@ -112,3 +112,26 @@ def test_branch_plot_shows_the_deciding_persistence_and_failed_runs(tmp_path):
     outcome = {"runs": runs, "branch": [{"speed_m_per_s": 60.0, "amplitude_m": 5e-3}], "speed_m_per_s": 55.0}
     path = plot_branch(outcome, tmp_path / "branch.png", 70.0, persist_ratio=0.9)
     assert Image.open(path).size[0] > 400
+
+
+def test_linear_speed_takes_the_rungs_slopes_at_zero_creepage():
+    """The creep coefficients of the linear model are the rung's sensitivities at zero creepage on the static patch:
+    Kalker's G a b C11, G a b C22 exactly for the linear rung (analytic), FASTSIM's slope on the scene's 20 x 20
+    grid for fastsim (its grid error against Kalker, measured: +0.125 % in c11 and c22, within 0.3 %)."""
+    from rigid_dynamics.contact.kalker import kalker_coefficients
+    from rigid_dynamics.wheelset.linear import creep_sensitivities_at_rest
+
+    scene = load_scene("hunting-conical")
+    nu = scene.material.poisson_ratio
+    for sens in creep_sensitivities_at_rest(scene, "linear"):
+        kalker = kalker_coefficients(sens.semi_axis_long_m / sens.semi_axis_lat_m, nu)
+        assert sens.kind == "analytic"
+        assert sens.coefficients().c11 == pytest.approx(float(kalker.c11), rel=1e-12)
+        assert sens.coefficients().c22 == pytest.approx(float(kalker.c22), rel=1e-12)
+    for sens in creep_sensitivities_at_rest(scene, "fastsim"):
+        kalker = kalker_coefficients(sens.semi_axis_long_m / sens.semi_axis_lat_m, nu)
+        assert sens.kind == "central-difference" and sens.error_estimate[0, 0] <= 1e-9 * abs(sens.jacobian[0, 0])
+        assert sens.coefficients().c11 == pytest.approx(float(kalker.c11), rel=3e-3)
+        assert sens.coefficients().c22 == pytest.approx(float(kalker.c22), rel=3e-3)
+    out = linear_critical_speed(dataclasses.replace(scene, contact_model="fastsim"))
+    assert out["creep_coefficients"]["rung"] == "fastsim" and out["creep_coefficients"]["kind"] == "central-difference"

@@ -8,7 +8,8 @@ Profiles and materials
     load_profile, builtin_profiles, Material, STEEL, combined_from_pair
 Contact: one patch, a batch, a case
     ContactGeometry, Creepage, ContactResult, ContactFields, models, get_model, solve_batch,
-    ContactCase, load_case, embedded_cases, solve_case, CaseSolution, WheelsetCase, solve_wheelset_case
+    ContactCase, load_case, embedded_cases, solve_case, CaseSolution, WheelsetCase, solve_wheelset_case,
+    OperatingPoint, creep_sensitivities
 Dynamics
     DynamicsScene, load_scene, embedded_scenes, Irregularities, simulate, SimulationResult,
     linear_model_for_scene, critical_speed, equivalent_conicity_from_names
@@ -48,6 +49,12 @@ _API: dict[str, tuple[str, str, str]] = {
     "models": ("rigid_dynamics.contact.registry", "model_names", "names of the registered contact models"),
     "get_model": ("rigid_dynamics.contact.registry", "get_model", "a contact model by name"),
     "solve_batch": ("rigid_dynamics.contact.models", "solve_batch", "Hertz + a creep law for arrays of patches"),
+    "OperatingPoint": ("rigid_dynamics.contact.sensitivities", "OperatingPoint", "a patch and its operating point"),
+    "creep_sensitivities": (
+        "rigid_dynamics.contact.sensitivities",
+        "creep_sensitivities",
+        "d(Fx, Fy, Mz)/d(xi, eta, phi, N) of a rung at an operating point",
+    ),
     "ContactCase": ("wheelrail.cases", "ContactCase", "a validated contact case (quadric or wheelset)"),
     "load_case": ("wheelrail.cases", "load_case", "read a case TOML file or embedded case"),
     "embedded_cases": ("wheelrail.cases", "embedded_cases", "embedded contact cases: name -> path"),

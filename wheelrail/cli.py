@@ -118,6 +118,9 @@ def cmd_contact(args) -> int:
 
     # checks --method and [solver] against the model's options; --set overrides before validation
     case, _, overrides = load_case_with(args.case, args.set, method=args.method)
+    if args.sensitivities and args.method == "fea":
+        raise ConfigError("--sensitivities with --method 'fea': expected a model other than fea (its central "
+                          "differences would take 17 FEA solves per patch)")  # fmt: skip
     wants_output = args.out is not None or args.plot
     if wants_output and args.out is None and _under_mpi():
         raise ConfigError("--plot under mpiexec: give --out DIR so every rank writes to one folder")
@@ -138,6 +141,8 @@ def cmd_contact(args) -> int:
             case = _with_fea_output(case, out_dir)
         solution = solve_case(case, args.method, progress=_progress_line if args.method == "fea" else None)
         record = solution_record(solution)
+        if args.sensitivities:
+            _add_sensitivities(record, case, solution, args.method)
         if overrides:
             record["overrides"] = overrides
         if out_dir is not None and _mpi_rank() == 0:
@@ -152,9 +157,47 @@ def cmd_contact(args) -> int:
         _print(to_json(record))
     else:
         _print(_contact_table(record))
+        if args.sensitivities:
+            _print(_sensitivity_table(record))
         if out_dir is not None:
             _print(f"output written to {out_dir}")
     return EXIT_OK if record["status"] == "ok" else EXIT_FAILED
+
+
+def _add_sensitivities(record: dict, case, solution, method: str) -> None:
+    """``--sensitivities``: every patch's d(Fx, Fy, Mz)/d(xi, eta, phi, N) (rigid_dynamics.contact.sensitivities)
+    into its record; a patch whose sensitivities failed makes the record's status "sensitivities-failed".
+    """
+    from rigid_dynamics.contact.sensitivities import OperatingPoint, creep_sensitivities
+
+    options = case.solver_options if case.kind == "quadric" else (case.solver_options or {}).get("model")
+    failed = []
+    for patch, (side, geometry, creepage, result) in zip(record["patches"], solution.patches, strict=True):
+        if result.status == "no-contact" or not result.normal_force_N:
+            patch["sensitivities"] = None
+            continue
+        point = OperatingPoint(geometry, creepage, case.material, float(result.normal_force_N), options)
+        sens = creep_sensitivities(method, point)
+        patch["sensitivities"] = sens.to_dict()
+        if not sens.success:
+            failed.append(f"{side}: {sens.status}: {sens.message}")
+    if failed and record["status"] == "ok":
+        record["status"], record["success"] = "sensitivities-failed", False
+        record["message"] = f"{record['message']}; sensitivities failed ({'; '.join(failed)})"
+
+
+def _sensitivity_table(record: dict) -> str:
+    """The sensitivities of every patch: one line per force, the four derivatives (units in the header)."""
+    lines = ["sensitivities   d/dxi [N]    d/deta [N]  d/dphi [N m]    d/dN [-]  (Mz row: N m, N m, N m^2, m)"]
+    for patch in record["patches"]:
+        sens = patch.get("sensitivities")
+        if not sens:
+            continue
+        lines.append(f"{patch['side']}: {sens['method']} {sens['kind']} ({sens['status']})")
+        for row, label in (("creep_force_long_N", "Fx"), ("creep_force_lat_N", "Fy"), ("spin_moment_Nm", "Mz")):
+            values = sens["jacobian"][row].values()
+            lines.append(f"  {label:<12}" + "".join("         n/a" if v is None else f"{v:12.4g}" for v in values))
+    return "\n".join(lines)
 
 
 def _progress_line(text: str) -> None:
@@ -604,6 +647,12 @@ def _add_contact(sub) -> None:
     contact.add_argument("--plot", action="store_true", help="write PNG maps of the patch fields")
     contact.add_argument("--out", type=out_path, help="output folder for summary, field files and plots")
     contact.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a case key (repeatable)")
+    contact.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="also d(Fx, Fy, Mz)/d(xi, eta, phi, N) per patch (analytic: linear, vermeulen-johnson; else central "
+        "differences with their error)",
+    )
     contact.set_defaults(func=cmd_contact)
 
 

@@ -1,7 +1,9 @@
 """``wheelrail critical-speed SCENE``: linear (eigenvalue) and nonlinear (limit-cycle) critical speed of a scene.
 
 Linear: the eigenvalues of the linearised wheelset (rigid_dynamics.wheelset.linear) with the creep coefficients of
-the scene's contact model at its static load; the conicity is the scene's (conical track) or, for real profiles,
+the scene's contact model at its static load (the slopes at zero creepage of its creep forces,
+rigid_dynamics.contact.sensitivities: Kalker's for the linear rung, the grid's for FASTSIM, KPEC and the BEM); the
+conicity is the scene's (conical track) or, for real profiles,
 the EN 15302 equivalent conicity at 3 mm amplitude (an estimate: the linear model of a profile pair is a cone).
 Nonlinear: the lowest speed at which the hunting limit cycle survives, followed down in speed from
 ``--high`` (default 1.2 x the linear speed) by comparisons.limit_cycle.limit_cycle_search.
@@ -24,7 +26,7 @@ MAX_STEPS = 1000
 def linear_critical_speed(scene) -> dict:
     """The linear critical speed of a scene: dict with speed, frequency, conicity used and how it was found."""
     from rigid_dynamics.wheelset import critical_speed, linear_model_for_scene
-    from rigid_dynamics.wheelset.linear import creep_coefficients
+    from rigid_dynamics.wheelset.linear import creep_sensitivities_at_rest
 
     track = scene.track
     note = "conical track"
@@ -48,8 +50,15 @@ def linear_critical_speed(scene) -> dict:
             scene, track=cone, contact_provider="conical", irregularities=type(scene.irregularities)()
         )
         note = f"cone of the EN 15302 equivalent conicity {conicity:.4f} (3 mm) of the profile pair"
-    f11, f22 = creep_coefficients(proxy)
+    try:
+        sensitivities = creep_sensitivities_at_rest(proxy)
+    except ValueError as exc:
+        return {"success": False, "status": "no-creep-coefficients", "message": str(exc), "speed_m_per_s": None,
+                "frequency_Hz": None, "conicity": proxy.track.conicity, "model": note}  # fmt: skip
+    coef = [s.coefficients() for s in sensitivities]
+    f11, f22 = float(sum(c.f11_N for c in coef) / len(coef)), float(sum(c.f22_N for c in coef) / len(coef))
     result = critical_speed(linear_model_for_scene(proxy, f11, f22))
+    error = [max(float(s.error_estimate[row, row]) for s in sensitivities) for row in (0, 1)]  # dFx/dxi, dFy/deta
     return {
         "success": result.success,
         "status": result.status,
@@ -59,6 +68,16 @@ def linear_critical_speed(scene) -> dict:
         "conicity": proxy.track.conicity,
         "model": note,
         "creep_coefficients_N": [f11, f22],
+        "creep_coefficients": {
+            "rung": sensitivities[0].method,
+            "kind": sensitivities[0].kind,
+            "f11_difference_error_N": error[0],
+            "f22_difference_error_N": error[1],
+            "c11": [c.c11 for c in coef],
+            "c22": [c.c22 for c in coef],
+            "note": "slopes at zero creepage of the rung's creep forces at the static patch "
+            "(rigid_dynamics.contact.sensitivities); the grid error of a grid rung is not in the difference error",
+        },
     }
 
 

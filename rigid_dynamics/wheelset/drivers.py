@@ -112,8 +112,12 @@ def tolerances(settings, scene):
 _JACOBIAN_RELATIVE_STEP = math.sqrt(np.finfo(float).eps)
 
 
-def state_jacobian(fun: Callable) -> Callable:
+def state_jacobian(fun: Callable, velocity_columns: Callable | None = None) -> Callable:
     """Jacobian d f / d y of the 14-state function ``fun`` for the implicit methods Radau and BDF.
+
+    ``velocity_columns``: optional (t, y) -> (n, 6) columns of the velocities (:func:`sensitivity_velocity_columns`:
+    from the creep-force sensitivities, for a rung the loop calls back); where it raises ValueError or ContactFailure
+    or returns a non-finite entry, those columns are differenced as the others.
 
     scipy's own finite-difference Jacobian (``num_jac``) perturbs column j by ``factor_j max(atol_j, |y_j|)``
     and multiplies ``factor_j`` by 10 at every evaluation where the column's difference is negligible, with no
@@ -152,7 +156,18 @@ def state_jacobian(fun: Callable) -> Callable:
         jac_matrix[POSITIONS, VELOCITIES] = np.eye(6)
         if n > N_RIGID:
             jac_matrix[track_positions(n), track_velocities(n)] = np.eye((n - N_RIGID) // 2)
-        for j in [*range(N_MECHANICAL), *range(N_RIGID, n)]:  # not the work integrals
+        given = None
+        if velocity_columns is not None:
+            try:
+                given = np.asarray(velocity_columns(t, y), float)
+            except (ValueError, ContactFailure):
+                given = None
+            if given is not None and not np.all(np.isfinite(given)):
+                given = None
+        if given is not None:
+            jac_matrix[6:, VELOCITIES] = given[6:]
+        differenced = [j for j in range(N_MECHANICAL) if given is None or not VELOCITIES.start <= j < VELOCITIES.stop]
+        for j in [*differenced, *range(N_RIGID, n)]:  # not the work integrals
             for sign in (1.0, -1.0):
                 trial = y.copy()
                 trial[j] += sign * _JACOBIAN_RELATIVE_STEP * max(abs(y[j]), 1.0)
@@ -259,6 +274,26 @@ def _force_error(model, solver) -> float:
     return math.inf if math.isnan(error) else error  # NaN: forces not computable at one of the two states
 
 
+def sensitivity_velocity_columns(model) -> Callable | None:
+    """The velocity columns from the creep-force sensitivities (wheelset.creep_jacobian) for the implicit methods'
+    Jacobian, when they are sound and pay: a rung the loop calls back (bem, fea, a user model) on the straight rigid
+    track; else None (the differences of a compiled law are as accurate and 10-200 times cheaper).
+
+    Measured (benchmarks/results/creep_sensitivities.md, radau_bem_jacobian.md): the BEM's velocity columns by
+    forward differences at sqrt(eps) are 150 % off (its tolerance and warm starts), from the sensitivities 0.5 %;
+    Radau on hunting-conical with the BEM for 0.01 s took 297 right-hand sides and 165 s with the differences, 112
+    and 72 s with the sensitivity columns (final states within 12 x the tolerance: the BEM's noise).
+    """
+    from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK
+    from rigid_dynamics.wheelset.compiled_records import law_code
+
+    if model is None or law_code(model.model) != LAW_CALLBACK or model.elastic or model.par["track_frame"] > 0:
+        return None
+    from rigid_dynamics.wheelset.creep_jacobian import creep_velocity_columns
+
+    return lambda t, y: creep_velocity_columns(model, t, y).columns
+
+
 def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -> int:
     """The Python right-hand side ``fun`` stepped one step at a time by a scipy ``OdeSolver``: RK45, DOP853, Radau
     (with :func:`state_jacobian`), BDF, LSODA, DP54 / BS32 off the compiled loop (scipy's RK45 / RK23), and RK4
@@ -280,7 +315,9 @@ def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -
         cls = _rk4_class()
     else:  # DP54 / BS32 off the compiled loop: the same pairs in scipy (RK45 / RK23), without located switches
         cls = getattr(integrate, SCIPY_EQUIVALENT.get(settings.method, settings.method))
-    options = {"jac": state_jacobian(fun)} if settings.method in ("Radau", "BDF") else {}
+    options = {}
+    if settings.method in ("Radau", "BDF"):
+        options = {"jac": state_jacobian(fun, sensitivity_velocity_columns(model))}
     if fixed:
         options = {"step": settings.fixed_step_s}
     atol = tolerances(settings, model.scene)

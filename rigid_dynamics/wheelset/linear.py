@@ -185,31 +185,38 @@ def linear_model_for_scene(
     )
 
 
-def creep_coefficients(scene: DynamicsScene, contact_model=None, provider=None) -> tuple[float, float]:
-    """Kalker creep coefficients f11, f22 (N) of the centred wheelset at rest on its static load.
+def creep_sensitivities_at_rest(scene: DynamicsScene, contact_model=None, provider=None) -> list:
+    """The creep-force sensitivities (rigid_dynamics.contact.sensitivities) of every wheel in contact of the centred
+    wheelset at rest on its static load, at zero creepage: one CreepSensitivities per patch (left wheel first).
 
-    Found by solving the scene's contact model at the static-equilibrium patch with a small
-    longitudinal creepage xi = 1e-7 (f11 = -T_x / xi) and lateral creepage eta = 1e-7 (f22 = -T_y / eta),
-    i.e. the slopes at zero creepage that the linearised equations need. Averaged over both wheels.
+    The rung is ``contact_model`` (default the scene's) with the options a run gives it (simulate.model_options:
+    the scene's FASTSIM grid, auto's tolerance); the patch is the static equilibrium's (approach, curvatures), the
+    derivatives under force control at its normal force. Analytic for the linear and Vermeulen-Johnson rungs (there
+    the slopes are Kalker's G a b C11, G a b C22), central differences for the others (FASTSIM, KPEC, BEM: their
+    grid's slope at zero creepage, with its difference error).
+
+    Raises:
+        ValueError: no static equilibrium, no wheel in contact, or a rung whose sensitivities failed (its message).
     """
     from dataclasses import replace
 
+    from rigid_dynamics.contact.sensitivities import OperatingPoint, creep_sensitivities
     from rigid_dynamics.contact.types import ContactGeometry, Creepage
     from rigid_dynamics.wheelset.parameters import InitialConditions
-    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, initial_state
+    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, initial_state, model_options
     from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
     centred = replace(scene, initial=InitialConditions())
     provider = provider if provider is not None else build_provider(centred)
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
-    model = WheelsetModel(centred, provider, model_obj)
+    options = model_options(getattr(model_obj, "name", ""), scene)
+    model = WheelsetModel(centred, provider, model_obj, options)
     state, ok, why = model.static_state(initial_state(centred))
     if not ok:
         raise ValueError(f"no static equilibrium for the creep coefficients: {why}")
     patches = provider.patches(state[:3], state[3], state[4], state[5])
-    f11, f22 = [], []
-    small = 1e-7
-    for k in range(len(patches)):
+    out = []
+    for k in np.argsort(patches.side, kind="stable"):
         if patches.approach_m[k] <= 0:
             continue
         geometry = ContactGeometry(
@@ -217,10 +224,20 @@ def creep_coefficients(scene: DynamicsScene, contact_model=None, provider=None) 
             float(patches.curvature_lat_1_per_m[k]),
             float(patches.approach_m[k]),
         )
-        rx = model_obj.solve(geometry, Creepage(small, 0.0, 0.0, scene.speed_m_per_s), scene.material)
-        ry = model_obj.solve(geometry, Creepage(0.0, small, 0.0, scene.speed_m_per_s), scene.material)
-        f11.append(-(rx.creep_force_long_N or 0.0) / small)
-        f22.append(-(ry.creep_force_lat_N or 0.0) / small)
-    if not f11:
+        point = OperatingPoint(geometry, Creepage(0.0, 0.0, 0.0, scene.speed_m_per_s), scene.material, None, options)
+        sens = creep_sensitivities(model_obj, point)
+        if not sens.success:
+            raise ValueError(f"creep sensitivities of {sens.method!r} at rest: {sens.status}: {sens.message}")
+        out.append(sens)
+    if not out:
         raise ValueError("no wheel in contact at rest: cannot linearise the creep forces")
-    return float(np.mean(f11)), float(np.mean(f22))
+    return out
+
+
+def creep_coefficients(scene: DynamicsScene, contact_model=None, provider=None) -> tuple[float, float]:
+    """Creep coefficients f11, f22 (N) of the centred wheelset at rest on its static load: the slopes at zero
+    creepage of the rung's creep forces, f11 = -dFx/dxi, f22 = -dFy/deta (:func:`creep_sensitivities_at_rest`; for
+    the linear rung Kalker's G a b C11, G a b C22), averaged over both wheels.
+    """
+    coef = [s.coefficients() for s in creep_sensitivities_at_rest(scene, contact_model, provider)]
+    return float(np.mean([c.f11_N for c in coef])), float(np.mean([c.f22_N for c in coef]))
