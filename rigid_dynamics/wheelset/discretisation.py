@@ -313,6 +313,12 @@ def contact_grid_error(result) -> dict:
         "method": (
             f"coarser companion: FASTSIM at {cx} x {cy} against {nx} x {ny} on {len(take)} recorded settled patches, "
             f"extrapolated with order {GRID_ORDER:g} (benchmarks/results/fastsim_grid.md)"
+            + (
+                "; plus table_departure: the creep-force table's forces against FASTSIM at the run's grid on the same "
+                "patches (contact.creep_table)"
+                if "table_departure" in base
+                else ""
+            )
         ),
     }
 
