@@ -279,3 +279,18 @@ def test_a_case_with_falling_friction_and_the_table_exits_2(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("wheelrail: error: ") and err.count("\n") == 1
     assert "friction law = 'exponential' (falling with the slip velocity)" in err and "Coulomb" in err
+
+
+@pytest.mark.parametrize(
+    ("option", "pattern"),
+    [
+        ("solver.source=bem", r"key 'solver.source' = 'bem': expected one of 'fastsim' \(option of the contact model"),
+        ("solver.nx=0", r"key 'solver.nx' = 0: expected an integer from 1 to 1000"),
+    ],
+)
+def test_bad_table_option_exits_2(capsys, option, pattern):
+    from wheelrail.cli import main
+
+    assert main(["contact", "hertz-quadric", "--method", "table", "--set", option]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wheelrail: error: ") and err.count("\n") == 1 and re.search(pattern, err), err
