@@ -204,7 +204,7 @@ def test_auto_serves_its_fastsim_rung_from_the_table(full_table):
 def test_a_dynamics_run_with_the_table_follows_fastsim():
     """polygonal-wheel (compiled 3-D search), 1 s, with contact_model "table" against "fastsim": after the settling
     distance the per-wheel contact forces part by less than 3 % of the static wheel load (measured 1.6 %, rms 0.3 %;
-    in the start-up the two runs' two-point contact flips part them by up to 98 % for a few ms, as the step does,
+    in the start-up the two runs' two-point contact flips part them by up to 98 % over t = 0.1-0.27 s, as the step does,
     benchmarks/results/step_sensitivity.md), over the last 0.3 s by less than 0.2 %; on the table run's own settled
     patches the table departs from FASTSIM by less than 0.5 % of the wheel load (the run's statement,
     discretisation.contact_grid_error).
