@@ -61,6 +61,10 @@ MODELS: dict[str, tuple[str, str]] = {
     "analyn": ("rigid_dynamics.contact.semi_hertzian:AnalynModel", "CONTACT's ANALYN semi-Hertzian normal + FASTSIM"),
     "bem": ("rigid_dynamics.contact.bem.model:BemModel", "boundary elements: CONTACT-style NORM + TANG"),
     "fea": ("fea.model:FeaModel", "finite elements (FEniCSx): normal contact, subsurface stresses"),
+    "table": (
+        "rigid_dynamics.contact.creep_table:TableModel",
+        "Hertz + FASTSIM's creep-force table (normalised creepages x a/b), for fast dynamics",
+    ),
     "auto": ("rigid_dynamics.contact.models:AutoModel", "cheapest model meeting the tolerance for the patch"),
 }
 """name -> ("module:Class", one-line description)."""

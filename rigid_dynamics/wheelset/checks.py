@@ -23,7 +23,9 @@ def check_scene(scene: DynamicsScene) -> None:
     """Raise SceneError for the first inconsistency between the scene's tables (module docstring).
 
     Checks:
-        contact_model: a registered model name (rigid_dynamics.contact.registry.MODELS).
+        contact_model: a registered model name (rigid_dynamics.contact.registry.MODELS); "table" (and creep_table)
+            with Coulomb friction only (contact.creep_table: falling friction is not tabulated).
+        creep_table: true only with contact_model "auto".
         contact_provider: "conical" only with wheel_profile "conical" and rail_profile "circular" (the analytic
             pair); "search" only with profiles (the analytic pair has no surface to search).
         irregularities.flat_length_m: L < 2 r0 (a flat is a chord of the wheel).
@@ -36,6 +38,7 @@ def check_scene(scene: DynamicsScene) -> None:
     _check_traction(scene)
     if isinstance(scene.contact_model, str) and scene.contact_model not in MODELS:
         raise SceneError("contact_model", scene.contact_model, "one of " + ", ".join(MODELS))
+    _check_creep_table(scene)
     track, irr = scene.track, scene.irregularities
     r0 = scene.wheelset.nominal_radius_m
     if scene.contact_provider == "conical" and not track.is_conical:
@@ -96,3 +99,24 @@ def _check_traction(scene: DynamicsScene) -> None:
             f"one of {', '.join(TRACTION_METHODS)} with traction.mode = {control.mode!r} (the controller runs in "
             "the compiled loop, sampled at the output times)",
         )
+
+
+def _check_creep_table(scene: DynamicsScene) -> None:
+    """The creep-force table's scene keys: ``creep_table`` with auto only; the table with Coulomb friction only."""
+    if scene.creep_table and scene.contact_model != "auto":
+        raise SceneError(
+            "creep_table",
+            scene.creep_table,
+            f"false with contact_model {scene.contact_model!r} (it serves auto's FASTSIM rung; contact_model "
+            "'table' is the table for every patch)",
+        )
+    if scene.contact_model == "table" or scene.creep_table:
+        law = scene.material.friction
+        if law is not None and not law.is_coulomb:
+            key = "contact_model" if scene.contact_model == "table" else "creep_table"
+            raise SceneError(
+                key,
+                getattr(scene, key),
+                f"Coulomb friction ([friction] law = 'coulomb'; this scene's falls with the slip velocity, "
+                f"{law.laws[0].law} form, which the creep-force table does not tabulate): use contact_model 'fastsim'",
+            )

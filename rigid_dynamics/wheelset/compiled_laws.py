@@ -9,6 +9,8 @@
   contact.linear.linear_one), ``vermeulen-johnson`` (eq 53-58 with the cube, contact.vermeulen_johnson.saturate_one
   on the linear forces) and ``fastsim`` (contact.fastsim._fastsim_one with the flexibilities of
   contact.fastsim.flexibilities_one; options nx, ny, traction_bound, flexibility).
+* ``table`` (:func:`_table_law`, contact.creep_table): FASTSIM's forces interpolated from its creep-force table over
+  the normalised creepages and a/b (``HertzKalkerTables.creep``); a patch beyond the table's a/b is solved by FASTSIM.
 * ``auto`` (:func:`_auto_choice`): the measured thresholds of contact/data/auto_thresholds.json in the parameter
   record; a patch auto gives to BEM goes through the callback (compiled_rhs._external).
 """
@@ -22,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from rigid_dynamics.contact.creep_table import CreepTable, empty_table, table_creep_law
 from rigid_dynamics.contact.fastsim import (
     FastsimGrid,
     FastsimPatch,
@@ -55,7 +58,7 @@ from rigid_dynamics.wheelset.layout import (
     N_FIELDS,
 )
 
-LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO, LAW_KPEC = range(7)
+LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO, LAW_KPEC, LAW_TABLE = range(8)
 LAW_CODES = {
     "hertz": LAW_HERTZ,
     "linear": LAW_LINEAR,
@@ -63,11 +66,13 @@ LAW_CODES = {
     "fastsim": LAW_FASTSIM,
     "auto": LAW_AUTO,
     "kpec": LAW_KPEC,
+    "table": LAW_TABLE,
 }
 """The laws compiled into the loop, by the name a contact model declares (contact.models.HertzianModel.compiled_law);
 LAW_CALLBACK: every patch through the callback (bem, fea, user models); LAW_AUTO: auto's rung chosen per patch
 (linear, Vermeulen-Johnson and FASTSIM inline, BEM through the callback); LAW_KPEC: CONTACT's KPEC + FASTSIM per strip
-on the patch's gap (:func:`_kpec_law`; the gap sampled by compiled_patch.py, or the quadric)."""
+on the patch's gap (:func:`_kpec_law`; the gap sampled by compiled_patch.py, or the quadric); LAW_TABLE: FASTSIM's
+creep-force table (:func:`_table_law`)."""
 
 
 class TabulatedHertzKalker:
@@ -126,7 +131,9 @@ class HertzKalkerTables(NamedTuple):
     uniform grid of ln(max(A, B)/min(A, B)) from ``log_ratio_start`` by ``log_ratio_step``; ``kalker`` (rows
     :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b); and the run's friction law ``friction``
     (contact.friction.FrictionRecord; one Coulomb law that varies nowhere: the parameter record's
-    ``friction_coefficient`` serves, as before the laws existed). The data of the compiled laws, passed per patch.
+    ``friction_coefficient`` serves, as before the laws existed); ``creep`` the run's creep-force table
+    (contact.creep_table.CreepTable; an empty one when no law reads it). The data of the compiled laws, passed per
+    patch.
     """
 
     log_ratio_start: float
@@ -136,11 +143,12 @@ class HertzKalkerTables(NamedTuple):
     log_ab_step: float
     kalker: np.ndarray
     friction: FrictionRecord
+    creep: CreepTable
 
 
-def hertz_kalker_tables(tables, friction=None) -> HertzKalkerTables:
-    """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker` and a contact.friction.FrictionLaw (None:
-    Coulomb with the parameter record's ``friction_coefficient``).
+def hertz_kalker_tables(tables, friction=None, creep=None) -> HertzKalkerTables:
+    """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`, a contact.friction.FrictionLaw (None:
+    Coulomb with the parameter record's ``friction_coefficient``) and a creep-force table (None: an empty one).
     """
     law = friction if friction is not None else uniform(0.0)
     return HertzKalkerTables(
@@ -151,6 +159,7 @@ def hertz_kalker_tables(tables, friction=None) -> HertzKalkerTables:
         float(tables.log_ab[1] - tables.log_ab[0]),
         np.ascontiguousarray(tables.c),
         law.record(),
+        creep if creep is not None else empty_table(),
     )
 
 
@@ -243,6 +252,21 @@ def _creep_law(par, code, dummy, patch, creep, friction):
     return tx, ty, mz
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _table_law(par, tables, dummy, patch, creep, friction):
+    """(T_x, T_y, M_z) of FASTSIM's creep-force table (tables.creep, contact.creep_table.table_creep_law) on a Hertz
+    patch = (N, a, b, C11, C22, C23, C33) with the patch's Coulomb coefficient; FASTSIM itself
+    (:func:`_creep_law`) where a/b is beyond the table.
+    """
+    normal, sa, sb, c11, c22, c23, _ = patch
+    tx, ty, mz, inside = table_creep_law(
+        tables.creep, par.shear_modulus_Pa, (sa, sb, c11, c22, c23), creep, friction.coefficient * normal
+    )
+    if inside:
+        return tx, ty, mz
+    return _creep_law(par, LAW_FASTSIM, dummy, patch, creep, friction)
+
+
 @njit(cache=True, _nrt=False)
 def _auto_threshold(par, rung, f):
     """Auto's threshold of feature f (layout.AUTO_FEATURE_NAMES) for rung (layout.AUTO_LINEAR, ...)."""
@@ -304,7 +328,7 @@ def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
     ``auto`` (par.model_code layout.LAW_AUTO): the features of contact.auto.patch_features that a quadric patch has
     (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
     are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
-    rec[c] as layout.AUTO_PATCH_FIELDS.
+    rec[c] as layout.AUTO_PATCH_FIELDS; par.auto_fastsim_table 1: the FASTSIM rung served by the creep-force table.
     """
     q, ca, cb = geometry
     xi, eta, spin = creep
@@ -312,6 +336,9 @@ def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
     normal, sa, sb, c11, c22, c23, c33 = patch
     code = int(par.model_code)
     friction = patch_friction(par, tables.friction, where)
+    if code == LAW_TABLE:
+        tx, ty, mz = _table_law(par, tables, dummy, patch, creep, friction)
+        return normal, sa, sb, tx, ty, mz, False
     if code != LAW_AUTO:
         tx, ty, mz = _creep_law(par, code, dummy, patch, creep, friction)
         return normal, sa, sb, tx, ty, mz, False
@@ -330,7 +357,9 @@ def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
     rung, deciding, threshold = _auto_choice(par, feats)
     to_callback = False
     tx, ty, mz = 0.0, 0.0, 0.0
-    if rung != AUTO_BEM:
+    if rung == AUTO_FASTSIM and par.auto_fastsim_table > 0:  # the table serves auto's FASTSIM rung
+        tx, ty, mz = _table_law(par, tables, dummy, patch, creep, friction)
+    elif rung != AUTO_BEM:
         tx, ty, mz = _creep_law(par, rung + LAW_LINEAR, dummy, patch, creep, friction)
         if rung == AUTO_FASTSIM and math.hypot(tx, ty) > (1.0 + par.auto_friction_bound_tolerance) * mu_n:
             rung, to_callback = AUTO_BEM, True

@@ -21,6 +21,7 @@ from rigid_dynamics.wheelset.compiled_laws import (
     LAW_AUTO,
     LAW_CALLBACK,
     LAW_CODES,
+    LAW_TABLE,
     HertzKalkerTables,
     auto_parameters,
     hertz_kalker_tables,
@@ -132,9 +133,22 @@ def friction_law_of(material):
     return law
 
 
+def _creep_table(scene, law, opts):
+    """FASTSIM's creep-force table at the run's grid, traction bound and flexibility for the scene's material
+    (contact.creep_table: from memory, the disk cache, or built); ValueError (contact.creep_table.TableUnavailable)
+    for a falling friction law.
+    """
+    from rigid_dynamics.contact.creep_table import SourceOptions, check_friction, creep_table
+
+    check_friction(law)
+    options = SourceOptions("fastsim", int(opts["nx"]), int(opts["ny"]), opts["traction_bound"], opts["flexibility"])
+    return creep_table(scene.material.poisson_ratio, options).table
+
+
 def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, python_geometry=False) -> PackedRun:
     """The :class:`PackedRun` of a WheelsetModel, its provider, the Hertz / Kalker tables and the contact model
-    instance. ``options``: FASTSIM's (nx, ny, traction_bound, flexibility) for ``fastsim`` and ``auto``;
+    instance. ``options``: FASTSIM's (nx, ny, traction_bound, flexibility) for ``fastsim``, ``table`` (its source)
+    and ``auto``;
     ``tolerance``: auto's; ``python_geometry``: the geometry given by Python for any provider.
     """
     from rigid_dynamics.contact.fastsim import FLEXIBILITY_CODES
@@ -161,7 +175,10 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     par["patch_sampled"] = 1.0 if scene.patch_geometry == "sampled" else 0.0
     if code == LAW_AUTO:
         auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
-    hk = hertz_kalker_tables(tables, law)
+        par["auto_fastsim_table"] = 1.0 if getattr(scene, "creep_table", False) else 0.0
+    hk = hertz_kalker_tables(
+        tables, law, _creep_table(scene, law, opts) if code == LAW_TABLE or par["auto_fastsim_table"] else None
+    )
     if mode == GEOMETRY_TABLES:
         par["nominal_radius_m"] = provider.r0
         if provider.irregularities is not None:

@@ -38,6 +38,7 @@ from rigid_dynamics.wheelset.compiled_laws import (
     LAW_CALLBACK,
     LAW_KPEC,
     LAW_LINEAR,
+    LAW_TABLE,
     _kpec_law,
     _law,
     mean_slip_coefficient,
@@ -49,6 +50,7 @@ from rigid_dynamics.wheelset.compiled_search import search_geometry, search_geom
 from rigid_dynamics.wheelset.compiled_tables import _table_geometry, table_scratch
 from rigid_dynamics.wheelset.layout import (
     APPROACH,
+    AUTO_FASTSIM,
     AUTO_RUNG,
     CALLBACK_FAILED,
     CONTACT_ANGLE,
@@ -220,12 +222,15 @@ def _external(t, y, c, side, g, creep, frame):
 @njit(cache=True, _nrt=False)
 def _served_law(par, rec, c, record):
     """The compiled law that served candidate c (compiled_laws.LAW_CODES): the run's, or for ``auto`` the rung it
-    chose (recorded in rec[c, AUTO_RUNG] when ``record``; NaN otherwise, then LAW_AUTO).
+    chose (recorded in rec[c, AUTO_RUNG] when ``record``; NaN otherwise, then LAW_AUTO; its FASTSIM rung served by
+    the creep-force table: LAW_TABLE).
     """
     code = int(par.model_code)
     if code != LAW_AUTO:
         return code
     if record and not math.isnan(rec[c, AUTO_RUNG]):
+        if int(rec[c, AUTO_RUNG]) == AUTO_FASTSIM and par.auto_fastsim_table > 0:
+            return LAW_TABLE
         return int(rec[c, AUTO_RUNG]) + LAW_LINEAR
     return LAW_AUTO
 

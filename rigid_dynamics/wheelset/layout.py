@@ -283,6 +283,7 @@ PARAMETER_FIELDS = (
     ("carried_mass_kg", "axle load / g: the mass whose quasi-static gravity and centrifugal load acts at the axle"),
     ("auto_level", "auto: the tolerance level whose thresholds apply (NaN: below every level, always BEM)"),
     ("auto_friction_bound_tolerance", "auto: FASTSIM above (1 + this) mu N is replaced by BEM (models.py)"),
+    ("auto_fastsim_table", "auto: 1: its FASTSIM rung served by FASTSIM's creep-force table (scene key creep_table)"),
     *(
         (f"auto_{r}_{f}", f"auto: threshold of {f} for {r} (NaN: no measured box)")
         for r in AUTO_RUNG_NAMES

@@ -526,6 +526,8 @@ class DynamicsScene:
         kpec_points: grid points per direction of the sampled gap (and of the quadric's) that the compiled KPEC
             law ("kpec") solves per patch in the loop (compiled_patch.py); the error of the default against a
             grid twice as fine is in benchmarks/results/kpec_loop.md.
+        creep_table: with contact_model "auto": its FASTSIM rung served by FASTSIM's creep-force table
+            (contact.creep_table; contact_model "table" is that table for every patch). False for other models.
     """
 
     name: str = "scene"
@@ -546,6 +548,7 @@ class DynamicsScene:
     fastsim_elements_per_strip: int = 20
     fastsim_strips: int = 20
     kpec_points: int = 24
+    creep_table: bool = False
     settling_distance_m: float = 10.0
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
@@ -567,6 +570,8 @@ class DynamicsScene:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1000:
                 raise ValueError(f"{name} = {value!r}: expected an integer from 1 to 1000")
+        if not isinstance(self.creep_table, bool):
+            raise ValueError(f"creep_table = {self.creep_table!r}: expected true or false")
         value = self.kpec_points
         if isinstance(value, bool) or not isinstance(value, int) or not 8 <= value <= 256:
             raise ValueError(f"kpec_points = {value!r}: expected an integer from 8 to 256")

@@ -147,11 +147,11 @@ def get_contact_model(name_or_model):
 
 
 def model_options(name: str, scene: DynamicsScene) -> dict | None:
-    """Options handed to the contact model in a run: the scene's FASTSIM grid, no FASTSIM fields; auto gets the
-    scene's tolerance.
+    """Options handed to the contact model in a run: the scene's FASTSIM grid, no FASTSIM fields (``table``: its
+    source's); auto gets the scene's tolerance.
     """
     fastsim = {"fields": False, "nx": scene.fastsim_elements_per_strip, "ny": scene.fastsim_strips}
-    if name == "fastsim":
+    if name in ("fastsim", "table"):
         return fastsim
     if name == "auto":
         return {"tolerance": scene.contact_tolerance, "model_options": {"fastsim": fastsim}}

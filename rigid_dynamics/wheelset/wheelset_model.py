@@ -54,7 +54,7 @@ from rigid_dynamics.materials import STANDARD_GRAVITY_M_PER_S2
 from rigid_dynamics.wheelset import compiled_rhs
 from rigid_dynamics.wheelset import track as track_model
 from rigid_dynamics.wheelset.callback import PatchCallback
-from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_FASTSIM, tables_for
+from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, LAW_CALLBACK, LAW_FASTSIM, LAW_TABLE, tables_for
 from rigid_dynamics.wheelset.compiled_motion import (
     ETA_ROW,
     SPEED_ROW,
@@ -225,7 +225,9 @@ class WheelsetModel:
         self.par = model_parameters(self)  # replaced by the packed record below (same fields, contact fields set)
         code = law_code(contact_model)
         opts = dict(model_options or {})
-        fastsim = opts if code == LAW_FASTSIM else dict((opts.get("model_options") or {}).get("fastsim") or {})
+        fastsim = (
+            opts if code in (LAW_FASTSIM, LAW_TABLE) else dict((opts.get("model_options") or {}).get("fastsim") or {})
+        )
         self.tables = tables_for(scene.material.shear_modulus_Pa, scene.material.poisson_ratio)
         tolerance = opts.get("tolerance", 0.05)
         self.packed = pack(self, provider, self.tables, contact_model, fastsim, tolerance, python_geometry)
