@@ -9,15 +9,15 @@ S = 0 to 0.3 at S = 100 mm along the track, the wheelset at 60 mm (V = 2). Our r
 inclination (the patch's contact angle) or the track distance.
 
 Tolerances (issue 26): per patch, the friction coefficient used within 0.002 of CONTACT's, Fx and Fs within 1 % of
-mu FN (mu CONTACT's for that patch), PMAX within 3 %. Recorded on this commit (pytest -s prints them): Fx 0.17 %
-(case 1), Fs 0.58 % (case 3, the small patch), PMAX 1.4 % (case 4), mu 0.0004 (case 3: contact angle 0.2484 rad
+mu FN (mu CONTACT's for that patch), PMAX within 3 %. Recorded on this commit (pytest -s prints them): Fx 0.90 %
+(case 2), Fs 0.58 % (case 3, the small patch), PMAX 0.43 % (case 3), mu 0.0004 (case 3: contact angle 0.2484 rad
 against CONTACT's 0.2480).
 
 Case 3 (5 mm shift) has two patches 6.8 mm apart, between D_SEP (6 mm) and CONTACT's D_TURN (2 D_SEP - D_COMB = 9
 mm): CONTACT keeps them apart and turns both contact planes towards their weighted angle by (D_TURN - D) / (D_TURN
 - D_SEP) of the difference (rigid_dynamics.contact.wheelset_patches.turned_angles), so the small tread patch
 (y_r = -23.76 mm, surface slope 0.133 rad) is solved at 0.248 rad, mu 0.258. Before that turning, with the profiles
-smoothed over 2 mm (the deck interpolates them, comparisons.manchester.PROFILE_SMOOTHING_M) and the rail placed
+smoothed over 2 mm (the deck interpolates them, comparisons.manchester.DECK_PROFILE_SMOOTHING_M) and the rail placed
 0.31 um further out (the gauge point, rigid_dynamics.geometry.placement), it was solved at 0.133 rad with mu 0.300
 and FN 1675 N against CONTACT's 1536 N.
 """
