@@ -29,8 +29,12 @@ with t = y_p the profile parameter, Z_top = min Z, and e_r chosen so that the ga
 y = s * G / 2. The gauge point is the innermost point of the canted profile (smallest Y) within the
 band 0 <= Z - Z_top <= h_g below the top (EN 13848-1 definition: the track gauge is the smallest
 distance between the rail heads in the range 0 to h_g = 14 mm below the running surface; CONTACT
-places its rails the same way, with GAUGHT, GAUGWD and CANT). N_id(y) is evaluated exactly on the
-spline: Y(t) = s y - e_r is solved for t by Newton's method, then
+places its rails the same way, with GAUGHT, GAUGWD and CANT). For a profile given by points the gauge
+point is taken on the cubic spline through its canted points over their chord length, as CONTACT does,
+when the profile is interpolated (smoothing 0; on the nearly vertical gauge face that spline follows the
+points more closely than the z_p(y_p) spline: 0.3 um apart on MBench_UIC60_v3); a smoothed profile is
+measured on its smoothed curve. N_id(y) is evaluated exactly on the spline: Y(t) = s y - e_r is solved
+for t by Newton's method, then
 
     dN_id/dy = s Z'/Y',   d2N_id/dy2 = (Z'' Y' - Z' Y'') / Y'^3.
 
@@ -332,8 +336,9 @@ def _canted_rail(curve, cant_rad):
 def _gauge_point(canted: _CantedRail, gauge_height_m):
     """Smallest Y of the canted profile within 0 <= Z - Z_top <= h (whole profile, overhangs included).
 
-    A profile given by points (a spline through ``knots_m``) is measured on the interpolating cubic spline of its
-    canted points over their chord length (:func:`_gauge_point_of_points`), an analytic curve on itself.
+    A profile whose spline interpolates its points (``knots_m``, no smoothing) is measured on the interpolating
+    cubic spline of its canted points over their chord length (:func:`_gauge_point_of_points`); a smoothed or an
+    analytic curve on itself.
     """
     curve = canted.curve
     knots = getattr(curve, "knots_m", None)
