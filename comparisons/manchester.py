@@ -42,6 +42,12 @@ STEPS = tuple(range(21))
 SHIFT_STEP_M = 0.5e-3
 YAW_STEP_RAD = 1.2e-3
 KINEMATICS = ("deck", "equilibrium")
+DECK_PROFILE_SMOOTHING_M = 0.0
+"""With CONTACT's deck (kinematics "deck") the profiles' splines interpolate their points, as the deck has them
+(SMOOTH = 0 on both profile lines of examples/mbench_a22_right.inp; the MBench v3 files are design profiles sampled
+every 0.1-0.5 mm). With the wheelrail default of 2 mm smoothing (kept for "equilibrium") the flange root's arcs are
+smeared: the gap there differs from CONTACT's by up to 1 um (1.8e-3 1/mm in its lateral curvature), which moves 9 %
+of a small second patch's normal force."""
 CONTACT_ELEMENT_SIZE_M = 0.2e-3  # DX = DS of CONTACT's deck
 REFERENCE_CSV = Path(__file__).parent / "data" / "contact_reference" / "mbench_a22_right.csv"
 
@@ -129,7 +135,10 @@ def a22_case(step: int, kinematics: str = "equilibrium") -> WheelsetCase:
     )
     if kinematics == "deck":
         ref = contact_reference()[step]
-        case = dataclasses.replace(case, roll_rad=ref["roll_rad"], pitch_rate_rad_per_s=ref["pitch_rate_rad_per_s"])
+        case = dataclasses.replace(
+            case, roll_rad=ref["roll_rad"], pitch_rate_rad_per_s=ref["pitch_rate_rad_per_s"],
+            profile_smoothing_m=DECK_PROFILE_SMOOTHING_M,
+        )  # fmt: skip
     return case
 
 
@@ -174,7 +183,7 @@ def sweep(
     variants of the deck); ``track_distance_m``: the wheelset's position along the track (CONTACT's S_WS);
     ``patch_options``: the case's patch options (A_SEP, D_SEP, D_COMB of another deck; None: the defaults).
     """
-    track = build_track(a22_case(0))
+    track = build_track(a22_case(0, kinematics))
     rows = []
     options = {"model": default_model_options(method) if model_options is None else model_options}
     if sides is not None:

@@ -1,7 +1,9 @@
 """Friction varying in place within a wheelset patch (the case option ``friction_place = "element"``): each BEM
 element's traction bound is mu at the rail's inclination under it. Checked on the A-2.2 flange-root patch (step 10,
 right wheel, CONTACT's D_SEP 6 / D_COMB 3 mm so that it is a patch of its own), where the rail's inclination runs
-from 0.26 to 0.34 rad across the contact."""
+from 0.26 to 0.34 rad across the contact. D_TURN = D_SEP: each patch in the plane of its own weighted angle (the
+deck's default D_TURN of 9 mm would turn the two patches, 6.8 mm apart, towards each other:
+tests/test_patch_turning.py), which the place function is checked against."""
 
 import math
 
@@ -25,7 +27,8 @@ def solved():
     out = {}
     for place in ("patch", "element"):
         options = {"model": {"element_size_m": 2e-4}, "sides": ("right",), "friction_place": place,
-                   "patch": {"distance_separation_m": 6e-3, "distance_combination_m": 3e-3}}  # fmt: skip
+                   "patch": {"distance_separation_m": 6e-3, "distance_combination_m": 3e-3,
+                             "distance_turning_m": 6e-3}}  # fmt: skip
         out[place] = solve_wheelset_case(case, MATERIAL.with_friction(LUBRICATED_FLANGE), "bem", options, track=track)
     return track, out
 

@@ -194,3 +194,17 @@ def test_analytic_test_surfaces_sphere_and_cylinder_curvature():
     k = _wheel_principal_curvatures(cyl.evaluate(0.7, 0.75 + np.linspace(-0.04, 0.05, 10)))
     np.testing.assert_allclose(k[:, 0], 0.0, atol=1e-12)
     np.testing.assert_allclose(k[:, 1], 1 / r0, rtol=1e-9)
+
+
+def test_gauge_point_of_an_interpolated_point_profile_is_contacts():
+    """An interpolated point profile's gauge point lies on the chord-length spline through its points, as CONTACT's:
+    MBench_UIC60_v3 (canted 1:40 in its points) at 14 mm, gauge 1435 mm: CONTACT (rev 2707, X_PROFIL = 3 on
+    tests/data/contact_friction/force_control/force_control.inp) prints "rail gauge point yg= -43.032558, offset
+    rail->track= 760.532558" (mm). The z(y) spline's gauge point lies 0.31 um further out; the placed surface then
+    measures the gauge within 1 um of G. With smoothing the curve is measured on itself (gauge exact)."""
+    track = TrackGeometry(
+        load_profile("MBench_UIC60_v3"), gauge_m=1.435, gauge_height_m=0.014, rail_inclination_rad=math.atan(1 / 40),
+        profile_is_canted=True, smoothing_wavelength_m=0.0,
+    )  # fmt: skip
+    assert track.rail_offset_m == pytest.approx(0.760532558, abs=2e-8)
+    assert track.measured_gauge_m() == pytest.approx(1.435, abs=1e-6)

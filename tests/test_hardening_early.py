@@ -110,6 +110,7 @@ def test_huge_workers_refused_with_the_estimate(capsys, tmp_path, command):
     ("table", "key", "value"),
     [
         ("[solver.patch]\ndistance_separation_m = -1.0\n", "solver.patch.distance_separation_m", "-1.0"),
+        ("[solver.patch]\ndistance_turning_m = -1.0\n", "solver.patch.distance_turning_m", "-1.0"),
         ("[solver.patch]\nfield_points = -3\n", "solver.patch.field_points", "-3"),
         ("[solver.search]\nfield_points = -3\n", "solver.search.field_points", "-3"),
         ("[solver.patch]\nlocus_step_m = 0.0\n", "solver.patch.locus_step_m", "0.0"),

@@ -533,6 +533,7 @@ class _Evaluator:
             # regions are joined only for a model that solves the joined gap (bem, fea); the analytic rungs take
             # each interpenetration region as its own patch (a joined patch is no ellipse)
             patch_options["distance_separation_m"] = 0.0
+            patch_options["distance_turning_m"] = 0.0  # and each keeps its own plane (no turning)
         patches, locus = wheel_patches(
             wheel, rail, pose, side, wheel_lateral_range_m=wheel.y_range_m, rail_lateral_range_m=rail.y_range_m,
             nominal_radius_m=track.nominal_radius_m, options=patch_options,

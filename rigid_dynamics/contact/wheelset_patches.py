@@ -13,8 +13,10 @@ at the deepest point. CONTACT's module 1 (E.A.H. Vollebregt, J.J. Kalker; open s
    their elastic interaction (CONTACT blends regions with D_COMB < d <= D_SEP; here they are joined fully and
    the patch says so in ``combination``), regions further apart are separate patches;
 4. places each patch's *contact reference point* at the interpenetration's weighted centre and its contact plane
-   at the weighted contact angle. With the gap along x approximated as g(x, y) = g(y) + a x^2, a = 1/(2 r0),
-   the weight of a lateral position is (the integral of the squared interpenetration along x)
+   at the weighted contact angle, turned towards a neighbouring patch's when the two lie between D_SEP and D_TURN
+   apart (:func:`turned_angles`; a small patch beside a large one takes most of the large one's angle). With the
+   gap along x approximated as g(x, y) = g(y) + a x^2, a = 1/(2 r0), the weight of a lateral position is (the
+   integral of the squared interpenetration along x)
 
        w(y) = int (c - a x^2)^2 dx over |x| < t0 = 16/15 c^2 t0,   c = -g(y) > 0,  t0 = sqrt(c / a),
 
@@ -49,13 +51,14 @@ DEFAULT_PATCH_OPTIONS: dict = {
     "angle_separation_rad": 0.5 * math.pi,  # A_SEP of CONTACT (90 degrees)
     "distance_separation_m": 8.0e-3,  # D_SEP
     "distance_combination_m": 4.0e-3,  # D_COMB
+    "distance_turning_m": None,  # D_TURN; None: CONTACT's default 2 D_SEP - D_COMB
     "locus_step_m": 5.0e-5,  # spacing of the contact locus along the axle
     "field_points": 25,  # coarse sample of the plane gap per direction (sizes the potential area)
     "field_margin": 0.3,  # margin of the sampled box around the interpenetration, fraction of its extent
     "ellipticity_tolerance": 0.2,  # single-region patches: is_elliptic when ellipticity_error <= this
     "rolling_direction": (1.0, 0.0, 0.0),
 }
-"""Options of :func:`wheel_patches` (CONTACT's A_SEP, D_SEP, D_COMB with CONTACT's defaults)."""
+"""Options of :func:`wheel_patches` (CONTACT's A_SEP, D_SEP, D_COMB, D_TURN with CONTACT's defaults)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -378,6 +381,42 @@ def group_regions(regions: list[InterpenetrationRegion], options) -> list[tuple[
     return groups
 
 
+def turning_distance_m(options) -> float:
+    """D_TURN of the options: ``distance_turning_m``, or CONTACT's default 2 D_SEP - D_COMB when it is None."""
+    value = options.get("distance_turning_m")
+    if value is None:
+        return 2.0 * options["distance_separation_m"] - options["distance_combination_m"]
+    return float(value)
+
+
+def turned_angles(groups: list[list[InterpenetrationRegion]], options) -> list[tuple[float, float]]:
+    """Each patch's contact reference angle and the turn in it, (angle, turn) in rad (module docstring, step 4).
+
+    A patch's own angle is its regions' weighted angle. Two neighbouring patches (along the axle) whose distance d
+    (between the end of one's last region and the start of the next one's first, rail surface, y-z plane) lies in
+    [D_SEP, D_TURN] and whose angles differ by at most A_SEP are turned towards their common weighted angle
+    (delta_1 w_1 + delta_2 w_2) / (w_1 + w_2) by the fraction f = (D_TURN - d) / (D_TURN - D_SEP) of the
+    difference: full joining's angle at D_SEP, none at D_TURN, so the patches' planes do not jump where the regions
+    stop being joined (CONTACT's "turning", user guide sec. "Identification of contact patches"). The turns of a
+    patch with two such neighbours add; each is taken from the angles before turning. No turning when
+    D_TURN <= D_SEP.
+    """
+    weights = [sum(r.weight for r in group) for group in groups]
+    own = [sum(r.angle_rad * r.weight for r in group) / w for group, w in zip(groups, weights, strict=True)]
+    turn = [0.0] * len(groups)
+    d_sep, d_turn = options["distance_separation_m"], turning_distance_m(options)
+    if d_turn > d_sep:
+        for k in range(len(groups) - 1):
+            d = float(np.hypot(*(groups[k + 1][0].ends_m[0] - groups[k][-1].ends_m[1])))
+            if abs(own[k] - own[k + 1]) > options["angle_separation_rad"] or not d_sep <= d <= d_turn:
+                continue
+            common = (own[k] * weights[k] + own[k + 1] * weights[k + 1]) / (weights[k] + weights[k + 1])
+            fraction = (d_turn - d) / (d_turn - d_sep)
+            turn[k] += fraction * (common - own[k])
+            turn[k + 1] += fraction * (common - own[k + 1])
+    return [(a + t, t) for a, t in zip(own, turn, strict=True)]
+
+
 def plane_gap(geo: _SideGeometry, locus: ContactLocus, origin, frame, x_m, y_m, iterations: int = 10):
     """Undeformed distance along the plane normal at points (x, y) of the plane (origin, frame), m.
 
@@ -442,6 +481,8 @@ class WheelPatch:
         min_vertical_gap_m: the largest vertical interpenetration (negative), m.
         wheel_point_m: the wheel's surface point on the normal through the reference point (main frame), m:
             the material point whose velocity gives the creepages (CONTACT's rolling radius is the wheel's).
+        angle_turn_rad: how far the contact angle was turned towards a neighbouring patch's (D_SEP <= d <=
+            D_TURN, :func:`turned_angles`), rad; 0 when not turned.
     """
 
     geometry: ContactGeometry
@@ -451,6 +492,7 @@ class WheelPatch:
     deepest_point_rail_m: tuple[float, float]
     min_vertical_gap_m: float
     wheel_point_m: np.ndarray
+    angle_turn_rad: float = 0.0
 
 
 def _curvatures(geo_exact: _SideGeometry, alpha0: float, y0: float, rail_xy, frame):
@@ -529,12 +571,13 @@ def wheel_patches(
     regions = interpenetration_regions(locus, nominal_radius_m)
     a_long = 0.5 / nominal_radius_m
     patches = []
-    for members, how in group_regions(regions, opts):
+    grouped = group_regions(regions, opts)
+    angles = turned_angles([[regions[k] for k in members] for members, _ in grouped], opts)
+    for (members, how), (delta, turn) in zip(grouped, angles, strict=True):
         group = [regions[k] for k in members]
         weight = sum(r.weight for r in group)
         x_c = sum(r.centre_m[0] * r.weight for r in group) / weight
         y_c = sum(r.centre_m[1] * r.weight for r in group) / weight
-        delta = sum(r.angle_rad * r.weight for r in group) / weight
         z_c = float(geo.rail.evaluate(np.array([x_c]), np.array([y_c]))[0][0])
         origin = np.array([x_c, y_c, z_c])
         sgn = -1.0 if side == "right" else 1.0
@@ -628,5 +671,7 @@ def wheel_patches(
         if hasattr(exact_rail, "to_profile_coordinates"):
             deep_profile = tuple(float(v) for v in exact_rail.to_profile_coordinates(p_deep[1], p_deep[2]))
         wheel_point = geo.wheel_point(np.array([alpha0]), np.array([lat0]))[0][0]
-        patches.append(WheelPatch(geometry, group, how, p_deep, deep_profile, deepest.min_gap_m, wheel_point))
+        patches.append(
+            WheelPatch(geometry, group, how, p_deep, deep_profile, deepest.min_gap_m, wheel_point, float(turn))
+        )
     return patches, locus

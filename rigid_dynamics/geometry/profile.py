@@ -277,6 +277,7 @@ class ProfileCurve:
     smoothing_wavelength_m: float = DEFAULT_SMOOTHING_WAVELENGTH_M
     _spline: object = field(init=False, repr=False, compare=False)
     _y_range: tuple = field(init=False, repr=False, compare=False)
+    _knots: tuple = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if not isinstance(self.profile, Profile):
@@ -292,6 +293,14 @@ class ProfileCurve:
         spline = make_interp_spline(y, z, k=3)
         object.__setattr__(self, "_spline", spline)
         object.__setattr__(self, "_y_range", (float(y[0]) / _MM_PER_M, float(y[-1]) / _MM_PER_M))
+        object.__setattr__(self, "_knots", None if L > 0 else (y / _MM_PER_M, z / _MM_PER_M))
+
+    @property
+    def knots_m(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The profile's points (y_p, z_p) when the spline interpolates them (no smoothing), m; None when smoothed
+        (the smoothed curve is then the profile's shape, measured on itself).
+        """
+        return self._knots
 
     @property
     def kind(self) -> str:
