@@ -665,20 +665,25 @@ def _shrunk_box(xs, ys, extent, margin):
 
 @njit(cache=True, _nrt=False)
 def warm_grid(surf, patch, box, margin, xs, ys, gap, columns):
-    """The gap on the given box (x_lo, x_hi, y_lo, y_hi; the last evaluation's) when it still fits the overlap as
-    fitted_grid's would: the overlap touches no side and the shrunk box keeps at least 80 % of each side. Returns
-    True when it fits (then xs, ys, gap hold it), else False (call fitted_grid).
+    """The gap on the given box (x_lo, x_hi, y_lo, y_hi; the last evaluation's) when it holds the overlap as
+    fitted_grid's would: the overlap touches no side; when the box is then more than 20 % too large on a side, the
+    gap on fitted_grid's last box (the overlap's extent plus margin, :func:`_shrunk_box`) of this sampling. Returns
+    the number of samplings (1 or 2; xs, ys, gap hold the gap), or 0 when the box does not hold the overlap (call
+    fitted_grid).
     """
     x_lo, x_hi, y_lo, y_hi = box[BOX_X_LO], box[BOX_X_HI], box[BOX_Y_LO], box[BOX_Y_HI]
     if not x_hi > x_lo:
-        return False
+        return 0
     sample_grid(surf, patch, (x_lo, x_hi, y_lo, y_hi), xs, ys, gap, columns)
     c0, c1, r0, r1 = _overlap_extent(gap)
     nx, ny = xs.shape[0], ys.shape[0]
     if c0 <= 0 or c1 >= nx - 1 or r0 <= 0 or r1 >= ny - 1:
-        return False
+        return 0
     fx0, fx1, fy0, fy1 = _shrunk_box(xs, ys, (c0, c1, r0, r1), margin)
-    return not (fx1 - fx0 < 0.8 * (x_hi - x_lo) or fy1 - fy0 < 0.8 * (y_hi - y_lo))
+    if fx1 - fx0 < 0.8 * (x_hi - x_lo) or fy1 - fy0 < 0.8 * (y_hi - y_lo):
+        sample_grid(surf, patch, (fx0, fx1, fy0, fy1), xs, ys, gap, columns)
+        return 2
+    return 1
 
 
 @njit(cache=True, _nrt=False)

@@ -155,10 +155,12 @@ def sample_candidates(y, run, cg, field, centre):
         fit = GridFit(FIRST_BOX_SCALE * math.sqrt(q / ca), FIRST_BOX_SCALE * math.sqrt(q / cb), par.kpec_margin,
                       MIN_HALF_SIZE_M)  # fmt: skip
         gap, xs, ys, box = field.gap[c], field.xs[c], field.ys[c], field.box[c]
-        # the last box of this candidate when it still fits the overlap as the fitted box would (one sampling),
-        # else the fitted box from the quadric's start (2-3 samplings)
-        if warm_grid(surf, patch, box, par.kpec_margin, xs, ys, gap, field.columns):
-            total += 1
+        # the last box of this candidate when it still holds the overlap as the fitted box would (one sampling;
+        # shrunk as fitted_grid's last step when too large: two), else the fitted box from the quadric's start
+        # (2-3 samplings)
+        warm = warm_grid(surf, patch, box, par.kpec_margin, xs, ys, gap, field.columns)
+        if warm > 0:
+            total += warm
         else:
             total += 1 + fitted_grid(surf, patch, fit, xs, ys, gap, field.columns)
         box[BOX_X_LO], box[BOX_X_HI], box[BOX_Y_LO], box[BOX_Y_HI] = xs[0], xs[-1], ys[0], ys[-1]
