@@ -31,8 +31,14 @@ from rigid_dynamics.files import write_text  # noqa: E402
 from rigid_dynamics.wheelset.simulate import simulate  # noqa: E402
 from wheelrail.scenes import load_scene  # noqa: E402
 
-PREVIOUS_SAMPLER = {"commit": "19dc8cd", "load": 2.7, "us_per_rhs": {"curve-flange": 864, "polygonal-wheel": 601}}
-"""The sampled KPEC's cost per right-hand side in this bench before the strip sampler (its results file then)."""
+PREVIOUS_SAMPLER = {
+    "commit": "19dc8cd",
+    "load": 2.7,
+    "us_per_rhs": {"curve-flange": 864, "polygonal-wheel": 601},
+    "law_us_per_rhs": {"curve-flange": 35, "polygonal-wheel": 46},
+}
+"""The sampled KPEC's and the quadric KPEC's cost per right-hand side in this bench before the strip sampler (its
+results file then)."""
 
 CASES = (
     ("kpec sampled 24", {"contact_model": "kpec"}),
@@ -117,9 +123,10 @@ def main(argv=None):
     write(rows, args)
 
 
-def write(rows, args):
+def write(rows, args, machine=None):
+    """The results files of ``rows``; ``machine``: as measured (default: this machine now)."""
     commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
-    machine = {
+    machine = machine or {
         "platform": platform.platform(),
         "processor": platform.processor(),
         "cpu_count": os.cpu_count(),
@@ -166,6 +173,16 @@ def write(rows, args):
             f"exact roots to round-off, tests/test_gap_kernels.py); the goal is {'met' if rtf >= 5 else 'not met'}."
         )
     before = PREVIOUS_SAMPLER
+    for scene in sorted({r["scene"] for r in rows}):
+        by = {r["case"]: r for r in rows if r["scene"] == scene}
+        law = by["kpec ellipse 24"]["us_per_rhs"]
+        now = (by["kpec sampled 24"]["us_per_rhs"] - law) / law
+        then = (before["us_per_rhs"][scene] - before["law_us_per_rhs"][scene]) / before["law_us_per_rhs"][scene]
+        lines.append(
+            f"- {scene}: the sampling costs {now:.2g} times the law's time per right-hand side (sampled minus quadric "
+            f"KPEC over quadric KPEC, one run: the machine's load cancels), {then:.2g} times before the strip sampler: "
+            f"{then / now:.2g}x cheaper."
+        )
     lines += [
         "",
         f"Before the strip sampler (commit {before['commit']}, the same bench, load {before['load']}): the sampled "
