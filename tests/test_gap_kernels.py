@@ -102,7 +102,7 @@ def test_regression_fitted_box_and_residual_equal_the_search(flange):
     q, a, b = patch.approach_m, patch.curvature_long_1_per_m, patch.curvature_lat_1_per_m
     fit = gk.GridFit(1.6 * np.sqrt(q / a), 1.6 * np.sqrt(q / b), 0.25, 1e-3)
     xs, ys, gap = np.empty(31), np.empty(31), np.empty((31, 31))
-    gk.fitted_grid(surf, rec, fit, xs, ys, gap, np.empty((31, 8)))
+    gk.fitted_grid(surf, rec, fit, xs, ys, gap, np.empty((31, gk.COLUMN_SCRATCH)))
     np.testing.assert_allclose(xs, u.x_m, rtol=0, atol=1e-15)
     np.testing.assert_allclose(ys, u.y_m, rtol=0, atol=1e-15)
     finite = np.isfinite(u.distance_m)
@@ -153,7 +153,7 @@ def test_row_sampler_equals_the_exact_newton_sampling(scene_name, pose, side, sc
     box = (scale * u.x_m[0], scale * u.x_m[-1], scale * u.y_m[0], scale * u.y_m[-1])
     n = 24
     xs, ys, gap = np.empty(n), np.empty(n), np.empty((n, n))
-    gk.sample_grid(surf, rec, box, xs, ys, gap, np.empty((n, 8)))
+    gk.sample_grid(surf, rec, box, xs, ys, gap, np.empty((n, gk.COLUMN_SCRATCH)))
     exact = _exact_reference(surf, rec, box, n)
     np.testing.assert_array_equal(gap[~np.isfinite(exact)], exact[~np.isfinite(exact)])
     finite = np.isfinite(exact)

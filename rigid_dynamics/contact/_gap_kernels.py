@@ -326,34 +326,6 @@ def _wheel_root(gx, gy, s, surf, patch, axes, mode, col, limit):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _wheel_polish(gx, gy, s, surf, axes, mode, col, limit):
-    """Two Newton steps of :func:`_wheel_root` from s, without a test between them (the points of a row are
-    independent; their iterations overlap in the processor). Returns (s, converged): converged when the second
-    step is below STEP_TOLERANCE_M (s then exact to about c step^2) and y_d is on the profile (else s is +inf).
-    """
-    pc, u, v, w = axes
-    b0 = pc[0] + gx * u[0] + gy * v[0]
-    b1 = pc[1] + gx * u[1] + gy * v[1]
-    b2 = pc[2] + gx * u[2] + gy * v[2]
-    step, p1 = math.nan, math.nan
-    for _ in range(2):
-        p0, p1, p2 = b0 + s * w[0], b1 + s * w[1], b2 + s * w[2]
-        rho = math.sqrt(p0 * p0 + p2 * p2)
-        r, r_y, _ = _table(p1, *surf.wheel)
-        irr, irr_a = _wheel_irr_at(p0, p2, rho, surf, mode, col, limit)
-        g0 = (p0 + irr_a * p2 / rho) / rho
-        g2 = (p2 - irr_a * p0 / rho) / rho
-        step = (rho - r - irr) / (g0 * w[0] - r_y * w[1] + g2 * w[2])
-        s -= step
-    if not abs(step) < STEP_TOLERANCE_M:
-        return math.nan, False
-    lat = p1 - step * w[1]
-    if not (lat >= surf.y_range[0] and lat <= surf.y_range[1]):
-        return math.inf, True
-    return s, True
-
-
-@njit(cache=True, _nrt=False, inline="always")
 def _rail_root(b0, b1, b2, patch, surf, t):
     """The rail's distance t along n from the base (b0, b1, b2) by Newton's method from t (the slope floored as
     :func:`_rail_distance`). Returns (t, dt/dx, dt/dy, converged); t +inf off the rail or beyond 0.05 m.
@@ -472,8 +444,8 @@ def sample_grid(surf, patch, box, xs, ys, gap, columns):
     wheel root by Newton's method (to the step tolerance) from the quadratic through the anchors' s(x), its rail
     root from the middle anchor's moved by dt/dx (exact along a row on an ideal rail, :func:`_rail_follows_rows`;
     else Newton's method from there). The points of a row are independent of each other. A point whose start
-    fails is solved by :func:`chain_point` from the middle anchor. columns (nx, 8): scratch (the wheel's column
-    series, the row's roots). Every root is the exact solve's to the step tolerance.
+    fails is solved by :func:`chain_point` from the middle anchor. columns (nx, COLUMN_SCRATCH):
+    scratch (the wheel's column series, the row's roots). Every root is the exact solve's to the step tolerance.
     """
     x_lo, x_hi, y_lo, y_hi = box
     nx, ny = xs.shape[0], ys.shape[0]
@@ -486,6 +458,7 @@ def sample_grid(surf, patch, box, xs, ys, gap, columns):
         col = chain_column(xs[i], surf, axes, mode)
         for k in range(5):
             columns[i, k] = col[k]
+        columns[i, COL_OFFSET] = 0.0
     linear_rail = _rail_follows_rows(surf, patch)
     centre = chain_point(0.0, 0.0, surf, patch, axes, mode, chain_column(0.0, surf, axes, mode), limit, NO_CHAIN)[1]
     first, middle, last = centre, centre, centre
@@ -500,7 +473,10 @@ def sample_grid(surf, patch, box, xs, ys, gap, columns):
         rail_ok = middle[0] == x1 and middle[1] == gy
         s0, s1, s2 = first[7], middle[7], last[7]
         t1, t_x = middle[2], middle[3]
-        if wheel_ok and rail_ok:
+        if not (wheel_ok and rail_ok):
+            for i in range(nx):
+                columns[i, COL_OFFSET] = 0.0
+        else:
             _polish_row(xs, gy, (x0, x1, x2), (s0, s1, s2), surf, axes, mode, limit, columns)
         for i in range(nx):
             if i == i0 or i == i1 or i == i2:
@@ -524,9 +500,11 @@ def sample_grid(surf, patch, box, xs, ys, gap, columns):
                 gap[j, i] = chain_point(gx, gy, surf, patch, axes, mode, _column(columns, i), limit, middle)[0]
 
 
-COL_ROOT, COL_STEP, COL_LATERAL = 5, 6, 7
+COL_ROOT, COL_STEP, COL_LATERAL, COL_OFFSET = 5, 6, 7, 8
 """Columns of sample_grid's scratch after the series (0-4): a row's wheel roots s, 0 where the root converged
-(else 1), and its y_d."""
+(else 1), its y_d, and the root's offset from the anchors' quadratic (the next row's start adds it)."""
+COLUMN_SCRATCH = 9
+"""Columns of sample_grid's scratch."""
 ROW_SWEEPS = 4
 """Newton sweeps over a row's points at most (they end when every step of a sweep is below STEP_TOLERANCE_M)."""
 
@@ -537,7 +515,8 @@ def _polish_row(xs, gy, anchor_x, anchor_s, surf, axes, mode, limit, columns):
     of :func:`_wheel_root` at every point from Lagrange's quadratic through the anchors' (x, s), the points
     interleaved (independent: the processor overlaps their iterations), repeated up to ROW_SWEEPS times until
     every step is below STEP_TOLERANCE_M (a point converged when its last step is: s then exact to about
-    c step^2); s +inf where y_d leaves the profile.
+    c step^2); s +inf where y_d leaves the profile. The start adds to the quadratic the previous row's offset of
+    its root from its quadratic (COL_OFFSET; 0 after a row not polished): it varies slowly across the rows.
     """
     x0, x1, x2 = anchor_x
     s0, s1, s2 = anchor_s
@@ -546,7 +525,9 @@ def _polish_row(xs, gy, anchor_x, anchor_s, surf, axes, mode, limit, columns):
     nx = xs.shape[0]
     for i in range(nx):
         gx = xs[i]
-        columns[i, COL_ROOT] = d0 * (gx - x1) * (gx - x2) + d1 * (gx - x0) * (gx - x2) + d2 * (gx - x0) * (gx - x1)
+        quadratic = d0 * (gx - x1) * (gx - x2) + d1 * (gx - x0) * (gx - x2) + d2 * (gx - x0) * (gx - x1)
+        columns[i, COL_ROOT] = quadratic + columns[i, COL_OFFSET]
+        columns[i, COL_OFFSET] = quadratic
     c0, c1, c2 = pc[0] + gy * v[0], pc[1] + gy * v[1], pc[2] + gy * v[2]
     for _ in range(ROW_SWEEPS):
         worst = 0.0
@@ -568,6 +549,8 @@ def _polish_row(xs, gy, anchor_x, anchor_s, surf, axes, mode, limit, columns):
             break
     for i in range(nx):
         lat = columns[i, COL_LATERAL]
+        offset = columns[i, COL_ROOT] - columns[i, COL_OFFSET]
+        columns[i, COL_OFFSET] = offset if columns[i, COL_STEP] == 0.0 and math.isfinite(offset) else 0.0
         if not (lat >= surf.y_range[0] and lat <= surf.y_range[1]):
             columns[i, COL_ROOT] = math.inf
 

@@ -30,6 +30,7 @@ from rigid_dynamics.contact._gap_kernels import (
     BOX_X_LO,
     BOX_Y_HI,
     BOX_Y_LO,
+    COLUMN_SCRATCH,
     GapPatch,
     GapSurfaces,
     GridFit,
@@ -69,7 +70,7 @@ class PatchScratch(NamedTuple):
     its grid xs (ncand, nx), ys (ncand, ny), m, the ellipticity residual (ncand,) and whether it was sampled
     (ncand,: 1 sampled, 0 the quadric); the law's fields (ny, nx): pressure, in_contact, tractions t_x, t_y, in_slip;
     the rows' first and last element in contact (ny,); per candidate the last sampled box (ncand, 4: x_lo, x_hi,
-    y_lo, y_hi, m; NaN: none); the sampler's column scratch (nx, 8: _gap_kernels.sample_grid).
+    y_lo, y_hi, m; NaN: none); the sampler's column scratch (nx, COLUMN_SCRATCH: _gap_kernels.sample_grid).
     """
 
     gap: np.ndarray
@@ -98,7 +99,7 @@ def patch_scratch(par, ncand):
         np.zeros((ncand, ny, nx)), np.zeros((ncand, nx)), np.zeros((ncand, ny)), np.full(ncand, np.nan),
         np.zeros(ncand), np.zeros((ny, nx)), np.zeros((ny, nx), np.bool_), np.zeros((ny, nx)), np.zeros((ny, nx)),
         np.zeros((ny, nx), np.bool_), np.zeros(ny, np.int64), np.zeros(ny, np.int64), np.full((ncand, 4), np.nan),
-        np.zeros((nx, 8)),
+        np.zeros((nx, COLUMN_SCRATCH)),
     )  # fmt: skip
 
 
