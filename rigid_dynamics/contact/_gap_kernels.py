@@ -221,6 +221,10 @@ SERIES_ERROR_M = 1.0e-13
 NO_CHAIN = (math.nan, math.nan, math.nan, 0.0, 0.0, math.nan, math.nan, math.nan, 0.0, 0.0)
 """A chain state with no neighbour: (x, y of the rail's last root, t, dt/dx, dt/dy, x, y of the wheel's, s, ds/dx,
 ds/dy)."""
+CHAIN_RAIL_X, CHAIN_RAIL_Y, CHAIN_T, CHAIN_T_X, CHAIN_T_Y, CHAIN_WHEEL_X, CHAIN_WHEEL_Y, CHAIN_S = range(8)
+"""Entries of a chain state (NO_CHAIN's layout; 8, 9: ds/dx, ds/dy)."""
+SERIES_COS, SERIES_SIN, SERIES_VALUE, SERIES_SLOPE, SERIES_CURVATURE = range(5)
+"""Entries of a column series (:func:`chain_column`): cos, sin alpha_c, R_irr, dR_irr/da, d2R_irr/da2."""
 WHEEL_IDEAL, WHEEL_SERIES, WHEEL_EXACT = range(3)
 """How the chained wheel root evaluates R_irr: none; harmonic rows by the column series; flats at each iterate."""
 
@@ -282,12 +286,14 @@ def _wheel_irr_at(p0, p2, rho, surf, mode, col, limit):
     if mode == WHEEL_IDEAL:
         return 0.0, 0.0
     if mode == WHEEL_SERIES:
-        den = col[0] * p0 + col[1] * p2
-        tan_da = (col[0] * p2 - col[1] * p0) / den
+        ca, sa = col[SERIES_COS], col[SERIES_SIN]
+        den = ca * p0 + sa * p2
+        tan_da = (ca * p2 - sa * p0) / den
         if den > 0.0 and abs(tan_da) <= limit:
             t2 = tan_da * tan_da
             da = tan_da * (1.0 - t2 * (1.0 / 3.0 - 0.2 * t2))
-            return col[2] + da * (col[3] + 0.5 * da * col[4]), col[3] + da * col[4]
+            value, slope, curvature = col[SERIES_VALUE], col[SERIES_SLOPE], col[SERIES_CURVATURE]
+            return value + da * (slope + 0.5 * da * curvature), slope + da * curvature
     v, va, _ = wheel_irregularity(math.atan2(p2, p0), surf.wheel_irr)
     return v, va
 
@@ -426,13 +432,16 @@ def _rail_follows_rows(surf, patch):
 
 @njit(cache=True, _nrt=False, inline="always")
 def _column(columns, i):
-    return columns[i, 0], columns[i, 1], columns[i, 2], columns[i, 3], columns[i, 4]
+    return (
+        columns[i, SERIES_COS], columns[i, SERIES_SIN], columns[i, SERIES_VALUE], columns[i, SERIES_SLOPE],
+        columns[i, SERIES_CURVATURE],
+    )  # fmt: skip
 
 
 @njit(cache=True, _nrt=False, inline="always")
 def _rooted_here(state, gx, gy):
     """Whether a chain state's wheel root is at (gx, gy) (else the chain kept an older root: none here)."""
-    return state[5] == gx and state[6] == gy
+    return state[CHAIN_WHEEL_X] == gx and state[CHAIN_WHEEL_Y] == gy
 
 
 @njit(cache=True, _nrt=False)
@@ -470,9 +479,9 @@ def sample_grid(surf, patch, box, xs, ys, gap, columns):
         gap[j, i1], middle = chain_point(x1, gy, surf, patch, axes, mode, _column(columns, i1), limit, middle)
         gap[j, i2], last = chain_point(x2, gy, surf, patch, axes, mode, _column(columns, i2), limit, last)
         wheel_ok = _rooted_here(first, x0, gy) and _rooted_here(middle, x1, gy) and _rooted_here(last, x2, gy)
-        rail_ok = middle[0] == x1 and middle[1] == gy
-        s0, s1, s2 = first[7], middle[7], last[7]
-        t1, t_x = middle[2], middle[3]
+        rail_ok = middle[CHAIN_RAIL_X] == x1 and middle[CHAIN_RAIL_Y] == gy
+        s0, s1, s2 = first[CHAIN_S], middle[CHAIN_S], last[CHAIN_S]
+        t1, t_x = middle[CHAIN_T], middle[CHAIN_T_X]
         if not (wheel_ok and rail_ok):
             for i in range(nx):
                 columns[i, COL_OFFSET] = 0.0
