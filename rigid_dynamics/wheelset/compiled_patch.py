@@ -30,6 +30,7 @@ from rigid_dynamics.contact._gap_kernels import (
     BOX_X_LO,
     BOX_Y_HI,
     BOX_Y_LO,
+    COLUMN_SCRATCH,
     GapPatch,
     GapSurfaces,
     GridFit,
@@ -69,7 +70,7 @@ class PatchScratch(NamedTuple):
     its grid xs (ncand, nx), ys (ncand, ny), m, the ellipticity residual (ncand,) and whether it was sampled
     (ncand,: 1 sampled, 0 the quadric); the law's fields (ny, nx): pressure, in_contact, tractions t_x, t_y, in_slip;
     the rows' first and last element in contact (ny,); per candidate the last sampled box (ncand, 4: x_lo, x_hi,
-    y_lo, y_hi, m; NaN: none).
+    y_lo, y_hi, m; NaN: none); the sampler's column scratch (nx, COLUMN_SCRATCH: _gap_kernels.sample_grid).
     """
 
     gap: np.ndarray
@@ -85,6 +86,7 @@ class PatchScratch(NamedTuple):
     first: np.ndarray
     last: np.ndarray
     box: np.ndarray
+    columns: np.ndarray
 
 
 @njit(cache=True)
@@ -97,6 +99,7 @@ def patch_scratch(par, ncand):
         np.zeros((ncand, ny, nx)), np.zeros((ncand, nx)), np.zeros((ncand, ny)), np.full(ncand, np.nan),
         np.zeros(ncand), np.zeros((ny, nx)), np.zeros((ny, nx), np.bool_), np.zeros((ny, nx)), np.zeros((ny, nx)),
         np.zeros((ny, nx), np.bool_), np.zeros(ny, np.int64), np.zeros(ny, np.int64), np.full((ncand, 4), np.nan),
+        np.zeros((nx, COLUMN_SCRATCH)),
     )  # fmt: skip
 
 
@@ -153,12 +156,14 @@ def sample_candidates(y, run, cg, field, centre):
         fit = GridFit(FIRST_BOX_SCALE * math.sqrt(q / ca), FIRST_BOX_SCALE * math.sqrt(q / cb), par.kpec_margin,
                       MIN_HALF_SIZE_M)  # fmt: skip
         gap, xs, ys, box = field.gap[c], field.xs[c], field.ys[c], field.box[c]
-        # the last box of this candidate when it still fits the overlap as the fitted box would (one sampling),
-        # else the fitted box from the quadric's start (2-3 samplings)
-        if warm_grid(surf, patch, box, par.kpec_margin, xs, ys, gap):
-            total += 1
+        # the last box of this candidate when it still holds the overlap as the fitted box would (one sampling;
+        # shrunk as fitted_grid's last step when too large: two), else the fitted box from the quadric's start
+        # (2-3 samplings)
+        warm = warm_grid(surf, patch, box, par.kpec_margin, xs, ys, gap, field.columns)
+        if warm > 0:
+            total += warm
         else:
-            total += 1 + fitted_grid(surf, patch, fit, xs, ys, gap)
+            total += 1 + fitted_grid(surf, patch, fit, xs, ys, gap, field.columns)
         box[BOX_X_LO], box[BOX_X_HI], box[BOX_Y_LO], box[BOX_Y_HI] = xs[0], xs[-1], ys[0], ys[-1]
         angle = g[G_ELLIPSE_ANGLE]
         if not math.isfinite(angle):
