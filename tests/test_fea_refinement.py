@@ -228,3 +228,32 @@ def test_refine_boxes_set_the_element_size_and_need_the_full_block():
         HertzBlockSpec(4e-3, 4e-3, refine_boxes_m=((0, 0, 4e-3, 1e-3),))
     with pytest.raises(ValueError, match="refine_boxes_m entry"):
         HertzBlockSpec(4e-3, 4e-3, symmetry="full", refine_boxes_m=((0, 0, -1.0, 1e-3),))
+
+
+def test_a_load_balanced_patch_reuses_its_series_only_on_the_same_meshes():
+    """FeaModel._reuse_series (bookkeeping, no FE solve): one solve on the memorised finest mesh carries the series'
+    estimate and status when the mesh (element size, block) is the same and the force within 10 %; else None (the
+    series runs again) with the reason kept."""
+    from fea.model import FeaModel
+    from rigid_dynamics.contact.types import ContactResult, Creepage
+
+    def level(force, size=1e-4):
+        extra = {"element_size_m": size, "block_half_width_m": 0.1}
+        result = ContactResult(method="fea", success=True, status="ok", message="active set converged",
+                               normal_force_N=force, max_pressure_Pa=1e9, contact_area_m2=1e-5, approach_m=1e-5,
+                               creepage=Creepage(), extra=extra)  # fmt: skip
+        return lambda opts: (result, lambda: None)
+
+    model = FeaModel()
+    info = {"relative_error": {"max_pressure": 0.03, "contact_area": 0.01}, "judged": ["max_pressure", "contact_area"],
+            "tolerance": 0.02}  # fmt: skip
+    model.series_memo["k"] = {"options": None, "status": "mesh-tolerance-not-met", "info": info,
+                              "normal_force_N": 1e4, "mesh": (1e-4, 0.1)}  # fmt: skip
+    reused = model._reuse_series("k", level(1.03e4), 0.0)
+    assert reused.status == "mesh-tolerance-not-met" and "tolerance 0.02 not met" in reused.message
+    assert reused.extra["discretisation_error"]["relative_error"]["max_pressure"] == 0.03
+    assert "force 10000 N" in reused.extra["discretisation_error"]["reused"]
+    assert model._reuse_series("k", level(1.2e4), 0.0) is None
+    assert model._reuse_series("k", level(1.03e4, size=2e-4), 0.0) is None
+    assert "mesh changed" in model.series_memo["k"]["rerun"]
+    assert model._reuse_series("other", level(1e4), 0.0) is None
