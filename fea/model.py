@@ -290,7 +290,7 @@ class FeaModel:
 
         key = None
         if opts.load_balanced and normal_force_N is None and opts.mesh_tolerance is not None:
-            key = _series_key(geometry, material, options)
+            key = (_series_key(geometry, material, options), math.degrees(geometry.contact_angle_rad))
             reused = self._reuse_series(key, solve_level, t0)
             if reused is not None:
                 return reused
@@ -302,8 +302,9 @@ class FeaModel:
             t0=t0,
         )
         info = result.extra.get("discretisation_error") or {}
-        if key is not None and key in self.series_memo and "rerun" in self.series_memo[key]:
-            info["series_rerun"] = self.series_memo[key]["rerun"]  # why the previous series was not reused
+        previous = self._memo_entry(key) if key is not None else None
+        if previous is not None and "rerun" in previous:
+            info["series_rerun"] = previous["rerun"]  # why the previous series was not reused
         if key is not None and info.get("estimated") and result.status in ("ok", "mesh-tolerance-not-met"):
             last = info["levels"][-1]
             finest = dataclasses.replace(
@@ -314,14 +315,27 @@ class FeaModel:
                 mesh_tolerance=None,
             )
             mesh = (result.extra.get("element_size_m"), result.extra.get("block_half_width_m"))
-            self.series_memo[key] = {
+            entries = self.series_memo.setdefault(key[0], [])
+            if previous is not None:
+                entries.remove(previous)
+            entries.append({
+                "angle_deg": key[1],
                 "options": finest,
                 "status": result.status,
                 "info": info,
                 "normal_force_N": result.normal_force_N,
                 "mesh": mesh,
-            }
+            })  # fmt: skip
         return result
+
+    def _memo_entry(self, key) -> dict | None:
+        """The memorised series of the patch ``key`` = (identity, contact angle in degrees): the entry of that
+        identity with the nearest contact angle within ``REUSE_ANGLE_DEG`` (a wheel's tread and flange patches differ
+        by more; a fixed rounding of the angle split one patch's poses 0.02 degrees apart).
+        """
+        entries = self.series_memo.get(key[0]) or []
+        near = [e for e in entries if abs(e["angle_deg"] - key[1]) <= REUSE_ANGLE_DEG]
+        return min(near, key=lambda e: abs(e["angle_deg"] - key[1])) if near else None
 
     @property
     def series_memo(self) -> dict:
@@ -337,7 +351,7 @@ class FeaModel:
         three to four solves, and the relative errors of the max pressure and area at a load a few per cent away are
         the same to their own accuracy). None: run the series.
         """
-        memo = self.series_memo.get(key)
+        memo = self._memo_entry(key)
         if memo is None:
             return None
         result, write = solve_level(memo["options"])
@@ -670,6 +684,8 @@ class FeaModel:
         )
 
 
+REUSE_ANGLE_DEG = 1.0
+"""A load-balanced solve reuses the series of the same side's patch whose contact angle is within this, degrees."""
 REUSE_FORCE_CHANGE = 0.1
 """A load-balanced solve reuses its patch's last series estimate when its force is within this fraction of the
 series' (:meth:`FeaModel._reuse_series`)."""
@@ -677,12 +693,12 @@ series' (:meth:`FeaModel._reuse_series`)."""
 
 def _series_key(geometry, material, options) -> tuple:
     """Identity of a patch for :meth:`FeaModel._reuse_series` within one model instance (one wheelset case): side,
-    contact angle (0.1 degree), material and options; the mesh itself (the rounded mesh box) is compared after the
-    solve. (The sampled patch's fitted curvatures move in their fourth digit from one pose to the next: not a key.)
+    material and options (the contact angle is matched within ``REUSE_ANGLE_DEG``, the mesh itself, the rounded mesh
+    box, is compared after the solve; the sampled patch's fitted curvatures move in their fourth digit from one pose
+    to the next: not a key).
     """
     return (
         geometry.side,
-        round(math.degrees(geometry.contact_angle_rad), 1),
         material.combined_modulus_Pa,
         material.poisson_ratio,
         repr(sorted((options or {}).items())),

@@ -247,13 +247,14 @@ def test_a_load_balanced_patch_reuses_its_series_only_on_the_same_meshes():
     model = FeaModel()
     info = {"relative_error": {"max_pressure": 0.03, "contact_area": 0.01}, "judged": ["max_pressure", "contact_area"],
             "tolerance": 0.02}  # fmt: skip
-    model.series_memo["k"] = {"options": None, "status": "mesh-tolerance-not-met", "info": info,
-                              "normal_force_N": 1e4, "mesh": (1e-4, 0.1)}  # fmt: skip
-    reused = model._reuse_series("k", level(1.03e4), 0.0)
+    model.series_memo["k"] = [{"angle_deg": 16.34, "options": None, "status": "mesh-tolerance-not-met",
+                               "info": info, "normal_force_N": 1e4, "mesh": (1e-4, 0.1)}]  # fmt: skip
+    reused = model._reuse_series(("k", 16.36), level(1.03e4), 0.0)
     assert reused.status == "mesh-tolerance-not-met" and "tolerance 0.02 not met" in reused.message
     assert reused.extra["discretisation_error"]["relative_error"]["max_pressure"] == 0.03
     assert "force 10000 N" in reused.extra["discretisation_error"]["reused"]
-    assert model._reuse_series("k", level(1.2e4), 0.0) is None
-    assert model._reuse_series("k", level(1.03e4, size=2e-4), 0.0) is None
-    assert "mesh changed" in model.series_memo["k"]["rerun"]
-    assert model._reuse_series("other", level(1e4), 0.0) is None
+    assert model._reuse_series(("k", 16.34), level(1.2e4), 0.0) is None
+    assert model._reuse_series(("k", 16.34), level(1.03e4, size=2e-4), 0.0) is None
+    assert "mesh changed" in model.series_memo["k"][0]["rerun"]
+    assert model._reuse_series(("k", 0.5), level(1e4), 0.0) is None  # the same side's tread patch
+    assert model._reuse_series(("other", 16.34), level(1e4), 0.0) is None
