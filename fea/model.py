@@ -29,6 +29,7 @@ writes it and the PNGs.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Mapping
@@ -86,6 +87,9 @@ class FeaOptions:
         grading: g, the growth of the element size per unit distance away from the patch on the first level
             (meshing.hertz); every refinement divides it by the refinement ratio, so the far field is refined
             with the patch (with a fixed grading the approach stagnates: measured on the Hertz case).
+        load_balanced: the caller balances the load with this solve's force under approach control (a wheelset
+            equilibrium, :meth:`FeaModel.load_balanced_options`): the max pressure and area are judged at the
+            finest level's force and the force is not judged (fea.refinement, load-balanced use).
     """
 
     quick: bool = False
@@ -109,6 +113,7 @@ class FeaOptions:
     mesh_tolerance: float | None = 0.02
     max_dofs: int = 200_000
     grading: float = 0.4
+    load_balanced: bool = False
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -206,6 +211,10 @@ OPTIONS = declare_dataclass(
             "minimum": 0,
             "exclusive_minimum": True,
         },
+        "load_balanced": {
+            "help": "the caller balances the load with the force (approach control): judge p and area "
+            "at the finest level's force, not the force"
+        },
     },
 )
 """Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``
@@ -229,6 +238,14 @@ class FeaModel:
         if opts.mesh_tolerance is None:
             return None
         return {**(options or {}), "mesh_tolerance": None}
+
+    @staticmethod
+    def load_balanced_options(options: Mapping | None) -> dict:
+        """Options of the solves of an iteration that balances a load with this model's force under approach control
+        (the wheelset equilibrium's full solves): ``load_balanced`` True (fea.refinement, load-balanced use).
+        """
+        FeaOptions.from_mapping(options)
+        return {**(options or {}), "load_balanced": True}
 
     @staticmethod
     def check_options(options: Mapping | None) -> None:
@@ -271,12 +288,99 @@ class FeaModel:
         def solve_level(level_opts):
             return self._solve_level(geometry, creepage, material, normal_force_N, level_opts, comm, t0)
 
-        return solve_to_tolerance(
+        key = None
+        if opts.load_balanced and normal_force_N is None and opts.mesh_tolerance is not None:
+            key = (_series_key(geometry, material, options), math.degrees(geometry.contact_angle_rad))
+            reused = self._reuse_series(key, solve_level, t0)
+            if reused is not None:
+                return reused
+        result = solve_to_tolerance(
             solve_level,
             opts,
             approach_control=normal_force_N is None,
             block_estimate=opts.formulation != "profiles",
             t0=t0,
+        )
+        info = result.extra.get("discretisation_error") or {}
+        previous = self._memo_entry(key) if key is not None else None
+        if previous is not None and "rerun" in previous:
+            info["series_rerun"] = previous["rerun"]  # why the previous series was not reused
+        if key is not None and info.get("estimated") and result.status in ("ok", "mesh-tolerance-not-met"):
+            last = info["levels"][-1]
+            finest = dataclasses.replace(
+                opts,
+                elements_per_semi_axis=last["elements_per_semi_axis"],
+                mesh_size_factor=1.0,
+                grading=last["grading"],
+                mesh_tolerance=None,
+            )
+            mesh = (result.extra.get("element_size_m"), result.extra.get("block_half_width_m"))
+            entries = self.series_memo.setdefault(key[0], [])
+            if previous is not None:
+                entries.remove(previous)
+            entries.append({
+                "angle_deg": key[1],
+                "options": finest,
+                "status": result.status,
+                "info": info,
+                "normal_force_N": result.normal_force_N,
+                "mesh": mesh,
+            })  # fmt: skip
+        return result
+
+    def _memo_entry(self, key) -> dict | None:
+        """The memorised series of the patch ``key`` = (identity, contact angle in degrees): the entry of that
+        identity with the nearest contact angle within ``REUSE_ANGLE_DEG`` (a wheel's tread and flange patches differ
+        by more; a fixed rounding of the angle split one patch's poses 0.02 degrees apart).
+        """
+        entries = self.series_memo.get(key[0]) or []
+        near = [e for e in entries if abs(e["angle_deg"] - key[1]) <= REUSE_ANGLE_DEG]
+        return min(near, key=lambda e: abs(e["angle_deg"] - key[1])) if near else None
+
+    @property
+    def series_memo(self) -> dict:
+        """The last refinement series of each load-balanced patch (:meth:`_reuse_series`)."""
+        if not hasattr(self, "_series_memo"):
+            self._series_memo = {}
+        return self._series_memo
+
+    def _reuse_series(self, key, solve_level, t0) -> ContactResult | None:
+        """A load-balanced solve of a patch whose series ran at a nearby pose: one solve on that series' finest mesh,
+        with its error estimate, when the mesh is the same (the rounded mesh box, :func:`_mesh_box`) and the force
+        within ``REUSE_FORCE_CHANGE`` of the series' (the wheelset equilibrium's later evaluations: the series costs
+        three to four solves, and the relative errors of the max pressure and area at a load a few per cent away are
+        the same to their own accuracy). None: run the series.
+        """
+        memo = self._memo_entry(key)
+        if memo is None:
+            return None
+        result, write = solve_level(memo["options"])
+        mesh = (result.extra.get("element_size_m"), result.extra.get("block_half_width_m"))
+        if result.status != "ok" or mesh != memo["mesh"]:
+            memo["rerun"] = f"mesh changed ({mesh} against {memo['mesh']}) or status {result.status}"
+            return None
+        if abs(result.normal_force_N / memo["normal_force_N"] - 1.0) > REUSE_FORCE_CHANGE:
+            memo["rerun"] = f"force {result.normal_force_N:.6g} N against {memo['normal_force_N']:.6g} N"
+            return None
+        write()
+        force = memo["normal_force_N"]
+        info = {
+            **memo["info"],
+            "reused": f"series run at this patch's previous solve on the same meshes (force {force:.6g} N)",
+        }
+        errors = info.get("relative_error", {})
+        shown = ", ".join(f"{n} {errors[n]:.2%}" for n in info.get("judged", ()) if errors.get(n) is not None)
+        met = "met" if memo["status"] == "ok" else "not met"
+        message = (
+            f"{result.message}; discretisation error ({shown}) from the series at force {force:.6g} N on the same "
+            f"meshes, tolerance {info.get('tolerance'):g} {met}"
+        )
+        return dataclasses.replace(
+            result,
+            status=memo["status"],
+            message=message,
+            wall_time_s=time.perf_counter() - t0,
+            extra={**result.extra, "discretisation_error": info},
         )
 
     def _solve_level(self, geometry, creepage, material, normal_force_N, opts, comm, t0):
@@ -300,6 +404,7 @@ class FeaModel:
         quadric = geometry.undeformed is None
 
         # Expected patch (Hertz) sizes the mesh.
+        regions = ()
         if quadric:
             if normal_force_N is not None:
                 expected = hertz_elliptic(a_curv, b_curv, normal_force_N, e_star)
@@ -336,6 +441,7 @@ class FeaModel:
             y_lo, y_hi = gy[overlap].min() - dy, gy[overlap].max() + dy
             center = (0.5 * (x_lo + x_hi), 0.5 * (y_lo + y_hi))
             semi = (0.5 * (x_hi - x_lo) / math.sqrt(2.0), 0.5 * (y_hi - y_lo) / math.sqrt(2.0))
+            regions = _overlap_regions(overlap, gx, gy, dx, dy)
 
             def gap0(x, y):
                 return geometry.gap_m(x, y) + geometry.approach_m
@@ -353,6 +459,9 @@ class FeaModel:
                 if not all(math.isfinite(v) for v in getattr(geometry, name)):
                     raise ValueError(f"geometry.{name} = {getattr(geometry, name)!r}: expected profile coordinates")
         semi, center = _mesh_box(semi, center)
+        boxes = ()
+        if not quadric and opts.formulation == "rigid" and len(regions) > 1:
+            boxes = tuple((*c, *r) for r, c in (_mesh_box(r[2:], r[:2]) for r in regions))
         spec = HertzBlockSpec(
             semi_axis_long_m=semi[0],
             semi_axis_lat_m=semi[1],
@@ -361,6 +470,7 @@ class FeaModel:
             grading=opts.grading,
             center_m=center,
             symmetry="quarter" if quadric and opts.formulation != "profiles" and not opts.surface_traction else "full",
+            refine_boxes_m=boxes,
         )
         t_mesh = time.perf_counter()
         limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
@@ -574,6 +684,27 @@ class FeaModel:
         )
 
 
+REUSE_ANGLE_DEG = 1.0
+"""A load-balanced solve reuses the series of the same side's patch whose contact angle is within this, degrees."""
+REUSE_FORCE_CHANGE = 0.1
+"""A load-balanced solve reuses its patch's last series estimate when its force is within this fraction of the
+series' (:meth:`FeaModel._reuse_series`)."""
+
+
+def _series_key(geometry, material, options) -> tuple:
+    """Identity of a patch for :meth:`FeaModel._reuse_series` within one model instance (one wheelset case): side,
+    material and options (the contact angle is matched within ``REUSE_ANGLE_DEG``, the mesh itself, the rounded mesh
+    box, is compared after the solve; the sampled patch's fitted curvatures move in their fourth digit from one pose
+    to the next: not a key).
+    """
+    return (
+        geometry.side,
+        material.combined_modulus_Pa,
+        material.poisson_ratio,
+        repr(sorted((options or {}).items())),
+    )
+
+
 MESH_SIZE_STEP = 1.1
 """The semi-axes that size the mesh are rounded to powers of this ratio (see :func:`_mesh_box`)."""
 MESH_CENTRE_STEP = 0.25
@@ -598,9 +729,36 @@ def _mesh_box(semi, center):
 def _peak_fit_radius(spec) -> float:
     """Radius of the peak-pressure fit (fea.postprocess.peak_pressure): sqrt(3 h_c min(a, b)), 0.71 min(a, b) at 6
     elements per semi-axis, shrinking as h^(1/2): the fit's bias O(r^4) then falls as h^2 while the number of nodes
-    it averages grows as 1/h.
+    it averages grows as 1/h. min(a, b) = n h_c: the narrowest region's for a patch of separate regions.
     """
-    return math.sqrt(3.0 * spec.contact_size_m * min(spec.semi_axis_long_m, spec.semi_axis_lat_m))
+    return math.sqrt(3.0 * spec.contact_size_m**2 * spec.elements_per_semi_axis)
+
+
+REGION_FLOOR = 1.0 / 3.0
+"""A separate region's semi-axes that size its refined box are at least this fraction of the largest region's
+narrower semi-axis (a region of a few sampled points must not set the element size of the whole patch)."""
+
+
+def _overlap_regions(overlap: np.ndarray, gx: np.ndarray, gy: np.ndarray, dx: float, dy: float) -> tuple:
+    """Separate regions of a sampled interpenetration (8-connected components of ``overlap`` on its grid), each as
+    (x_c, y_c, a, b): centre and semi-axes of its box padded by one sample, over sqrt(2) (as the one box of the whole
+    overlap, the interpenetration of two quadrics being sqrt(2) times their contact patch), largest region first.
+    """
+    from scipy import ndimage
+
+    labels, count = ndimage.label(overlap, structure=np.ones((3, 3), dtype=int))
+    if count < 2:
+        return ()
+    regions = []
+    for k in range(1, count + 1):
+        mask = labels == k
+        x_lo, x_hi = gx[mask].min() - dx, gx[mask].max() + dx
+        y_lo, y_hi = gy[mask].min() - dy, gy[mask].max() + dy
+        a, b = 0.5 * (x_hi - x_lo) / math.sqrt(2.0), 0.5 * (y_hi - y_lo) / math.sqrt(2.0)
+        regions.append((int(mask.sum()), (0.5 * (x_lo + x_hi), 0.5 * (y_lo + y_hi), a, b)))
+    regions.sort(key=lambda item: -item[0])
+    floor = REGION_FLOOR * min(regions[0][1][2:])
+    return tuple((xc, yc, max(a, floor), max(b, floor)) for _, (xc, yc, a, b) in regions)
 
 
 def _nothing() -> None:

@@ -64,6 +64,36 @@ def test_approach_control_takes_the_pressure_block_error_as_a_third_of_the_force
     assert estimate(levels, block)["block_size_relative_error"]["max_pressure"] == pytest.approx(0.1 / (1 - 2**-0.75))
 
 
+def test_an_oscillating_series_states_the_range_of_its_last_three_levels():
+    """Up, down: no power law holds; the error is the range of the last three levels (Stern et al. 2001, whose
+    half range is doubled), not Richardson's at the clipped order 0.5 (4.5 times the last difference)."""
+    error, _, _ = richardson_error([27.93, 28.26, 27.86])
+    assert error == pytest.approx(0.40)
+    error, _, _ = richardson_error([1.0, 1.2, 1.1, 1.15])
+    assert error == pytest.approx(0.1)
+
+
+def test_load_balanced_scales_every_level_to_the_finest_force():
+    """A Hertz patch at three approaches: p ~ N^(1/3), A ~ N^(2/3), the force off by the mesh's stiffness (a test of
+    the bookkeeping against Hertz's scaling, exact here): at the finest level's force the max pressure and the area
+    of all levels agree, so their mesh error is zero; the force is estimated but not judged (fea.refinement)."""
+    forces = [11057.0, 10738.0, 10566.0]
+    levels = [
+        {"normal_force": n, "max_pressure": 5e8 * (n / 1e4) ** (1 / 3), "contact_area": 3e-5 * (n / 1e4) ** (2 / 3),
+         "approach": 1e-5}
+        for n in forces
+    ]  # fmt: skip
+    block = {"normal_force": 10800.0, "max_pressure": 6e8, "approach": 1e-5, "contact_area": 3e-5}
+    out = estimate(levels, block, approach_control=True, load_balanced=True, block_factor=40.0)
+    assert out["mesh_relative_error"]["max_pressure"] == pytest.approx(0.0, abs=1e-12)
+    assert out["mesh_relative_error"]["contact_area"] == pytest.approx(0.0, abs=1e-12)
+    assert out["block_size_relative_error"]["max_pressure"] == pytest.approx(0.005 / 4)
+    assert out["block_size_relative_error"]["contact_area"] == pytest.approx(0.003 / 4)
+    assert out["relative_error"]["normal_force"] > 0.03  # the stiffness error, reported
+    plain = estimate(levels, block, approach_control=True)
+    assert plain["mesh_relative_error"]["max_pressure"] > 0.005  # at a fixed approach the load change shows
+
+
 def test_richardson_needs_two_levels():
     with pytest.raises(ValueError, match="at least two levels"):
         richardson_error([1.0])
@@ -161,3 +191,70 @@ def test_bad_refinement_options_raise(options, match):
 
     with pytest.raises(ValueError, match=match):
         FeaOptions.from_mapping(options)
+
+
+def test_separate_interpenetration_regions_get_their_own_refined_boxes():
+    """Two strips 10 mm apart (the joined flange-root patch of manchester-a22): one box each, sized by its own
+    extent (over sqrt(2), as the single box), largest first; a one-sample speck is floored at a third of the largest
+    region's narrower semi-axis; one region gives none (the single box of the whole overlap, as before)."""
+    import numpy as np
+
+    from fea.model import _overlap_regions
+
+    x = np.arange(-6.0, 6.01, 0.5) * 1e-3
+    y = np.arange(-12.0, 3.01, 0.5) * 1e-3
+    gx, gy = np.meshgrid(x, y)
+    wide = (np.abs(gx) <= 4e-3 + 1e-9) & (np.abs(gy - 0.5e-3) <= 1.0e-3 + 1e-9)
+    narrow = (np.abs(gx) <= 3e-3 + 1e-9) & (np.abs(gy + 9.5e-3) <= 0.5e-3 + 1e-9)
+    speck = (np.abs(gx - 5e-3) < 1e-6) & (np.abs(gy + 5e-3) < 1e-6)
+    regions = _overlap_regions(wide | narrow | speck, gx, gy, 0.5e-3, 0.5e-3)
+    assert len(regions) == 3
+    xc, yc, a, b = regions[0]
+    assert (xc, yc) == pytest.approx((0.0, 0.5e-3), abs=1e-12)
+    assert (a, b) == pytest.approx((4.5e-3 / math.sqrt(2), 1.5e-3 / math.sqrt(2)))
+    assert regions[1][1] == pytest.approx(-9.5e-3) and regions[1][3] == pytest.approx(1.0e-3 / math.sqrt(2))
+    assert min(regions[2][2:]) == pytest.approx(1.5e-3 / math.sqrt(2) / 3)
+    assert _overlap_regions(wide, gx, gy, 0.5e-3, 0.5e-3) == ()
+
+
+def test_refine_boxes_set_the_element_size_and_need_the_full_block():
+    from meshing.hertz import HertzBlockSpec
+
+    spec = HertzBlockSpec(
+        4e-3, 4e-3, 6.0, symmetry="full", refine_boxes_m=((0, 0, 4e-3, 1.2e-3), (0, -9e-3, 3e-3, 0.9e-3))
+    )
+    assert spec.contact_size_m == pytest.approx(0.9e-3 / 6)
+    with pytest.raises(ValueError, match="refine_boxes_m"):
+        HertzBlockSpec(4e-3, 4e-3, refine_boxes_m=((0, 0, 4e-3, 1e-3),))
+    with pytest.raises(ValueError, match="refine_boxes_m entry"):
+        HertzBlockSpec(4e-3, 4e-3, symmetry="full", refine_boxes_m=((0, 0, -1.0, 1e-3),))
+
+
+def test_a_load_balanced_patch_reuses_its_series_only_on_the_same_meshes():
+    """FeaModel._reuse_series (bookkeeping, no FE solve): one solve on the memorised finest mesh carries the series'
+    estimate and status when the mesh (element size, block) is the same and the force within 10 %; else None (the
+    series runs again) with the reason kept."""
+    from fea.model import FeaModel
+    from rigid_dynamics.contact.types import ContactResult, Creepage
+
+    def level(force, size=1e-4):
+        extra = {"element_size_m": size, "block_half_width_m": 0.1}
+        result = ContactResult(method="fea", success=True, status="ok", message="active set converged",
+                               normal_force_N=force, max_pressure_Pa=1e9, contact_area_m2=1e-5, approach_m=1e-5,
+                               creepage=Creepage(), extra=extra)  # fmt: skip
+        return lambda opts: (result, lambda: None)
+
+    model = FeaModel()
+    info = {"relative_error": {"max_pressure": 0.03, "contact_area": 0.01}, "judged": ["max_pressure", "contact_area"],
+            "tolerance": 0.02}  # fmt: skip
+    model.series_memo["k"] = [{"angle_deg": 16.34, "options": None, "status": "mesh-tolerance-not-met",
+                               "info": info, "normal_force_N": 1e4, "mesh": (1e-4, 0.1)}]  # fmt: skip
+    reused = model._reuse_series(("k", 16.36), level(1.03e4), 0.0)
+    assert reused.status == "mesh-tolerance-not-met" and "tolerance 0.02 not met" in reused.message
+    assert reused.extra["discretisation_error"]["relative_error"]["max_pressure"] == 0.03
+    assert "force 10000 N" in reused.extra["discretisation_error"]["reused"]
+    assert model._reuse_series(("k", 16.34), level(1.2e4), 0.0) is None
+    assert model._reuse_series(("k", 16.34), level(1.03e4, size=2e-4), 0.0) is None
+    assert "mesh changed" in model.series_memo["k"][0]["rerun"]
+    assert model._reuse_series(("k", 0.5), level(1e4), 0.0) is None  # the same side's tread patch
+    assert model._reuse_series(("other", 16.34), level(1e4), 0.0) is None

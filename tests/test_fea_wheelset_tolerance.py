@@ -90,3 +90,32 @@ def test_a_model_with_coarse_options_is_balanced_on_them_first():
     assert all("(coarse mesh)" in line for line in lines[:first_full])
     assert "(coarse mesh)" not in lines[-1]
     assert sol.load_tolerance == pytest.approx(STATED) and sol.equilibrium_residual < STATED
+
+
+class LoadBalanced(CoarseFirst):
+    """A model with ``load_balanced_options`` (as the FEA): its full solves state the load error their max pressure
+    and area afford (``load_tolerance``, 0.5 %) besides a large force error (8 %, an approach error under load
+    balance); the equilibrium must balance to the former, not accept the latter."""
+
+    @staticmethod
+    def load_balanced_options(options):
+        return {"balanced": True}
+
+    def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
+        balanced = bool(options and options.get("balanced"))
+        if not balanced:
+            return super().solve(geometry, creepage, material, normal_force_N=normal_force_N, options=options)
+        r = self.hertz.solve(geometry, creepage, material, normal_force_N=normal_force_N)
+        info = {"relative_error": {"normal_force": 0.08}, "load_tolerance": 0.005}
+        scale = 1.0 / 1.04  # the full solve's mesh is 4 % softer than the coarse one, smoothly (one mesh per box)
+        return dataclasses.replace(
+            r, normal_force_N=r.normal_force_N * scale, extra={**r.extra, "discretisation_error": info}
+        )
+
+
+def test_a_load_balanced_model_is_balanced_to_its_load_tolerance_not_its_force_error():
+    model = LoadBalanced()
+    sol = solve_wheelset_case(_case(), STEEL, model)
+    assert sol.success and sol.status == "ok", sol.message
+    assert sol.load_tolerance == pytest.approx(0.005)
+    assert sol.equilibrium_residual < 0.005

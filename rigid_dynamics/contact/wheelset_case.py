@@ -29,7 +29,10 @@ Residuals phi_i = (F_i / W)^(2/3) - 1 (nearly linear in the sink: F ~ q^1.5); th
 (W / F)^(2/3), then secant (per wheel) or Broyden's method (both wheels), until |F_i / W - 1| <
 ``force_tolerance``, or the patches' stated relative error of their normal forces when larger (a model with a
 discretisation error, the FEA: see ``_load_tolerance``). A model with ``coarse_options(options)`` (the FEA: its
-first mesh, without the refinement series) is balanced first with those, then with its own options from there.
+first mesh, without the refinement series) is balanced first with those, then with its own options from there,
+passed through ``load_balanced_options(options)`` when it has it (the FEA: its max pressure and area are then
+judged at its own force and it states the load error they afford, ``load_tolerance``, which the equilibrium meets
+instead of the force's error: fea.refinement, load-balanced use).
 The tangential problem is part of every evaluation, since its forces carry part of W.
 
 Pitch rate: the case's ``pitch_rate_rad_per_s`` (the wheelset's angular velocity about its axle, with CONTACT's
@@ -605,6 +608,8 @@ def _load_tolerance(state: _WheelState, opts) -> float:
     for p in state.patches:
         info = p.result.extra.get("discretisation_error") or {}
         error = (info.get("relative_error") or {}).get("normal_force")
+        if info.get("load_tolerance") is not None:
+            error = info["load_tolerance"]  # a load-balanced solve states the load error its p and area afford
         force = abs(p.result.normal_force_N)
         if error is not None and math.isfinite(error) and math.isfinite(force):
             weighted += error * force
@@ -791,7 +796,9 @@ def solve_wheelset_case(
         tolerance = opts["force_tolerance"]
         opts["force_tolerance"] = max(tolerance, COARSE_FORCE_TOLERANCE)
         states, warm, iterations, status = solve_pose(omega, None)
-        evaluator.model_options, evaluator.phase = opts["model"], ""
+        balanced = getattr(contact_model, "load_balanced_options", None)
+        evaluator.model_options = balanced(opts["model"]) if balanced is not None else opts["model"]
+        evaluator.phase = ""
         opts["force_tolerance"] = tolerance
         if states is not None and status == "ok":
             states, warm, its, status = solve_pose(omega, warm)
