@@ -440,8 +440,10 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             for i in range(nst):
                 ys[i] = y[i] + hd * combined[i]
             last = s == ns - 1
-            if last:
-                st = _rhs(t_new, ys, run, ws, check or not fixed, True, stage)
+            if last and (check or not fixed):
+                st = _rhs(t_new, ys, run, ws, True, True, stage)
+            elif last:
+                st = _rhs(t_new, ys, run, ws, False, True, stage)
             else:
                 st = _rhs(t + cc[s] * h, ys, run, ws, False, False, stage)
             for i in range(nst):

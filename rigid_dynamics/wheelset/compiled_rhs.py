@@ -386,10 +386,13 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
     return OK
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _rhs(t, y, run, ws, record, full, out):
     """d/dt of the full state: the candidate geometry (:func:`_geometry`; ``full``: the search with its lateral
     scan; mode layout.GEOMETRY_GIVEN: ws.cg as the caller filled it), then :func:`_forces`. Returns the status.
+    Inlined (numba IR) at each call site, as :func:`_geometry`: a call would pass the run and workspace records field
+    by field (some 430 scalars), which made the compiled loop's RK4 step 40 % dearer than the former RK4 loop's
+    (benchmarks/results/compile_and_speed_issue25.md).
     """
     _geometry(y, run, ws, full)
     if run.par.model_code == LAW_KPEC:
@@ -400,7 +403,7 @@ def _rhs(t, y, run, ws, record, full, out):
     return _forces(t, y, run.par, run.tables, run.sides, ws.cg, ws.rec, ws.scratch, ws.dummy, ws.patch, record, out)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _geometry(y, run, ws, full):
     """The candidate geometry at the state y into ws.cg (tables or search; given: left alone)."""
     par = run.par
