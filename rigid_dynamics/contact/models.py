@@ -184,6 +184,9 @@ class HertzianModel:
     compiled_law: str | None = None
     OPTIONS: dict = declare()
     SATURATING: bool | None = None
+    MODELS_FRICTION_LAW = False
+    """True: :meth:`tangential` applies the material's friction law itself (FASTSIM, element-wise); False: the
+    law is reduced to one Coulomb coefficient per patch first (:func:`coulomb_for_patch`)."""
 
     def tangential(self, hertz: HertzBatch, creepage: Creepage, material: Material, opts: dict):
         raise NotImplementedError(f"{type(self).__name__} defines no tangential law")
@@ -202,9 +205,15 @@ class HertzianModel:
         hertz, reason = _hertz(geometry, material, normal_force_N)
         if hertz is None:
             return _base_result(self.name, geometry, creepage, None, reason, start)
+        note = None
+        if self.SATURATING is not None and not self.MODELS_FRICTION_LAW:
+            material, note = coulomb_for_patch(geometry, creepage, material)
         forces, extra = self.tangential(hertz, creepage, material, opts)
         result = _base_result(self.name, geometry, creepage, hertz, reason, start, **forces)
         result.extra.update(extra)
+        if note is not None:
+            result = dataclasses.replace(result, message=f"{result.message}; {note}")
+            result.extra["friction_coefficient_used"] = material.friction_coefficient
         if self.SATURATING is None:
             return result
         return _friction_bound(result, material, saturating=self.SATURATING)
@@ -224,6 +233,37 @@ def _patch_place(geometry: ContactGeometry, material: Material) -> float:
     if not math.isfinite(value):
         raise ValueError(f"friction varies_with = {varies_with!r}: the patch has no such place ({value!r})")
     return float(value)
+
+
+def coulomb_for_patch(geometry: ContactGeometry, creepage: Creepage, material: Material) -> tuple[Material, str | None]:
+    """The Coulomb material a rung without an element-wise friction law solves a patch with, and the sentence that
+    says so (None when the material is Coulomb everywhere already).
+
+    A law varying in place is taken at the patch's reference point (:func:`_patch_place`); a falling law at the
+    patch's mean rigid slip velocity V sqrt(xi^2 + eta^2) (the spin's rigid slip averages to zero over the patch),
+    as the compiled loop's analytic laws take it (``wheelset.compiled_laws.mean_slip_coefficient``). Exact for a
+    Coulomb law that varies in place and for a falling law in full slip; in partial slip the slipping elements move
+    slower than the rigid slip, so the coefficient is the law's at a higher speed than theirs (FASTSIM and the BEM
+    bound every element at its own slip velocity).
+    """
+    law = material.friction
+    if law is None or (law.is_coulomb and not law.varies):
+        return material, None
+    from rigid_dynamics.contact.fastsim import law_at_place
+
+    one = law_at_place(law, _patch_place(geometry, material)) if law.varies else law
+    if one.is_coulomb:
+        mu = one.laws[0].static
+        note = f"friction at the patch's reference point: Coulomb mu = {mu:.4g}"
+    else:
+        speed = creepage.rolling_speed_m_per_s * math.hypot(creepage.longitudinal, creepage.lateral)
+        mu = one.coefficient(speed)
+        note = (
+            f"falling friction ({one.laws[0].law}) at the patch's mean rigid slip velocity {speed:.4g} m/s: mu = "
+            f"{mu:.4g} (this rung applies one coefficient per patch; fastsim and bem bound each element at its own "
+            "slip velocity)"
+        )
+    return Material(material.shear_modulus_Pa, material.poisson_ratio, mu), note
 
 
 class HertzModel(HertzianModel):
@@ -302,6 +342,7 @@ class FastsimModel(HertzianModel):
 
     name = "fastsim"
     compiled_law = "fastsim"
+    MODELS_FRICTION_LAW = True
     description = "Hertz + Kalker's FASTSIM (simplified theory)"
     SATURATING = True
     OPTIONS: dict = declare(

@@ -74,7 +74,7 @@ class KpecModel:
     def solve(self, geometry, creepage, material, *, normal_force_N=None, options=None):
         """One patch (see the class docstring); :class:`~.types.ContactResult`."""
         from rigid_dynamics.contact.kpec import fastrip_strips, fastsim_strips, simplified_flexibilities
-        from rigid_dynamics.contact.models import _options
+        from rigid_dynamics.contact.models import _options, coulomb_for_patch
         from rigid_dynamics.contact.types import ContactFields, ContactResult
 
         start = time.perf_counter()
@@ -86,6 +86,7 @@ class KpecModel:
             )
         if normal_force_N is not None and (not math.isfinite(normal_force_N) or normal_force_N <= 0):
             raise ValueError(f"normal_force_N = {normal_force_N!r}: expected None or a finite number > 0")
+        material, friction_note = coulomb_for_patch(geometry, creepage, material)
         g_mod, nu, mu = material.shear_modulus_Pa, material.poisson_ratio, material.friction_coefficient
         h_min = _minimum_gap(geometry)
 
@@ -127,6 +128,8 @@ class KpecModel:
         message = f"{self.name.upper()} + {'FaStrip' if opts['tangential'] == 'fastrip' else 'FASTSIM'} per strip"
         if not converged:
             message = f"force control did not converge in {iterations} steps: F_N = {force!r} N"
+        elif friction_note is not None:
+            message = f"{message}; {friction_note}"
         dx, dy = x[1] - x[0], y[1] - y[0]
         fn_kpec, p_max, curv_a, curv_b, y_mid, a_eq, b_eq, penetration = out
         l1, l2, l3, a_fl, b_fl = simplified_flexibilities(
