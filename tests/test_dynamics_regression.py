@@ -9,7 +9,8 @@ The references in tests/data/dynamics_regression/ were written by commit 56c49d8
 cases below; the eleven cases that run FASTSIM were rewritten when FASTSIM's blending weight dropped the spin term
 (as CONTACT's; session 11: states moved by 6e-4 to 8e-2 of their block's scale, a change of physics, not of
 structure, so ``--write CASE ...`` rewrote only those). ``python tests/test_dynamics_regression.py --write [CASE ...]``
-writes them with the code in the tree. Every case runs through ``simulate``: the default path of each scene (compiled 3-D search for the irregular scenes,
+writes them with the code in the tree. Every case runs through ``simulate``: the default path of each scene
+(compiled 3-D search for the irregular scenes,
 scipy's RK45 on the conical provider for hunting-conical) and the table provider with each compiled creep law on
 both the compiled RK4 loop and the Python right-hand side.
 
