@@ -24,7 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.contact.creep_table import CreepTable, empty_table, table_creep_law
+from rigid_dynamics.contact.creep_table import CreepTable, empty_table, table_creep_law, uniform_cell
 from rigid_dynamics.contact.fastsim import (
     FastsimGrid,
     FastsimPatch,
@@ -163,18 +163,6 @@ def hertz_kalker_tables(tables, friction=None, creep=None) -> HertzKalkerTables:
     )
 
 
-@njit(cache=True, _nrt=False)
-def _uniform(x, x0, step, n):
-    """(cell, weight) of x on the uniform grid x0 + i step, i < n, clamped to its ends."""
-    f = (x - x0) / step
-    if f < 0.0:
-        f = 0.0
-    if f > n - 1.0:
-        f = n - 1.0
-    i = min(int(f), n - 2)
-    return i, f - i
-
-
 @njit(cache=True, _nrt=False, inline="always")
 def _hertz_kalker(par, tables, q, ca, cb):
     """Hertz under approach control (tables of the axial function) and Kalker's C11, C22, C23, C33 (tables of a/b):
@@ -182,7 +170,7 @@ def _hertz_kalker(par, tables, q, ca, cb):
     """
     amin, amax = min(ca, cb), max(ca, cb)
     hz = tables.hertz
-    i, w = _uniform(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, hz.shape[1])
+    i, w = uniform_cell(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, hz.shape[1])
     pp = hz[HERTZ_P, i] * (1 - w) + hz[HERTZ_P, i + 1] * w
     kk_ = hz[HERTZ_K, i] * (1 - w) + hz[HERTZ_K, i + 1] * w
     dd = hz[HERTZ_D, i] * (1 - w) + hz[HERTZ_D, i + 1] * w
@@ -191,7 +179,7 @@ def _hertz_kalker(par, tables, q, ca, cb):
     minor = major * math.sqrt(pp)
     sa, sb = (major, minor) if ca <= cb else (minor, major)
     kk = tables.kalker
-    i, w = _uniform(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    i, w = uniform_cell(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
     c11 = kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w
     c22 = kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w
     c23 = kk[KALKER_C23, i] * (1 - w) + kk[KALKER_C23, i + 1] * w
@@ -377,7 +365,7 @@ def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
 def _kalker_c(tables, ratio):
     """Kalker's (C11, C22, C23) for a/b = ratio from the tables (:func:`_hertz_kalker`'s interpolation)."""
     kk = tables.kalker
-    i, w = _uniform(math.log(ratio), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    i, w = uniform_cell(math.log(ratio), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
     return (
         kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w,
         kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w,
