@@ -80,6 +80,7 @@ WHEELSET_GEOMETRY_KEYS = {
     "rail_profile_left",
     "rail_profile_cant_rad",
     "profile_smoothing_m",
+    "rail_profile_smoothing_m",
     "wheel_profile_mirror_y",
     "wheel_profile_mirror_z",
     "rail_profile_mirror_y",
