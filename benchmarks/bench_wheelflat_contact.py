@@ -10,7 +10,8 @@ BEM) after a first position that compiles.
 Set-up as the deck: right wheel, roll 0 (per-wheel kinematics), total vertical force 125 kN, pitch rate
 -4.08190679 rad/s, V = 2 m/s, r0 = 0.49 m, cant 0.020 rad, BEM with 0.4 mm elements; the wheel profile is the first
 slice, the out-of-roundness the slices' deviation from it (with the base's offset at the tape circle: the files'
-wheel), both smoothed with L_filt = 5 mm (CONTACT's wheel SMOOTH 5 mm), the rail not smoothed (its SMOOTH 0).
+wheel), both smoothed as CONTACT's wheel SMOOTH 5 with its default ISMOOTH 0 (L_filt 9.1 mm,
+slices.contact_smoothing_wavelength_m), the rail not smoothed (its SMOOTH 0).
 wheel_rotation_rad = -PITCH.
 """
 
@@ -27,10 +28,10 @@ sys.path.insert(0, str(ROOT))
 
 from rigid_dynamics.contact.wheelset_case import WheelsetCase, solve_wheelset_case  # noqa: E402
 from rigid_dynamics.files import write_text  # noqa: E402
-from rigid_dynamics.geometry.slices import read_wheel_slices  # noqa: E402
+from rigid_dynamics.geometry.slices import contact_smoothing_wavelength_m, read_wheel_slices  # noqa: E402
 from rigid_dynamics.materials import Material  # noqa: E402
 
-SMOOTHING_M = 0.005
+CONTACT_WHEEL_SMOOTH = 5.0  # the deck's wheel SMOOTH (ISMOOTH 0: a smoothing parameter, not a wavelength)
 
 
 def main(argv):
@@ -41,9 +42,10 @@ def main(argv):
         for row in csv.DictReader(f):
             reference[float(row["pitch_deg"])] = {k: float(v) for k, v in row.items()}
     pitches = pitches or sorted(reference, reverse=True)
-    slices = read_wheel_slices(examples / "S1002_flat.slcw", smoothing_wavelength_m=SMOOTHING_M)
     first = next(line for line in (examples / "S1002_flat.slcw").read_text().splitlines() if "'" in line)
     base = examples / first.split("'")[1]
+    smoothing_m = contact_smoothing_wavelength_m(CONTACT_WHEEL_SMOOTH, base)
+    slices = read_wheel_slices(examples / "S1002_flat.slcw", smoothing_wavelength_m=smoothing_m)
     material = Material(82e9, 0.28, 0.3)
     lines = [
         "# CONTACT's wheelflat.inp: wheelset case (BEM, 0.4 mm) against CONTACT's published solution",
@@ -61,7 +63,7 @@ def main(argv):
             gauge_height_m=0.014, flange_back_distance_m=1.360, nominal_radius_m=0.49, rail_inclination_rad=0.02,
             wheel_load_N=125e3, rolling_speed_m_per_s=2.0, roll_rad=0.0, pitch_rate_rad_per_s=-4.08190679,
             wheel_rotation_rad=-math.radians(pitch), wheel_irregularities_right=(slices.irregularity,),
-            profile_smoothing_m=SMOOTHING_M, rail_profile_smoothing_m=0.0,
+            profile_smoothing_m=smoothing_m, rail_profile_smoothing_m=0.0,
         )  # fmt: skip
         started = time.perf_counter()
         sol = solve_wheelset_case(

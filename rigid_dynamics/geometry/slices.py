@@ -36,11 +36,11 @@ range is not reproduced (the spline is periodic).
 
 The wheel profile of a case that uses such a file should be the base slice's file (R_irr is relative to it).
 
-Status: verified on a parametric flat written as slices (tests/test_geometry_slices.py) and compared with
-CONTACT's published solution of its examples/wheelflat.inp (benchmarks/results/wheelflat_contact.md). The
-example's file says TH_INTPOL 2; read as interpolating (before TH_INTPOL was honoured) the peak pressure was +13 %
-and +34 % off CONTACT's at -37 and -40 deg, read as CONTACT reads it -8.0 % and +14.7 %, the area +9.8 % and -3.8 %
-(benchmarks/results/wheelflat_slice_interpolation.md: still outside 3 % / 5 %; the rest is not explained).
+Status: verified on a parametric flat written as slices (tests/test_geometry_slices.py) and against CONTACT's
+published solution of its examples/wheelflat.inp (tests/test_wheelflat_contact_reference.py, all 26 angles in
+benchmarks/results/wheelflat_contact.md) once read as CONTACT reads it: TH_INTPOL 2, the base's file offset kept,
+the wheel's SMOOTH taken as CONTACT's default ISMOOTH 0 parameter (:func:`contact_smoothing_wavelength_m`), the rail
+unsmoothed.
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ from .irregularities import MeasuredWheelIrregularity
 from .profile import Profile
 from .readers import read_profile
 
-__all__ = ["WheelSlices", "read_wheel_slices"]
+__all__ = ["WheelSlices", "contact_smoothing_wavelength_m", "read_wheel_slices"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,6 +223,20 @@ def read_wheel_slices(path, lateral_step_m: float = 5.0e-4, smoothing_wavelength
     order = np.argsort(alpha)
     irregularity = MeasuredWheelIrregularity(alpha[order], grid, deviation[order])
     return WheelSlices(base, irregularity, theta, str(path), int(th_intpol), z0 / 1e3)
+
+
+def contact_smoothing_wavelength_m(smooth: float, path) -> float:
+    """L_filt (m) of this package's smoothing splines equivalent to CONTACT's profile SMOOTH with its default method
+    (ISMOOTH 0: a non-weighted smoothing spline, sum over the file's points of (z_i - f(s_i))^2 + SMOOTH times the
+    integral of f''^2 ds, s in mm; CONTACT's m_profile, read to learn). The weighted spline here minimises
+    integral (z - f)^2 ds + (L_filt / 2 pi)^4 integral f''^2 ds; a sum over points spaced h is the integral / h, so
+    L_filt = 2 pi (h SMOOTH)^(1/4) with h the mean spacing of the file's points (mm). Exact for uniform spacing;
+    CONTACT's wheelflat slices (SMOOTH 5, h 0.87 mm) give 9.1 mm, not the 5 mm that reading SMOOTH as L_filt gives
+    (ISMOOTH 1 and 2 take SMOOTH as L_filt: use it directly then).
+    """
+    y_mm, _ = _points(Path(path))
+    spacing_mm = float(np.mean(np.abs(np.diff(y_mm))))
+    return 2.0 * math.pi * (spacing_mm * float(smooth)) ** 0.25 / 1e3
 
 
 def approximating_values(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
