@@ -14,8 +14,8 @@ flat's trailing edge), the two worst before the causes were found (PMAX -8 % and
 is in the bench, kept out of the suite for its time. Recorded over all 26 angles:
 benchmarks/results/wheelflat_contact.md; at these two the departures are below 0.5 % in pressure and area and
 0.2 % of mu N in the forces.
-This is the static case (rigid_dynamics.contact.wheelset_case), not the dynamics loop's contact: the loop's test
-on this flat is not built (the loop takes a measured wheel through its numpy provider, GEOMETRY_GIVEN).
+This is the static case (rigid_dynamics.contact.wheelset_case); the dynamics loop's contact on the same flat:
+tests/test_loop_sampled_wheelflat.py.
 """
 
 import csv
