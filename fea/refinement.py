@@ -158,11 +158,12 @@ def _relative(error: float, value: float | None) -> float | None:
 
 def estimate(
     levels: list[dict], block: dict | None, approach_control: bool = False, load_balanced: bool = False,
-    block_factor: float = 20.0,
+    block_factor: float = 20.0, block_level: int = 0,
 ) -> dict:  # fmt: skip
     """Relative error estimates of the finest of ``levels`` (each a dict of :func:`_quantities`).
 
-    ``block``: the quantities of the first level solved with twice the block size, or None.
+    ``block``: the quantities of the level ``levels[block_level]`` solved with twice the block size, or None (the
+    first level of the series; 1 when a coarser level was put before it, ``measure_order``).
     ``approach_control``: the force is an output; the max pressure's block-size error is then a third of the
     force's (module docstring, ``PRESSURE_PER_FORCE``), not the difference of the two blocks' coarse meshes.
     ``load_balanced`` (with ``approach_control``): the caller balances the load with the force; the max pressure, the
@@ -194,10 +195,11 @@ def estimate(
         if balanced and name in LOAD_CONTROL_BLOCK_ERROR:
             block_error = LOAD_CONTROL_BLOCK_ERROR[name] * (20.0 / block_factor) ** 2
         elif block is not None and name in BLOCK_SENSITIVE and block.get(name) is not None:
-            difference = abs(block[name] - levels[0][name])
+            base = levels[block_level]
+            difference = abs(block[name] - base[name])
             block_error = _relative(difference / (1.0 - 2.0**-BLOCK_DECAY_ORDER), finest[name])
             if name == "max_pressure" and approach_control and block.get("normal_force") is not None:
-                force = abs(block["normal_force"] - levels[0]["normal_force"]) / (1.0 - 2.0**-BLOCK_DECAY_ORDER)
+                force = abs(block["normal_force"] - base["normal_force"]) / (1.0 - 2.0**-BLOCK_DECAY_ORDER)
                 block_error = PRESSURE_PER_FORCE * _relative(force, finest["normal_force"])
         out["mesh_relative_error"][name] = mesh
         out["block_size_relative_error"][name] = block_error
@@ -285,7 +287,8 @@ def solve_to_tolerance(
             else:
                 info["order_level"] = f"not used: {coarse.status} ({coarse.message})"
         if k >= 1:
-            info.update(estimate(levels, block, approach_control, balanced, opts.block_factor))
+            block_level = 1 if records[0].get("order_level") else 0  # the block check's mesh is the first level's
+            info.update(estimate(levels, block, approach_control, balanced, opts.block_factor, block_level))
             info["estimated"] = True
             worst = {name: info["relative_error"].get(name) for name in judged}
             if all(e is not None and e <= tol for e in worst.values()):

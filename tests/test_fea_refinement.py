@@ -300,3 +300,30 @@ def test_a_sampled_patch_measures_its_order_before_trusting_two_levels():
     assert info["levels"][0]["order_level"] and info["observed_order"]["max_pressure"] > 3
     assert info["mesh_relative_error"]["max_pressure"] >= abs(1542.6 / 1572 - 1)
     assert measured.status == "mesh-tolerance-not-met" and measured.max_pressure_Pa == 1542.6e6
+
+
+def test_the_block_check_is_compared_with_its_own_mesh_when_a_coarser_level_is_added():
+    """The block check solves the first level's mesh (n0) with twice the block; the coarser level put before it
+    (``measure_order``) must not be taken as its base (that compared two meshes: a 9 % block error on a sampled Hertz
+    patch whose max pressure was 0.2 % from Hertz). Bookkeeping with a fake solve, no FE."""
+    from fea.model import FeaOptions
+    from fea.refinement import BLOCK_DECAY_ORDER, solve_to_tolerance
+    from rigid_dynamics.contact.types import ContactResult
+
+    pressures = {4.0 / 1.5: 1.74e9, 4.0: 1.689e9, 6.0: 1.637e9, 9.0: 1.619e9}
+
+    def solve_level(opts):
+        n = opts.elements_per_semi_axis
+        wide = opts.domain_factor == 24.0  # twice the quick block of 12 semi-axes
+        p = 1.0001 * pressures[4.0] if wide else pressures[min(pressures, key=lambda k: abs(k - n))]
+        result = ContactResult(method="fea", success=True, status="ok", message="solved", normal_force_N=1e5,
+                               max_pressure_Pa=p, contact_area_m2=9e-5, approach_m=1e-4,
+                               extra={"dofs": int(3000 * (n / 4.0) ** 3)})  # fmt: skip
+        return result, lambda: None
+
+    opts = FeaOptions.from_mapping({"quick": True, "stresses": False, "max_dofs": 20000})
+    r = solve_to_tolerance(solve_level, opts, approach_control=False, block_estimate=True, t0=0.0, measure_order=True)
+    info = r.extra["discretisation_error"]
+    assert info["levels"][0]["order_level"] and info["block_size_check"]["domain_factor"] == 24.0
+    block = info["block_size_relative_error"]["max_pressure"]
+    assert block == pytest.approx(1e-4 * pressures[4.0] / (1 - 2**-BLOCK_DECAY_ORDER) / r.max_pressure_Pa)
