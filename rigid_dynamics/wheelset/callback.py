@@ -65,6 +65,7 @@ class PatchCallback:
         self.sampling_seconds = 0.0
         self.patches = "contact"
         self.former = None
+        self.reuse = None  # auto: (its anchor store, tolerance level, enabled), set by WheelsetModel
         self.grid_error = {"estimated": 0, "not_estimated": 0, "above_tolerance": 0, "largest_force": 0.0,
                            "largest": 0.0, "tolerance": None, "t_s": None}  # fmt: skip
 
@@ -87,7 +88,17 @@ class PatchCallback:
             "sampling_seconds": float(self.sampling_seconds),
             "bem_warm_start": bool(self.bem and self.warm_start),
             **({"bem": self.warm_counts(), "bem_grid_error": dict(self.grid_error)} if self.bem else {}),
+            **({"auto_reuse": self.reuse_stats()} if self.reuse is not None else {}),
         }
+
+    def reuse_stats(self) -> dict:
+        """``auto``'s reuse of its BEM patches over the run (auto_reuse.reuse_stats of the run's store; ``enabled``
+        False when the scene switched it off).
+        """
+        from rigid_dynamics.wheelset.auto_reuse import reuse_stats
+
+        store, tolerance, enabled = self.reuse
+        return {"enabled": bool(enabled), **reuse_stats(store, tolerance)}
 
     def _record_grid_error(self, result, t_s: float) -> None:
         """Keep the run's largest BEM grid-error estimate (bem.model.grid_error_estimate, every solve's own) of the

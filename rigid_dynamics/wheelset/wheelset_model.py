@@ -245,6 +245,9 @@ class WheelsetModel:
             # auto solves each candidate with its own rung: a region joined into a BEM candidate's patch would lose
             # the force its own (compiled) rung gives it, so auto's BEM samples each candidate on its own plane
             self.callback.patches = "search"
+            level = float(self.par["auto_level"])
+            self.callback.reuse = (self.packed.tables.reuse, None if np.isnan(level) else level,
+                                   self.par["auto_reuse"] > 0)  # fmt: skip
         self.auto = code == LAW_AUTO
         ncand = len(self.packed.sides)
         self._rec = np.zeros((ncand + 2, N_FIELDS))
