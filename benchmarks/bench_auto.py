@@ -6,7 +6,8 @@ rigid_dynamics/wheelset/auto_reuse.py), the same without the reuse (every BEM pa
 ``contact_model = "bem"`` (BEM on the sampled gap, default BEM options), everything else as in the scene file except
 curve-flange, started at the pose its FASTSIM run settles to (y = -6.28 mm, yaw -4.55 mrad: the left wheel on its
 flange root; settling distance 0; benchmarks/bench_bem_loop_sampled.py). Each run in its own process (``--one``): the
-whole-process time (interpreter start, imports, numba cache loading, scene set-up, run) is measured from outside,
+whole-process time (interpreter start, imports, numba cache loading, scene set-up, run; less the same-state
+comparison below, made after the run in that process) is measured from outside,
 the in-process time is ``SimulationResult.wall_time_s`` (static equilibrium, integration, recording); real-time
 factor = simulated seconds / wall seconds.
 
@@ -16,6 +17,11 @@ run's largest BEM creep force, and over max(|F_t,bem|, 0.01 mu N_bem) (the bench
 ``contact_tolerance`` bounds per patch). Both runs sample the same output grid; a run that does not end "ok" is
 reported as such. The reuse's own error (its correction against a fresh BEM solve at each re-solve, measured in the
 run) is reported from summary's ``callback.auto_reuse``.
+
+Same state (:func:`same_state_departure`): the two runs' trajectories part (start-up transients, two-point contact
+flips), so the departures above mix the contact models' difference with the states'. auto's recorded per-patch forces
+are therefore also compared with always-BEM's at auto's own states (each output sample's state given to a BEM
+WheelsetModel of the scene): the per-patch departure the tolerance is about, overall and per auto rung.
 
 Writes benchmarks/results/auto_vs_bem.md and auto_vs_bem.json (time series in benchmarks/results/auto_vs_bem_runs/).
 Run: PYTHONPATH=. .venv/bin/python benchmarks/bench_auto.py [SCENE ...] [--reuse-bem]
@@ -90,6 +96,8 @@ def run_one(scene_name: str, duration: float, variant: str, npz: Path) -> dict:
         "mu": scene.material.friction_coefficient,
         "provider": result.provider,
     }
+    if model == "auto":
+        out["same_state"] = same_state_departure(scene, result)
     if "auto_rung" in result.patches:
         from rigid_dynamics.contact.auto import AUTO_RUNGS
 
@@ -98,6 +106,55 @@ def run_one(scene_name: str, duration: float, variant: str, npz: Path) -> dict:
         out["rung_share"] = {r: float(np.mean(codes == i)) if len(codes) else 0.0 for i, r in enumerate(AUTO_RUNGS)}
         out["rung_count"] = {r: int(np.sum(codes == i)) for i, r in enumerate(AUTO_RUNGS)}
     return out
+
+
+def same_state_departure(scene, result) -> dict:
+    """auto's per-patch forces against always-BEM's at auto's own states: each output sample's state (and elastic
+    track) given to a BEM WheelsetModel of the same scene (WheelsetModel.contact: the loop's BEM on the sampled gap,
+    patches formed as always-BEM forms them); per patch (side, slot) in contact in both, |N_auto - N_bem| / Q0,
+    |N_auto - N_bem| / N_bem and the creep force's |F_auto - F_bem| / max(|F_bem|, 0.01 mu N_bem), the largest
+    overall and per auto rung. Free of the trajectories' drifting apart: the number the tolerance is about.
+    """
+    from dataclasses import replace
+
+    from rigid_dynamics.contact.auto import AUTO_RUNGS
+    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
+
+    start = time.perf_counter()
+    bem_scene = replace(scene, contact_model="bem")
+    model = WheelsetModel(
+        bem_scene, build_provider(bem_scene), get_contact_model("bem"), model_options("bem", bem_scene)
+    )
+    model.frame_x0 = float(result.states[0, 0])
+    q0, mu = scene.static_wheel_load_N, scene.material.friction_coefficient
+    p = result.patches
+    by_rung: dict = {}
+    worst = {"normal_over_Q0": 0.0, "normal_relative": 0.0, "creep_bench": 0.0, "creep_bench_t_s": None}
+    for k in range(len(result.t)):
+        track = result.track_full_states[k] if result.track_full_states is not None else None
+        cs = model.contact(result.states[k], record=True, track=track, keep_search_memory=True)
+        for i, (side, slot) in enumerate(zip(cs.side, cs.slot, strict=True)):
+            nb = float(np.nan_to_num(cs.values["normal_force_N"][i]))
+            na = float(np.nan_to_num(p["normal_force_N"][k, side, slot]))
+            if not (na > 0 and nb > 0):
+                continue
+            fb = np.hypot(cs.values["creep_force_long_N"][i], cs.values["creep_force_lat_N"][i])
+            df = np.hypot(
+                p["creep_force_long_N"][k, side, slot] - cs.values["creep_force_long_N"][i],
+                p["creep_force_lat_N"][k, side, slot] - cs.values["creep_force_lat_N"][i],
+            )
+            creep = float(df / max(fb, 0.01 * mu * nb))
+            rung = AUTO_RUNGS[int(p["auto_rung"][k, side, slot])]
+            entry = by_rung.setdefault(rung, {"patches": 0, "max_creep_bench": 0.0, "max_normal_relative": 0.0})
+            entry["patches"] += 1
+            entry["max_creep_bench"] = max(entry["max_creep_bench"], creep)
+            entry["max_normal_relative"] = max(entry["max_normal_relative"], abs(na - nb) / nb)
+            worst["normal_over_Q0"] = max(worst["normal_over_Q0"], abs(na - nb) / q0)
+            worst["normal_relative"] = max(worst["normal_relative"], abs(na - nb) / nb)
+            if creep > worst["creep_bench"]:
+                worst["creep_bench"], worst["creep_bench_t_s"] = creep, float(result.t[k])
+    return {**worst, "by_rung": by_rung, "samples": len(result.t), "seconds": time.perf_counter() - start}
 
 
 def compare(auto_npz: Path, bem_npz: Path, load_N: float, mu: float) -> dict:
@@ -147,6 +204,7 @@ def run_variant(scene: str, variant: str, scratch: Path) -> dict:
     if proc.returncode != 0:
         raise SystemExit(f"{scene} {variant}: {proc.stderr.strip().splitlines()[-1]}")
     info = json.loads(proc.stdout.strip().splitlines()[-1])
+    whole -= (info.get("same_state") or {}).get("seconds", 0.0)  # the comparison after the run is not the run's
     info["whole_process_s"] = whole
     info["whole_process_real_time_factor"] = duration / whole
     info["commit"] = subprocess.run(

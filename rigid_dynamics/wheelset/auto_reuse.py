@@ -10,18 +10,20 @@ anchor's trust region are served by FASTSIM on the ellipse corrected by the stor
     N = N_Hertz r_N,    F = mu N (f_FASTSIM(c*, a/b) + (f_BEM - f_FASTSIM)_anchor)   (|F| <= mu N)
 
 The inputs and their distance from the anchor (the largest of): the normalised creepages c* = (xi*, eta*, phi^)
-(creep_table.normalised_creepages), |c* - c*_0| / (|c*_0| + :data:`CREEP_FLOOR`); ln(a/b) and ln q (approach), each
-as |change|; the contact point's lateral place on the wheel profile over the anchor's lateral semi-axis
-|y_w - y_w0| / b_0 (a patch moving across the profile changes its sampled shape). Leaving the region (distance above
-the candidate's radius), the patch is solved by the callback again and becomes the new anchor.
+(creep_table.normalised_creepages), |c* - c*_0| / (|c*_0| + ``creep_floor``); ln(a/b) and ln q (approach), each
+as |change| (times a weight, :data:`DEFAULTS`); the contact point's lateral place on the wheel profile over the
+anchor's lateral semi-axis |y_w - y_w0| / b_0 (a patch moving across the profile changes its sampled shape).
+Leaving the region (distance above the candidate's radius), the patch is solved by the callback again and becomes
+the new anchor.
 
 The radius adapts to the error it causes, measured in the run: at each re-solve from inside twice the radius the
 corrected value the old anchor would have served is compared with the fresh BEM solution (the correction's error at
 the trust region's edge, where it is largest: the error grows with the distance): the creep force by the bench's
 definition |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM) and the normal force |N - N_BEM| / N_BEM. Above half the
-tolerance level the candidate's radius halves (down to :data:`RADIUS_MIN`), below an eighth of it it grows by half
-(up to :data:`RADIUS_MAX`). The run's largest observed errors, the served and solved counts are kept in the store's
-last row (:data:`STATS` columns) and reported in summary.json (callback.PatchCallback.stats, ``auto_reuse``).
+tolerance level the candidate's radius halves (down to ``radius_min``), below an eighth of it it grows by half
+(up to ``radius_max``; :data:`DEFAULTS`). The run's largest observed errors, the served and solved counts are kept
+in the store's last row (:data:`STATS` columns) and reported in summary.json (callback.PatchCallback.stats,
+``auto_reuse``).
 
 The store (:func:`reuse_store`) is an array of the run (compiled_laws.HertzKalkerTables.reuse): one row per
 candidate (:data:`ANCHOR` columns), the statistics row last. Off (par.auto_reuse 0, scene key ``auto_reuse``):
@@ -67,21 +69,39 @@ callback, re-solves whose correction error was measured, the largest measured er
 definition; normal force, relative) and the time of the largest, radius changes, measured errors above the tolerance
 level."""
 T_SERVED, T_SOLVED, T_CHECKED, T_MAX_FORCE, T_MAX_NORMAL, T_MAX_T, T_SHRUNK, T_GROWN, T_ABOVE = range(len(STATS))
-N_REUSE = max(len(ANCHOR), len(STATS))
+SETTINGS = ("radius_start", "radius_min", "radius_max", "creep_floor", "approach_weight", "shape_weight",
+            "place_weight")  # fmt: skip
+"""The trust region's settings, kept in the statistics row after :data:`STATS` (set by :func:`reuse_store` from
+:data:`DEFAULTS`, so that a study can change them without recompiling): the radii, the creepage distance's floor and
+the weights of |change of ln q|, |change of ln(a/b)| and of the lateral place in the distance."""
+C_RADIUS_START, C_RADIUS_MIN, C_RADIUS_MAX, C_CREEP_FLOOR, C_APPROACH, C_SHAPE, C_PLACE = range(
+    len(STATS), len(STATS) + len(SETTINGS)
+)
+N_REUSE = max(len(ANCHOR), len(STATS) + len(SETTINGS))
 
-RADIUS_START = 0.1
-"""A new anchor's trust radius (distance units of the module docstring)."""
-RADIUS_MIN = 0.0125
-RADIUS_MAX = 0.4
-CREEP_FLOOR = 0.1
-"""Added to |c*_0| in the creepage distance: near zero creepage the force is linear in c* and small; a change of 0.1
-in c* is a tenth of the saturation scale."""
+DEFAULTS = {
+    "radius_start": 0.1,
+    "radius_min": 0.0125,
+    "radius_max": 0.4,
+    "creep_floor": 0.1,
+    "approach_weight": 1.0,
+    "shape_weight": 1.0,
+    "place_weight": 1.0,
+}
+"""The settings (:data:`SETTINGS`): a new anchor's radius, its bounds; the creep floor added to |c*_0| in the
+creepage distance (near zero creepage the force is linear in c* and small; 0.1 is a tenth of the saturation
+scale); the weights of the other distances."""
 
 
-def reuse_store(candidates: int) -> np.ndarray:
-    """A fresh store for ``candidates`` candidates (no anchor) and the statistics row (zeros)."""
+def reuse_store(candidates: int, settings: dict | None = None) -> np.ndarray:
+    """A fresh store for ``candidates`` candidates (no anchor), the statistics row (zeros) and the settings
+    (:data:`DEFAULTS`, updated by ``settings``).
+    """
+    values = {**DEFAULTS, **(settings or {})}
     store = np.zeros((candidates + 1, N_REUSE))
-    store[:candidates, R_RADIUS] = RADIUS_START
+    store[:candidates, R_RADIUS] = values["radius_start"]
+    for k, name in enumerate(SETTINGS):
+        store[-1, len(STATS) + k] = values[name]
     return store
 
 
@@ -102,6 +122,7 @@ def reuse_stats(store: np.ndarray, tolerance: float | None) -> dict:
         "tolerance": tolerance,
         "radius_shrunk": int(row[T_SHRUNK]),
         "radius_grown": int(row[T_GROWN]),
+        "settings": {name: float(row[len(STATS) + k]) for k, name in enumerate(SETTINGS)},
         "error_definition": (
             "the corrected FASTSIM value the old anchor would have served against the fresh BEM solution, at each "
             "re-solve from inside twice the trust radius: creep force |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM), "
@@ -127,14 +148,14 @@ def _cheap(par, tables, dummy, g, creep, where):
 
 
 @njit(cache=True, _nrt=False)
-def _distance(row, star, log_ab, g):
-    """The distance of the inputs from the anchor in ``row`` (module docstring)."""
+def _distance(row, star, log_ab, g, st):
+    """The distance of the inputs from the anchor in ``row`` (module docstring; st the statistics row: settings)."""
     ds = math.sqrt((star[0] - row[R_XS]) ** 2 + (star[1] - row[R_YS]) ** 2 + (star[2] - row[R_PS]) ** 2)
     s0 = math.sqrt(row[R_XS] ** 2 + row[R_YS] ** 2 + row[R_PS] ** 2)
-    d = ds / (s0 + CREEP_FLOOR)
-    d = max(d, abs(log_ab - row[R_LOG_AB]))
-    d = max(d, abs(math.log(g[G_APPROACH]) - row[R_LOG_Q]))
-    return max(d, abs(g[G_WHEEL_LATERAL] - row[R_WHEEL_Y]) / row[R_HALF_WIDTH])
+    d = ds / (s0 + st[C_CREEP_FLOOR])
+    d = max(d, st[C_SHAPE] * abs(log_ab - row[R_LOG_AB]))
+    d = max(d, st[C_APPROACH] * abs(math.log(g[G_APPROACH]) - row[R_LOG_Q]))
+    return max(d, st[C_PLACE] * abs(g[G_WHEEL_LATERAL] - row[R_WHEEL_Y]) / row[R_HALF_WIDTH])
 
 
 @njit(cache=True, _nrt=False)
@@ -165,7 +186,7 @@ def reuse_serve(par, tables, dummy, g, creep, where, c):
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
     row = store[c]
     cheap = _cheap(par, tables, dummy, g, creep, where)
-    if not cheap[3] > 0.0 or _distance(row, cheap[7], cheap[8], g) > row[R_RADIUS]:
+    if not cheap[3] > 0.0 or _distance(row, cheap[7], cheap[8], g, store[-1]) > row[R_RADIUS]:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
     n, tx, ty, mz, sa, sb, area, pmax = _corrected(row, cheap)
     store[-1, T_SERVED] += 1.0
@@ -193,7 +214,7 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
         row[R_VALID] = 0.0
         return
     radius = row[R_RADIUS]
-    if row[R_VALID] > 0.0 and _distance(row, cheap[7], cheap[8], g) <= 2.0 * radius:
+    if row[R_VALID] > 0.0 and _distance(row, cheap[7], cheap[8], g, store[-1]) <= 2.0 * radius:
         n, tx, ty, _, _, _, _, _ = _corrected(row, cheap)
         mu_nb = mu_n * n_b / normal_h
         e_f = math.hypot(tx - tx_b, ty - ty_b) / max(math.hypot(tx_b, ty_b), 0.01 * mu_nb)
@@ -207,11 +228,11 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
         worst = max(e_f, e_n)
         if worst > level:
             st[T_ABOVE] += 1.0
-        if worst > 0.5 * level and radius > RADIUS_MIN:
-            radius = max(0.5 * radius, RADIUS_MIN)
+        if worst > 0.5 * level and radius > st[C_RADIUS_MIN]:
+            radius = max(0.5 * radius, st[C_RADIUS_MIN])
             st[T_SHRUNK] += 1.0
-        elif worst < 0.125 * level and radius < RADIUS_MAX:
-            radius = min(1.5 * radius, RADIUS_MAX)
+        elif worst < 0.125 * level and radius < st[C_RADIUS_MAX]:
+            radius = min(1.5 * radius, st[C_RADIUS_MAX])
             st[T_GROWN] += 1.0
     ratio = n_b / normal_h
     mu_nb = mu_n * ratio

@@ -32,7 +32,9 @@ class PatchCallback:
     "contact", the default: CONTACT's module 1, formed_patches.py: interpenetration regions joined or split, each
     patch solved in the plane of its weighted reference point, the forces returned in the candidate's frame) or
     (``patches`` "search", and on an elastic track) each candidate on its own plane at its deepest point
-    (search.patch_undeformed_distance). On an elastic track (``elastic``) the pose is moved along the track's
+    (search.patch_undeformed_distance); ``patches`` "auto" (auto's BEM rung: the other candidates keep their own
+    rungs) forms the patch as "contact" when it holds the candidate's region alone, else samples the candidate on
+    its own plane as "search". On an elastic track (``elastic``) the pose is moved along the track's
     vertical by the rail displacement under the wheel that the candidate's approach implies (one correction: the
     sampled approach equals the candidate's to second order; the rail's lateral displacement is not sampled
     separately).
@@ -147,7 +149,9 @@ class PatchCallback:
             )
             geometry = self.geometries.get(patch.candidate)
             if self.sample and (geometry is None or geometry.undeformed is None):
-                target = self._formed(patch) if self.patches == "contact" and not self.elastic else False
+                target = self._formed(patch) if self.patches in ("contact", "auto") and not self.elastic else False
+                if self.patches == "auto" and (target is None or (target is not False and len(target.regions) > 1)):
+                    target = False  # auto: a patch joining other candidates' regions: the candidate on its own plane
                 if target is None:  # its region is in a patch served by a deeper candidate
                     return _JOINED
                 if target is False:
