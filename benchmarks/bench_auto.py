@@ -55,6 +55,8 @@ STARTS = {"curve-flange": {"lateral_displacement_m": -0.00628, "yaw_rad": -0.004
 """Scenes started at a settled pose (settling distance 0): curve-flange on its flange root."""
 VARIANTS = {"auto": ("auto", True), "auto-no-reuse": ("auto", False), "bem": ("bem", True)}
 """Run name -> (contact model, auto_reuse)."""
+WHOLE = {"polygonal-wheel": 2.0, "curve-flange": 2.0}
+"""Scenes also run whole (their own duration and start) with auto alone: always-BEM would take hours."""
 OUT = ROOT / "benchmarks" / "results"
 
 
@@ -64,13 +66,14 @@ def run_one(scene_name: str, duration: float, variant: str, npz: Path) -> dict:
     from wheelrail.config import read_toml
     from wheelrail.scenes import parse_scene, resolve_scene_path
 
-    model, reuse = VARIANTS[variant]
+    whole = variant == "auto-whole"
+    model, reuse = VARIANTS["auto" if whole else variant]
     path = resolve_scene_path(scene_name)
     doc = read_toml(path, "scene file")
     doc["duration_s"] = duration
     doc["contact_model"] = model
     doc["auto_reuse"] = reuse
-    if scene_name in STARTS:
+    if scene_name in STARTS and not whole:
         doc["settling_distance_m"] = 0.0
         doc["initial"] = {**doc.get("initial", {}), **STARTS[scene_name]}
     scene = parse_scene(doc, base_dir=path.parent)
@@ -96,7 +99,7 @@ def run_one(scene_name: str, duration: float, variant: str, npz: Path) -> dict:
         "mu": scene.material.friction_coefficient,
         "provider": result.provider,
     }
-    if model == "auto":
+    if model == "auto" and not whole:
         out["same_state"] = same_state_departure(scene, result)
     if "auto_rung" in result.patches:
         from rigid_dynamics.contact.auto import AUTO_RUNGS
@@ -187,12 +190,14 @@ def compare(auto_npz: Path, bem_npz: Path, load_N: float, mu: float) -> dict:
 
 
 def run_variant(scene: str, variant: str, scratch: Path) -> dict:
-    """One run in its own process (``--one``), its numbers kept beside its time series (scratch/scene-variant.json)."""
+    """One run in its own process (``--one``), its numbers kept beside its time series (scratch/scene-variant.json);
+    variant "auto-whole": the scene's whole duration (WHOLE) from its own start.
+    """
     from comparisons.bench import machine
     from rigid_dynamics.files import write_json
 
     npz = scratch / f"{scene}-{variant}.npz"
-    duration = {**SCENES, **OTHER_SCENES}[scene]
+    duration = WHOLE[scene] if variant == "auto-whole" else {**SCENES, **OTHER_SCENES}[scene]
     start = time.perf_counter()
     proc = subprocess.run(
         [sys.executable, __file__, "--one", scene, str(duration), variant, str(npz)],
@@ -249,10 +254,55 @@ def main() -> int:
                 per[variant]["mu"],
             )
         rows.append({"scene": scene, "runs": per, "error": errors})
-    write_json(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows})
-    write_text(OUT / "auto_vs_bem.md", "\n".join(report(rows)))
+    whole = {}
+    for scene in [n for n in names if n in WHOLE]:
+        kept = scratch / f"{scene}-auto-whole.json"
+        if only and "auto-whole" not in only[0].split(",") and kept.exists():
+            whole[scene] = {**json.loads(kept.read_text()), "reused": True}
+        else:
+            whole[scene] = run_variant(scene, "auto-whole", scratch)
+    write_json(OUT / "auto_vs_bem.json", {"machine": machine(), "rows": rows, "whole": whole})
+    write_text(OUT / "auto_vs_bem.md", "\n".join(report(rows) + whole_report(whole)))
     print(f"written {OUT / 'auto_vs_bem.md'}")
     return 0
+
+
+def whole_report(whole: dict) -> list:
+    """The lines of the whole-scene runs (auto alone)."""
+    lines = [
+        "## Whole scenes, auto alone",
+        "",
+        "Each scene at its own duration and start (curve-flange from its own start: the flange contact forms "
+        "during the run), `auto` with the reuse; always-BEM is not run (hours).",
+        "",
+        "| scene | simulated | status | RTF in process | RTF whole process | rungs (patches in contact) | BEM solves "
+        "| callback s (of which patch formation) | reuse: served / solved, measured correction error (creep, "
+        "normal), count above tolerance |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for scene, run in whole.items():
+        cb = run.get("callback") or {}
+        reuse = cb.get("auto_reuse") or {}
+        share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in run.get("rung_share", {}).items() if v > 0)
+        lines.append(
+            f"| {scene} | {run['duration_s']:g} s | {run['status']} | {run['real_time_factor']:.3g} | "
+            f"{run['whole_process_real_time_factor']:.3g} | {share} | {cb.get('solves', '-')} | "
+            f"{cb.get('seconds', 0.0):.1f} ({cb.get('sampling_seconds', 0.0):.1f}) | "
+            f"{reuse.get('served_by_correction')} / {reuse.get('solved_by_callback')}, "
+            f"{_pct(reuse.get('max_creep_force_error'))}, {_pct(reuse.get('max_normal_force_error'))}, "
+            f"{reuse.get('errors_above_tolerance')} of {reuse.get('errors_measured')} |"
+        )
+    return [*lines, ""]
+
+
+def _same_state_text(ss) -> str:
+    if not ss:
+        return "-"
+    rungs = "; ".join(
+        f"{k} {_pct(e['max_creep_bench'])}, {_pct(e['max_normal_relative'])} ({e['patches']})"
+        for k, e in ss["by_rung"].items()
+    )
+    return f"{_pct(ss['normal_relative'])}, {_pct(ss['creep_bench'])}; {rungs}"
 
 
 def _pct(v, digits=2):
@@ -285,8 +335,9 @@ def report(rows: list) -> list:
         "| scene | simulated | tolerance | run | status | RTF in process | RTF whole process | x always-BEM (in "
         "process) | max dN / Q0 | max dF_creep / peak BEM creep | max creep error (bench definition) | rungs "
         "(patches in contact) | BEM solves | reuse: served / solved, measured correction error (creep, normal), "
-        "count above tolerance |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "count above tolerance | same state: max dN / N_BEM, max creep error (bench definition); per rung: creep, "
+        "normal |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         bem = r["runs"]["bem"]
@@ -309,7 +360,7 @@ def report(rows: list) -> list:
                 f"{_pct(e['max_normal_diff_over_wheel_load']) if e else '-'} | "
                 f"{_pct(e['max_creep_diff_over_peak_bem_creep']) if e else '-'} | "
                 f"{_pct(e['max_creep_error_bench_definition']) if e else '-'} | {share or '-'} | "
-                f"{cb.get('solves', '-')} | {reuse_text} |"
+                f"{cb.get('solves', '-')} | {reuse_text} | {_same_state_text(run.get('same_state'))} |"
             )
     lines += [
         "",
@@ -320,7 +371,10 @@ def report(rows: list) -> list:
         "always-BEM (BEM on the sampled gap, the loop's grid), not errors against a reference; the two runs' "
         "states also drift apart. The reuse's measured correction error: at each re-solve from inside twice the "
         "trust radius, the value the old anchor would have served against the fresh BEM solution (bench "
-        "definition for the creep force, relative for the normal force; summary.json `callback.auto_reuse`).",
+        "definition for the creep force, relative for the normal force; summary.json `callback.auto_reuse`). Same "
+        "state: auto's recorded per-patch forces against always-BEM's evaluated at auto's own state of each output "
+        "sample (WheelsetModel.contact with the BEM: the same patches formed, the trajectories' parting removed), "
+        "per patch in contact in both; per rung the largest and the number of patches.",
         "",
     ]
     return lines

@@ -123,16 +123,16 @@ def test_the_radius_follows_the_measured_error():
 
 
 def test_a_run_records_the_reused_rung_and_its_error():
-    """Regression (the run's record): polygonal-wheel with auto at 5 % for 10 ms: some patches given to BEM are served
+    """Regression (the run's record): polygonal-wheel with auto at 5 % for 6 ms: some patches given to BEM are served
     by the correction (rung "bem-corrected", law "bem-corrected"), the summary's callback.auto_reuse counts them and
-    states the measured correction error; with ``auto_reuse = false`` none is.
+    states the measured correction error (``auto_reuse = false`` serves none: the unit test above, par.auto_reuse 0).
     """
     from dataclasses import replace
 
     from rigid_dynamics.wheelset import simulate
     from wheelrail.scenes import load_scene, resolve_scene_path
 
-    scene = replace(load_scene(resolve_scene_path("polygonal-wheel")), contact_model="auto", duration_s=0.01)
+    scene = replace(load_scene(resolve_scene_path("polygonal-wheel")), contact_model="auto", duration_s=0.006)
     result = simulate(scene)
     reuse = result.callback_stats["auto_reuse"]
     rungs = result.summary()["auto"]["rung_share"]
@@ -141,9 +141,6 @@ def test_a_run_records_the_reused_rung_and_its_error():
     assert reuse["errors_measured"] == 0 or reuse["max_creep_force_error"] >= 0.0
     laws = {law for patch in result.patch_summary().values() for law in patch["law"]}
     assert "bem-corrected" in laws
-    off = simulate(replace(scene, auto_reuse=False))
-    assert off.callback_stats["auto_reuse"]["served_by_correction"] == 0
-    assert off.summary()["auto"]["rung_share"]["bem-corrected"] == 0
 
 
 def test_bad_auto_reuse_key_exits_2(capsys):
