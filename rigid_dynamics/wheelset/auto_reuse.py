@@ -26,8 +26,9 @@ in the store's last row (:data:`STATS` columns) and reported in summary.json (ca
 ``auto_reuse``).
 
 The store (:func:`reuse_store`) is an array of the run (compiled_laws.HertzKalkerTables.reuse): one row per
-candidate (:data:`ANCHOR` columns), the statistics row last. Off (par.auto_reuse 0, scene key ``auto_reuse``):
-every BEM patch is solved by the callback, as before.
+candidate (:data:`ANCHOR` columns), the statistics row last. Off (par.auto_reuse 0, scene key ``auto_reuse``; and
+for a tolerance below every measured level, where auto asks for BEM on every patch): every BEM patch is solved by
+the callback, as before.
 """
 
 from __future__ import annotations
@@ -131,6 +132,14 @@ def reuse_stats(store: np.ndarray, tolerance: float | None) -> dict:
     }
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _enabled(par, store, c):
+    """Whether candidate c may be reused: the run's switch (par.auto_reuse), a measured tolerance level (a tolerance
+    below every level asks for BEM on every patch: no reuse) and a row in the store.
+    """
+    return par.auto_reuse > 0.0 and par.auto_level > 0.0 and c < store.shape[0] - 1
+
+
 @njit(cache=True, _nrt=False)
 def _cheap(par, tables, dummy, g, creep, where):
     """FASTSIM on Hertz's ellipse of the geometry row g at creep = (xi, eta, phi): (N, a, b, mu N, normalised
@@ -182,7 +191,7 @@ def reuse_serve(par, tables, dummy, g, creep, where, c):
     M_z, a, b, area, max pressure, patch geometry code, ellipticity residual); served False: solve it (callback).
     """
     store = tables.reuse
-    if par.auto_reuse <= 0.0 or c >= store.shape[0] - 1 or store[c, R_VALID] <= 0.0 or not g[G_APPROACH] > 0.0:
+    if not _enabled(par, store, c) or store[c, R_VALID] <= 0.0 or not g[G_APPROACH] > 0.0:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
     row = store[c]
     cheap = _cheap(par, tables, dummy, g, creep, where)
@@ -200,7 +209,7 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
     within twice the old radius (adapting the radius), then make it the anchor (module docstring).
     """
     store = tables.reuse
-    if par.auto_reuse <= 0.0 or c >= store.shape[0] - 1:
+    if not _enabled(par, store, c):
         return
     store[-1, T_SOLVED] += 1.0
     n_b, tx_b, ty_b, mz_b, sa_b, sb_b, area_b, pmax_b, geom, resid = solved
@@ -224,7 +233,7 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
         if e_f > st[T_MAX_FORCE]:
             st[T_MAX_FORCE], st[T_MAX_T] = e_f, t
         st[T_MAX_NORMAL] = max(st[T_MAX_NORMAL], e_n)
-        level = par.auto_level if math.isfinite(par.auto_level) else 0.05
+        level = par.auto_level
         worst = max(e_f, e_n)
         if worst > level:
             st[T_ABOVE] += 1.0
