@@ -19,6 +19,7 @@ ANCHOR_CREEP = (2.0e-3, -1.0e-3, 0.8)  # |F| ~0.65 mu N with spin: auto gives su
 
 def _setup():
     from rigid_dynamics.contact.fastsim import FLEXIBILITY_CODES
+    from rigid_dynamics.wheelset.auto_reuse import reuse_store
     from rigid_dynamics.wheelset.compiled_laws import LAW_AUTO, hertz_kalker_tables, tables_for
     from rigid_dynamics.wheelset.layout import G_APPROACH, G_CURVATURE_LAT, G_CURVATURE_LONG, N_GEO, new_parameters
 
@@ -29,7 +30,7 @@ def _setup():
     par["fastsim_nx"] = par["fastsim_ny"] = 20
     par["flexibility_code"] = FLEXIBILITY_CODES["three"]
     par["auto_level"], par["auto_reuse"] = 0.05, 1.0
-    hk = hertz_kalker_tables(tables, None, None, candidates=1)
+    hk = hertz_kalker_tables(tables, None, None, reuse_store(1))
     hertz = wr.get_model("hertz").solve(wr.ContactGeometry.quadric(*RADII), wr.Creepage(0, 0, 0), wr.STEEL,
                                         normal_force_N=LOAD_N)  # fmt: skip
     g = np.zeros(N_GEO)

@@ -142,24 +142,25 @@ def _enabled(par, store, c):
 
 @njit(cache=True, _nrt=False)
 def _cheap(par, tables, dummy, g, creep, where):
-    """FASTSIM on Hertz's ellipse of the geometry row g at creep = (xi, eta, phi): (N, a, b, mu N, normalised
-    F_x, F_y, M_z (over mu N, mu N sqrt(ab)), c* (3-tuple), ln(a/b)); mu N = 0: no friction bound (forces 0).
+    """FASTSIM on Hertz's ellipse of the geometry row g at creep = (xi, eta, phi): ((N, a, b, mu N), (F_x, F_y, M_z)
+    normalised by mu N and mu N sqrt(ab), c* (3-tuple), ln(a/b)); mu N = 0: no friction bound (forces 0).
     """
     patch = _hertz_kalker(par, tables, g[G_APPROACH], g[G_CURVATURE_LONG], g[G_CURVATURE_LAT])
     normal, sa, sb, c11, c22, c23, _ = patch
     friction = patch_friction(par, tables.friction, where)
     mu_n = friction.coefficient * normal
     if not mu_n > 0.0:
-        return normal, sa, sb, 0.0, 0.0, 0.0, 0.0, (0.0, 0.0, 0.0), math.log(sa / sb)
+        return (normal, sa, sb, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), math.log(sa / sb)
     tx, ty, mz = _creep_law(par, LAW_FASTSIM, dummy, patch, creep, friction)
     star = normalised_creepages(par.shear_modulus_Pa, (sa, sb, c11, c22, c23), mu_n, creep)
-    return normal, sa, sb, mu_n, tx / mu_n, ty / mu_n, mz / (mu_n * math.sqrt(sa * sb)), star, math.log(sa / sb)
+    return (normal, sa, sb, mu_n), (tx / mu_n, ty / mu_n, mz / (mu_n * math.sqrt(sa * sb))), star, math.log(sa / sb)
 
 
 @njit(cache=True, _nrt=False)
 def _distance(row, star, log_ab, g, st):
     """The distance of the inputs from the anchor in ``row`` (module docstring; st the statistics row: settings)."""
-    ds = math.sqrt((star[0] - row[R_XS]) ** 2 + (star[1] - row[R_YS]) ** 2 + (star[2] - row[R_PS]) ** 2)
+    xs, ys, ps = star
+    ds = math.sqrt((xs - row[R_XS]) ** 2 + (ys - row[R_YS]) ** 2 + (ps - row[R_PS]) ** 2)
     s0 = math.sqrt(row[R_XS] ** 2 + row[R_YS] ** 2 + row[R_PS] ** 2)
     d = ds / (s0 + st[C_CREEP_FLOOR])
     d = max(d, st[C_SHAPE] * abs(log_ab - row[R_LOG_AB]))
@@ -168,9 +169,12 @@ def _distance(row, star, log_ab, g, st):
 
 
 @njit(cache=True, _nrt=False)
-def _corrected(row, cheap):
-    """(N, T_x, T_y, M_z, a, b, area, max pressure) of the anchor's correction applied to FASTSIM's ``cheap``."""
-    normal_h, sa, sb, mu_n, fx, fy, mz = cheap[0], cheap[1], cheap[2], cheap[3], cheap[4], cheap[5], cheap[6]
+def _corrected(row, hertz, forces):
+    """(N, T_x, T_y, M_z, a, b, area, max pressure) of the anchor's correction applied to FASTSIM's normalised
+    ``forces`` on the Hertz patch ``hertz`` = (N, a, b, mu N).
+    """
+    normal_h, sa, sb, mu_n = hertz
+    fx, fy, mz = forces
     normal = normal_h * row[R_NORMAL_RATIO]
     mu_nc = mu_n * row[R_NORMAL_RATIO]
     gx, gy = fx + row[R_DFX], fy + row[R_DFY]
@@ -194,12 +198,35 @@ def reuse_serve(par, tables, dummy, g, creep, where, c):
     if not _enabled(par, store, c) or store[c, R_VALID] <= 0.0 or not g[G_APPROACH] > 0.0:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
     row = store[c]
-    cheap = _cheap(par, tables, dummy, g, creep, where)
-    if not cheap[3] > 0.0 or _distance(row, cheap[7], cheap[8], g, store[-1]) > row[R_RADIUS]:
+    hertz, forces, star, log_ab = _cheap(par, tables, dummy, g, creep, where)
+    mu_n = hertz[-1]
+    if not mu_n > 0.0 or _distance(row, star, log_ab, g, store[-1]) > row[R_RADIUS]:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
-    n, tx, ty, mz, sa, sb, area, pmax = _corrected(row, cheap)
+    n, tx, ty, mz, sa, sb, area, pmax = _corrected(row, hertz, forces)
     store[-1, T_SERVED] += 1.0
     return True, n, tx, ty, mz, sa, sb, area, pmax, int(row[R_GEOMETRY]), row[R_RESIDUAL]
+
+
+@njit(cache=True, _nrt=False)
+def _measure(st, radius, errors, level, t):
+    """Count a measured correction error (errors = (creep, normal)) in the statistics row st and return the radius
+    adapted to it (module docstring).
+    """
+    e_f, e_n = errors
+    st[T_CHECKED] += 1.0
+    if e_f > st[T_MAX_FORCE]:
+        st[T_MAX_FORCE], st[T_MAX_T] = e_f, t
+    st[T_MAX_NORMAL] = max(st[T_MAX_NORMAL], e_n)
+    worst = max(e_f, e_n)
+    if worst > level:
+        st[T_ABOVE] += 1.0
+    if worst > 0.5 * level and radius > st[C_RADIUS_MIN]:
+        st[T_SHRUNK] += 1.0
+        return max(0.5 * radius, st[C_RADIUS_MIN])
+    if worst < 0.125 * level and radius < st[C_RADIUS_MAX]:
+        st[T_GROWN] += 1.0
+        return min(1.5 * radius, st[C_RADIUS_MAX])
+    return radius
 
 
 @njit(cache=True, _nrt=False)
@@ -217,44 +244,29 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
     if not (g[G_APPROACH] > 0.0 and n_b > 0.0):
         row[R_VALID] = 0.0
         return
-    cheap = _cheap(par, tables, dummy, g, creep, where)
-    normal_h, sa, sb, mu_n = cheap[0], cheap[1], cheap[2], cheap[3]
+    hertz, forces, star, log_ab = _cheap(par, tables, dummy, g, creep, where)
+    normal_h, sa, sb, mu_n = hertz
     if not mu_n > 0.0:
         row[R_VALID] = 0.0
         return
     radius = row[R_RADIUS]
-    if row[R_VALID] > 0.0 and _distance(row, cheap[7], cheap[8], g, store[-1]) <= 2.0 * radius:
-        n, tx, ty, _, _, _, _, _ = _corrected(row, cheap)
+    if row[R_VALID] > 0.0 and _distance(row, star, log_ab, g, store[-1]) <= 2.0 * radius:
+        n, tx, ty, _, _, _, _, _ = _corrected(row, hertz, forces)
         mu_nb = mu_n * n_b / normal_h
         e_f = math.hypot(tx - tx_b, ty - ty_b) / max(math.hypot(tx_b, ty_b), 0.01 * mu_nb)
-        e_n = abs(n - n_b) / n_b
-        st = store[-1]
-        st[T_CHECKED] += 1.0
-        if e_f > st[T_MAX_FORCE]:
-            st[T_MAX_FORCE], st[T_MAX_T] = e_f, t
-        st[T_MAX_NORMAL] = max(st[T_MAX_NORMAL], e_n)
-        level = par.auto_level
-        worst = max(e_f, e_n)
-        if worst > level:
-            st[T_ABOVE] += 1.0
-        if worst > 0.5 * level and radius > st[C_RADIUS_MIN]:
-            radius = max(0.5 * radius, st[C_RADIUS_MIN])
-            st[T_SHRUNK] += 1.0
-        elif worst < 0.125 * level and radius < st[C_RADIUS_MAX]:
-            radius = min(1.5 * radius, st[C_RADIUS_MAX])
-            st[T_GROWN] += 1.0
+        radius = _measure(store[-1], radius, (e_f, abs(n - n_b) / n_b), par.auto_level, t)
     ratio = n_b / normal_h
     mu_nb = mu_n * ratio
-    star, log_ab = cheap[7], cheap[8]
+    fx, fy, mz = forces
     row[R_VALID] = 1.0
-    row[R_XS], row[R_YS], row[R_PS] = star[0], star[1], star[2]
+    row[R_XS], row[R_YS], row[R_PS] = star
     row[R_LOG_AB], row[R_LOG_Q], row[R_WHEEL_Y] = log_ab, math.log(g[G_APPROACH]), g[G_WHEEL_LATERAL]
     row[R_HALF_WIDTH] = sb
     row[R_RADIUS] = radius
     row[R_NORMAL_RATIO] = ratio
-    row[R_DFX] = tx_b / mu_nb - cheap[4]
-    row[R_DFY] = ty_b / mu_nb - cheap[5]
-    row[R_DMZ] = mz_b / (mu_nb * math.sqrt(sa * sb)) - cheap[6]
+    row[R_DFX] = tx_b / mu_nb - fx
+    row[R_DFY] = ty_b / mu_nb - fy
+    row[R_DMZ] = mz_b / (mu_nb * math.sqrt(sa * sb)) - mz
     row[R_A_RATIO], row[R_B_RATIO] = sa_b / sa, sb_b / sb
     area_h = math.pi * sa * sb
     row[R_AREA_RATIO] = area_b / area_h if math.isfinite(area_b) else 1.0

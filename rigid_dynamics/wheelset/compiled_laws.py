@@ -151,13 +151,11 @@ class HertzKalkerTables(NamedTuple):
     reuse: np.ndarray
 
 
-def hertz_kalker_tables(tables, friction=None, creep=None, candidates=0) -> HertzKalkerTables:
+def hertz_kalker_tables(tables, friction=None, creep=None, reuse=None) -> HertzKalkerTables:
     """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`, a contact.friction.FrictionLaw (None:
-    Coulomb with the parameter record's ``friction_coefficient``), a creep-force table (None: an empty one) and a
-    fresh store of auto's BEM anchors for ``candidates`` candidates (auto_reuse.reuse_store).
+    Coulomb with the parameter record's ``friction_coefficient``), a creep-force table (None: an empty one) and the
+    run's store of auto's BEM anchors (auto_reuse.reuse_store; None: one with no candidate's row, nothing reused).
     """
-    from rigid_dynamics.wheelset.auto_reuse import reuse_store
-
     law = friction if friction is not None else uniform(0.0)
     return HertzKalkerTables(
         float(tables.log_r[0]),
@@ -168,7 +166,7 @@ def hertz_kalker_tables(tables, friction=None, creep=None, candidates=0) -> Hert
         np.ascontiguousarray(tables.c),
         law.record(),
         creep if creep is not None else empty_table(),
-        reuse_store(int(candidates)),
+        reuse if reuse is not None else np.zeros((1, 1)),
     )
 
 

@@ -153,6 +153,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     """
     from rigid_dynamics.contact.fastsim import FLEXIBILITY_CODES
     from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
+    from rigid_dynamics.wheelset.auto_reuse import reuse_store
 
     mode = GEOMETRY_GIVEN if python_geometry else geometry_mode(provider)
     m = model_wheelset
@@ -181,7 +182,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
         tables,
         law,
         _creep_table(scene, law, opts) if code == LAW_TABLE or par["auto_fastsim_table"] else None,
-        _candidates(provider, mode),
+        reuse_store(_candidates(provider, mode)),
     )
     if mode == GEOMETRY_TABLES:
         par["nominal_radius_m"] = provider.r0

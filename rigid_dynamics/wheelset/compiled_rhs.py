@@ -231,16 +231,18 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     and the law code.
     """
     par, tables, dummy, where, rec, record = laws
-    reduced = (creep[1], creep[2], creep[3])
-    got = reuse_serve(par, tables, dummy, g, reduced, where, c)
-    if got[0]:
+    _, xi, eta, spin = creep
+    served, normal, tx, ty, mz, sa, sb, area, pmax, geom, resid = reuse_serve(
+        par, tables, dummy, g, (xi, eta, spin), where, c
+    )
+    if served:
         if record:
             rec[c, AUTO_RUNG] = AUTO_BEM_CORRECTED
-        return got[1], got[2], got[3], got[4], got[5], got[6], got[7], got[8], got[9], got[10], 0, LAW_BEM_CORRECTED
+        return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, 0, LAW_BEM_CORRECTED
     normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(t, y, c, side, g, creep, frame)
     if st == 0:
         solved = (normal, tx, ty, mz, sa, sb, area, pmax, geom, resid)
-        reuse_anchor(par, tables, dummy, g, reduced, where, c, t, solved)
+        reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved)
     return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, LAW_CALLBACK
 
 
