@@ -59,6 +59,9 @@ from rigid_dynamics.wheelset.layout import (
 )
 
 LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO, LAW_KPEC, LAW_TABLE = range(8)
+LAW_BEM_CORRECTED = 8
+"""The ``contact_law_code`` of an auto patch served by FASTSIM on the ellipse corrected by a stored BEM solution
+(wheelset/auto_reuse.py); no model declares it."""
 LAW_CODES = {
     "hertz": LAW_HERTZ,
     "linear": LAW_LINEAR,
@@ -132,8 +135,9 @@ class HertzKalkerTables(NamedTuple):
     :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b); and the run's friction law ``friction``
     (contact.friction.FrictionRecord; one Coulomb law that varies nowhere: the parameter record's
     ``friction_coefficient`` serves, as before the laws existed); ``creep`` the run's creep-force table
-    (contact.creep_table.CreepTable; an empty one when no law reads it). The data of the compiled laws, passed per
-    patch.
+    (contact.creep_table.CreepTable; an empty one when no law reads it); ``reuse`` auto's store of BEM anchors
+    (auto_reuse.reuse_store: one row per candidate and a statistics row; written by the loop). The data of the
+    compiled laws, passed per patch.
     """
 
     log_ratio_start: float
@@ -144,11 +148,13 @@ class HertzKalkerTables(NamedTuple):
     kalker: np.ndarray
     friction: FrictionRecord
     creep: CreepTable
+    reuse: np.ndarray
 
 
-def hertz_kalker_tables(tables, friction=None, creep=None) -> HertzKalkerTables:
+def hertz_kalker_tables(tables, friction=None, creep=None, reuse=None) -> HertzKalkerTables:
     """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`, a contact.friction.FrictionLaw (None:
-    Coulomb with the parameter record's ``friction_coefficient``) and a creep-force table (None: an empty one).
+    Coulomb with the parameter record's ``friction_coefficient``), a creep-force table (None: an empty one) and the
+    run's store of auto's BEM anchors (auto_reuse.reuse_store; None: one with no candidate's row, nothing reused).
     """
     law = friction if friction is not None else uniform(0.0)
     return HertzKalkerTables(
@@ -160,6 +166,7 @@ def hertz_kalker_tables(tables, friction=None, creep=None) -> HertzKalkerTables:
         np.ascontiguousarray(tables.c),
         law.record(),
         creep if creep is not None else empty_table(),
+        reuse if reuse is not None else np.zeros((1, 1)),
     )
 
 
