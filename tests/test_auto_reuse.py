@@ -151,3 +151,25 @@ def test_bad_auto_reuse_key_exits_2(capsys):
     err = capsys.readouterr().err
     pattern = r"auto_reuse.* = 2: expected true or false"
     assert err.startswith("wheelrail: error: ") and err.count("\n") == 1 and re.search(pattern, err), err
+
+
+def test_a_measured_correction_above_the_tolerance_turns_an_ok_run_into_a_warning():
+    """An ok run whose reuse measured a correction beyond contact_tolerance ends "warning", naming the count and the
+    largest error (an ok status must not stand on corrections known to miss); within it, or with no reuse, it stays."""
+    from rigid_dynamics.wheelset.discretisation import auto_reuse_check
+
+    reuse = {
+        "errors_above_tolerance": 2,
+        "errors_measured": 12,
+        "tolerance": 0.05,
+        "max_creep_force_error": 0.34,
+        "max_creep_force_error_t_s": 0.0121,
+        "max_normal_force_error": 0.19,
+    }
+    status, message = auto_reuse_check("ok", "reached t = 0.0135 s", {"auto_reuse": reuse})
+    assert status == "warning"
+    assert "2 of 12" in message and "0.34" in message and "auto_reuse = false" in message
+    within = dict(reuse, errors_above_tolerance=0)
+    assert auto_reuse_check("ok", "m", {"auto_reuse": within}) == ("ok", "m")
+    assert auto_reuse_check("ok", "m", {}) == ("ok", "m")
+    assert auto_reuse_check("force-anomaly", "m", {"auto_reuse": reuse}) == ("force-anomaly", "m")
