@@ -14,6 +14,10 @@ repeated up to 5 times within 0.2 s and the shortest wall time kept) and compare
 * ``normal_error``: the largest of the normal-force, max-pressure and area errors (the quantities every rung,
   the FEA included, solves and states): the FEA's error on a creep case, where its creep forces are a status
   (``creep_status``), shown in the tolerance table's FEA column and in the plots (hollow markers, off the front);
+* ``result_status``: the status of the model's own result(s) on the side ("ok", or e.g. the FEA's
+  "mesh-tolerance-not-met" when its stated error is above the run's mesh tolerance within its budget, the BEM's
+  "warning" when its grid error is above its grid tolerance): the run's ``status`` says the solve succeeded and its
+  numbers are used, this one whether the model met its own tolerance (both in the row);
 * ``stated_check``: for a model that states its error, whether the error against the reference is within the
   stated error plus the reference's own, per quantity (an understated error is named, never hidden).
 
@@ -96,6 +100,7 @@ class BenchRun:
     stated_error: float | None = None
     normal_error: float | None = None
     creep_status: str | None = None
+    result_status: str = "ok"
     stated_check: dict | None = None
 
     def row(self) -> dict:
@@ -116,6 +121,7 @@ class BenchRun:
         out["stated_errors"] = self.stated
         out["normal_error"] = self.normal_error
         out["creep_status"] = self.creep_status
+        out["result_status"] = self.result_status
         out["stated_check"] = self.stated_check
         out["message"] = self.message
         return out
@@ -269,6 +275,8 @@ def run_one(named, model: str, resolution: str, options: dict) -> BenchRun:
         return run
     from comparisons.stated_errors import largest, side_stated_errors
 
+    side_results = [p[3] for p in patches if p[0] == named.side]
+    run.result_status = next((r.status for r in side_results if r.status != "ok"), "ok")
     run.values = side_values(patches, named.side)
     run.errors, run.error = case_errors(named, run.values)
     run.stated = side_stated_errors([p[3] for p in patches if p[0] == named.side])
@@ -389,6 +397,8 @@ def _fea_cell(runs: list[BenchRun], case: str, row: dict | None) -> str:
     else:
         tol, best = min(met, key=lambda item: item[0])
         text = f"{int(round(100 * tol))} %: {best.resolution} {_pct(best.normal_error)} in {_time(best.wall_time_s)}"
+    if best.result_status != "ok":
+        text += f" ({best.result_status})"
     text += f", stated {_stated(best)}{_check_word(best)}" + ("" if met else ")")
     if best.creep_status:
         text += f"; creep forces: {best.creep_status}"
@@ -437,6 +447,8 @@ def _row_status(run: BenchRun) -> str:
     creep case, the status of its creep forces.
     """
     text = run.status if run.status == "ok" else f"{run.status}: {run.message[:60]}"
+    if run.status == "ok" and run.result_status != "ok":
+        text += f" ({run.result_status})"
     return text + (f"; creep forces {run.creep_status}" if run.creep_status else "")
 
 

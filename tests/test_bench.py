@@ -148,7 +148,7 @@ def test_fea_on_a_creep_case_has_a_creep_status_its_normal_error_and_a_checked_s
             spin_moment_Nm=None,
             max_pressure_Pa=ref["max_pressure_Pa"] * 1.03,
             contact_area_m2=ref["contact_area_m2"] * 0.99,
-            status="ok",
+            status="mesh-tolerance-not-met",
             message="",
             extra={"discretisation_error": {"relative_error": {"normal_force": 0.0, "max_pressure": 0.01,
                                                                "contact_area": 0.02}}},
@@ -169,4 +169,5 @@ def test_fea_on_a_creep_case_has_a_creep_status_its_normal_error_and_a_checked_s
     cell = bench._fea_cell([run], "creep-long-mid", fea_table["creep-long-mid"])
     assert cell.startswith("5 %: tol2%") and "creep forces: error-not-stated" in cell and "UNDERSTATED" in cell
     assert bench._plotted(run) and bench.pareto_front([run]) == []
-    assert "creep forces error-not-stated" in bench._row_status(run)
+    assert "(mesh-tolerance-not-met); creep forces error-not-stated" in bench._row_status(run)
+    assert run.result_status == "mesh-tolerance-not-met" and "(mesh-tolerance-not-met)" in cell
