@@ -2,9 +2,6 @@
 VENV := .venv
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
-# two pytest-xdist workers, each test file in one of them (module fixtures computed once; every test writes only
-# under its tmp_path or atomically into the numba and table caches); PYTEST_WORKERS=0: one process
-PYTEST_WORKERS ?= 2
 
 .PHONY: demo test lint docs setup clean clean-numba
 
@@ -17,7 +14,7 @@ demo: $(STAMP)
 	$(VENV)/bin/wheelrail demo
 
 test: $(STAMP)
-	$(VENV)/bin/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadfile $(PYTEST_ARGS)
+	$(VENV)/bin/python -m pytest -q $(PYTEST_ARGS)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .
