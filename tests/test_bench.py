@@ -61,10 +61,13 @@ def test_tiny_bench_writes_csv_markdown_plots(tmp_path, monkeypatch, capsys):
     assert float(hertz["error"]) < 1e-9  # Hertz against its closed form
     summary = json.loads((tmp_path / "bench.json").read_text())
     assert summary["tolerance_table"]["hertz-ab-1"]["1%"]["model"] == "hertz"
+    # printed status, JSON status and exit code agree (rows not ok are findings about their rung, counted)
+    assert summary["status"] == "ok" and summary["runs_not_ok"] == 0
     text = (tmp_path / "bench.md").read_text()
     assert "Tolerance table" in text and "| creep-long-mid |" in text
     assert (tmp_path / "time_vs_error-creep-long-mid.png").stat().st_size > 1000
-    assert "fastest within 5 %" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "fastest within 5 %" in printed and "bench: status ok:" in printed
 
 
 @pytest.mark.parametrize(
