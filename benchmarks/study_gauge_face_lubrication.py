@@ -68,6 +68,11 @@ def variants(scene):
     }
 
 
+def _stat(reduce, values) -> float:
+    """``reduce`` over ``values``; NaN when there are none (a run that failed before the window says why)."""
+    return float(reduce(values)) if np.size(values) else float("nan")
+
+
 def quantities(result) -> dict:
     """Statistics over the window t >= WINDOW_START_S (module text): per wheel the mean and the largest of Y/Q,
     the mean Y and Q (main frame, on the wheel), the sums over its patches of the normal force and the creep forces
@@ -82,19 +87,19 @@ def quantities(result) -> dict:
     for i, side in enumerate(SIDES):
         loaded = f[:, i, 2] != 0.0  # Q = 0: the wheel lifted (Y/Q undefined there; counted below)
         ratio = f[loaded, i, 1] / f[loaded, i, 2]
-        out[f"{side}: Y/Q mean"] = float(np.mean(ratio))
-        out[f"{side}: |Y/Q| max"] = float(np.max(np.abs(ratio)))
-        out[f"{side}: Y mean (N)"] = float(np.mean(f[:, i, 1]))
-        out[f"{side}: Q mean (N)"] = float(np.mean(f[:, i, 2]))
-        out[f"{side}: N mean (N)"] = float(np.mean(normal[:, i].sum(axis=1)))
-        out[f"{side}: T_x mean (N)"] = float(np.mean(np.nansum(p["creep_force_long_N"][keep][:, i], axis=1)))
-        out[f"{side}: T_y mean (N)"] = float(np.mean(np.nansum(p["creep_force_lat_N"][keep][:, i], axis=1)))
+        out[f"{side}: Y/Q mean"] = _stat(np.mean, ratio)
+        out[f"{side}: |Y/Q| max"] = _stat(np.max, np.abs(ratio))
+        out[f"{side}: Y mean (N)"] = _stat(np.mean, f[:, i, 1])
+        out[f"{side}: Q mean (N)"] = _stat(np.mean, f[:, i, 2])
+        out[f"{side}: N mean (N)"] = _stat(np.mean, normal[:, i].sum(axis=1))
+        out[f"{side}: T_x mean (N)"] = _stat(np.mean, np.nansum(p["creep_force_long_N"][keep][:, i], axis=1))
+        out[f"{side}: T_y mean (N)"] = _stat(np.mean, np.nansum(p["creep_force_lat_N"][keep][:, i], axis=1))
     gauge = np.where((angle[:, 0] > GAUGE_SIDE_RAD) & (normal[:, 0] > 0), normal[:, 0], 0.0)
-    out["outer: gauge-side patch N max (N)"] = float(np.max(gauge))
-    out["outer: gauge-side patch N mean (N)"] = float(np.mean(gauge.sum(axis=1)))
+    out["outer: gauge-side patch N max (N)"] = _stat(np.max, gauge)
+    out["outer: gauge-side patch N mean (N)"] = _stat(np.mean, gauge.sum(axis=1))
     touching = angle[:, 0][normal[:, 0] > 0]
-    out["outer: contact angle min (rad)"] = float(np.min(touching)) if touching.size else float("nan")
-    out["outer: contact angle max (rad)"] = float(np.max(touching)) if touching.size else float("nan")
+    out["outer: contact angle min (rad)"] = _stat(np.min, touching)
+    out["outer: contact angle max (rad)"] = _stat(np.max, touching)
     out["wheel lifts in the window"] = float(
         sum(1 for kind, _, time_s in result.events if kind == "wheel-lift" and time_s >= WINDOW_START_S)
     )

@@ -300,6 +300,7 @@ class FeaModel:
             approach_control=normal_force_N is None,
             block_estimate=opts.formulation != "profiles",
             t0=t0,
+            measure_order=geometry.undeformed is not None,
         )
         info = result.extra.get("discretisation_error") or {}
         previous = self._memo_entry(key) if key is not None else None

@@ -61,10 +61,13 @@ def test_tiny_bench_writes_csv_markdown_plots(tmp_path, monkeypatch, capsys):
     assert float(hertz["error"]) < 1e-9  # Hertz against its closed form
     summary = json.loads((tmp_path / "bench.json").read_text())
     assert summary["tolerance_table"]["hertz-ab-1"]["1%"]["model"] == "hertz"
+    # printed status, JSON status and exit code agree (rows not ok are findings about their rung, counted)
+    assert summary["status"] == "ok" and summary["runs_not_ok"] == 0
     text = (tmp_path / "bench.md").read_text()
     assert "Tolerance table" in text and "| creep-long-mid |" in text
     assert (tmp_path / "time_vs_error-creep-long-mid.png").stat().st_size > 1000
-    assert "fastest within 5 %" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "fastest within 5 %" in printed and "bench: status ok:" in printed
 
 
 @pytest.mark.parametrize(
@@ -128,3 +131,46 @@ def test_plots_one_style_per_rung_percent_axis_overview_and_front_over_answering
     assert 1e-5 not in list(front.get_xdata())  # Hertz not on the front
     assert ax.yaxis.get_major_formatter()(0.05, 0) == "5 %"
     plt.close(fig)
+
+
+def test_fea_on_a_creep_case_has_a_creep_status_its_normal_error_and_a_checked_stated_error(monkeypatch):
+    """The FEA on a creep case: no creep-force number (a status), its error on N, p max and area against the
+    reference, and its stated error checked against that error (synthetic FEA result, no solve)."""
+    from rigid_dynamics.contact.types import ContactResult
+
+    named = load_named_case("creep-long-mid")
+    ref = named.reference
+
+    def fake_solve(case, model, options):
+        result = ContactResult(
+            method="fea",
+            success=True,
+            normal_force_N=ref["normal_force_N"],
+            creep_force_long_N=None,
+            creep_force_lat_N=None,
+            spin_moment_Nm=None,
+            max_pressure_Pa=ref["max_pressure_Pa"] * 1.03,
+            contact_area_m2=ref["contact_area_m2"] * 0.99,
+            status="mesh-tolerance-not-met",
+            message="",
+            extra={"discretisation_error": {"relative_error": {"normal_force": 0.0, "max_pressure": 0.01,
+                                                               "contact_area": 0.02}}},
+        )  # fmt: skip
+        return [("single", case.geometry, case.creepage, result)], True, ""
+
+    monkeypatch.setattr(bench, "solve_contact_case", fake_solve)
+    run = bench.run_one(named, "fea", "tol2%", {})
+    assert run.status == "ok" and run.creep_status == bench.FEA_CREEP_STATUS
+    assert run.error is None  # it does not answer the case's creep-force question
+    assert run.normal_error == pytest.approx(0.03)
+    check = run.stated_check
+    assert check["contact_area"]["holds"] and not check["max_pressure"]["holds"]  # 3 % > 1 % + the ref's own
+    assert "UNDERSTATED (max pressure)" in bench._check_word(run)
+    # the tolerance table's FEA column and the plots take it on its normal problem; the front does not
+    fea_table = bench.fea_tolerance_table([run])
+    assert fea_table["creep-long-mid"][0.05] is run and fea_table["creep-long-mid"][0.02] is None
+    cell = bench._fea_cell([run], "creep-long-mid", fea_table["creep-long-mid"])
+    assert cell.startswith("5 %: tol2%") and "creep forces: error-not-stated" in cell and "UNDERSTATED" in cell
+    assert bench._plotted(run) and bench.pareto_front([run]) == []
+    assert "(mesh-tolerance-not-met); creep forces error-not-stated" in bench._row_status(run)
+    assert run.result_status == "mesh-tolerance-not-met" and "(mesh-tolerance-not-met)" in cell

@@ -132,6 +132,7 @@ def test_the_signature_check_counts_parameters():
 
 KERNEL_FILES = (
     *sorted((PACKAGE / "wheelset").glob("compiled_*.py")),
+    PACKAGE / "wheelset" / "auto_reuse.py",
     *sorted((PACKAGE / "contact").glob("_*_kernels.py")),
     PACKAGE / "contact" / "fastrip.py",
     PACKAGE / "contact" / "kpec.py",

@@ -184,7 +184,9 @@ def test_auto_choice_in_the_loop_is_the_documented_rule():
     for idx in zip(*np.nonzero(touching), strict=True):
         features = {f: float(result.patches[f"auto_{f}"][idx]) for f in FEATURES}
         choice = choose_rung(features, scene.contact_tolerance, fastsim_grid=(20, 20))
-        assert AUTO_RUNGS[int(rung[idx])] == choice["model"]
+        # a BEM patch served by its stored solution's correction (wheelset/auto_reuse.py) is recorded as such
+        served = AUTO_RUNGS[int(rung[idx])]
+        assert (served if served != "bem-corrected" else "bem") == choice["model"]
         deciding = int(result.patches["auto_deciding_feature"][idx])
         assert FEATURES[deciding] == choice["deciding_feature"]
 

@@ -36,6 +36,7 @@ def test_one_coefficient_rungs_take_the_law_at_the_rigid_slip_velocity(method):
     result = _fx(method)
     assert result.status == "ok"
     assert "falling friction" in result.message and "0.5 m/s" in result.message
+    assert result.extra["friction_coefficient_used"] == pytest.approx(mu, rel=1e-12)  # recorded, not only in text
     assert result.creep_force_long_N == pytest.approx(mu * NORMAL_N, rel=5e-3)
     fastsim = _fx("fastsim")
     assert result.creep_force_long_N == pytest.approx(fastsim.creep_force_long_N, rel=1e-2)

@@ -229,3 +229,25 @@ def test_irregularity_errors():
         TabulatedRailDeflection(a, np.zeros(3))
     with pytest.raises(ValueError, match="foundation_modulus_N_per_m2 must be a finite number > 0"):
         WinklerRailDeflection(1e5, 0.0, 6e6, -1.0)
+
+
+def test_measured_wheel_local_evaluation_equals_dense_regression():
+    """Regression (two code paths of one spline): MeasuredWheelIrregularity.evaluate's compiled local bicubic
+    evaluation (geometry._bicubic, 16 coefficients per point) equals the dense evaluation it replaced (every lateral
+    basis function at every point, through the spline's own scipy objects), value and derivatives to second order,
+    across the periodic wrap and outside the lateral range (0 there)."""
+    from rigid_dynamics.geometry import MeasuredWheelIrregularity
+
+    rng = np.random.default_rng(3)
+    angle = np.sort(rng.uniform(-3.0, 3.0, 40))
+    y = np.linspace(-0.03, 0.04, 30)
+    irr = MeasuredWheelIrregularity(angle, y, 1e-4 * rng.standard_normal((40, 30)))
+    a = rng.uniform(-9.0, 9.0, 3000)
+    yy = rng.uniform(-0.04, 0.05, 3000)
+    got = irr.evaluate(a, yy)
+    inside = (yy >= y[0]) & (yy <= y[-1])
+    yc = np.clip(yy, y[0], y[-1])
+    for k, (p, q) in enumerate(((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2))):
+        dense = np.einsum("ij,ij->i", irr._spline_a(a, nu=p), np.nan_to_num(irr._basis_y(yc, nu=q)))
+        want = np.where(inside, dense, 0.0)
+        np.testing.assert_allclose(got[k], want, rtol=0, atol=1e-12 * max(1.0, np.max(np.abs(want))))

@@ -71,20 +71,23 @@ def test_approximating_slices_read_as_contacts_b_spline(tmp_path):
     """TH_INTPOL 2: the slices are the control points of a cubic B-spline along the angle (CONTACT's approximating
     spline). Reference, closed form: on uniform knots h a cubic B-spline whose control points lie on c theta^2 is
     c (theta^2 + h^2 / 3) (the B-spline reproduces quadratics shifted by c h^2 / 3), here 1.33e-7 m on the 2 mrad
-    dense slices; TH_INTPOL 1 passes through the slices. Values relative to the first (base) slice, on the constant
-    part."""
+    dense slices; TH_INTPOL 1 passes through the slices. The base slice lies on the constant part (c 0.01 = 1 mm
+    of material at the tape circle): the reader re-zeroes the base profile there and keeps that offset in R_irr
+    (``origin_offset_m``), so the wheel is the files' at every angle, as CONTACT reads them."""
     parabola = _Parabola()
     (tmp_path / "a").mkdir()
     (tmp_path / "i").mkdir()
     approx = read_wheel_slices(_write(tmp_path / "a", parabola, th_intpol=2))
     interp = read_wheel_slices(_write(tmp_path / "i", parabola, th_intpol=1))
     assert (approx.th_intpol, interp.th_intpol) == (2, 1)
+    assert approx.origin_offset_m == pytest.approx(parabola.c * 0.01, abs=1e-12)
+    assert float(approx.base.z_m[np.argmin(np.abs(approx.base.y_m))]) == pytest.approx(0.0, abs=1e-9)
     h = 0.2 / 100
     theta = THETA_FLAT + h * np.arange(-30, 31)
     alpha = 0.5 * math.pi - theta
     for y in (-0.02, 0.0, 0.03):
         ys = np.full_like(alpha, y)
-        want = parabola.c * ((theta - THETA_FLAT) ** 2 - 0.01)  # relative to the base slice (constant part)
+        want = parabola.c * (theta - THETA_FLAT) ** 2  # the files' wheel: the base's offset kept
         np.testing.assert_allclose(interp.irregularity.evaluate(alpha, ys)[0], want, atol=1e-11)
         np.testing.assert_allclose(approx.irregularity.evaluate(alpha, ys)[0], want + parabola.c * h**2 / 3, atol=1e-11)
 

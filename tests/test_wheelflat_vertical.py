@@ -67,7 +67,9 @@ def test_wheelset_model_impact_against_the_vertical_model(track):
         track_dynamics=replace(scene.track_dynamics, model=track),
         # the step this comparison was measured at (the shipped scene's is 6.25 us since its modes reach 15 kHz);
         # checked at every step, the force error estimate at 6.25 us and 3.125 us is 0.143 at t = 0.0105062 s, the
-        # same at both steps: not a step error (a step-independent jump of the estimate, under investigation)
+        # same at both steps: not a step error but the Hertzian force's jump where the contact point crosses the
+        # flat's leading edge (the rolling curvature jumps there; the BEM on the sampled gap is continuous:
+        # benchmarks/results/flat_edge_force.md)
         integrator=replace(scene.integrator, fixed_step_s=25e-6, output_step_s=25e-6, lift_half_step_check=False),
     )
     result = simulate(scene)

@@ -192,6 +192,7 @@ def test_left_and_right_profiles_may_differ():
         ({"rolling_speed_m_per_s": 0.0}, "rolling_speed_m_per_s = 0.0"),
         ({"rail_profile_cant_rad": 0.3}, "rail_profile_cant_rad = 0.3"),
         ({"profile_smoothing_m": -1e-3}, "profile_smoothing_m = -0.001"),
+        ({"rail_profile_smoothing_m": 0.1}, r"rail_profile_smoothing_m = 0.1: expected a length in \[0, 0.05\] m"),
         ({"wheel_profile_mirror_z": 1}, "wheel_profile_mirror_z = 1"),
         ({"wheel_profile_left": ""}, "wheel_profile_left = ''"),
     ],
@@ -228,3 +229,36 @@ def test_mirrored_case_mirrors_the_solution():
         assert q.geometry.rolling_radius_m == pytest.approx(p.geometry.rolling_radius_m, abs=1e-8)
         assert q.creepage.longitudinal == pytest.approx(p.creepage.longitudinal, abs=1e-8)
         assert q.creepage.spin_1_per_m == pytest.approx(-p.creepage.spin_1_per_m, rel=1e-5)
+
+
+def test_rail_smoothing_apart_from_the_wheels():
+    """rail_profile_smoothing_m (CONTACT's per-profile SMOOTH) smooths the rails alone: the wheels are those of the
+    case's profile_smoothing_m, the rails those of a case smoothed with the rail's value throughout."""
+    from rigid_dynamics.contact.track import build_track
+
+    both = build_track(a22(0.0, profile_smoothing_m=0.005))
+    split = build_track(a22(0.0, profile_smoothing_m=0.005, rail_profile_smoothing_m=0.0))
+    bare = build_track(a22(0.0, profile_smoothing_m=0.0))
+    y = np.linspace(-0.02, 0.02, 41)
+    wheel = [t.wheels["right"].evaluate(np.pi / 2, y)[0] for t in (both, split)]
+    np.testing.assert_array_equal(*wheel)
+    y_rail = np.linspace(*bare.rails["right"].y_range_m, 401)[5:-5]
+    rail = [t.rails["right"].evaluate(np.zeros_like(y_rail), y_rail)[0] for t in (split, bare, both)]
+    np.testing.assert_array_equal(rail[0], rail[1])
+    assert np.isfinite(rail[0]).sum() > 300 and np.nanmax(np.abs(rail[0] - rail[2])) > 1e-7
+
+
+def test_case_file_rail_smoothing_key(tmp_path):
+    """``geometry.rail_profile_smoothing_m`` in a case file: read, and a bad value is a one-line error naming it."""
+    from hardening_helpers import STEEL
+
+    from wheelrail.cases import load_case
+    from wheelrail.config import ConfigError
+
+    head = STEEL + '[geometry]\nkind = "wheelset"\nwheel_profile = "S1002"\nrail_profile = "UIC60"\n'
+    tail = "[loading]\nwheel_load_N = 8e4\n"
+    (tmp_path / "ok.toml").write_text(head + "rail_profile_smoothing_m = 0.0\n" + tail)
+    assert load_case(tmp_path / "ok.toml").wheelset.rail_profile_smoothing_m == 0.0
+    (tmp_path / "bad.toml").write_text(head + "rail_profile_smoothing_m = 0.5\n" + tail)
+    with pytest.raises(ConfigError, match=r"rail_profile_smoothing_m = 0.5: expected a length in \[0, 0.05\] m"):
+        load_case(tmp_path / "bad.toml")

@@ -26,8 +26,9 @@ A case file has the tables
   of the flat's centre), ``flat_shape`` ("rounded", default, or "new"; rigid_dynamics.geometry.WheelFlat),
   ``wheel_slices_file`` (a CONTACT wheel slices file, .slcw, relative to the case file: a measured out-of-round
   wheel relative to its first slice, rigid_dynamics.geometry.slices, smoothed along y with the case's
-  ``profile_smoothing_m``; the case's wheel_profile should be that slice's file) and ``side`` ("both", default,
-  "left" or "right");
+  ``profile_smoothing_m``, a wavelength L_filt: CONTACT's SMOOTH under its default ISMOOTH 0 is a smoothing
+  parameter, converted by slices.contact_smoothing_wavelength_m; the case's wheel_profile should be that slice's
+  file) and ``side`` ("both", default, "left" or "right");
 * ``[solver]``: for a quadric case the options of the contact model; for a wheelset case the case's options
   (``rigid_dynamics.contact.wheelset_case.DEFAULT_CASE_OPTIONS``) with the model's options in ``[solver.model]``.
   Both are checked against their declarations before any work (:func:`check_solver_options`;
@@ -80,6 +81,7 @@ WHEELSET_GEOMETRY_KEYS = {
     "rail_profile_left",
     "rail_profile_cant_rad",
     "profile_smoothing_m",
+    "rail_profile_smoothing_m",
     "wheel_profile_mirror_y",
     "wheel_profile_mirror_z",
     "rail_profile_mirror_y",

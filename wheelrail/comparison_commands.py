@@ -109,7 +109,10 @@ def cmd_bench(args) -> int:
             bar.close()
         summary = write_bench(runs, cases, out_dir, args.quick, time.perf_counter() - start)
     failed = [r for r in runs if r.status != "ok"]
-    print(f"bench: {len(runs)} runs over {len(cases)} cases in {summary['wall_time_s']:.0f} s, {len(failed)} not ok")
+    print(
+        f"bench: status {summary['status']}: {len(runs)} runs over {len(cases)} cases in {summary['wall_time_s']:.0f} s,"
+        f" {len(failed)} not ok (each a finding about its rung, with its message in bench.md)"
+    )
     for case, row in summary["tolerance_table"].items():
         best = row["5%"]
         text = "none" if best is None else f"{best['model']} {best['resolution']} ({best['wall_time_s'] * 1e3:.3g} ms)"
@@ -213,6 +216,7 @@ def _demo(scene, source, models, out_dir) -> int:
         fx, fy = v.get("creep_force_long_N"), v.get("creep_force_lat_N")
         return "-" if fx is None or fy is None else f"{math.hypot(fx, fy) / 1e3:.2f}"
 
+    fea_vs_bem = _fea_vs_bem_headline(models.get("fea", {}))
     stresses = {s["source"]: s for s in compare["subsurface"]}
     with_t = stresses.get("BEM pressure + tractions, half-space", {})
     fea = next((v for k, v in stresses.items() if k.startswith("FEA")), {})
@@ -223,6 +227,7 @@ def _demo(scene, source, models, out_dir) -> int:
         f"at the peak, max pressure [MPa] Hertz {p0('hertz')}, FASTSIM{grid('fastsim')} {p0('fastsim')}, "
         f"BEM{grid('bem')} {p0('bem')}, FEA{grid('fea')} {p0('fea')}; creep force [kN] FASTSIM {creep('fastsim')}, "
         f"BEM {creep('bem')}",
+        *fea_vs_bem,
         "subsurface max von Mises: "
         + (
             f"BEM + tractions (half-space) {with_t['max_von_mises_Pa'] / 1e6:.0f} MPa at "
@@ -270,6 +275,21 @@ def _demo(scene, source, models, out_dir) -> int:
         + "; see the report's table"
     )
     return 1
+
+
+def _fea_vs_bem_headline(fea: dict) -> list[str]:
+    """The demo's lines on the FEA against the BEM at the peak: each quantity with both stated errors and the
+    verdict (comparisons.compare.verdict), and why; one line saying so when the FEA did not run or failed.
+    """
+    from comparisons.compare import agreement_sentence
+
+    if not fea:
+        return []
+    agreement = fea.get("agreement_with_bem") or {}
+    if not agreement:
+        return [f"FEA vs BEM at the peak: no comparison (FEA {fea.get('status')}: {fea.get('message', '')[:160]})"]
+    head = f"FEA ({fea.get('status')}; {fea.get('resolution', '')}) vs BEM at the peak: "
+    return [head + "; ".join(agreement_sentence(n, a) for n, a in agreement.items()), fea.get("verdict_why", "")]
 
 
 def _auto_summary(result) -> list:

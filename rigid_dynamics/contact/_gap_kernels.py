@@ -444,6 +444,18 @@ def _rooted_here(state, gx, gy):
     return state[CHAIN_WHEEL_X] == gx and state[CHAIN_WHEEL_Y] == gy
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def grid_axes(box, xs, ys):
+    """Fill xs, ys with the linspace of box = (x_lo, x_hi, y_lo, y_hi) at their lengths; (nx, ny)."""
+    x_lo, x_hi, y_lo, y_hi = box
+    nx, ny = xs.shape[0], ys.shape[0]
+    for i in range(nx):
+        xs[i] = x_lo + (x_hi - x_lo) * i / (nx - 1)
+    for j in range(ny):
+        ys[j] = y_lo + (y_hi - y_lo) * j / (ny - 1)
+    return nx, ny
+
+
 @njit(cache=True, _nrt=False)
 def sample_grid(surf, patch, box, xs, ys, gap, columns):
     """The gap on the grid xs x ys (linspace of box = (x_lo, x_hi, y_lo, y_hi), filled here) into gap (ny, nx).
@@ -456,12 +468,7 @@ def sample_grid(surf, patch, box, xs, ys, gap, columns):
     fails is solved by :func:`chain_point` from the middle anchor. columns (nx, COLUMN_SCRATCH):
     scratch (the wheel's column series, the row's roots). Every root is the exact solve's to the step tolerance.
     """
-    x_lo, x_hi, y_lo, y_hi = box
-    nx, ny = xs.shape[0], ys.shape[0]
-    for i in range(nx):
-        xs[i] = x_lo + (x_hi - x_lo) * i / (nx - 1)
-    for j in range(ny):
-        ys[j] = y_lo + (y_hi - y_lo) * j / (ny - 1)
+    nx, ny = grid_axes(box, xs, ys)
     axes, mode, limit = chain_axes(surf, patch)
     for i in range(nx):
         col = chain_column(xs[i], surf, axes, mode)
@@ -567,12 +574,7 @@ def _polish_row(xs, gy, anchor_x, anchor_s, surf, axes, mode, limit, columns):
 @njit(cache=True, _nrt=False)
 def exact_grid(surf, patch, box, xs, ys, gap):
     """The gap on the grid of box by :func:`exact_gap` at every point (the reference of :func:`sample_grid`)."""
-    x_lo, x_hi, y_lo, y_hi = box
-    nx, ny = xs.shape[0], ys.shape[0]
-    for i in range(nx):
-        xs[i] = x_lo + (x_hi - x_lo) * i / (nx - 1)
-    for j in range(ny):
-        ys[j] = y_lo + (y_hi - y_lo) * j / (ny - 1)
+    nx, ny = grid_axes(box, xs, ys)
     for j in range(ny):
         for i in range(nx):
             gap[j, i] = exact_gap(xs[i], ys[j], surf, patch)
@@ -706,12 +708,7 @@ def quadric_grid(quadric, q, box, xs, ys, gap):
     """The quadric gap A x'^2 + B y'^2 - q (quadric = (A, B, angle)) on the grid of box into xs, ys, gap."""
     big_a, big_b, angle = quadric
     c, s = math.cos(angle), math.sin(angle)
-    x_lo, x_hi, y_lo, y_hi = box
-    nx, ny = xs.shape[0], ys.shape[0]
-    for i in range(nx):
-        xs[i] = x_lo + (x_hi - x_lo) * i / (nx - 1)
-    for j in range(ny):
-        ys[j] = y_lo + (y_hi - y_lo) * j / (ny - 1)
+    nx, ny = grid_axes(box, xs, ys)
     for j in range(ny):
         for i in range(nx):
             xr, yr = c * xs[i] + s * ys[j], -s * xs[i] + c * ys[j]

@@ -43,8 +43,10 @@ FEATURES = ("saturation", "spin_share", "ellipticity_residual", "curvature_chang
 """Patch features, in the order of the dynamics' ``auto_deciding_feature`` codes."""
 RUNG_MODELS = ("linear", "vermeulen-johnson", "fastsim")
 """The cheaper rungs auto may choose, in cost order (BEM is the fallback)."""
-AUTO_RUNGS = ("linear", "vermeulen-johnson", "fastsim", "bem")
-"""Codes of the dynamics' ``auto_rung`` field (index into this tuple)."""
+AUTO_RUNGS = ("linear", "vermeulen-johnson", "fastsim", "bem", "bem-corrected")
+"""Codes of the dynamics' ``auto_rung`` field (index into this tuple); "bem-corrected": a patch auto gave to BEM
+served in the loop by FASTSIM corrected by a stored BEM solution within its trust region
+(rigid_dynamics/wheelset/auto_reuse.py)."""
 PRIMARY_FEATURE = {"linear": "saturation", "vermeulen-johnson": "spin_share", "fastsim": "ellipticity_residual"}
 """The feature along which a rung's box is grown (the error mechanism the rung neglects)."""
 LEVELS = (0.10, 0.05, 0.02, 0.01)

@@ -194,8 +194,10 @@ def normalised_creepages(shear_modulus_Pa, patch, mu_n, creep):
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _axis(x, x0, step, n):
-    """(cell, weight) of x on the uniform axis x0 + i step, i < n, clamped to its ends."""
+def uniform_cell(x, x0, step, n):
+    """(cell, weight) of x on the uniform axis x0 + i step, i < n, clamped to its ends (the compiled Hertz and
+    Kalker tables, wheelset.compiled_laws, look up their axes with it too).
+    """
     f = (x - x0) / step
     if f < 0.0:
         f = 0.0
@@ -223,10 +225,10 @@ def tabulated_forces(table, log_ratio, star):
     spread = 1.0 - math.sqrt(1.0 - rho)  # the magnitude axis (module docstring)
     theta = math.atan2(ys, xs)
     lam = math.asin(max(-1.0, min(1.0, zs / r)))
-    i0, w0 = _axis(log_ratio, table.log_ratio_start, table.log_ratio_step, ns)
-    i1, w1 = _axis(lam, -0.5 * math.pi, math.pi / (nl - 1), nl)
-    i2, w2 = _axis(theta, -math.pi, 2.0 * math.pi / (nt - 1), nt)
-    i3, w3 = _axis(spread, 0.0, 1.0 / (nr - 1), nr)
+    i0, w0 = uniform_cell(log_ratio, table.log_ratio_start, table.log_ratio_step, ns)
+    i1, w1 = uniform_cell(lam, -0.5 * math.pi, math.pi / (nl - 1), nl)
+    i2, w2 = uniform_cell(theta, -math.pi, 2.0 * math.pi / (nt - 1), nt)
+    i3, w3 = uniform_cell(spread, 0.0, 1.0 / (nr - 1), nr)
     fx, fy, mz = 0.0, 0.0, 0.0  # the table holds F / rho
     for d0 in range(2):
         c0 = w0 if d0 else 1.0 - w0

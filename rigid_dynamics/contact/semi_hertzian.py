@@ -182,6 +182,7 @@ class KpecModel:
                 "flexibility_ellipse_m": [float(a_fl), float(b_fl)],
                 "contact_touches_potential_area_edge": edge,
                 "method_error": "not estimated (approximate method; benchmarks/results/kpec.md)",
+                **({"friction_coefficient_used": float(mu)} if friction_note is not None else {}),
             },
         )
 

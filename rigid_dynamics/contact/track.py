@@ -11,7 +11,8 @@ Orientation. Profiles are read in the internal convention (readers.py: y towards
 of another orientation is turned by the case's ``*_profile_mirror_y`` / ``*_profile_mirror_z`` (as CONTACT's
 MIRRORY, MIRRORZ). A wheel whose flange comes out inside the tape circle is an error that says so, not something
 mended silently. Left and right profiles may differ (``wheel_profile_left``, ``rail_profile_left``; default the
-right ones, mirrored); ``profile_smoothing_m`` sets the profile splines' smoothing wavelength (default 2 mm).
+right ones, mirrored); ``profile_smoothing_m`` sets the profile splines' smoothing wavelength (default 2 mm),
+``rail_profile_smoothing_m`` the rails' when it differs (CONTACT's per-profile SMOOTH).
 """
 
 from __future__ import annotations
@@ -136,6 +137,7 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
             defaults in brackets) wheel_profile_left, rail_profile_left [the right ones, mirrored],
             rail_profile_cant_rad [the profile's own ``cant_rad``], rail_inclination_left_rad /
             rail_inclination_right_rad [rail_inclination_rad], profile_smoothing_m [2 mm],
+            rail_profile_smoothing_m [profile_smoothing_m],
             wheel_profile_mirror_y/_z, rail_profile_mirror_y/_z [False].
         wheel_irregularities, rail_irregularities: optional side -> tuple of irregularities (geometry module).
 
@@ -148,6 +150,8 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
 
     smoothing = getattr(case, "profile_smoothing_m", None)
     smoothing = DEFAULT_SMOOTHING_WAVELENGTH_M if smoothing is None else smoothing
+    rail_smoothing = getattr(case, "rail_profile_smoothing_m", None)
+    rail_smoothing = smoothing if rail_smoothing is None else rail_smoothing
     wheel_mirror = (
         bool(getattr(case, "wheel_profile_mirror_y", False)),
         bool(getattr(case, "wheel_profile_mirror_z", False)),
@@ -176,7 +180,7 @@ def build_track(case, *, wheel_irregularities=None, rail_irregularities=None) ->
         inclination = case.rail_inclination_rad if inclination is None else inclination
         track = TrackGeometry(
             rail, gauge_m=case.gauge_m, gauge_height_m=case.gauge_height_m,
-            rail_inclination_rad=inclination - cant, smoothing_wavelength_m=smoothing,
+            rail_inclination_rad=inclination - cant, smoothing_wavelength_m=rail_smoothing,
         )  # fmt: skip
         wheels[side] = wheelset.wheel_surface(side, wheel_irregularities.get(side, ()))
         _check_flange_outside(wheelset.curve, getattr(wheel, "name", names["wheel"][side]))

@@ -211,6 +211,9 @@ class WheelsetCase:
         rail_profile_cant_rad: cant already contained in the rail profile's points, rad; None: the profile's own
             (built-in profiles know theirs, e.g. MBench_UIC60_v3 1:40; a file has 0 unless stated here).
         profile_smoothing_m: smoothing wavelength L_filt of the profile splines, m (default 2 mm; 0 interpolates).
+        rail_profile_smoothing_m: the rails' L_filt when it differs from the wheels' (CONTACT smooths each profile
+            with its own SMOOTH: its wheelflat example the wheel with 5 mm, the rail not at all), m; None:
+            profile_smoothing_m.
         wheel_profile_mirror_y, wheel_profile_mirror_z, rail_profile_mirror_y, rail_profile_mirror_z: turn a
             profile file of another orientation into the internal one (y towards the field side, z down), as
             CONTACT's MIRRORY / MIRRORZ.
@@ -243,6 +246,7 @@ class WheelsetCase:
     rail_profile_left: str | None = None
     rail_profile_cant_rad: float | None = None
     profile_smoothing_m: float = 0.002
+    rail_profile_smoothing_m: float | None = None
     wheel_profile_mirror_y: bool = False
     wheel_profile_mirror_z: bool = False
     rail_profile_mirror_y: bool = False
@@ -309,14 +313,17 @@ class WheelsetCase:
             or abs(value) >= 0.2
         ):
             raise ValueError(f"rail_profile_cant_rad = {value!r}: expected None or an angle with |angle| < 0.2 rad")
-        value = self.profile_smoothing_m
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, float))
-            or not math.isfinite(value)
-            or not 0 <= value <= 0.05
-        ):
-            raise ValueError(f"profile_smoothing_m = {value!r}: expected a length in [0, 0.05] m")
+        for name in ("profile_smoothing_m", "rail_profile_smoothing_m"):
+            value = getattr(self, name)
+            if value is None and name == "rail_profile_smoothing_m":
+                continue
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, float))
+                or not math.isfinite(value)
+                or not 0 <= value <= 0.05
+            ):
+                raise ValueError(f"{name} = {value!r}: expected a length in [0, 0.05] m")
         if self.roll_rad is not None and (
             isinstance(self.roll_rad, bool)
             or not isinstance(self.roll_rad, (int, float))

@@ -245,18 +245,21 @@ class MeasuredWheelIrregularity:
         object.__setattr__(self, "_basis_y", basis)
 
     def evaluate(self, angle_rad, y_m):
+        """(R, R_a, R_y, R_aa, R_ay, R_yy) at the points: the bicubic spline's 4 x 4 coefficients nonzero at each
+        point (compiled, geometry._bicubic); the same spline as ``_spline_a`` x ``_basis_y`` evaluated densely.
+        """
+        from rigid_dynamics.geometry._bicubic import evaluate_bicubic
+
         a, y = np.broadcast_arrays(np.asarray(angle_rad, dtype=float), np.asarray(y_m, dtype=float))
         shape = a.shape
-        a, y = a.ravel(), y.ravel()
+        a, y = np.ascontiguousarray(a.ravel()), y.ravel()
         inside = (y >= self.y_m[0]) & (y <= self.y_m[-1])
         yc = np.clip(y, self.y_m[0], self.y_m[-1])
-        out = []
-        for p, q in ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)):
-            ca = self._spline_a(a, nu=p)  # (n, n_cy)
-            by = np.nan_to_num(self._basis_y(yc, nu=q))  # (n, n_cy)
-            val = np.einsum("ij,ij->i", ca, by)
-            out.append(np.where(inside, val, 0.0).reshape(shape))
-        return tuple(out)
+        sa, sy = self._spline_a, self._basis_y
+        out = np.empty((6, a.size))
+        evaluate_bicubic(sa.t, sy.t, np.ascontiguousarray(sa.c, float), True, a, yc, out)
+        out[:, ~inside] = 0.0
+        return tuple(row.reshape(shape) for row in out)
 
 
 # --------------------------------------------------------------------------------------------- rail

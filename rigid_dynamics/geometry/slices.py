@@ -17,7 +17,12 @@ radial deviation of slice k from the base is
 
     R_irr(theta_k, y_p) = z_p,k(y_p) - z_p,base(y_p)             (z_p down: a positive value adds material)
 
-on the lateral range common to all slices. Angles: CONTACT's theta_wc is the wheel's angle with the contact at
+on the lateral range common to all slices, plus the base's own offset: a slice's z is the wheel's radius relative
+to the nominal radius (CONTACT's wheel profile frame: its profile reader keeps the file's z, m_profile's
+profile_finish_grid), while the profile reader re-zeroes the base at the tape circle, so the file's z_p,base(0)
+(``origin_offset_m``; -0.041 mm in CONTACT's wheelflat example: its rolling radius at the tape circle is 0.041 mm
+below r0) is kept in R_irr at every angle and the wheel is the file's. Angles: CONTACT's theta_wc is the wheel's
+angle with the contact at
 theta_wc = -PITCH; in this package the wheel's material angle at its lowest point is alpha = pi/2 - phi with
 phi = -PITCH (wheelset_case: phi' = -pitch rate), so alpha = pi/2 - theta_wc. Along the angle the surface is
 CONTACT's (its m_bspline_make, read to learn, not copied): TH_INTPOL 1 interpolates the slices; TH_INTPOL 2 takes
@@ -31,11 +36,11 @@ range is not reproduced (the spline is periodic).
 
 The wheel profile of a case that uses such a file should be the base slice's file (R_irr is relative to it).
 
-Status: verified on a parametric flat written as slices (tests/test_geometry_slices.py) and compared with
-CONTACT's published solution of its examples/wheelflat.inp (benchmarks/results/wheelflat_contact.md). The
-example's file says TH_INTPOL 2; read as interpolating (before TH_INTPOL was honoured) the peak pressure was +13 %
-and +34 % off CONTACT's at -37 and -40 deg, read as CONTACT reads it -8.0 % and +14.7 %, the area +9.8 % and -3.8 %
-(benchmarks/results/wheelflat_slice_interpolation.md: still outside 3 % / 5 %; the rest is not explained).
+Status: verified on a parametric flat written as slices (tests/test_geometry_slices.py) and against CONTACT's
+published solution of its examples/wheelflat.inp (tests/test_wheelflat_contact_reference.py, all 26 angles in
+benchmarks/results/wheelflat_contact.md) once read as CONTACT reads it: TH_INTPOL 2, the base's file offset kept,
+the wheel's SMOOTH taken as CONTACT's default ISMOOTH 0 parameter (:func:`contact_smoothing_wavelength_m`), the rail
+unsmoothed.
 """
 
 from __future__ import annotations
@@ -51,7 +56,7 @@ from .irregularities import MeasuredWheelIrregularity
 from .profile import Profile
 from .readers import read_profile
 
-__all__ = ["WheelSlices", "read_wheel_slices"]
+__all__ = ["WheelSlices", "contact_smoothing_wavelength_m", "read_wheel_slices"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,6 +69,8 @@ class WheelSlices:
         theta_rad: CONTACT's slice angles theta_wc, rad, shape (n,).
         source: the file.
         th_intpol: the file's TH_INTPOL: 1 interpolating, 2 approximating spline along the angle (module docstring).
+        origin_offset_m: the base slice's z_p at the tape circle in the file (internal orientation, z down), m: the
+            shift the profile reader removed from ``base``, kept in ``irregularity`` (module docstring).
     """
 
     base: Profile
@@ -71,6 +78,7 @@ class WheelSlices:
     theta_rad: np.ndarray
     source: str
     th_intpol: int = 1
+    origin_offset_m: float = 0.0
 
 
 def _lines(path: Path):
@@ -200,7 +208,8 @@ def read_wheel_slices(path, lateral_step_m: float = 5.0e-4, smoothing_wavelength
     grid = np.arange(lo, hi + 0.5 * lateral_step_m, lateral_step_m)
     grid = grid[grid <= hi]
     base_z = np.interp(grid, base.y_m, base.z_m)
-    deviation = np.array([np.interp(grid, y, z) - base_z for y, z in profiles])
+    # the file's z relative to the reader's base: the base's removed offset z0 is kept (module docstring)
+    deviation = np.array([np.interp(grid, y, z) - base_z for y, z in profiles]) + z0 / 1e3
     if smoothing_wavelength_m > 0:
         from scipy.interpolate import make_smoothing_spline
 
@@ -213,7 +222,21 @@ def read_wheel_slices(path, lateral_step_m: float = 5.0e-4, smoothing_wavelength
     alpha = 0.5 * math.pi - theta  # module docstring
     order = np.argsort(alpha)
     irregularity = MeasuredWheelIrregularity(alpha[order], grid, deviation[order])
-    return WheelSlices(base, irregularity, theta, str(path), int(th_intpol))
+    return WheelSlices(base, irregularity, theta, str(path), int(th_intpol), z0 / 1e3)
+
+
+def contact_smoothing_wavelength_m(smooth: float, path) -> float:
+    """L_filt (m) of this package's smoothing splines equivalent to CONTACT's profile SMOOTH with its default method
+    (ISMOOTH 0: a non-weighted smoothing spline, sum over the file's points of (z_i - f(s_i))^2 + SMOOTH times the
+    integral of f''^2 ds, s in mm; CONTACT's m_profile, read to learn). The weighted spline here minimises
+    integral (z - f)^2 ds + (L_filt / 2 pi)^4 integral f''^2 ds; a sum over points spaced h is the integral / h, so
+    L_filt = 2 pi (h SMOOTH)^(1/4) with h the mean spacing of the file's points (mm). Exact for uniform spacing;
+    CONTACT's wheelflat slices (SMOOTH 5, h 0.87 mm) give 9.1 mm, not the 5 mm that reading SMOOTH as L_filt gives
+    (ISMOOTH 1 and 2 take SMOOTH as L_filt: use it directly then).
+    """
+    y_mm, _ = _points(Path(path))
+    spacing_mm = float(np.mean(np.abs(np.diff(y_mm))))
+    return 2.0 * math.pi * (spacing_mm * float(smooth)) ** 0.25 / 1e3
 
 
 def approximating_values(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:

@@ -32,7 +32,9 @@ class PatchCallback:
     "contact", the default: CONTACT's module 1, formed_patches.py: interpenetration regions joined or split, each
     patch solved in the plane of its weighted reference point, the forces returned in the candidate's frame) or
     (``patches`` "search", and on an elastic track) each candidate on its own plane at its deepest point
-    (search.patch_undeformed_distance). On an elastic track (``elastic``) the pose is moved along the track's
+    (search.patch_undeformed_distance); ``patches`` "auto" (auto's BEM rung: the other candidates keep their own
+    rungs) forms the patch as "contact" when it holds the candidate's region alone, else samples the candidate on
+    its own plane as "search". On an elastic track (``elastic``) the pose is moved along the track's
     vertical by the rail displacement under the wheel that the candidate's approach implies (one correction: the
     sampled approach equals the candidate's to second order; the rail's lateral displacement is not sampled
     separately).
@@ -65,6 +67,7 @@ class PatchCallback:
         self.sampling_seconds = 0.0
         self.patches = "contact"
         self.former = None
+        self.reuse = None  # auto: (its anchor store, tolerance level, enabled), set by WheelsetModel
         self.grid_error = {"estimated": 0, "not_estimated": 0, "above_tolerance": 0, "largest_force": 0.0,
                            "largest": 0.0, "tolerance": None, "t_s": None}  # fmt: skip
 
@@ -87,7 +90,17 @@ class PatchCallback:
             "sampling_seconds": float(self.sampling_seconds),
             "bem_warm_start": bool(self.bem and self.warm_start),
             **({"bem": self.warm_counts(), "bem_grid_error": dict(self.grid_error)} if self.bem else {}),
+            **({"auto_reuse": self.reuse_stats()} if self.reuse is not None else {}),
         }
+
+    def reuse_stats(self) -> dict:
+        """``auto``'s reuse of its BEM patches over the run (auto_reuse.reuse_stats of the run's store; ``enabled``
+        False when the scene switched it off).
+        """
+        from rigid_dynamics.wheelset.auto_reuse import reuse_stats
+
+        store, tolerance, enabled = self.reuse
+        return {"enabled": bool(enabled), **reuse_stats(store, tolerance)}
 
     def _record_grid_error(self, result, t_s: float) -> None:
         """Keep the run's largest BEM grid-error estimate (bem.model.grid_error_estimate, every solve's own) of the
@@ -136,7 +149,9 @@ class PatchCallback:
             )
             geometry = self.geometries.get(patch.candidate)
             if self.sample and (geometry is None or geometry.undeformed is None):
-                target = self._formed(patch) if self.patches == "contact" and not self.elastic else False
+                target = self._formed(patch) if self.patches in ("contact", "auto") and not self.elastic else False
+                if self.patches == "auto" and (target is None or (target is not False and len(target.regions) > 1)):
+                    target = False  # auto: a patch joining other candidates' regions: the candidate on its own plane
                 if target is None:  # its region is in a patch served by a deeper candidate
                     return _JOINED
                 if target is False:

@@ -24,7 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from rigid_dynamics.contact.creep_table import CreepTable, empty_table, table_creep_law
+from rigid_dynamics.contact.creep_table import CreepTable, empty_table, table_creep_law, uniform_cell
 from rigid_dynamics.contact.fastsim import (
     FastsimGrid,
     FastsimPatch,
@@ -59,6 +59,9 @@ from rigid_dynamics.wheelset.layout import (
 )
 
 LAW_HERTZ, LAW_LINEAR, LAW_VERMEULEN_JOHNSON, LAW_FASTSIM, LAW_CALLBACK, LAW_AUTO, LAW_KPEC, LAW_TABLE = range(8)
+LAW_BEM_CORRECTED = 8
+"""The ``contact_law_code`` of an auto patch served by FASTSIM on the ellipse corrected by a stored BEM solution
+(wheelset/auto_reuse.py); no model declares it."""
 LAW_CODES = {
     "hertz": LAW_HERTZ,
     "linear": LAW_LINEAR,
@@ -132,8 +135,9 @@ class HertzKalkerTables(NamedTuple):
     :data:`KALKER_C11`, ...) on a uniform grid of ln(a/b); and the run's friction law ``friction``
     (contact.friction.FrictionRecord; one Coulomb law that varies nowhere: the parameter record's
     ``friction_coefficient`` serves, as before the laws existed); ``creep`` the run's creep-force table
-    (contact.creep_table.CreepTable; an empty one when no law reads it). The data of the compiled laws, passed per
-    patch.
+    (contact.creep_table.CreepTable; an empty one when no law reads it); ``reuse`` auto's store of BEM anchors
+    (auto_reuse.reuse_store: one row per candidate and a statistics row; written by the loop). The data of the
+    compiled laws, passed per patch.
     """
 
     log_ratio_start: float
@@ -144,11 +148,13 @@ class HertzKalkerTables(NamedTuple):
     kalker: np.ndarray
     friction: FrictionRecord
     creep: CreepTable
+    reuse: np.ndarray
 
 
-def hertz_kalker_tables(tables, friction=None, creep=None) -> HertzKalkerTables:
+def hertz_kalker_tables(tables, friction=None, creep=None, reuse=None) -> HertzKalkerTables:
     """The :class:`HertzKalkerTables` of a :class:`TabulatedHertzKalker`, a contact.friction.FrictionLaw (None:
-    Coulomb with the parameter record's ``friction_coefficient``) and a creep-force table (None: an empty one).
+    Coulomb with the parameter record's ``friction_coefficient``), a creep-force table (None: an empty one) and the
+    run's store of auto's BEM anchors (auto_reuse.reuse_store; None: one with no candidate's row, nothing reused).
     """
     law = friction if friction is not None else uniform(0.0)
     return HertzKalkerTables(
@@ -160,19 +166,8 @@ def hertz_kalker_tables(tables, friction=None, creep=None) -> HertzKalkerTables:
         np.ascontiguousarray(tables.c),
         law.record(),
         creep if creep is not None else empty_table(),
+        reuse if reuse is not None else np.zeros((1, 1)),
     )
-
-
-@njit(cache=True, _nrt=False)
-def _uniform(x, x0, step, n):
-    """(cell, weight) of x on the uniform grid x0 + i step, i < n, clamped to its ends."""
-    f = (x - x0) / step
-    if f < 0.0:
-        f = 0.0
-    if f > n - 1.0:
-        f = n - 1.0
-    i = min(int(f), n - 2)
-    return i, f - i
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -182,7 +177,7 @@ def _hertz_kalker(par, tables, q, ca, cb):
     """
     amin, amax = min(ca, cb), max(ca, cb)
     hz = tables.hertz
-    i, w = _uniform(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, hz.shape[1])
+    i, w = uniform_cell(math.log(amax / amin), tables.log_ratio_start, tables.log_ratio_step, hz.shape[1])
     pp = hz[HERTZ_P, i] * (1 - w) + hz[HERTZ_P, i + 1] * w
     kk_ = hz[HERTZ_K, i] * (1 - w) + hz[HERTZ_K, i + 1] * w
     dd = hz[HERTZ_D, i] * (1 - w) + hz[HERTZ_D, i + 1] * w
@@ -191,7 +186,7 @@ def _hertz_kalker(par, tables, q, ca, cb):
     minor = major * math.sqrt(pp)
     sa, sb = (major, minor) if ca <= cb else (minor, major)
     kk = tables.kalker
-    i, w = _uniform(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    i, w = uniform_cell(math.log(sa / sb), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
     c11 = kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w
     c22 = kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w
     c23 = kk[KALKER_C23, i] * (1 - w) + kk[KALKER_C23, i + 1] * w
@@ -377,7 +372,7 @@ def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
 def _kalker_c(tables, ratio):
     """Kalker's (C11, C22, C23) for a/b = ratio from the tables (:func:`_hertz_kalker`'s interpolation)."""
     kk = tables.kalker
-    i, w = _uniform(math.log(ratio), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
+    i, w = uniform_cell(math.log(ratio), tables.log_ab_start, tables.log_ab_step, kk.shape[1])
     return (
         kk[KALKER_C11, i] * (1 - w) + kk[KALKER_C11, i + 1] * w,
         kk[KALKER_C22, i] * (1 - w) + kk[KALKER_C22, i + 1] * w,

@@ -153,6 +153,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     """
     from rigid_dynamics.contact.fastsim import FLEXIBILITY_CODES
     from rigid_dynamics.contact.search import DEFAULT_OPTIONS as SEARCH_OPTIONS
+    from rigid_dynamics.wheelset.auto_reuse import reuse_store
 
     mode = GEOMETRY_GIVEN if python_geometry else geometry_mode(provider)
     m = model_wheelset
@@ -176,8 +177,12 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     if code == LAW_AUTO:
         auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
         par["auto_fastsim_table"] = 1.0 if getattr(scene, "creep_table", False) else 0.0
+        par["auto_reuse"] = 1.0 if getattr(scene, "auto_reuse", True) else 0.0
     hk = hertz_kalker_tables(
-        tables, law, _creep_table(scene, law, opts) if code == LAW_TABLE or par["auto_fastsim_table"] else None
+        tables,
+        law,
+        _creep_table(scene, law, opts) if code == LAW_TABLE or par["auto_fastsim_table"] else None,
+        reuse_store(_candidates(provider, mode)),
     )
     if mode == GEOMETRY_TABLES:
         par["nominal_radius_m"] = provider.r0
@@ -193,6 +198,11 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
         return PackedRun(par, hk, sides, slots, mode, no_table_geometry(slots), search_args(provider, provider.options))
     par["nominal_radius_m"] = getattr(provider, "r0", scene.wheelset.nominal_radius_m)
     return PackedRun(par, hk, sides, slots, mode, no_table_geometry(slots), no_search_args())
+
+
+def _candidates(provider, mode) -> int:
+    """The run's number of candidates (:func:`pack`'s sides): the table provider's, else 4 (two per side)."""
+    return len(provider.side) if mode == GEOMETRY_TABLES else 4
 
 
 def load(run: PackedRun) -> None:

@@ -33,8 +33,10 @@ import numpy as np
 from numba import njit, objmode
 
 from rigid_dynamics.contact.friction import VARIES_ALONG_TRACK, VARIES_WITH_INCLINATION
+from rigid_dynamics.wheelset.auto_reuse import reuse_anchor, reuse_serve
 from rigid_dynamics.wheelset.compiled_laws import (
     LAW_AUTO,
+    LAW_BEM_CORRECTED,
     LAW_CALLBACK,
     LAW_KPEC,
     LAW_LINEAR,
@@ -50,6 +52,7 @@ from rigid_dynamics.wheelset.compiled_search import search_geometry, search_geom
 from rigid_dynamics.wheelset.compiled_tables import _table_geometry, table_scratch
 from rigid_dynamics.wheelset.layout import (
     APPROACH,
+    AUTO_BEM_CORRECTED,
     AUTO_FASTSIM,
     AUTO_RUNG,
     CALLBACK_FAILED,
@@ -220,6 +223,30 @@ def _external(t, y, c, side, g, creep, frame):
 
 
 @njit(cache=True, _nrt=False)
+def _auto_bem(t, y, c, side, g, creep, frame, laws):
+    """A patch ``auto`` gave to BEM: served by its stored BEM anchor's correction of FASTSIM within the trust
+    region (auto_reuse.reuse_serve; recorded as rung layout.AUTO_BEM_CORRECTED, law compiled_laws.LAW_BEM_CORRECTED),
+    else solved by the callback (:func:`_external`) and made the candidate's anchor (auto_reuse.reuse_anchor).
+    Arguments as :func:`_external`'s; laws = (par, tables, dummy, where, rec, record). Returns _external's values
+    and the law code.
+    """
+    par, tables, dummy, where, rec, record = laws
+    _, xi, eta, spin = creep
+    served, normal, tx, ty, mz, sa, sb, area, pmax, geom, resid = reuse_serve(
+        par, tables, dummy, g, (xi, eta, spin), where, c
+    )
+    if served:
+        if record:
+            rec[c, AUTO_RUNG] = AUTO_BEM_CORRECTED
+        return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, 0, LAW_BEM_CORRECTED
+    normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(t, y, c, side, g, creep, frame)
+    if st == 0:
+        solved = (normal, tx, ty, mz, sa, sb, area, pmax, geom, resid)
+        reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved)
+    return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, LAW_CALLBACK
+
+
+@njit(cache=True, _nrt=False)
 def _served_law(par, rec, c, record):
     """The compiled law that served candidate c (compiled_laws.LAW_CODES): the run's, or for ``auto`` the rung it
     chose (recorded in rec[c, AUTO_RUNG] when ``record``; NaN otherwise, then LAW_AUTO; its FASTSIM rung served by
@@ -335,11 +362,10 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
             pmax = 1.5 * normal / area if area > 0.0 else math.nan
             geom, resid = PATCH_ELLIPSE, math.nan
             law = _served_law(par, rec, c, record)
-            if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): the callback solves the patch
-                normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(
-                    t, y, c, side, g, (speed, xi, eta, spin), (ex, ey)
+            if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): its anchor or the callback
+                normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, law = _auto_bem(
+                    t, y, c, side, g, (speed, xi, eta, spin), (ex, ey), (par, tables, dummy, where, rec, record)
                 )
-                law = LAW_CALLBACK
                 if st != 0:
                     return CALLBACK_FAILED
         for k in range(3):

@@ -175,6 +175,23 @@ def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, 
     )
 
 
+def auto_reuse_check(status: str, message: str, callback_stats) -> tuple[str, str]:
+    """(status, message) with ``auto``'s reuse of its BEM patches judged (wheelset/auto_reuse.py): an "ok" run ends
+    "warning" when a correction measured at a re-solve departed from the fresh BEM solution by more than the
+    tolerance (the patches served between re-solves are not measured; those near such a re-solve may be as far off).
+    """
+    reuse = (callback_stats or {}).get("auto_reuse")
+    if status != "ok" or not reuse or not reuse.get("errors_above_tolerance"):
+        return status, message
+    return "warning", (
+        f"{message}; auto's reused BEM patches: {reuse['errors_above_tolerance']} of {reuse['errors_measured']} "
+        f"measured corrections departed from the fresh BEM solution by more than contact_tolerance = "
+        f"{reuse['tolerance']:g} (largest: creep force {reuse['max_creep_force_error']:.3g} at t = "
+        f"{reuse['max_creep_force_error_t_s']:.6g} s, normal force {reuse['max_normal_force_error']:.3g}); "
+        "auto_reuse = false solves every such patch"
+    )
+
+
 def _contact_grid_error(result) -> dict:
     """The contact grid's statement: the BEM's own estimate of every solve in the loop (callback.PatchCallback
     keeps the largest), or "not estimated" for the other models.

@@ -95,7 +95,8 @@ AUTO_FEATURE_NAMES = ("saturation", "spin_share", "ellipticity_residual", "curva
 """auto's features in the order of the compiled thresholds (contact.auto.FEATURES' names)."""
 AUTO_RUNG_NAMES = ("linear", "vermeulen_johnson", "fastsim")
 """auto's compiled rungs in the order of the parameter record's thresholds; rung 3 (:data:`AUTO_BEM`) is BEM."""
-AUTO_LINEAR, AUTO_VERMEULEN_JOHNSON, AUTO_FASTSIM, AUTO_BEM = range(4)
+AUTO_LINEAR, AUTO_VERMEULEN_JOHNSON, AUTO_FASTSIM, AUTO_BEM, AUTO_BEM_CORRECTED = range(5)
+"""AUTO_BEM_CORRECTED: a BEM patch served by FASTSIM corrected by its stored BEM solution (wheelset/auto_reuse.py)."""
 
 # --- the candidate geometry ------------------------------------------------------------------------------------------
 GEOMETRY_FIELDS = (
@@ -284,6 +285,7 @@ PARAMETER_FIELDS = (
     ("auto_level", "auto: the tolerance level whose thresholds apply (NaN: below every level, always BEM)"),
     ("auto_friction_bound_tolerance", "auto: FASTSIM above (1 + this) mu N is replaced by BEM (models.py)"),
     ("auto_fastsim_table", "auto: 1: its FASTSIM rung served by FASTSIM's creep-force table (scene key creep_table)"),
+    ("auto_reuse", "auto: 1: its BEM patches reused within a trust region (auto_reuse.py; scene key auto_reuse)"),
     *(
         (f"auto_{r}_{f}", f"auto: threshold of {f} for {r} (NaN: no measured box)")
         for r in AUTO_RUNG_NAMES

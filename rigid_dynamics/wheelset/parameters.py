@@ -528,6 +528,10 @@ class DynamicsScene:
             grid twice as fine is in benchmarks/results/kpec_loop.md.
         creep_table: with contact_model "auto": its FASTSIM rung served by FASTSIM's creep-force table
             (contact.creep_table; contact_model "table" is that table for every patch). False for other models.
+        auto_reuse: with contact_model "auto": a patch it gives to BEM is solved once and served on later
+            right-hand sides by FASTSIM corrected by that solution while its inputs stay in a trust region whose
+            radius follows the correction's error measured at each re-solve (wheelset/auto_reuse.py); false: every
+            such patch solved by BEM. Other models ignore it.
     """
 
     name: str = "scene"
@@ -549,6 +553,7 @@ class DynamicsScene:
     fastsim_strips: int = 20
     kpec_points: int = 24
     creep_table: bool = False
+    auto_reuse: bool = True
     settling_distance_m: float = 10.0
     integrator: IntegratorSettings = field(default_factory=IntegratorSettings)
     initial: InitialConditions = field(default_factory=InitialConditions)
@@ -572,6 +577,8 @@ class DynamicsScene:
                 raise ValueError(f"{name} = {value!r}: expected an integer from 1 to 1000")
         if not isinstance(self.creep_table, bool):
             raise ValueError(f"creep_table = {self.creep_table!r}: expected true or false")
+        if not isinstance(self.auto_reuse, bool):
+            raise ValueError(f"auto_reuse = {self.auto_reuse!r}: expected true or false")
         value = self.kpec_points
         if isinstance(value, bool) or not isinstance(value, int) or not 8 <= value <= 256:
             raise ValueError(f"kpec_points = {value!r}: expected an integer from 8 to 256")

@@ -304,7 +304,7 @@ class SimulationResult:
         the track's ``flange_contact_angle_rad``), the ellipticity residual of a sampled gap (median and largest),
         and the largest max pressure (Pa) and contact area (m^2); slots never in contact are left out.
         """
-        from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK, LAW_CODES
+        from rigid_dynamics.wheelset.compiled_laws import LAW_BEM_CORRECTED, LAW_CALLBACK, LAW_CODES
         from rigid_dynamics.wheelset.layout import PATCH_GEOMETRY_NAMES
         from rigid_dynamics.wheelset.table import SLOT_NAMES
 
@@ -313,6 +313,7 @@ class SimulationResult:
         law_names = {code: name for name, code in LAW_CODES.items()}
         # the callback's model; auto's BEM rung (auto.AUTO_RUNGS' last, recorded as LAW_LINEAR + 3 = LAW_CALLBACK)
         law_names[LAW_CALLBACK] = "bem" if self.contact_model == "auto" else self.contact_model or "callback"
+        law_names[LAW_BEM_CORRECTED] = "bem-corrected"  # auto's BEM patch reused (wheelset/auto_reuse.py)
         flange_angle = self.scene.track.flange_contact_angle_rad if self.scene is not None else 0.5
         out = {}
         for i, side in enumerate(SIDES):

@@ -42,7 +42,9 @@ error estimate) reaches the end with an energy balance above :data:`ENERGY_TOLER
 loose for the run), or when the beam's modal cut-off error (discretisation.modal_cutoff_check, a measured rule)
 exceeds ``force_tolerance``, or when a BEM patch's own grid-error estimate of its forces exceeds the BEM's
 ``grid_tolerance`` (discretisation.contact_grid_check), or when a companion estimate (the contact grid, the geometry
-tables, scipy's step: discretisation.companion_check) exceeds ``force_tolerance``; and ``"ok"`` when it reaches the
+tables, scipy's step: discretisation.companion_check) exceeds ``force_tolerance``, or when ``auto`` reused BEM patches
+and a correction measured at a re-solve departed from the fresh solution by more than ``contact_tolerance``
+(discretisation.auto_reuse_check); and ``"ok"`` when it reaches the
 end without any of these (one function judges a run's step or tolerances this way: :func:`judge_step`; the
 companions follow it). Events (wheel lift, contact restored, flange contact onset, adhesion limit and wheel slide) are
 detected on the output samples, so their times are known to one output step.
@@ -60,6 +62,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.discretisation import (
     Companions,
+    auto_reuse_check,
     companion_check,
     companion_errors,
     contact_grid_check,
@@ -377,7 +380,8 @@ def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray
        the step or a tenth of the tolerances (:func:`_half_step_check`);
     4. scipy's methods (no force error estimate): the energy balance (:func:`_energy_check`);
     5. the beam's modal cut-off error (discretisation.modal_cutoff_check);
-    6. the BEM patches' own grid-error estimates (discretisation.contact_grid_check).
+    6. the BEM patches' own grid-error estimates (discretisation.contact_grid_check);
+    7. auto's reused BEM patches' measured corrections (discretisation.auto_reuse_check).
     """
     scene = result.scene
     settings = scene.integrator
@@ -405,6 +409,7 @@ def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray
         result = _energy_check(result, settings)
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
     status, message = contact_grid_check(status, message, result.callback_stats)
+    status, message = auto_reuse_check(status, message, result.callback_stats)
     return result if status == result.status else replace(result, status=status, message=message)
 
 

@@ -243,8 +243,12 @@ class WheelsetModel:
             bem_options = (opts.get("model_options") or {}).get("bem")
             self.callback = PatchCallback(get_model("bem"), bem_options, scene.material, surfaces, self.elastic)
             # auto solves each candidate with its own rung: a region joined into a BEM candidate's patch would lose
-            # the force its own (compiled) rung gives it, so auto's BEM samples each candidate on its own plane
-            self.callback.patches = "search"
+            # the force its own (compiled) rung gives it, so auto's BEM forms a patch as always-BEM does (CONTACT's
+            # plane) only when it holds the candidate's region alone, else samples the candidate on its own plane
+            self.callback.patches = "auto"
+            level = float(self.par["auto_level"])
+            self.callback.reuse = (self.packed.tables.reuse, None if np.isnan(level) else level,
+                                   self.par["auto_reuse"] > 0)  # fmt: skip
         self.auto = code == LAW_AUTO
         ncand = len(self.packed.sides)
         self._rec = np.zeros((ncand + 2, N_FIELDS))

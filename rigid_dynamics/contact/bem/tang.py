@@ -602,8 +602,11 @@ def solve_tang_law(
     shape = (influence.ny, influence.nx)
     record = law.record()
     places = np.broadcast_to(np.asarray(place, float), shape)
-    coefficient = np.vectorize(lambda s, x: friction_coefficient(record, s, x), otypes=[float])
-    mu_s = coefficient(np.zeros(shape), places)
+    if law.is_coulomb and not law.varies:  # one coefficient everywhere (the same float the law's evaluation gives)
+        mu_s = np.full(shape, friction_coefficient(record, 0.0, 0.0))
+    else:
+        coefficient = np.vectorize(lambda s, x: friction_coefficient(record, s, x), otypes=[float])
+        mu_s = coefficient(np.zeros(shape), places)
     common = {"problem": "rolling", "tolerance": tolerance, "max_iterations": max_iterations}
     start = {"initial_traction": initial_traction, "initial_slip": initial_slip} if initial_traction else {}
     tang = solve_tang(influence, pressure_Pa, mu_s, rigid_slip_x, rigid_slip_y, **common, **start)

@@ -1,0 +1,275 @@
+"""``auto``'s BEM patches reused across right-hand sides within a trust region (compiled).
+
+A patch auto gives to BEM is solved by the callback (BEM on the sampled gap, callback.PatchCallback) and that
+solution is kept per candidate as an *anchor*: the cheap rung's value at the same input (FASTSIM on Hertz's ellipse
+at the run's grid, compiled_laws._creep_law) and the BEM's departure from it, in the normalised form of
+contact.creep_table (creep forces over mu N, spin moment over mu N sqrt(ab)) and as ratios of the normal force, the
+semi-axes, the contact area and the max pressure to Hertz's. Later right-hand sides whose inputs stay within the
+anchor's trust region are served by FASTSIM on the ellipse corrected by the stored departure (:func:`reuse_serve`)::
+
+    N = N_Hertz r_N,    F = mu N (f_FASTSIM(c*, a/b) + (f_BEM - f_FASTSIM)_anchor)   (|F| <= mu N)
+
+The inputs and their distance from the anchor (the largest of): the normalised creepages c* = (xi*, eta*, phi^)
+(creep_table.normalised_creepages), |c* - c*_0| / (|c*_0| + ``creep_floor``); ln(a/b) and ln q (approach), each
+as |change| (times a weight, :data:`DEFAULTS`); the contact point's lateral place on the wheel profile over the
+anchor's lateral semi-axis |y_w - y_w0| / b_0 (a patch moving across the profile changes its sampled shape).
+Leaving the region (distance above the candidate's radius), the patch is solved by the callback again and becomes
+the new anchor.
+
+The radius adapts to the error it causes, measured in the run: at each re-solve from inside twice the radius the
+corrected value the old anchor would have served is compared with the fresh BEM solution (the correction's error at
+the trust region's edge, where it is largest: the error grows with the distance): the creep force by the bench's
+definition |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM) and the normal force |N - N_BEM| / N_BEM. Above half the
+tolerance level the candidate's radius halves (down to ``radius_min``), below an eighth of it it grows by half
+(up to ``radius_max``; :data:`DEFAULTS`). The run's largest observed errors, the served and solved counts are kept
+in the store's last row (:data:`STATS` columns) and reported in summary.json (callback.PatchCallback.stats,
+``auto_reuse``).
+
+The store (:func:`reuse_store`) is an array of the run (compiled_laws.HertzKalkerTables.reuse): one row per
+candidate (:data:`ANCHOR` columns), the statistics row last. Off (par.auto_reuse 0, scene key ``auto_reuse``; and
+for a tolerance below every measured level, where auto asks for BEM on every patch): every BEM patch is solved by
+the callback, as before.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rigid_dynamics.contact.creep_table import normalised_creepages
+from rigid_dynamics.wheelset.compiled_laws import LAW_FASTSIM, _creep_law, _hertz_kalker, patch_friction
+from rigid_dynamics.wheelset.layout import G_APPROACH, G_CURVATURE_LAT, G_CURVATURE_LONG, G_WHEEL_LATERAL
+
+ANCHOR = (
+    "valid", "creep_star_long", "creep_star_lat", "creep_star_spin", "log_ab", "log_approach", "wheel_lateral_m",
+    "half_width_m", "radius", "normal_ratio", "force_long_departure", "force_lat_departure", "moment_departure",
+    "semi_axis_long_ratio", "semi_axis_lat_ratio", "area_ratio", "max_pressure_ratio", "patch_geometry",
+    "ellipticity_residual",
+)  # fmt: skip
+"""Columns of a candidate's row: its anchor (valid 1/0), the anchor's inputs, the trust radius, the corrections and
+the anchor's patch geometry code and ellipticity residual (module docstring)."""
+(
+    R_VALID, R_XS, R_YS, R_PS, R_LOG_AB, R_LOG_Q, R_WHEEL_Y, R_HALF_WIDTH, R_RADIUS, R_NORMAL_RATIO, R_DFX, R_DFY,
+    R_DMZ, R_A_RATIO, R_B_RATIO, R_AREA_RATIO, R_PMAX_RATIO, R_GEOMETRY, R_RESIDUAL,
+) = range(len(ANCHOR))  # fmt: skip
+STATS = (
+    "served",
+    "solved",
+    "checked",
+    "max_force_error",
+    "max_normal_error",
+    "max_force_error_t_s",
+    "radius_shrunk",
+    "radius_grown",
+    "checked_above_tolerance",
+)
+"""Columns of the statistics row (the last): right-hand-side patches served by the correction, solved by the
+callback, re-solves whose correction error was measured, the largest measured errors (creep force, bench
+definition; normal force, relative) and the time of the largest, radius changes, measured errors above the tolerance
+level."""
+T_SERVED, T_SOLVED, T_CHECKED, T_MAX_FORCE, T_MAX_NORMAL, T_MAX_T, T_SHRUNK, T_GROWN, T_ABOVE = range(len(STATS))
+SETTINGS = ("radius_start", "radius_min", "radius_max", "creep_floor", "approach_weight", "shape_weight",
+            "place_weight")  # fmt: skip
+"""The trust region's settings, kept in the statistics row after :data:`STATS` (set by :func:`reuse_store` from
+:data:`DEFAULTS`, so that a study can change them without recompiling): the radii, the creepage distance's floor and
+the weights of |change of ln q|, |change of ln(a/b)| and of the lateral place in the distance."""
+C_RADIUS_START, C_RADIUS_MIN, C_RADIUS_MAX, C_CREEP_FLOOR, C_APPROACH, C_SHAPE, C_PLACE = range(
+    len(STATS), len(STATS) + len(SETTINGS)
+)
+N_REUSE = max(len(ANCHOR), len(STATS) + len(SETTINGS))
+
+DEFAULTS = {
+    "radius_start": 0.1,
+    "radius_min": 0.0125,
+    "radius_max": 0.4,
+    "creep_floor": 0.1,
+    "approach_weight": 1.0,
+    "shape_weight": 1.0,
+    "place_weight": 1.0,
+}
+"""The settings (:data:`SETTINGS`): a new anchor's radius, its bounds; the creep floor added to |c*_0| in the
+creepage distance (near zero creepage the force is linear in c* and small; 0.1 is a tenth of the saturation
+scale); the weights of the other distances."""
+
+
+def reuse_store(candidates: int, settings: dict | None = None) -> np.ndarray:
+    """A fresh store for ``candidates`` candidates (no anchor), the statistics row (zeros) and the settings
+    (:data:`DEFAULTS`, updated by ``settings``).
+    """
+    values = {**DEFAULTS, **(settings or {})}
+    store = np.zeros((candidates + 1, N_REUSE))
+    store[:candidates, R_RADIUS] = values["radius_start"]
+    for k, name in enumerate(SETTINGS):
+        store[-1, len(STATS) + k] = values[name]
+    return store
+
+
+def reuse_stats(store: np.ndarray, tolerance: float | None) -> dict:
+    """The statistics row of a run's store as a dict (summary.json ``auto_reuse``)."""
+    row = store[-1]
+    served, solved = int(row[T_SERVED]), int(row[T_SOLVED])
+    checked = int(row[T_CHECKED])
+    return {
+        "served_by_correction": served,
+        "solved_by_callback": solved,
+        "share_served_by_correction": served / (served + solved) if served + solved else 0.0,
+        "errors_measured": checked,
+        "max_creep_force_error": float(row[T_MAX_FORCE]) if checked else None,
+        "max_creep_force_error_t_s": float(row[T_MAX_T]) if checked else None,
+        "max_normal_force_error": float(row[T_MAX_NORMAL]) if checked else None,
+        "errors_above_tolerance": int(row[T_ABOVE]),
+        "tolerance": tolerance,
+        "radius_shrunk": int(row[T_SHRUNK]),
+        "radius_grown": int(row[T_GROWN]),
+        "settings": {name: float(row[len(STATS) + k]) for k, name in enumerate(SETTINGS)},
+        "error_definition": (
+            "the corrected FASTSIM value the old anchor would have served against the fresh BEM solution, at each "
+            "re-solve from inside twice the trust radius: creep force |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM), "
+            "normal force |N - N_BEM| / N_BEM"
+        ),
+    }
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _enabled(par, store, c):
+    """Whether candidate c may be reused: the run's switch (par.auto_reuse), a measured tolerance level (a tolerance
+    below every level asks for BEM on every patch: no reuse) and a row in the store.
+    """
+    return par.auto_reuse > 0.0 and par.auto_level > 0.0 and c < store.shape[0] - 1
+
+
+@njit(cache=True, _nrt=False)
+def _cheap(par, tables, dummy, g, creep, where):
+    """FASTSIM on Hertz's ellipse of the geometry row g at creep = (xi, eta, phi): ((N, a, b, mu N), (F_x, F_y, M_z)
+    normalised by mu N and mu N sqrt(ab), c* (3-tuple), ln(a/b)); mu N = 0: no friction bound (forces 0).
+    """
+    patch = _hertz_kalker(par, tables, g[G_APPROACH], g[G_CURVATURE_LONG], g[G_CURVATURE_LAT])
+    normal, sa, sb, c11, c22, c23, _ = patch
+    friction = patch_friction(par, tables.friction, where)
+    mu_n = friction.coefficient * normal
+    if not mu_n > 0.0:
+        return (normal, sa, sb, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), math.log(sa / sb)
+    tx, ty, mz = _creep_law(par, LAW_FASTSIM, dummy, patch, creep, friction)
+    star = normalised_creepages(par.shear_modulus_Pa, (sa, sb, c11, c22, c23), mu_n, creep)
+    return (normal, sa, sb, mu_n), (tx / mu_n, ty / mu_n, mz / (mu_n * math.sqrt(sa * sb))), star, math.log(sa / sb)
+
+
+@njit(cache=True, _nrt=False)
+def _distance(row, star, log_ab, g, st):
+    """The distance of the inputs from the anchor in ``row`` (module docstring; st the statistics row: settings)."""
+    xs, ys, ps = star
+    ds = math.sqrt((xs - row[R_XS]) ** 2 + (ys - row[R_YS]) ** 2 + (ps - row[R_PS]) ** 2)
+    s0 = math.sqrt(row[R_XS] ** 2 + row[R_YS] ** 2 + row[R_PS] ** 2)
+    d = ds / (s0 + st[C_CREEP_FLOOR])
+    d = max(d, st[C_SHAPE] * abs(log_ab - row[R_LOG_AB]))
+    d = max(d, st[C_APPROACH] * abs(math.log(g[G_APPROACH]) - row[R_LOG_Q]))
+    return max(d, st[C_PLACE] * abs(g[G_WHEEL_LATERAL] - row[R_WHEEL_Y]) / row[R_HALF_WIDTH])
+
+
+@njit(cache=True, _nrt=False)
+def _corrected(row, hertz, forces):
+    """(N, T_x, T_y, M_z, a, b, area, max pressure) of the anchor's correction applied to FASTSIM's normalised
+    ``forces`` on the Hertz patch ``hertz`` = (N, a, b, mu N).
+    """
+    normal_h, sa, sb, mu_n = hertz
+    fx, fy, mz = forces
+    normal = normal_h * row[R_NORMAL_RATIO]
+    mu_nc = mu_n * row[R_NORMAL_RATIO]
+    gx, gy = fx + row[R_DFX], fy + row[R_DFY]
+    size = math.hypot(gx, gy)
+    if size > 1.0:  # Coulomb's bound on the corrected force
+        gx, gy = gx / size, gy / size
+    area_h = math.pi * sa * sb
+    pmax_h = 1.5 * normal_h / area_h if area_h > 0.0 else math.nan
+    return (
+        normal, mu_nc * gx, mu_nc * gy, mu_nc * math.sqrt(sa * sb) * (mz + row[R_DMZ]), sa * row[R_A_RATIO],
+        sb * row[R_B_RATIO], area_h * row[R_AREA_RATIO], pmax_h * row[R_PMAX_RATIO],
+    )  # fmt: skip
+
+
+@njit(cache=True, _nrt=False)
+def reuse_serve(par, tables, dummy, g, creep, where, c):
+    """Candidate c by its anchor's correction when the inputs are within its trust region: (served, N, T_x, T_y,
+    M_z, a, b, area, max pressure, patch geometry code, ellipticity residual); served False: solve it (callback).
+    """
+    store = tables.reuse
+    if not _enabled(par, store, c) or store[c, R_VALID] <= 0.0 or not g[G_APPROACH] > 0.0:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
+    row = store[c]
+    hertz, forces, star, log_ab = _cheap(par, tables, dummy, g, creep, where)
+    mu_n = hertz[-1]
+    if not mu_n > 0.0 or _distance(row, star, log_ab, g, store[-1]) > row[R_RADIUS]:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
+    n, tx, ty, mz, sa, sb, area, pmax = _corrected(row, hertz, forces)
+    store[-1, T_SERVED] += 1.0
+    return True, n, tx, ty, mz, sa, sb, area, pmax, int(row[R_GEOMETRY]), row[R_RESIDUAL]
+
+
+@njit(cache=True, _nrt=False)
+def _measure(st, radius, errors, level, t):
+    """Count a measured correction error (errors = (creep, normal)) in the statistics row st and return the radius
+    adapted to it (module docstring).
+    """
+    e_f, e_n = errors
+    st[T_CHECKED] += 1.0
+    if e_f > st[T_MAX_FORCE]:
+        st[T_MAX_FORCE], st[T_MAX_T] = e_f, t
+    st[T_MAX_NORMAL] = max(st[T_MAX_NORMAL], e_n)
+    worst = max(e_f, e_n)
+    if worst > level:
+        st[T_ABOVE] += 1.0
+    if worst > 0.5 * level and radius > st[C_RADIUS_MIN]:
+        st[T_SHRUNK] += 1.0
+        return max(0.5 * radius, st[C_RADIUS_MIN])
+    if worst < 0.125 * level and radius < st[C_RADIUS_MAX]:
+        st[T_GROWN] += 1.0
+        return min(1.5 * radius, st[C_RADIUS_MAX])
+    return radius
+
+
+@njit(cache=True, _nrt=False)
+def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
+    """Candidate c solved by the callback at this input (solved = (N, T_x, T_y, M_z, a, b, area, max pressure,
+    patch geometry code, ellipticity residual)): measure the old anchor's correction against it when the input is
+    within twice the old radius (adapting the radius), then make it the anchor (module docstring).
+    """
+    store = tables.reuse
+    if not _enabled(par, store, c):
+        return
+    store[-1, T_SOLVED] += 1.0
+    n_b, tx_b, ty_b, mz_b, sa_b, sb_b, area_b, pmax_b, geom, resid = solved
+    row = store[c]
+    if not (g[G_APPROACH] > 0.0 and n_b > 0.0):
+        row[R_VALID] = 0.0
+        return
+    hertz, forces, star, log_ab = _cheap(par, tables, dummy, g, creep, where)
+    normal_h, sa, sb, mu_n = hertz
+    if not mu_n > 0.0:
+        row[R_VALID] = 0.0
+        return
+    radius = row[R_RADIUS]
+    if row[R_VALID] > 0.0 and _distance(row, star, log_ab, g, store[-1]) <= 2.0 * radius:
+        n, tx, ty, _, _, _, _, _ = _corrected(row, hertz, forces)
+        mu_nb = mu_n * n_b / normal_h
+        e_f = math.hypot(tx - tx_b, ty - ty_b) / max(math.hypot(tx_b, ty_b), 0.01 * mu_nb)
+        radius = _measure(store[-1], radius, (e_f, abs(n - n_b) / n_b), par.auto_level, t)
+    ratio = n_b / normal_h
+    mu_nb = mu_n * ratio
+    fx, fy, mz = forces
+    row[R_VALID] = 1.0
+    row[R_XS], row[R_YS], row[R_PS] = star
+    row[R_LOG_AB], row[R_LOG_Q], row[R_WHEEL_Y] = log_ab, math.log(g[G_APPROACH]), g[G_WHEEL_LATERAL]
+    row[R_HALF_WIDTH] = sb
+    row[R_RADIUS] = radius
+    row[R_NORMAL_RATIO] = ratio
+    row[R_DFX] = tx_b / mu_nb - fx
+    row[R_DFY] = ty_b / mu_nb - fy
+    row[R_DMZ] = mz_b / (mu_nb * math.sqrt(sa * sb)) - mz
+    row[R_A_RATIO], row[R_B_RATIO] = sa_b / sa, sb_b / sb
+    area_h = math.pi * sa * sb
+    row[R_AREA_RATIO] = area_b / area_h if math.isfinite(area_b) else 1.0
+    pmax_h = 1.5 * normal_h / area_h
+    row[R_PMAX_RATIO] = pmax_b / pmax_h if math.isfinite(pmax_b) else 1.0
+    row[R_GEOMETRY], row[R_RESIDUAL] = geom, resid
