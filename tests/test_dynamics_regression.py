@@ -98,7 +98,8 @@ CASES["polygonal-wheel-tables-auto-compiled"] = (
     None,
 )
 # the same with auto's reuse of BEM patches within a trust region (issue 28, scene key auto_reuse, the default): written
-# by commit bca7066's tree; the reuse moves the states by 1.5e-6 of the block against the case above
+# by commit bca7066's tree and rewritten with FASTSIM's CONTACT blending weight (branch fsb2: its corrected FASTSIM
+# moved 8.4e-7); the reuse moves the states by 1.5e-6 of the block against the case above
 CASES["polygonal-wheel-tables-auto-reuse-compiled"] = (
     ("polygonal-wheel", 0.05, "tables", "auto", None, None, "ellipse", True),
     None,
