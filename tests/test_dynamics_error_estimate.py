@@ -85,10 +85,11 @@ def test_sparse_output_still_checks_the_impacts():
 
 def test_wheel_flat_at_5_ms_is_not_ok():
     """The issue's case: 5 ms on wheel-flat reported ok with 1.9 MN. With the force-anomaly limit lifted, so that
-    the run finishes, the estimate flags it."""
+    the run finishes, the estimate flags it: above ten static loads (simulate.STEP_ERROR_DIVERGED) with the step
+    beyond RK4's stability limit, the run is step-unstable."""
     result = simulate(_at_step("wheel-flat", 5e-3, 0.4, max_force_factor=1e4))
-    assert result.status == "warning", result.message
-    assert result.summary()["force_error_estimate"] > 1.0
+    assert result.status == "step-unstable", result.message
+    assert result.summary()["force_error_estimate"] > 10.0 and "stability limit" in result.message
 
 
 def test_shipped_wheel_flat_at_5_ms_says_the_step_is_unstable_and_its_own_step_passes():
@@ -125,9 +126,11 @@ def test_failure_within_the_start_limit_is_judged_at_the_impact():
     print(result.status, result.message)
     assert result.status == "step-unstable", result.message
     # the numerical blow-up ends as derailed, force-anomaly or blow-up (the rail's deflection beyond
-    # recorder.MAX_RAIL_DEFLECTION_M) depending on round-off and which bound it crosses first (all seen); either way
-    # the message names the state of the largest contact force
-    assert result.message.startswith(("derailed", "force-anomaly", "blow-up"))
+    # recorder.MAX_RAIL_DEFLECTION_M) depending on round-off and which bound it crosses first (all seen), or reaches
+    # the end with a force error estimate of many static loads (simulate.STEP_ERROR_DIVERGED; seen with FASTSIM's
+    # CONTACT blending weight: 25.5 at t = 0.114 s); either way the message names the state of the largest contact
+    # force
+    assert result.message.startswith(("derailed", "force-anomaly", "blow-up", "warning (reached"))
     assert "the largest contact force" in result.message
     assert "0.5 ms" in result.message
 

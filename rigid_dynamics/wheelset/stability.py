@@ -139,13 +139,17 @@ NUMERICAL_LOOKING = ("blow-up", "force-anomaly", "derailed", "solver-failed")
 """Run statuses that an unstable fixed step produces without any physics behind them."""
 
 
-def judge_fixed_step(status: str, message: str, step_s: float, limit: StepLimit) -> tuple[str, str]:
+def judge_fixed_step(
+    status: str, message: str, step_s: float, limit: StepLimit, diverged: bool = False
+) -> tuple[str, str]:
     """(status, message) of a fixed-step run given its step and its :class:`StepLimit`.
 
-    A step within the limit changes nothing. Beyond it: a blow-up, force anomaly, derailment or solver failure
-    becomes ``"step-unstable"`` (the integrator, not the wheelset, diverged; the original status is kept in the
-    message); an ``ok`` run becomes ``"warning"`` (a stiff mode is integrated outside RK4's stability region, so
-    its numbers are not to be trusted even when nothing grew); any other status keeps its name and gets the note.
+    A step within the limit changes nothing. Beyond it: a blow-up, force anomaly, derailment or solver failure, or
+    a run that reached its end with a diverged force error estimate (``diverged``: above ten static wheel loads,
+    simulate.STEP_ERROR_DIVERGED) becomes ``"step-unstable"`` (the integrator, not the wheelset, diverged; the
+    original status is kept in the message); an ``ok`` run becomes ``"warning"`` (a stiff mode is integrated
+    outside RK4's stability region, so its numbers are not to be trusted even when nothing grew); any other status
+    keeps its name and gets the note.
     """
     if not step_s > limit.max_step_s:
         return status, message
@@ -153,7 +157,7 @@ def judge_fixed_step(status: str, message: str, step_s: float, limit: StepLimit)
         f"the fixed step {1e3 * step_s:.3g} ms is {step_s / limit.max_step_s:.2g} x {limit.describe()}; "
         f"use fixed_step_s <= {limit.max_step_s:.2g} s"
     )
-    if status in NUMERICAL_LOOKING:
+    if status in NUMERICAL_LOOKING or diverged:
         return "step-unstable", f"{status} ({message}) is numerical: {note}"
     if status == "ok":
         return "warning", f"{message}; {note}" if message else note
