@@ -110,8 +110,9 @@ def cmd_bench(args) -> int:
         summary = write_bench(runs, cases, out_dir, args.quick, time.perf_counter() - start)
     failed = [r for r in runs if r.status != "ok"]
     print(
-        f"bench: status {summary['status']}: {len(runs)} runs over {len(cases)} cases in {summary['wall_time_s']:.0f} s,"
-        f" {len(failed)} not ok (each a finding about its rung, with its message in bench.md)"
+        f"bench: status {summary['status']}: {len(runs)} runs over {len(cases)} cases"
+        f" in {summary['wall_time_s']:.0f} s, {len(failed)} not ok"
+        " (each a finding about its rung, with its message in bench.md)"
     )
     for case, row in summary["tolerance_table"].items():
         best = row["5%"]
