@@ -39,20 +39,13 @@ WINDOW = 0.8
 
 
 def _window_fit(xy, p, usable, centre, semi) -> float | None:
-    """The cap of fea.postprocess.peak_pressure fitted over an ellipse of semi-axes ``semi`` around ``centre``."""
+    """The cap of fea.postprocess.peak_pressure (postprocess.quadric_cap_peak) fitted over the usable nodes within
+    an ellipse of semi-axes ``semi`` around ``centre`` (None: no cap, or its top outside the ellipse)."""
+    from fea.postprocess import quadric_cap_peak
+
     d = (xy - centre) / np.asarray(semi)
     near = usable & (np.hypot(d[:, 0], d[:, 1]) <= 1.0)
-    if near.sum() < 12:
-        return None
-    x, y, p2 = d[near, 0], d[near, 1], p[near] ** 2
-    matrix = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
-    c, *_ = np.linalg.lstsq(matrix, p2, rcond=None)
-    hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
-    if not np.all(np.linalg.eigvalsh(hessian) < 0):
-        return None
-    top = np.linalg.solve(hessian, -c[1:3])
-    value = float(c[0] + c[1:3] @ top + 0.5 * top @ hessian @ top)
-    return math.sqrt(value) if value > 0 else None
+    return quadric_cap_peak(d[near], p[near])
 
 
 def _strip(xy, p, usable, guess) -> tuple[np.ndarray, tuple[float, float]]:

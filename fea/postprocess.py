@@ -202,9 +202,25 @@ def peak_pressure(
     """
     d = xy - np.asarray(guess_m, float)
     near = usable & (np.hypot(d[:, 0], d[:, 1]) <= radius_m)
-    if near.sum() < 12:
+    return quadric_cap_peak(d[near] / radius_m, pressure[near])
+
+
+def quadric_cap_peak(scaled_xy: np.ndarray, pressure: np.ndarray) -> float | None:
+    """Peak of the quadric cap fitted to squared pressures on scaled coordinates (None: no fit).
+
+    The fit of :func:`peak_pressure` on nodes given in coordinates scaled so that the fit window is the unit disc
+    around the origin (a circle of radius r: positions / r; an ellipse of semi-axes (a, b): positions / (a, b)).
+    p^2 = c0 + c1 x + c2 y + c3 x^2 + c4 x y + c5 y^2 by least squares; None with fewer than 12 nodes, when the fit
+    is not a cap (Hessian not negative definite), when its top lies outside the window (|top| > 1) or its p^2 there
+    is not positive.
+
+    Args:
+        scaled_xy: (k, 2) the window's nodes, scaled positions relative to its centre. pressure: (k,) their nodal
+        pressures, Pa.
+    """
+    if len(scaled_xy) < 12:
         return None
-    x, y, p2 = d[near, 0] / radius_m, d[near, 1] / radius_m, pressure[near] ** 2
+    x, y, p2 = scaled_xy[:, 0], scaled_xy[:, 1], pressure**2
     matrix = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
     c, *_ = np.linalg.lstsq(matrix, p2, rcond=None)
     hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])

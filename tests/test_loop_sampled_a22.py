@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 import pytest
+from loop_helpers import height_at_load
 
 from comparisons.manchester import (
     CONTACT_ELEMENT_SIZE_M,
@@ -93,33 +94,15 @@ def _height_at_load(model, step, zs, tolerance):
     raise AssertionError(f"step {step}: the height iteration did not reach {LOAD_N} N: {load} N")
 
 
-def _bracketed_height(model, step, z_lo, z_hi, tolerance):
-    """The height (between z_lo, no contact, and z_hi, deep) of LOAD_N by the Illinois method on load^(2/3)."""
-    f_lo, f_hi = -(LOAD_N ** (2 / 3)), _right_wheel(model, step, z_hi)[2] ** (2 / 3) - LOAD_N ** (2 / 3)
-    side = 0
-    for _ in range(60):
-        z = z_hi - f_hi * (z_hi - z_lo) / (f_hi - f_lo)
-        load = _right_wheel(model, step, z)[2]
-        f = load ** (2 / 3) - LOAD_N ** (2 / 3)
-        if abs(load / LOAD_N - 1.0) < tolerance:
-            return z
-        if f > 0:
-            z_hi, f_hi = z, f
-            f_lo = 0.5 * f_lo if side == 1 else f_lo
-            side = 1
-        else:
-            z_lo, f_lo = z, f
-            f_hi = 0.5 * f_hi if side == -1 else f_hi
-            side = -1
-    raise AssertionError(f"step {step}: the height iteration did not reach {LOAD_N} N: {load} N")
-
-
 def _held_at_load(model, probe, step):
     """The loop's contact with the wheelset's height solved for LOAD_N on the right wheel: a start from the loop with
-    Hertz's law (no BEM solve) between a height out of contact and one 2 mm below the nominal, then the BEM loop's
+    Hertz's law (no BEM solve) between a height out of contact and one 2 mm below the nominal (loop_helpers.
+    height_at_load: the Illinois method on load^(2/3)), then the BEM loop's
     own height to 1e-6 of the load."""
     z0 = -0.46
-    z_hertz = _bracketed_height(probe, step, z0 - 0.01, z0 + 0.002, 1e-3)
+    z_hertz, _, _ = height_at_load(
+        lambda z: _right_wheel(probe, step, z), LOAD_N, z0 - 0.01, z0 + 0.002, 1e-3, 60, f"step {step}"
+    )
     _, contact, right = _height_at_load(model, step, [z_hertz, z_hertz + 1e-6], 1e-6)
     return contact, right
 

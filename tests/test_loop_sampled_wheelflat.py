@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from loop_helpers import height_at_load
 
 from rigid_dynamics.contact.registry import get_model
 from rigid_dynamics.contact.track import build_track
@@ -78,27 +79,12 @@ def _right_wheel(model, pitch_deg, z):
 
 
 def _held_at_load(model, pitch_deg, z_lo, z_hi, tolerance=1e-4):
-    """The height of LOAD_N on the right wheel between z_lo (out of contact) and z_hi (deeper) by the Illinois
-    method on load^(2/3) (linear in the height for a Hertzian contact)."""
-    f_lo = -(LOAD_N ** (2 / 3))
-    f_hi = _right_wheel(model, pitch_deg, z_hi)[2] ** (2 / 3) - LOAD_N ** (2 / 3)
-    assert f_hi > 0, f"pitch {pitch_deg} deg: the deep height {z_hi} m carries less than {LOAD_N} N"
-    side = 0
-    for _ in range(40):
-        z = z_hi - f_hi * (z_hi - z_lo) / (f_hi - f_lo)
-        contact, right, load = _right_wheel(model, pitch_deg, z)
-        f = load ** (2 / 3) - LOAD_N ** (2 / 3)
-        if abs(load / LOAD_N - 1.0) < tolerance:
-            return contact, right
-        if f > 0:
-            z_hi, f_hi = z, f
-            f_lo = 0.5 * f_lo if side == 1 else f_lo
-            side = 1
-        else:
-            z_lo, f_lo = z, f
-            f_hi = 0.5 * f_hi if side == -1 else f_hi
-            side = -1
-    raise AssertionError(f"pitch {pitch_deg} deg: the height iteration did not reach {LOAD_N} N: {load} N")
+    """The right wheel's contact at the height of LOAD_N between z_lo (out of contact) and z_hi (deeper)
+    (loop_helpers.height_at_load: the Illinois method on load^(2/3))."""
+    _, contact, right = height_at_load(
+        lambda z: _right_wheel(model, pitch_deg, z), LOAD_N, z_lo, z_hi, tolerance, 40, f"pitch {pitch_deg} deg"
+    )
+    return contact, right
 
 
 @pytest.mark.parametrize("pitch_deg", [-37.0])
