@@ -17,7 +17,8 @@ import pytest
 from hardening_helpers import assert_bad_scene
 
 from rigid_dynamics.wheelset import build_provider, compiled_loop, simulate
-from rigid_dynamics.wheelset.compiled_loop import (
+from rigid_dynamics.wheelset.parameters import IntegratorSettings
+from rigid_dynamics.wheelset.tableaux import (
     BS32_A,
     BS32_B_HAT,
     DP54_A,
@@ -28,7 +29,6 @@ from rigid_dynamics.wheelset.compiled_loop import (
     RK4_B_HAT,
     TABLEAUX,
 )
-from rigid_dynamics.wheelset.parameters import IntegratorSettings
 from wheelrail.scenes import load_scene
 
 

@@ -6,26 +6,7 @@ calls it in chunks.
 
 The right-hand side is compiled_rhs._rhs (tables or the compiled 3-D search; the lateral scan ``full`` at each step's
 first stage, which for these FSAL tableaux is the previous step's last stage, and at the recorded samples). The
-methods (:data:`TABLEAUX`; Butcher tableaux below, module constants with their sources;
-tests/test_dynamics_adaptive.py checks their order conditions and observed orders):
-
-* ``DP54``: Dormand & Prince, "A family of embedded Runge-Kutta formulae", J. Comput. Appl. Math. 6 (1980) 19-26
-  (the 5th-order solution is propagated, the 4th-order one estimates the error; 6 new right-hand sides per step,
-  first-same-as-last), dense output of order 4 by Shampine's interpolant ("Some practical Runge-Kutta formulas",
-  Math. Comp. 46 (1986) 135-150; the coefficients of Hairer, Norsett & Wanner, Solving ODEs I, 2nd ed., II.6,
-  as scipy's RK45 uses them);
-* ``BS32``: Bogacki & Shampine, "A 3(2) pair of Runge-Kutta formulas", Appl. Math. Lett. 2 (1989) 321-325
-  (3 new right-hand sides per step, first-same-as-last), dense output by cubic Hermite interpolation between the
-  step's ends (order 3);
-* ``RK4``: the classical Runge-Kutta method of order 4 with a fixed step (:data:`FIXED_STEP`), written
-  first-same-as-last with a fifth stage k5 = f(t + h, y4), the next step's k1 (4 new right-hand sides per step, as
-  the classical method), its rows as integers over their common denominator, y4 = y + h/6 (k1 + 2 k2 + 2 k3 + k4)
-  as the formula is written. Its embedded third-order formula y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6) (Hairer,
-  Norsett & Wanner I, II.4) is the error indicator, not a step control: the force error estimate (the per-wheel
-  contact forces at y4 and y3, drivers.force_error_check) every ``check_every`` steps and at every sample, a sample
-  carrying the largest since the previous one. The step's times are t0 + n h; nothing is rejected or located (a
-  failed stage or a non-finite state ends the run with its status); the samples lie on step ends (multiples of the
-  step).
+methods and their sources: :mod:`rigid_dynamics.wheelset.tableaux` (:data:`~rigid_dynamics.wheelset.tableaux.TABLEAUX`).
 
 Step control (Hairer, Norsett & Wanner I, II.4): the error of a step is err = h sum_i e_i k_i (e = b - b_hat), its
 size the root-mean-square over the mechanical and track states of err_j / (atol_j + rtol max(|y_j|, |y_new_j|))
@@ -69,7 +50,6 @@ failed, 6 step-size underflow).
 from __future__ import annotations
 
 import math
-from fractions import Fraction as F
 from typing import NamedTuple
 
 import numpy as np
@@ -102,25 +82,6 @@ MAX_EVENTS = 100_000
 
 STEPS_PER_CALL = 2000
 """Accepted steps per call of the compiled loop (between calls the driver checks wall time and budget)."""
-
-
-class Tableau(NamedTuple):
-    """An explicit Runge-Kutta method as the compiled loop takes it (:func:`_tableau`): A (s, s) whose last row is
-    the propagated weights b, each row i as ``a[i] / d[i]`` (the stage's state is y + (h / d_i) sum_j a_ij k_j;
-    d = 1 for the pairs, RK4's rows as integers over their common denominator), the nodes c, the error weights
-    e = b - b_hat, the dense output P (s, 4), k = the order of the error estimate + 1 (the controller's exponent),
-    and b_hat once more as each weight's numerator over its denominator (the embedded solution of the force error
-    estimate, y + h sum_j (n_j k_j) / d_j: RK4's y + h (k1/6 + k2/3 + k3/3 + k5/6) as the formula is written).
-    """
-
-    a: np.ndarray
-    d: np.ndarray
-    c: np.ndarray
-    e: np.ndarray
-    p: np.ndarray
-    k_order: float
-    b_hat_num: np.ndarray
-    b_hat_den: np.ndarray
 
 
 class StepControl(NamedTuple):
@@ -202,6 +163,36 @@ class Outcome(NamedTuple):
     last_failure: int
 
 
+class LoopWork(NamedTuple):
+    """The work arrays of :func:`_advance` (allocated by :func:`embedded_run`, once per call): the right-hand side's
+    workspace (compiled_rhs.Workspace), the new state, a stage's state, a scratch right-hand side, the stage sum, a
+    stage's right-hand side (states,), the record at the step's end, the contact set and approaches at the step's
+    end, at a trial point and at the ends of the location's bracket (candidates,), the per-wheel forces at y4 and
+    y3 (2, 3), and the search memory saved at the step's start and at its end (compiled_search.SearchArgs' mem,
+    n_mem).
+    """
+
+    ws: tuple
+    y_new: np.ndarray
+    ys: np.ndarray
+    scratch: np.ndarray
+    combined: np.ndarray
+    stage: np.ndarray
+    rec_end: np.ndarray
+    mask1: np.ndarray
+    gap1: np.ndarray
+    mask_t: np.ndarray
+    gap_t: np.ndarray
+    gap_lo: np.ndarray
+    gap_hi: np.ndarray
+    f4: np.ndarray
+    f3: np.ndarray
+    mem_save: np.ndarray
+    n_mem_save: np.ndarray
+    mem_end: np.ndarray
+    n_mem_end: np.ndarray
+
+
 @njit(cache=True)
 def _outcome(status, t, y, h, accepted, rejected, k_out, evaluations, located, last_failure):
     """An :class:`Outcome` of one type for every return of the loops (with reference counting: it hands ``y`` back
@@ -211,95 +202,6 @@ def _outcome(status, t, y, h, accepted, rejected, k_out, evaluations, located, l
         int(status), float(t), y, float(h), int(accepted), int(rejected), int(k_out), int(evaluations), int(located),
         int(last_failure),
     )  # fmt: skip
-
-
-def _tableau(a_rows, b_hat, k_order, p_rows=None, integer_rows=False):
-    """The :class:`Tableau` of an FSAL pair from its rows of A (the last row is b), the embedded weights b_hat, k (the
-    order of the error estimate + 1) and the dense-output matrix P (coefficients of theta, theta^2, theta^3,
-    theta^4; None: cubic Hermite between the step's ends, exact in Fractions). ``integer_rows``: each row of A as
-    integers over its common denominator d_i (RK4: y + h/6 (k1 + 2 k2 + 2 k3 + k4) as the formula is written);
-    else d = 1 and the rows as their fractions' floats.
-    """
-    s = len(a_rows)
-    a = [[F(0)] * s for _ in range(s)]
-    for i, row in enumerate(a_rows):
-        for j, v in enumerate(row):
-            a[i][j] = F(v)
-    b = a[s - 1]
-    d = [math.lcm(*(v.denominator for v in row)) if integer_rows else 1 for row in a]
-    c = [sum(row, F(0)) for row in a]
-    e = [b[j] - F(b_hat[j]) for j in range(s)]
-    if p_rows is None:
-        # y(theta) = y0 + h [h01 sum b_i k_i + h10 k_1 + h11 k_s] with the Hermite basis h01 = 3t^2 - 2t^3,
-        # h10 = t - 2t^2 + t^3, h11 = t^3 - t^2 (k_1 = f(y0), k_s = f(y1) for an FSAL pair)
-        p_rows = [[0, 3 * b[j], -2 * b[j], 0] for j in range(s)]
-        p_rows[0] = [p_rows[0][0] + 1, p_rows[0][1] - 2, p_rows[0][2] + 1, 0]
-        p_rows[s - 1] = [p_rows[s - 1][0], p_rows[s - 1][1] - 1, p_rows[s - 1][2] + 1, 0]
-    as_float = np.array([[float(v * d[i]) for v in row] for i, row in enumerate(a)])
-    return Tableau(
-        as_float,
-        np.array([float(v) for v in d]),
-        np.array([float(v) for v in c]),
-        np.array([float(v) for v in e]),
-        np.array([[float(F(v)) for v in row] for row in p_rows]),
-        float(k_order),
-        np.array([float(F(v).numerator) for v in b_hat]),
-        np.array([float(F(v).denominator) for v in b_hat]),
-    )
-
-
-DP54_A = (
-    (),
-    (F(1, 5),),
-    (F(3, 40), F(9, 40)),
-    (F(44, 45), F(-56, 15), F(32, 9)),
-    (F(19372, 6561), F(-25360, 2187), F(64448, 6561), F(-212, 729)),
-    (F(9017, 3168), F(-355, 33), F(46732, 5247), F(49, 176), F(-5103, 18656)),
-    (F(35, 384), F(0), F(500, 1113), F(125, 192), F(-2187, 6784), F(11, 84)),
-)
-"""Dormand-Prince 5(4): rows of A; the last row is the 5th-order weights b (FSAL) (Dormand & Prince 1980, table 2)."""
-DP54_B_HAT = (F(5179, 57600), 0, F(7571, 16695), F(393, 640), F(-92097, 339200), F(187, 2100), F(1, 40))
-"""Dormand-Prince 5(4): the embedded 4th-order weights."""
-DP54_P = (
-    (1, F(-8048581381, 2820520608), F(8663915743, 2820520608), F(-12715105075, 11282082432)),
-    (0, 0, 0, 0),
-    (0, F(131558114200, 32700410799), F(-68118460800, 10900136933), F(87487479700, 32700410799)),
-    (0, F(-1754552775, 470086768), F(14199869525, 1410260304), F(-10690763975, 1880347072)),
-    (0, F(127303824393, 49829197408), F(-318862633887, 49829197408), F(701980252875, 199316789632)),
-    (0, F(-282668133, 205662961), F(2019193451, 616988883), F(-1453857185, 822651844)),
-    (0, F(40617522, 29380423), F(-110615467, 29380423), F(69997945, 29380423)),
-)
-"""Dormand-Prince 5(4): Shampine's 4th-order dense output, y(t + theta h) = y + h sum_i k_i sum_p P[i, p]
-theta^(p+1) (Shampine 1986; Hairer, Norsett & Wanner I, II.6)."""
-
-BS32_A = ((), (F(1, 2),), (0, F(3, 4)), (F(2, 9), F(1, 3), F(4, 9)))
-"""Bogacki-Shampine 3(2): rows of A; the last row is the 3rd-order weights b (FSAL) (Bogacki & Shampine 1989)."""
-BS32_B_HAT = (F(7, 24), F(1, 4), F(1, 3), F(1, 8))
-"""Bogacki-Shampine 3(2): the embedded 2nd-order weights."""
-
-RK4_A = ((), (F(1, 2),), (0, F(1, 2)), (0, 0, 1), (F(1, 6), F(1, 3), F(1, 3), F(1, 6)))
-"""The classical Runge-Kutta method of order 4, written first-same-as-last: its four stages and a fifth, the
-derivative at the step's end k5 = f(t + h, y4) (the next step's k1), whose row of A is RK4's weights b."""
-RK4_B_HAT = (F(1, 6), F(1, 3), F(1, 3), 0, F(1, 6))
-"""The third-order formula embedded in RK4's stages with k5: y3 = y + h (k1/6 + k2/3 + k3/3 + k5/6), so
-y4 - y3 = h/6 (k4 - k5) (Hairer, Norsett & Wanner, Solving ODEs I, 2nd ed., II.4, embedded formulas of order 4(3)):
-the force error estimate's second state (drivers.force_error_check)."""
-
-PAIRS = {
-    # name: (tableau, new right-hand sides per step)
-    "DP54": (_tableau(DP54_A, DP54_B_HAT, 5, DP54_P), 6),
-    "BS32": (_tableau(BS32_A, BS32_B_HAT, 3), 3),
-}
-"""The embedded pairs by the scene's ``[integrator] method`` (PI step-size control)."""
-
-TABLEAUX = {**PAIRS, "RK4": (_tableau(RK4_A, RK4_B_HAT, 4, integer_rows=True), 4)}
-"""Every method of the compiled loop: the embedded pairs and RK4 (fixed step, :data:`FIXED_STEP`; its dense output
-the cubic Hermite between the step's ends, as drivers.RK4's)."""
-
-SCIPY_EQUIVALENT = {"DP54": "RK45", "BS32": "RK23"}
-"""The same pairs in scipy (the Python path, for scenes the compiled loop cannot run): RK45 is Dormand-Prince 5(4)
-with Shampine's dense output, RK23 Bogacki-Shampine 3(2); scipy's controller is an I controller and it does not
-locate contact switches."""
 
 
 @njit(cache=True, _nrt=False)
@@ -364,31 +266,87 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
     docstring for the control, the fixed step and the events.
 
     Carried between calls (the driver keeps ``carried``, :class:`Carried`, and ``events``, :class:`EventLog`).
-    Returns an :class:`Outcome`.
+    Returns an :class:`Outcome`. The work arrays are allocated here, once per call; the steps run in
+    :func:`_advance`, compiled without reference counting.
     """
+    ncand = run.sides.shape[0]
+    nst = y.shape[0]
+    y = y.copy()
+    mem, n_mem = run.search.mem, run.search.n_mem
+    work = LoopWork(
+        workspace(run, np.empty((ncand + 2, N_FIELDS))), np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst),
+        np.empty(nst), np.empty((ncand + 2, N_FIELDS)), np.empty(ncand, np.int64), np.empty(ncand),
+        np.empty(ncand, np.int64), np.empty(ncand), np.empty(ncand), np.empty(ncand), np.empty((2, 3)),
+        np.empty((2, 3)), mem.copy(), n_mem.copy(), mem.copy(), n_mem.copy(),
+    )  # fmt: skip
+    status, t, h, accepted, rejected, k_out, evals, located, last_fail = _advance(
+        y, (t0, t_end, h, k_out), tableau, control, run, outputs, carried, events, work
+    )
+    return _outcome(status, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _ended(status, t, h, accepted, rejected, k_out, evaluations, located, last_failure):
+    """What :func:`_advance` returns: the scalars of an :class:`Outcome` (its state is the caller's y)."""
+    return (
+        int(status), float(t), float(h), int(accepted), int(rejected), int(k_out), int(evaluations), int(located),
+        int(last_failure),
+    )  # fmt: skip
+
+
+@njit(cache=True, _nrt=False)
+def _copy_into(src, dst):
+    """dst[...] = src, element by element (no temporary: this module's loop runs without reference counting)."""
+    for i in np.ndindex(src.shape):
+        dst[i] = src[i]
+
+
+@njit(cache=True, _nrt=False)
+def _advance(y, span, tableau, control, run, outputs, carried, events, work):
+    """The steps of :func:`embedded_run` from (span[0], y) to span[1] with the first step span[2] and the next
+    output index span[3], y advanced in place; compiled without reference counting (numba's reference counts on
+    the run's and the workspace's arrays, taken at every inlined right-hand side, cost a third of an RK4 step:
+    benchmarks/results/compile_and_speed_issue25.md). Returns the scalars of the :class:`Outcome` (:func:`_ended`).
+    """
+    t0, t_end, h, k_out = span
     a, d, cc, e, p, k_order, b_hat_num, b_hat_den = tableau
     rtol, atol, weight, h_min, h_max, event_tol, max_steps, controller, check_every = control
     fixed = controller == FIXED_STEP
     out_times, states, recs, errs = outputs
     carry, kst, mask0, gap0 = carried
     ev_t, ev_mask, n_ev = events
-    par, sides = run.par, run.sides
+    ws, y_new, ys, scratch, combined, stage, rec_end = (
+        work.ws,
+        work.y_new,
+        work.ys,
+        work.scratch,
+        work.combined,
+        work.stage,
+        work.rec_end,
+    )
+    mask1, gap1, mask_t, gap_t, gap_lo, gap_hi = (
+        work.mask1,
+        work.gap1,
+        work.mask_t,
+        work.gap_t,
+        work.gap_lo,
+        work.gap_hi,
+    )
+    f4, f3, mem_save, n_mem_save, mem_end, n_mem_end = (
+        work.f4,
+        work.f3,
+        work.mem_save,
+        work.n_mem_save,
+        work.mem_end,
+        work.n_mem_end,
+    )
+    sides = run.sides
     ncand = sides.shape[0]
-    ws = workspace(run, np.empty((ncand + 2, N_FIELDS)))
     rec = ws.rec
     nst = y.shape[0]
     ns = a.shape[0]
-    y = y.copy()
-    y_new, ys, scratch, combined, stage = np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst), np.empty(nst)
-    rec_end = np.empty((ncand + 2, N_FIELDS))
-    mask1, gap1 = np.empty(ncand, np.int64), np.empty(ncand)
-    mask_t, gap_t = np.empty(ncand, np.int64), np.empty(ncand)
-    gap_lo, gap_hi = np.empty(ncand), np.empty(ncand)
-    f4, f3 = np.empty((2, 3)), np.empty((2, 3))
     mem, n_mem = run.search.mem, run.search.n_mem
-    mem_save, n_mem_save = mem.copy(), n_mem.copy()
-    mem_end, n_mem_end = mem.copy(), n_mem.copy()
-    fmax, ymax = par.max_force_N, par.max_lateral_m
+    fmax, ymax = run.par.max_force_N, run.par.max_lateral_m
     t = t0
     evals, accepted, rejected, located, last_fail = 0, 0, 0, 0, 0
     pending = np.nan  # the largest force error estimate since the last sample (NaN: none)
@@ -396,7 +354,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
         st = _rhs(t, y, run, ws, True, True, kst[0])
         evals += 1
         if st != 0:
-            return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
+            return _ended(st, t, h, accepted, rejected, k_out, evals, located, st)
         _contact_mask(rec, ncand, mask0, gap0)
         carry[STARTED] = 1.0
         if n_ev[0] == 0 and ev_t.shape[0] > 0:
@@ -422,15 +380,15 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             if t + 1.01 * h >= t_end:
                 h = t_end - t
         if not h >= h_min:
-            return _outcome(UNDERFLOW, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
+            return _ended(UNDERFLOW, t, h, accepted, rejected, k_out, evals, located, last_fail)
         # the fixed step's times are t0 + n h (no sum of rounded steps), the controlled steps' t + h
         t_new = t0 + (accepted + 1) * h if fixed else t + h
         # a step that ends on or past a sample (and the fixed step every check_every steps) has a force error estimate
         sample = k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny
         check = sample or (fixed and check_every > 0 and (accepted + 1) % check_every == 0)
         if not fixed:  # (the fixed step is never retried: no memory to restore)
-            mem_save[:, :, :] = mem
-            n_mem_save[:] = n_mem
+            _copy_into(mem, mem_save)
+            _copy_into(n_mem, n_mem_save)
         # the stages; the last one is f(t + h, y_new) (FSAL), evaluated with the lateral scan and with its record
         # (the fixed step's only when it is checked: its record serves the estimate and the sample)
         failed = 0
@@ -451,7 +409,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             evals += 1
             if st == CALLBACK_FAILED or (st != 0 and fixed):
                 # the contact model behind the callback failed (not a matter of the step), or a fixed step's stage
-                return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
+                return _ended(st, t, h, accepted, rejected, k_out, evals, located, st)
             if st != 0:
                 failed = st
                 break
@@ -476,15 +434,15 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             # a stage failed or the step is not finite: a quarter of the step, the memory of the step's start
             last_fail = failed
             rejected += 1
-            mem[:, :, :] = mem_save
-            n_mem[:] = n_mem_save
+            _copy_into(mem_save, mem)
+            _copy_into(n_mem_save, n_mem)
             h *= 0.25
             after_reject = True
             continue
         if norm > 1.0:
             rejected += 1
-            mem[:, :, :] = mem_save
-            n_mem[:] = n_mem_save
+            _copy_into(mem_save, mem)
+            _copy_into(n_mem_save, n_mem)
             h *= max(0.2, 0.9 * norm ** (-1.0 / k_order))
             after_reject = True
             continue
@@ -496,8 +454,8 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                     rec_end[i, f] = rec[i, f]
         switched = False
         if not fixed:
-            mem_end[:, :, :] = mem
-            n_mem_end[:] = n_mem
+            _copy_into(mem, mem_end)
+            _copy_into(n_mem, n_mem_end)
             _contact_mask(rec, ncand, mask1, gap1)
             for c in range(ncand):
                 if mask1[c] != mask0[c]:
@@ -525,8 +483,8 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                 margin = 0.01 * (hi - lo)
                 theta = min(max(theta, lo + margin), hi - margin)
                 _dense(y, h, kst, p, theta, ys)
-                mem[:, :, :] = mem_save
-                n_mem[:] = n_mem_save
+                _copy_into(mem_save, mem)
+                _copy_into(n_mem_save, n_mem)
                 st = _rhs(t + theta * h, ys, run, ws, True, True, scratch)
                 evals += 1
                 if st != 0:
@@ -557,8 +515,8 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
                 # redo the step from its start (and the start's memory) to end just after the switch
                 located += 1
                 rejected += 1
-                mem[:, :, :] = mem_save
-                n_mem[:] = n_mem_save
+                _copy_into(mem_save, mem)
+                _copy_into(n_mem_save, n_mem)
                 event_t = t + hi * h
                 h_event = h  # the controller's step: the next step after the switch starts from it again
                 h = hi * h + 0.5 * event_tol
@@ -566,7 +524,7 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             _contact_mask(rec_end, ncand, mask1, gap1)
         for i in range(nst):
             if not np.isfinite(y_new[i]):
-                return _outcome(BLOW_UP, t, y, h, accepted, rejected, k_out, evals, located, BLOW_UP)
+                return _ended(BLOW_UP, t, h, accepted, rejected, k_out, evals, located, BLOW_UP)
         # force error estimate of a step with output samples (and of the fixed step every check_every steps): the
         # per-wheel contact forces at the propagated solution against those at the embedded lower-order one,
         # y + h sum_j b_hat_j k_j; a sample carries the largest since the previous sample
@@ -587,36 +545,36 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             if not fixed:
                 # (RK4 keeps the memory this evaluation leaves, as the fixed-step loop before it did: the regression
                 # references hold it; the memory of the step's end instead moves corrugation's states by 1e-8)
-                mem[:, :, :] = mem_end
-                n_mem[:] = n_mem_end
+                _copy_into(mem_end, mem)
+                _copy_into(n_mem_end, n_mem)
         # the output samples within (t, t_new]: dense output and a right-hand side with record there
         while k_out < out_times.shape[0] and out_times[k_out] <= t_new + tiny:
             theta = (out_times[k_out] - t) / h
             if abs(1.0 - theta) * h <= tiny:
-                states[k_out, :] = y_new
-                recs[k_out, :, :] = rec_end
+                _copy_into(y_new, states[k_out])
+                _copy_into(rec_end, recs[k_out])
             else:
                 _dense(y, h, kst, p, theta, ys)
                 st = _rhs(out_times[k_out], ys, run, ws, True, True, scratch)
                 evals += 1
                 if st != 0:
-                    return _outcome(st, t, y, h, accepted, rejected, k_out, evals, located, st)
-                states[k_out, :] = ys
-                recs[k_out, :, :] = rec
+                    return _ended(st, t, h, accepted, rejected, k_out, evals, located, st)
+                _copy_into(ys, states[k_out])
+                _copy_into(rec, recs[k_out])
             side_forces(recs[k_out], sides, f4)
             errs[k_out] = pending if k_out == k_first else np.nan
             pending = np.nan
             k_out += 1
             for sd in range(2):
                 if f4[sd, NORMAL_FORCE] > fmax:
-                    return _outcome(
-                        FORCE_ANOMALY, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, FORCE_ANOMALY
-                    )
+                    _copy_into(y_new, y)
+                    return _ended(FORCE_ANOMALY, t_new, h, accepted + 1, rejected, k_out, evals, located, FORCE_ANOMALY)
             if abs(states[k_out - 1, Y]) > ymax:
-                return _outcome(DERAILED, t_new, y_new, h, accepted + 1, rejected, k_out, evals, located, DERAILED)
+                _copy_into(y_new, y)
+                return _ended(DERAILED, t_new, h, accepted + 1, rejected, k_out, evals, located, DERAILED)
         if not fixed:
-            mem[:, :, :] = mem_end
-            n_mem[:] = n_mem_end
+            _copy_into(mem_end, mem)
+            _copy_into(n_mem_end, n_mem)
             switched = False
             for c in range(ncand):
                 if mask1[c] != mask0[c]:
@@ -647,4 +605,4 @@ def embedded_run(y, t0, t_end, h, tableau, control, run, outputs, k_out, carried
             h = max(h, min(h_event, 10.0 * h_event * factor))
             h_event = np.nan
         after_reject = False
-    return _outcome(OK, t, y, h, accepted, rejected, k_out, evals, located, last_fail)
+    return _ended(OK, t, h, accepted, rejected, k_out, evals, located, last_fail)

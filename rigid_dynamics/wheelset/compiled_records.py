@@ -80,7 +80,7 @@ def supported(scene, provider) -> bool:
     compiled (tables or search). Any contact model: the compiled laws inline, ``auto``'s choice inline, the others
     (bem, fea, user models) through the callback.
     """
-    from rigid_dynamics.wheelset.compiled_loop import TABLEAUX
+    from rigid_dynamics.wheelset.tableaux import TABLEAUX
 
     return scene.integrator.method in TABLEAUX and geometry_mode(provider) != GEOMETRY_GIVEN
 
@@ -207,13 +207,12 @@ def _candidates(provider, mode) -> int:
 
 def load(run: PackedRun) -> None:
     """Load (from numba's cache, or compile) the compiled loop and rhs_once for the types of ``run``: zero steps
-    (one compilation serves every tableau and controller of compiled_loop.TABLEAUX: the same argument types), and
+    (one compilation serves every tableau and controller of tableaux.TABLEAUX: the same argument types), and
     one right-hand side at the zero state (no wheel near a rail there: no candidate enters the search memory, whose
     warm starts are its only state).
     """
     from rigid_dynamics.wheelset.compiled_loop import (
         PI_CONTROL,
-        TABLEAUX,
         Carried,
         EventLog,
         Outputs,
@@ -221,6 +220,7 @@ def load(run: PackedRun) -> None:
         embedded_run,
     )
     from rigid_dynamics.wheelset.compiled_rhs import rhs_once
+    from rigid_dynamics.wheelset.tableaux import TABLEAUX
 
     y = np.zeros(n_states(int(run.par["track_positions"])))
     ncand = len(run.sides)

@@ -308,7 +308,7 @@ def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -
     """
     from scipy import integrate
 
-    from rigid_dynamics.wheelset.compiled_loop import SCIPY_EQUIVALENT
+    from rigid_dynamics.wheelset.tableaux import SCIPY_EQUIVALENT
 
     fixed = settings.method == "RK4"
     if fixed:
@@ -527,7 +527,7 @@ def _longitudinal_sums(rec: np.ndarray, ncand: int) -> tuple[float, float, float
 
 
 def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
-    """The compiled loop (compiled_loop.embedded_run) for every method of compiled_loop.TABLEAUX: the embedded pairs
+    """The compiled loop (compiled_loop.embedded_run) for every method of tableaux.TABLEAUX: the embedded pairs
     DP54/BS32 with step-size control, in calls of compiled_loop.STEPS_PER_CALL accepted steps, and RK4 with its
     fixed step (:func:`_fixed_step_plan`), so that wall time, budget and progress are watched between calls.
     Records the samples at the output times (the pairs: multiples of output_step_s, and the end; RK4: every
@@ -540,13 +540,13 @@ def run_compiled(model, y0, duration, settings, recorder, report, start) -> int:
         MIN_STEP_S,
         STARTED,
         STEPS_PER_CALL,
-        TABLEAUX,
         Carried,
         EventLog,
         Outputs,
         embedded_run,
     )
     from rigid_dynamics.wheelset.compiled_rhs import rhs_once, use_callback
+    from rigid_dynamics.wheelset.tableaux import TABLEAUX
 
     scene, run = model.scene, model.packed
     use_callback(model.callback)

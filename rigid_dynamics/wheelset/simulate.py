@@ -188,9 +188,9 @@ def simulate(
     """
     provider = provider if provider is not None else build_provider(scene)
     model_obj = get_contact_model(contact_model if contact_model is not None else scene.contact_model)
-    from rigid_dynamics.wheelset.compiled_loop import PAIRS
     from rigid_dynamics.wheelset.compiled_records import geometry_mode, load, supported
     from rigid_dynamics.wheelset.layout import GEOMETRY_SEARCH
+    from rigid_dynamics.wheelset.tableaux import PAIRS
 
     embedded = scene.integrator.method in PAIRS
     can_compile = supported(scene, provider)
