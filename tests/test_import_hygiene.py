@@ -188,3 +188,31 @@ def test_contact_json_loads_only_the_bem_kernels(method):
     code, _, loaded = done.stdout.strip().partition(" ")
     assert code == "0", done.stdout
     assert loaded == "rigid_dynamics.contact.bem.norm,rigid_dynamics.contact.bem.tang", loaded
+
+
+EXIT_CODE = """
+import atexit, gc, json, sys
+atexit.register(lambda: print("frozen at exit:", gc.get_freeze_count(), file=sys.stderr))  # runs after main's
+from wheelrail.cli import main
+code = main(["contact", "hertz-quadric", "--json"])
+print("frozen at return:", gc.get_freeze_count(), file=sys.stderr)
+sys.exit(code)
+"""
+
+
+def test_contact_skips_the_collection_at_exit():
+    """``wheelrail contact`` freezes the garbage collector's objects at the interpreter's exit (not when it returns:
+    a caller that goes on is untouched), which spares the shutdown's full collections over numba's registries
+    (0.2-0.25 s, benchmarks/results/startup.md); the JSON still comes out whole and the exit status is the
+    command's."""
+    done = subprocess.run(
+        [sys.executable, "-c", EXIT_CODE],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    assert __import__("json").loads(done.stdout)["status"] == "ok"
+    lines = dict(line.split(": ") for line in done.stderr.strip().splitlines())
+    assert int(lines["frozen at exit"]) > int(lines["frozen at return"]) + 10_000, done.stderr

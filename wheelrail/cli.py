@@ -109,8 +109,34 @@ def cmd_cases(args) -> int:
 # --- contact ------------------------------------------------------------------------------
 
 
+_FROZEN_AT_EXIT = {"registered": False}
+
+
+def _skip_collection_at_exit() -> None:
+    """Freeze Python's cyclic garbage collector's objects when the interpreter exits (``atexit``; once per process).
+
+    After numba has loaded a kernel the process tracks about 120,000 objects (numba's typing and lowering
+    registries, scipy's and numpy's modules), and the interpreter's shutdown runs several full collections over them:
+    0.2-0.25 s of CPU for nothing, a fifth of ``wheelrail contact <quadric case> --json``
+    (benchmarks/results/startup.md). ``gc.freeze()`` at exit leaves those objects to the end of the process (their
+    memory returns to the OS with it). The atexit handlers registered before this one still run after it, and every
+    file the command writes is closed before it returns (atomic writes), so nothing waits on a collection at exit;
+    a caller that goes on (a test calling :func:`main`) is untouched until its own exit.
+    """
+    if _FROZEN_AT_EXIT["registered"]:
+        return
+    import atexit
+    import gc
+
+    atexit.register(gc.freeze)
+    _FROZEN_AT_EXIT["registered"] = True
+
+
 def cmd_contact(args) -> int:
     from contextlib import ExitStack
+
+    if args.method != "fea":  # fea's PETSc/MPI objects are left to their own shutdown
+        _skip_collection_at_exit()
 
     from wheelrail.cases import resolve_case_path, solution_record, solve_case
     from wheelrail.output import copy_input, output_folder, safe_name, to_json, write_json
