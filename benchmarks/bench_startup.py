@@ -45,6 +45,9 @@ COMMANDS = {
     "python -c 'import numba, scipy.linalg'": ["-c", "import numba, scipy.linalg"],
     "python -c 'import numba, scipy.fft' (the floor with numba)": ["-c", "import numba, scipy.fft"],
     "one cached numba kernel (the floor of a compiled command)": [str(ROOT / "benchmarks" / "numba_floor_kernel.py")],
+    "one cached numba kernel, collector frozen at exit (as wheelrail contact)": [
+        str(ROOT / "benchmarks" / "numba_floor_kernel.py"), "--freeze-at-exit",
+    ],
 }  # fmt: skip
 FLOORS = {name for name in COMMANDS if not name.startswith("contact")}
 """Commands that do not depend on the tree: run with the first tree only."""
