@@ -194,8 +194,10 @@ EXIT_CODE = """
 import atexit, gc, json, sys
 atexit.register(lambda: print("frozen at exit:", gc.get_freeze_count(), file=sys.stderr))  # runs after main's
 from wheelrail.cli import main
+threshold = gc.get_threshold()
 code = main(["contact", "hertz-quadric", "--json"])
 print("frozen at return:", gc.get_freeze_count(), file=sys.stderr)
+print("threshold restored:", gc.get_threshold() == threshold, file=sys.stderr)
 sys.exit(code)
 """
 
@@ -204,7 +206,7 @@ def test_contact_skips_the_collection_at_exit():
     """``wheelrail contact`` freezes the garbage collector's objects at the interpreter's exit (not when it returns:
     a caller that goes on is untouched), which spares the shutdown's full collections over numba's registries
     (0.2-0.25 s, benchmarks/results/startup.md); the JSON still comes out whole and the exit status is the
-    command's."""
+    command's. The collector's young threshold, raised while the command runs, is restored when it returns."""
     done = subprocess.run(
         [sys.executable, "-c", EXIT_CODE],
         capture_output=True,
@@ -216,3 +218,4 @@ def test_contact_skips_the_collection_at_exit():
     assert __import__("json").loads(done.stdout)["status"] == "ok"
     lines = dict(line.split(": ") for line in done.stderr.strip().splitlines())
     assert int(lines["frozen at exit"]) > int(lines["frozen at return"]) + 10_000, done.stderr
+    assert lines["threshold restored"] == "True", done.stderr  # raised while the command runs (cli.py)
