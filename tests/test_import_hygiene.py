@@ -57,9 +57,19 @@ print(code, ",".join(sorted(m for m in sys.modules if m.split(".")[0] in heavy o
 """
 
 CONTACT_HEAVY = set(HEAVY) | {"meshio", "h5py", "scipy.interpolate", "scipy.optimize", "scipy.integrate"}
+CONTACT_HEAVY |= {"scipy.sparse", "scipy.stats", "scipy.signal", "scipy.ndimage"}
+CONTACT_HEAVY |= {
+    "rigid_dynamics.wheelset",
+    "rigid_dynamics.contact.fastsim",
+    "rigid_dynamics.contact.wheelset_case",
+    "rigid_dynamics.contact.semi_hertzian",
+    "wheelrail.scenes",
+}
 """What ``wheelrail contact <quadric case> --json`` (no output folder, no plots) must not import: the files' and
 plots' libraries, the FE stack, and the scipy packages the contact models used to import at module level (PCHIP of
-Kalker's table, the Hertz root) -- a fifth to a third of the command's start-up (benchmarks/results/startup.md)."""
+Kalker's table, the Hertz root) -- a fifth to a third of the command's start-up (benchmarks/results/startup.md) --
+nor scipy's other packages, nor the dynamics, FASTSIM, the wheelset-case search, the semi-Hertzian models or the
+scenes: none of them is used by a quadric case solved by hertz, bem, or auto choosing bem."""
 
 
 @pytest.mark.parametrize("method", [None, "hertz", "bem"])
@@ -144,3 +154,68 @@ def test_auto_choosing_an_analytic_model_imports_no_numba(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["0", "linear", "False"], done.stdout
+
+
+KERNELS_CODE = """
+import contextlib, io, sys
+from wheelrail.cli import main
+with contextlib.redirect_stdout(io.StringIO()):
+    code = main(["contact", "hertz-quadric", "--json"{method}])
+from numba.core.registry import CPUDispatcher
+from rigid_dynamics.contact import lazy_kernels
+loaded = {name for name, module in list(sys.modules.items()) if name.startswith(("rigid_dynamics", "wheelrail"))
+          for value in list(vars(module).values()) if isinstance(value, CPUDispatcher) and value.overloads}
+loaded |= {source + " (compiled copies)" for source in lazy_kernels._COPIES}
+print(code, ",".join(sorted(loaded)))
+"""
+
+
+@pytest.mark.parametrize("method", [None, "bem"])
+def test_contact_json_loads_only_the_bem_kernels(method):
+    """``wheelrail contact hertz-quadric --json`` (auto, which chooses bem here) and ``--method bem`` load (from
+    numba's cache) only the BEM's kernels (bem/norm.py, bem/tang.py): none of the compiled copies of Hertz, Kalker's
+    table, the linear theory or the friction law, which ``auto`` and the BEM call a few times each, as Python
+    (lazy_kernels.PYTHON_CALLS_LIMIT; 2-4 ms a kernel, benchmarks/results/startup.md)."""
+    extra = "" if method is None else f', "--method", "{method}"'
+    done = subprocess.run(
+        [sys.executable, "-c", KERNELS_CODE.replace("{method}", extra)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    code, _, loaded = done.stdout.strip().partition(" ")
+    assert code == "0", done.stdout
+    assert loaded == "rigid_dynamics.contact.bem.norm,rigid_dynamics.contact.bem.tang", loaded
+
+
+EXIT_CODE = """
+import atexit, gc, json, sys
+atexit.register(lambda: print("frozen at exit:", gc.get_freeze_count(), file=sys.stderr))  # runs after main's
+from wheelrail.cli import main
+threshold = gc.get_threshold()
+code = main(["contact", "hertz-quadric", "--json"])
+print("frozen at return:", gc.get_freeze_count(), file=sys.stderr)
+print("threshold restored:", gc.get_threshold() == threshold, file=sys.stderr)
+sys.exit(code)
+"""
+
+
+def test_contact_skips_the_collection_at_exit():
+    """``wheelrail contact`` freezes the garbage collector's objects at the interpreter's exit (not when it returns:
+    a caller that goes on is untouched), which spares the shutdown's full collections over numba's registries
+    (0.2-0.25 s, benchmarks/results/startup.md); the JSON still comes out whole and the exit status is the
+    command's. The collector's young threshold, raised while the command runs, is restored when it returns."""
+    done = subprocess.run(
+        [sys.executable, "-c", EXIT_CODE],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+    assert done.returncode == 0, done.stderr
+    assert __import__("json").loads(done.stdout)["status"] == "ok"
+    lines = dict(line.split(": ") for line in done.stderr.strip().splitlines())
+    assert int(lines["frozen at exit"]) > int(lines["frozen at return"]) + 10_000, done.stderr
+    assert lines["threshold restored"] == "True", done.stderr  # raised while the command runs (cli.py)

@@ -60,3 +60,51 @@ def test_public_compiled_laws_are_the_compiled_copies():
     assert isinstance(linear.linear_one, CPUDispatcher)
     assert isinstance(vermeulen_johnson.saturate_one, CPUDispatcher)
     assert linear.linear_one is linear.compiled_kernels()["_linear_one"]
+
+
+def test_friction_coefficient_same_bits():
+    """``friction._friction_coefficient`` as Python and as its compiled copy: Coulomb, CONTACT's three falling forms,
+    Polach's law and a law varying in place, at slip velocities 0 to 20 m/s and places inside and beyond the nodes."""
+    from rigid_dynamics.contact import friction
+
+    forms = ("linear", "rational", "exponential")
+    slow = (friction.polach(0.4, 0.5, 0.6), friction.polach(0.2, 0.5, 0.3))
+    laws = [
+        friction.uniform(0.3),
+        *(friction.FrictionLaw((friction.falling(f, 0.2, 0.1, 2.0, 0.05, 5.0),)) for f in forms),
+        friction.FrictionLaw((friction.polach(0.55, 0.4, 0.6),)),
+        friction.varying("surface_inclination", (0.3, 0.5), slow),
+        friction.varying("rail_lateral", (-0.01, 0.0, 0.02), tuple(friction.coulomb(m) for m in (0.4, 0.3, 0.1))),
+    ]
+    compiled = friction.compiled_kernels()["_friction_coefficient"]
+    for law in laws:
+        record = law.record()
+        for s in (0.0, 0.07, 0.7, 2.0, 5.0, 20.0):
+            for place in (-0.1, 0.3, 0.41, 0.5, 0.9):
+                assert friction._friction_coefficient(record, s, place) == compiled(record, s, place)
+
+
+def test_small_batches_run_as_python_until_the_call_limit(monkeypatch):
+    """With numba imported (as after the BEM's import) a module's first ``PYTHON_CALLS_LIMIT`` small batches run as
+    Python -- a one-patch command (``wheelrail contact``, whose ``auto`` solves Hertz and Kalker's table before the
+    BEM) loads none of the analytic models' compiled copies -- and later ones, and large batches, by the compiled
+    copies; the Hertz patch is the same bits before and after the switch."""
+    import numba  # noqa: F401  (the situation tested: numba loaded, the module's copies not made)
+
+    from rigid_dynamics.contact import hertz, lazy_kernels
+
+    monkeypatch.setattr(lazy_kernels, "_COPIES", {})
+    monkeypatch.setattr(lazy_kernels, "_PYTHON_CALLS", {})
+
+    def solve():
+        return hertz.hertz_solve_batch(2.0, 3.7, normal_force_N=1e4, shear_modulus_Pa=8.2e10, poisson_ratio=0.28)
+
+    first = solve()
+    for _ in range(lazy_kernels.PYTHON_CALLS_LIMIT - 1):
+        solve()
+    assert hertz.__name__ not in lazy_kernels._COPIES
+    after = solve()  # the limit's next call: the compiled copies
+    assert hertz.__name__ in lazy_kernels._COPIES
+    for name in ("semi_axis_long_m", "semi_axis_lat_m", "approach_m", "normal_force_N", "max_pressure_Pa"):
+        np.testing.assert_array_equal(getattr(first, name), getattr(after, name))
+    assert not lazy_kernels.run_as_python(lazy_kernels.PYTHON_BATCH_LIMIT + 1, "some.module")

@@ -31,6 +31,7 @@ A subcommand is a function ``cmd_<name>(args) -> int`` and a function adding its
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -109,7 +110,58 @@ def cmd_cases(args) -> int:
 # --- contact ------------------------------------------------------------------------------
 
 
+_FROZEN_AT_EXIT = {"registered": False}
+
+
+def _skip_collection_at_exit() -> None:
+    """Freeze Python's cyclic garbage collector's objects when the interpreter exits (``atexit``; once per process).
+
+    After numba has loaded a kernel the process tracks about 120,000 objects (numba's typing and lowering
+    registries, scipy's and numpy's modules), and the interpreter's shutdown runs several full collections over them:
+    0.2-0.25 s of CPU for nothing, a fifth of ``wheelrail contact <quadric case> --json``
+    (benchmarks/results/startup.md). ``gc.freeze()`` at exit leaves those objects to the end of the process (their
+    memory returns to the OS with it). The atexit handlers registered before this one still run after it, and every
+    file the command writes is closed before it returns (atomic writes), so nothing waits on a collection at exit;
+    a caller that goes on (a test calling :func:`main`) is untouched until its own exit.
+    """
+    if _FROZEN_AT_EXIT["registered"]:
+        return
+    import atexit
+    import gc
+
+    atexit.register(gc.freeze)
+    _FROZEN_AT_EXIT["registered"] = True
+
+
+YOUNG_COLLECTION_THRESHOLD = 20_000
+"""Allocations of container objects between two young-generation collections while ``wheelrail contact`` runs
+(Python's default: 700). Importing numba and loading its kernels creates about 120,000 long-lived objects; at the
+default the collector runs some 250 times over them during the command (0.05-0.07 s CPU of its 0.9 s, measured in
+fresh processes), at 20,000 a few times (0.05 s saved; benchmarks/results/startup.md)."""
+
+
+@contextlib.contextmanager
+def _fewer_collections():
+    """Python's young-generation threshold raised to :data:`YOUNG_COLLECTION_THRESHOLD` inside, restored after."""
+    import gc
+
+    before = gc.get_threshold()
+    gc.set_threshold(max(before[0], YOUNG_COLLECTION_THRESHOLD), *before[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*before)
+
+
 def cmd_contact(args) -> int:
+    if args.method == "fea":  # fea's PETSc/MPI objects are left to their own collections and shutdown
+        return _contact(args)
+    _skip_collection_at_exit()
+    with _fewer_collections():
+        return _contact(args)
+
+
+def _contact(args) -> int:
     from contextlib import ExitStack
 
     from wheelrail.cases import resolve_case_path, solution_record, solve_case

@@ -378,7 +378,7 @@ def compiled_kernels() -> dict:
 
 def _evaluate(record: FrictionRecord, slip_velocity_m_per_s: float, place: float) -> float:
     """The coefficient by the Python kernel before numba is loaded, else by the compiled one (same bits)."""
-    kernel = _friction_coefficient if run_as_python(1) else compiled_kernels()["_friction_coefficient"]
+    kernel = _friction_coefficient if run_as_python(1, __name__) else compiled_kernels()["_friction_coefficient"]
     return float(kernel(record, slip_velocity_m_per_s, place))
 
 

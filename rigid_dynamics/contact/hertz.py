@@ -33,7 +33,8 @@ To keep full precision for every ratio from 1 (A = B) to beyond 1e4 (b/a ~ 4e-3)
 
 The loops below are plain Python; :func:`compiled_kernels` compiles the same functions with numba (scipy's two
 functions then called through ``scipy.special.cython_special``): a batch of 10,000 costs well
-under 1 us per patch there. A small batch in a process that has not imported numba runs the same source as Python
+under 1 us per patch there. A small batch in a process that has not imported numba (or one of this module's first
+few small batches where numba is loaded: lazy_kernels.PYTHON_CALLS_LIMIT) runs the same source as Python
 (scipy's ufuncs: the same compiled functions), so that a command solving one Hertz patch never pays numba's start-up
 (about 0.6-0.8 s CPU, benchmarks/results/startup.md); both paths give the same bits (tests/test_hertz.py).
 
@@ -112,7 +113,7 @@ def compiled_kernels() -> dict:
 
 def _kernels(n: int):
     """The compiled copies, or None where a batch of ``n`` runs as Python (numba not imported, n small)."""
-    return None if run_as_python(n) else compiled_kernels()
+    return None if run_as_python(n, __name__) else compiled_kernels()
 
 
 def _kdbc(p):

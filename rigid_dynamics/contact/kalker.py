@@ -246,7 +246,7 @@ def slender_asymptotes(a_over_b: np.ndarray, poisson_ratio) -> np.ndarray:
     a_over_b = np.atleast_1d(np.asarray(a_over_b, dtype=float))
     nu = np.broadcast_to(np.asarray(poisson_ratio, dtype=float), a_over_b.shape)
     out = np.empty((a_over_b.size, 4))
-    (_asymptotes_many if run_as_python(out.shape[0]) else compiled_kernels()["_asymptotes_many"])(
+    (_asymptotes_many if run_as_python(out.shape[0], __name__) else compiled_kernels()["_asymptotes_many"])(
         np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out
     )
     return out.reshape(a_over_b.shape + (4,))
@@ -282,7 +282,7 @@ def kalker_coefficients(a_over_b, poisson_ratio) -> CreepCoefficients:
     if not (np.all(np.isfinite(nu)) and np.all((nu > -1.0) & (nu <= 0.5))):
         raise ValueError(f"poisson_ratio = {poisson_ratio!r}: expected values in (-1, 0.5]")
     out = np.empty((a_over_b.size, 4))
-    (_coefficients_many if run_as_python(out.shape[0]) else compiled_kernels()["_coefficients_many"])(
+    (_coefficients_many if run_as_python(out.shape[0], __name__) else compiled_kernels()["_coefficients_many"])(
         np.array(a_over_b.ravel(), dtype=float), np.array(nu.ravel(), dtype=float), out
     )
     return CreepCoefficients(*(out[:, i].reshape(shape) for i in range(4)))

@@ -93,6 +93,6 @@ def linear_creep_forces(
         np.ascontiguousarray(np.broadcast_to(v, a.shape), dtype=float).ravel() for v in (c.c11, c.c22, c.c23, c.c33)
     )
     out = np.empty((3, flat[0].size))
-    kernel = _linear_many if run_as_python(out.shape[1]) else compiled_kernels()["_linear_many"]
+    kernel = _linear_many if run_as_python(out.shape[1], __name__) else compiled_kernels()["_linear_many"]
     kernel(float(shear_modulus_Pa), flat[0], flat[1], coef, flat[2], flat[3], flat[4], out)
     return out[0].reshape(a.shape), out[1].reshape(a.shape), out[2].reshape(a.shape)

@@ -82,6 +82,6 @@ def vermeulen_johnson_saturation(
         raise ValueError("normal_force_N and friction_coefficient: expected values >= 0")
     shape = tx.shape
     out = np.empty((2, tx.size))
-    kernel = _saturate_many if run_as_python(out.shape[1]) else compiled_kernels()["_saturate_many"]
+    kernel = _saturate_many if run_as_python(out.shape[1], __name__) else compiled_kernels()["_saturate_many"]
     kernel(*(np.ascontiguousarray(v, dtype=float).ravel() for v in (tx, ty, f * n)), out)
     return out[0].reshape(shape), out[1].reshape(shape)

@@ -597,14 +597,14 @@ def solve_tang_law(
         rolling_speed_m_per_s: V > 0 (slip velocity = V times the dimensionless slip).
         max_friction_iterations: outer iteration limit; not converged -> ``converged`` False.
     """
-    from rigid_dynamics.contact.friction import friction_coefficient
-
     shape = (influence.ny, influence.nx)
     record = law.record()
     places = np.broadcast_to(np.asarray(place, float), shape)
-    if law.is_coulomb and not law.varies:  # one coefficient everywhere (the same float the law's evaluation gives)
-        mu_s = np.full(shape, friction_coefficient(record, 0.0, 0.0))
+    if law.is_coulomb and not law.varies:  # one coefficient everywhere (one evaluation of the law: as Python or
+        mu_s = np.full(shape, law.static_coefficient())  # compiled, the same bits, friction.py / lazy_kernels.py)
     else:
+        from rigid_dynamics.contact.friction import friction_coefficient
+
         coefficient = np.vectorize(lambda s, x: friction_coefficient(record, s, x), otypes=[float])
         mu_s = coefficient(np.zeros(shape), places)
     common = {"problem": "rolling", "tolerance": tolerance, "max_iterations": max_iterations}
