@@ -113,8 +113,15 @@ def test_two_elastic_bodies_match_hertz():
 
 
 def test_quadratic_elements_match_hertz():
-    """P2 displacements (constraint at vertices and edge midpoints) on the quick mesh."""
-    r = FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options={"degree": 2, "quick": True})
+    """P2 displacements (constraint at vertices and edge midpoints) on the quick mesh.
+
+    Checks that the P2 path gives Hertz's patch: the force to 1e-6 (load control), p0 and the semi-axes within 5 %,
+    on one quick mesh (measured: p0 -0.24 %, a and b -0.17 %; 17 500 unknowns, 2.7 s). The claim is the element, not
+    the refinement series (the quick series to 200 000 unknowns took 14-74 s here for the same assertions); the P2
+    series and its error estimate are checked against Hertz to 1 % in test_fea_refinement.py.
+    """
+    options = {"degree": 2, "quick": True, "mesh_tolerance": None}
+    r = FeaModel().solve(ELLIPTIC, Creepage(), STEEL_210, normal_force_N=FORCE_N, options=options)
     ref = hertz_elliptic(
         ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m, FORCE_N, STEEL_210.combined_modulus_Pa
     )
