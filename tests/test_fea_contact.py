@@ -153,7 +153,7 @@ def test_sampled_gap_full_block_agrees_with_quadric_hertz():
     the pressure's centroid within 0.2 mm of the gap's minimum, no elliptic fit. On one mesh of 6 elements per
     semi-axis in quick's block (measured: p0 +1.6 %, area -2.7 %, centroid 6 um off; 15 000 unknowns, 2.3 s):
     the claim is the sampled path, not the refinement series (whose accuracy the elliptic tests check); the
-    quick series to 200 000 unknowns cost 84 s here for the same assertions.
+    quick series to 200 000 unknowns cost 84-139 s here for the same assertions.
     """
     A, B = ELLIPTIC.curvature_long_1_per_m, ELLIPTIC.curvature_lat_1_per_m
     x = np.linspace(-0.02, 0.02, 81)
