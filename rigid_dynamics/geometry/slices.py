@@ -85,6 +85,11 @@ def _lines(path: Path):
     """Non-empty lines of a file with ``%`` comments removed (outside quotes)."""
     out = []
     for raw in path.read_text(errors="replace").splitlines():
+        if "'" not in raw and '"' not in raw:  # no quotes: the comment starts at the first % (the loop's result)
+            text = raw.split("%", 1)[0].strip()
+            if text:
+                out.append(text)
+            continue
         line, quoted = [], None
         for ch in raw:
             if ch in "'\"":
