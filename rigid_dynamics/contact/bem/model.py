@@ -959,12 +959,15 @@ def _with_grid_error(result: ContactResult, estimate, tolerance: float, refineme
             if status == "ok":
                 status = "warning"
             message += (
-                f"; estimated grid error above grid_tolerance {tolerance:g} at {nx} x {ny} elements: "
+                f"; estimated grid error above grid_tolerance {tolerance:g} ({tolerance:.2%}) at {nx} x {ny} elements: "
                 + ", ".join(worst)
                 + " (a finer grid: smaller dx_m/element_size_m, larger nx/ny, or more max_refinements)"
             )
         else:
-            message += f"; estimated grid error {estimate['largest_relative']:.2%} <= {tolerance:g} at {nx} x {ny}"
+            message += (
+                f"; estimated grid error {estimate['largest_relative']:.2%} <= grid_tolerance {tolerance:g} "
+                f"({tolerance:.2%}) at {nx} x {ny}"
+            )
     return dataclasses.replace(result, status=status, message=message, extra=extra, wall_time_s=wall_time_s)
 
 
