@@ -59,7 +59,8 @@ def test_element_size_through_the_cli(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     patch = data["patches"][0]
     assert code == 1 and patch["status"] == "warning", patch
-    assert "estimated grid error above grid_tolerance 0.02 (2.00%)" in patch["message"] and "contact area" in patch["message"]
+    message = patch["message"]
+    assert "estimated grid error above grid_tolerance 0.02 (2.00%)" in message and "contact area" in message
     grid = patch["diagnostics"]["grid_error"]
     assert 0.02 < grid["largest_relative"] == patch["diagnostics"]["grid_error_estimate"] < 0.1
     assert patch["diagnostics"]["dx_m"] == pytest.approx(1e-3) and grid["refinements"] == 0
