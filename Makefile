@@ -1,7 +1,7 @@
 # Two commands for a new user: `make demo` and `make test` (both set up .venv on first use).
 VENV := .venv
 STAMP := $(VENV)/.installed
-PYTEST_ARGS ?=
+PYTEST_ARGS ?= --durations=25  # the slowest tests printed: where the suite's time goes (issue 27)
 
 .PHONY: demo test lint docs setup clean clean-numba
 
