@@ -5,6 +5,19 @@ import sys
 
 import pytest
 
+
+def _python(code: str, *args: str, timeout: float = 300):
+    """``python -c code args...`` in a fresh interpreter from the repository's root (what a user's process
+    imports and loads); the completed process, output as text."""
+    return subprocess.run(
+        [sys.executable, "-c", code, *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
+    )
+
+
 HEAVY = (
     "gmsh",
     "dolfinx",
@@ -36,13 +49,7 @@ print(",".join(sorted(m for m in sys.modules if m.split(".")[0] in {heavy})))
 
 
 def test_core_and_front_import_no_heavy_package():
-    done = subprocess.run(
-        [sys.executable, "-c", CODE.replace("{heavy}", repr(set(HEAVY)))],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(CODE.replace("{heavy}", repr(set(HEAVY))))
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "", f"heavy modules imported: {done.stdout.strip()}"
 
@@ -77,13 +84,7 @@ def test_contact_json_imports_no_heavy_module(method):
     """``wheelrail contact hertz-quadric --json`` (auto, which chooses bem here; hertz; bem) imports none of
     ``CONTACT_HEAVY``."""
     extra = "" if method is None else f', "--method", "{method}"'
-    done = subprocess.run(
-        [sys.executable, "-c", CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(CONTACT_HEAVY))],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(CONTACT_HEAVY)))
     assert done.returncode == 0, done.stderr
     code, _, imported = done.stdout.strip().partition(" ")
     assert code == "0", done.stdout
@@ -103,13 +104,7 @@ def test_contact_json_without_kernels_imports_no_numba(method):
     nor llvmlite, nor any of ``CONTACT_HEAVY``."""
     heavy = CONTACT_HEAVY | {"numba", "llvmlite"}
     extra = f', "--method", "{method}"'
-    done = subprocess.run(
-        [sys.executable, "-c", CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(heavy))],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(CONTACT_CODE.replace("{method}", extra).replace("{heavy}", repr(heavy)))
     assert done.returncode == 0, done.stderr
     code, _, imported = done.stdout.strip().partition(" ")
     assert code == NO_KERNEL_METHODS[method], done.stdout
@@ -145,13 +140,7 @@ print(code, json.loads(out.getvalue())["patches"][0]["model"], "numba" in sys.mo
 def test_auto_choosing_an_analytic_model_imports_no_numba(tmp_path):
     """``wheelrail contact <quadric case> --json`` whose ``auto`` choice is the linear theory (hertz-quadric with a
     tenth of its creepages and no spin) warms up only the chosen model and imports no numba."""
-    done = subprocess.run(
-        [sys.executable, "-c", AUTO_ANALYTIC_CODE, str(tmp_path / "small-creep.toml")],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(AUTO_ANALYTIC_CODE, str(tmp_path / "small-creep.toml"))
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["0", "linear", "False"], done.stdout
 
@@ -177,13 +166,7 @@ def test_contact_json_loads_only_the_bem_kernels(method):
     table, the linear theory or the friction law, which ``auto`` and the BEM call a few times each, as Python
     (lazy_kernels.PYTHON_CALLS_LIMIT; 2-4 ms a kernel, benchmarks/results/startup.md)."""
     extra = "" if method is None else f', "--method", "{method}"'
-    done = subprocess.run(
-        [sys.executable, "-c", KERNELS_CODE.replace("{method}", extra)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(KERNELS_CODE.replace("{method}", extra))
     assert done.returncode == 0, done.stderr
     code, _, loaded = done.stdout.strip().partition(" ")
     assert code == "0", done.stdout
@@ -207,13 +190,7 @@ def test_contact_skips_the_collection_at_exit():
     a caller that goes on is untouched), which spares the shutdown's full collections over numba's registries
     (0.2-0.25 s, benchmarks/results/startup.md); the JSON still comes out whole and the exit status is the
     command's. The collector's young threshold, raised while the command runs, is restored when it returns."""
-    done = subprocess.run(
-        [sys.executable, "-c", EXIT_CODE],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(EXIT_CODE)
     assert done.returncode == 0, done.stderr
     assert __import__("json").loads(done.stdout)["status"] == "ok"
     lines = dict(line.split(": ") for line in done.stderr.strip().splitlines())
@@ -234,13 +211,7 @@ sys.exit(code)
 def test_run_skips_the_collection_at_exit(tmp_path):
     """``wheelrail run`` freezes the collector's objects at exit as ``contact`` does (0.3 s CPU of a short run's
     shutdown), not when it returns; the run's outputs are written whole and its exit status is the run's."""
-    done = subprocess.run(
-        [sys.executable, "-c", RUN_EXIT_CODE, str(tmp_path / "out")],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=str(__import__("pathlib").Path(__file__).resolve().parents[1]),
-    )
+    done = _python(RUN_EXIT_CODE, str(tmp_path / "out"), timeout=600)
     assert done.returncode == 0, done.stderr
     assert __import__("json").loads((tmp_path / "out" / "summary.json").read_text())["status"] == "ok"
     lines = dict(line.split(": ") for line in done.stderr.strip().splitlines() if ": " in line)
