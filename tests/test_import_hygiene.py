@@ -204,15 +204,19 @@ atexit.register(lambda: print("frozen at exit:", gc.get_freeze_count(), file=sys
 from wheelrail.cli import main
 code = main(["run", "hunting-conical", "--no-plots", "--quiet", "--set", "duration_s=0.01", "--out", sys.argv[1]])
 print("frozen at return:", gc.get_freeze_count(), file=sys.stderr)
+print("pandas imported:", "pandas" in sys.modules, file=sys.stderr)
 sys.exit(code)
 """
 
 
 def test_run_skips_the_collection_at_exit(tmp_path):
     """``wheelrail run`` freezes the collector's objects at exit as ``contact`` does (0.3 s CPU of a short run's
-    shutdown), not when it returns; the run's outputs are written whole and its exit status is the run's."""
+    shutdown), not when it returns; the run's outputs are written whole and its exit status is the run's. It
+    writes its tables (CSV, Parquet) without importing pandas (0.25-0.33 s; rigid_dynamics/wheelset/table.py)."""
     done = _python(RUN_EXIT_CODE, str(tmp_path / "out"), timeout=600)
     assert done.returncode == 0, done.stderr
     assert __import__("json").loads((tmp_path / "out" / "summary.json").read_text())["status"] == "ok"
     lines = dict(line.split(": ") for line in done.stderr.strip().splitlines() if ": " in line)
     assert int(lines["frozen at exit"]) > int(lines["frozen at return"]) + 10_000, done.stderr
+    assert lines["pandas imported"] == "False", done.stderr
+    assert {"timeseries.csv", "timeseries.parquet"} <= {p.name for p in (tmp_path / "out").iterdir()}
