@@ -315,31 +315,8 @@ def _advance(y, span, tableau, control, run, outputs, carried, events, work):
     out_times, states, recs, errs = outputs
     carry, kst, mask0, gap0 = carried
     ev_t, ev_mask, n_ev = events
-    ws, y_new, ys, scratch, combined, stage, rec_end = (
-        work.ws,
-        work.y_new,
-        work.ys,
-        work.scratch,
-        work.combined,
-        work.stage,
-        work.rec_end,
-    )
-    mask1, gap1, mask_t, gap_t, gap_lo, gap_hi = (
-        work.mask1,
-        work.gap1,
-        work.mask_t,
-        work.gap_t,
-        work.gap_lo,
-        work.gap_hi,
-    )
-    f4, f3, mem_save, n_mem_save, mem_end, n_mem_end = (
-        work.f4,
-        work.f3,
-        work.mem_save,
-        work.n_mem_save,
-        work.mem_end,
-        work.n_mem_end,
-    )
+    ws, y_new, ys, scratch, combined, stage, rec_end, mask1, gap1, mask_t, gap_t, gap_lo, gap_hi, f4, f3, mem_save, \
+        n_mem_save, mem_end, n_mem_end = work  # fmt: skip
     sides = run.sides
     ncand = sides.shape[0]
     rec = ws.rec
@@ -449,9 +426,7 @@ def _advance(y, span, tableau, control, run, outputs, carried, events, work):
         # accepted by the error control; the memory of the step's end (the last stage's scan) is what the next step
         # starts from: evaluations off the step's path (location, output samples) restore it
         if check or not fixed:
-            for i in range(ncand + 2):
-                for f in range(N_FIELDS):
-                    rec_end[i, f] = rec[i, f]
+            _copy_into(rec, rec_end)
         switched = False
         if not fixed:
             _copy_into(mem, mem_end)
