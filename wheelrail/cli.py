@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import os
 import sys
 import time
@@ -110,11 +111,9 @@ def cmd_cases(args) -> int:
 # --- contact ------------------------------------------------------------------------------
 
 
-_FROZEN_AT_EXIT = {"registered": False}
-
-
-def _skip_collection_at_exit() -> None:
-    """Freeze Python's cyclic garbage collector's objects when the interpreter exits (``atexit``; once per process).
+def _skip_collection_at_exit(model: str) -> None:
+    """Freeze Python's cyclic garbage collector's objects when the interpreter exits (``atexit``; once per process),
+    except for ``model`` "fea", whose PETSc/MPI objects are left to their own collections and shutdown.
 
     After numba has loaded a kernel the process tracks about 120,000 objects (numba's typing and lowering
     registries, scipy's and numpy's modules), and the interpreter's shutdown runs several full collections over them:
@@ -125,13 +124,17 @@ def _skip_collection_at_exit() -> None:
     and every file the command writes is closed before it returns (atomic writes), so nothing waits on a
     collection at exit; a caller that goes on (a test calling :func:`main`) is untouched until its own exit.
     """
-    if _FROZEN_AT_EXIT["registered"]:
-        return
+    if model != "fea":
+        _freeze_at_exit()
+
+
+@functools.cache
+def _freeze_at_exit() -> None:
+    """Register ``gc.freeze`` with ``atexit``, once per process (:func:`_skip_collection_at_exit`)."""
     import atexit
     import gc
 
     atexit.register(gc.freeze)
-    _FROZEN_AT_EXIT["registered"] = True
 
 
 YOUNG_COLLECTION_THRESHOLD = 20_000
@@ -155,9 +158,9 @@ def _fewer_collections():
 
 
 def cmd_contact(args) -> int:
-    if args.method == "fea":  # fea's PETSc/MPI objects are left to their own collections and shutdown
+    _skip_collection_at_exit(args.method)
+    if args.method == "fea":  # as for the collection at exit: fea's PETSc/MPI objects are left alone
         return _contact(args)
-    _skip_collection_at_exit()
     with _fewer_collections():
         return _contact(args)
 
@@ -359,8 +362,7 @@ def cmd_run(args) -> int:
     from wheelrail.scenes import DEFAULT_SCENE, write_run_outputs
 
     scene, source, overrides = load_scene_with(args.scene or DEFAULT_SCENE, args.set)
-    if scene.contact_model != "fea":  # (fea's PETSc/MPI objects are left to their own collections, as in contact)
-        _skip_collection_at_exit()  # 0.3 s CPU of a 2 s `run polygonal-wheel` (tests/test_import_hygiene.py)
+    _skip_collection_at_exit(scene.contact_model)  # 0.3 s CPU of a 2 s `run polygonal-wheel` (test_import_hygiene)
     from rigid_dynamics.wheelset import simulate
 
     with output_folder(args.out, f"run-{source.stem}") as out_dir:
