@@ -24,6 +24,7 @@ from hardening_helpers import assert_error, run
         (["stress", "--workers", "two"], ["--workers 'two'"]),
         (["manchester", "--method", "kalker"], ["--method 'kalker'"]),
         (["run", "--out", ""], ["--out", "'': expected a folder path"]),
+        (["demo", "--patch-geometry", "round"], ["--patch-geometry: invalid choice: 'round'", "'sampled', 'ellipse'"]),
     ],
 )
 def test_bad_arguments(capsys, tmp_path, monkeypatch, argv, fragments):

@@ -457,11 +457,9 @@ def auto_parameters(par, tolerance: float, fastsim_grid) -> None:
     ``tolerance`` (contact.auto.level_for; none: NaN, every patch BEM) and per rung (linear, Vermeulen-Johnson,
     FASTSIM at the run's grid by contact.auto.fastsim_rung) the feature box (NaN: no measured box).
     """
-    from rigid_dynamics.contact.auto import fastsim_rung, level_for, load_thresholds
     from rigid_dynamics.contact.models import FRICTION_BOUND_TOLERANCE
 
-    data = load_thresholds()
-    key = level_for(tolerance, data)
+    key, boxes = auto_boxes(tolerance, fastsim_grid)
     par["auto_friction_bound_tolerance"] = FRICTION_BOUND_TOLERANCE
     for rung in AUTO_RUNG_NAMES:
         for f in AUTO_FEATURE_NAMES:
@@ -470,11 +468,27 @@ def auto_parameters(par, tolerance: float, fastsim_grid) -> None:
         par["auto_level"] = np.nan
         return
     par["auto_level"] = float(key)
-    level = data["levels"][key]
-    labels = ("linear", "vermeulen-johnson", fastsim_rung(int(fastsim_grid[0]), int(fastsim_grid[1]), level))
-    for rung, label in zip(AUTO_RUNG_NAMES, labels, strict=True):
-        entry = level.get(label) if label is not None else None
-        box = None if entry is None else entry["thresholds"]
+    for rung, (_, box) in zip(AUTO_RUNG_NAMES, boxes, strict=True):
         if box is not None:
             for f in AUTO_FEATURE_NAMES:
                 par[f"auto_{rung}_{f}"] = float(box[f])
+
+
+def auto_boxes(tolerance: float, fastsim_grid) -> tuple:
+    """(the level of ``tolerance`` or None, [(rung label, its feature box or None)] for the loop's compiled rungs
+    linear, Vermeulen-Johnson and FASTSIM at the run's grid, in :data:`AUTO_RUNG_NAMES` order), from
+    contact/data/auto_thresholds.json (contact.auto).
+    """
+    from rigid_dynamics.contact.auto import fastsim_rung, level_for, load_thresholds
+
+    data = load_thresholds()
+    key = level_for(tolerance, data)
+    if key is None:
+        return None, [(None, None)] * len(AUTO_RUNG_NAMES)
+    level = data["levels"][key]
+    labels = ("linear", "vermeulen-johnson", fastsim_rung(int(fastsim_grid[0]), int(fastsim_grid[1]), level))
+    boxes = []
+    for label in labels:
+        entry = level.get(label) if label is not None else None
+        boxes.append((label, None if entry is None else entry["thresholds"]))
+    return key, boxes

@@ -281,7 +281,8 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
     """d/dt of the full state into ``out`` from the candidate geometry cg (ncand, layout.N_GEO) (a candidate with
     q = NaN is absent: recorded as NaN); fills the patch record rec (ncand + 2, layout.N_FIELDS) and the side
     forces when ``record``; sc: the scratch rows (layout.SCRATCH_ROWS, 3); dummy: FASTSIM's empty field array;
-    field: the sampled patches (compiled_patch.PatchScratch) of LAW_KPEC.
+    field: the sampled patches (compiled_patch.PatchScratch) of LAW_KPEC, and of LAW_AUTO when ``record`` (the
+    ellipticity residual recorded beside the ellipse auto's compiled rungs served).
     Returns the status (layout.STATUS). (The run's and the workspace's arrays are passed apart, not as their
     records: a record argument is passed field by field, and this runs for every right-hand side.)
     """
@@ -361,6 +362,8 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
             area = math.pi * sa * sb
             pmax = 1.5 * normal / area if area > 0.0 else math.nan
             geom, resid = PATCH_ELLIPSE, math.nan
+            if record and field.sampled[c] > 0.0:  # auto: the sampled gap's departure from the ellipse it served
+                resid = field.residual[c]
             law = _served_law(par, rec, c, record)
             if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): its anchor or the callback
                 normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, law = _auto_bem(
@@ -421,7 +424,10 @@ def _rhs(t, y, run, ws, record, full, out):
     (benchmarks/results/compile_and_speed_issue25.md).
     """
     _geometry(y, run, ws, full)
-    if run.par.model_code == LAW_KPEC:
+    # KPEC solves the sampled gap; auto (which decides on Hertz's ellipse) has it sampled on its recorded
+    # evaluations, so that the run states how far its patches depart from the ellipse (_forces)
+    code = run.par.model_code
+    if code == LAW_KPEC or (code == LAW_AUTO and record):
         if run.mode == GEOMETRY_SEARCH and run.par.patch_sampled > 0:
             sample_candidates(y, run, ws.cg, ws.patch, ws.scratch[S_SEARCH_CENTRE])
         else:

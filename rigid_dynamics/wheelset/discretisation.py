@@ -192,6 +192,63 @@ def auto_reuse_check(status: str, message: str, callback_stats) -> tuple[str, st
     )
 
 
+def auto_geometry(result, fastsim_grid) -> dict | None:
+    """How far ``auto``'s patches served on Hertz's ellipse depart from it: None for other models. Auto decides in
+    the compiled loop on the ellipse's features (its geometric features are 0 there); with the 3-D search and
+    ``patch_geometry = "sampled"`` its recorded evaluations also sample the gap (compiled_patch.sample_candidates)
+    and record its ellipticity residual. A recorded patch served by linear theory, Vermeulen-Johnson or FASTSIM whose
+    residual exceeds that rung's measured box at the run's level (contact/data/auto_thresholds.json; the boxes come
+    from the bench's cases, and a box of 0 means no measured case beyond the ellipse) is outside what the thresholds
+    were measured on: its error against the BEM on the sampled gap is not known. Returns the counts, the largest
+    residual and whether the geometry was seen (``seen`` False on the tables or with ``patch_geometry =
+    "ellipse"``: nothing sampled).
+    """
+    from rigid_dynamics.wheelset.compiled_laws import auto_boxes
+    from rigid_dynamics.wheelset.layout import AUTO_BEM
+
+    p = result.patches
+    if result.contact_model != "auto" or "auto_rung" not in p or not len(result.t):
+        return None
+    rung = np.asarray(p["auto_rung"], float)
+    residual = np.asarray(p["ellipticity_residual"], float)
+    served = np.isfinite(rung) & (np.nan_to_num(np.asarray(p["normal_force_N"], float)) > 0) & (rung < AUTO_BEM)
+    seen = served & np.isfinite(residual)
+    out = {"served_on_ellipse": int(served.sum()), "seen": bool(seen.any()), "checked": int(seen.sum()),
+           "outside_box": 0, "largest_residual": None, "largest_outside_t_s": None}  # fmt: skip
+    if not seen.any():
+        return out
+    out["largest_residual"] = float(residual[seen].max())
+    key, boxes = auto_boxes(result.scene.contact_tolerance, fastsim_grid)
+    limit = np.full(rung.shape, np.inf)
+    for i, (_, box) in enumerate(boxes):
+        if box is not None:
+            limit[seen & (rung == i)] = box["ellipticity_residual"]
+    outside = seen & (residual > limit)
+    out["outside_box"] = int(outside.sum())
+    out["level"] = None if key is None else float(key)
+    if outside.any():
+        k = np.argwhere(outside)
+        worst = k[int(np.argmax(residual[outside]))]
+        out["largest_outside"] = float(residual[tuple(worst)])
+        out["largest_outside_t_s"] = float(result.t[worst[0]])
+    return out
+
+
+def auto_geometry_check(status: str, message: str, geometry: dict | None) -> tuple[str, str]:
+    """(status, message) with :func:`auto_geometry` judged: an "ok" run of ``auto`` that served recorded patches on
+    the ellipse outside their rung's measured ellipticity box ends "warning", naming how many and the largest.
+    """
+    if status != "ok" or not geometry or not geometry["outside_box"]:
+        return status, message
+    return "warning", (
+        f"{message}; auto served {geometry['outside_box']} of {geometry['checked']} recorded patches on Hertz's "
+        f"ellipse whose sampled gap departs from it beyond the rung's measured box (ellipticity residual up to "
+        f"{geometry['largest_outside']:.3g} at t = {geometry['largest_outside_t_s']:.6g} s; auto decides on the "
+        'ellipse in the loop): their error against the BEM on the sampled gap is not known (contact_model "bem" '
+        "solves the sampled patches)"
+    )
+
+
 def _contact_grid_error(result) -> dict:
     """The contact grid's statement: the BEM's own estimate of every solve in the loop (callback.PatchCallback
     keeps the largest), or "not estimated" for the other models.

@@ -385,8 +385,18 @@ class SimulationResult:
                     f: float(np.count_nonzero(deciding == i) / n) for i, f in enumerate(FEATURES)
                 },
                 "thresholds": thresholds_identity(load_thresholds()),
+                "geometry": self.auto_geometry(),
             }
         }
+
+    def auto_geometry(self) -> dict | None:
+        """discretisation.auto_geometry at the scene's FASTSIM grid: auto's ellipse-served patches against their
+        sampled gap.
+        """
+        from rigid_dynamics.wheelset.discretisation import auto_geometry
+
+        scene = self.scene
+        return None if scene is None else auto_geometry(self, (scene.fastsim_elements_per_strip, scene.fastsim_strips))
 
     def _error_summary(self, num) -> dict:
         """The force error estimate of a fixed-step run in the summary: the largest after the settling distance

@@ -44,7 +44,8 @@ exceeds ``force_tolerance``, or when a BEM patch's own grid-error estimate of it
 ``grid_tolerance`` (discretisation.contact_grid_check), or when a companion estimate (the contact grid, the geometry
 tables, scipy's step: discretisation.companion_check) exceeds ``force_tolerance``, or when ``auto`` reused BEM patches
 and a correction measured at a re-solve departed from the fresh solution by more than ``contact_tolerance``
-(discretisation.auto_reuse_check); and ``"ok"`` when it reaches the
+(discretisation.auto_reuse_check), or when ``auto`` served recorded patches on Hertz's ellipse whose sampled gap
+departs from it beyond the rung's measured box (discretisation.auto_geometry_check); and ``"ok"`` when it reaches the
 end without any of these (one function judges a run's step or tolerances this way: :func:`judge_step`; the
 companions follow it). Events (wheel lift, contact restored, flange contact onset, adhesion limit and wheel slide) are
 detected on the output samples, so their times are known to one output step.
@@ -62,6 +63,7 @@ import numpy as np
 
 from rigid_dynamics.wheelset.discretisation import (
     Companions,
+    auto_geometry_check,
     auto_reuse_check,
     companion_check,
     companion_errors,
@@ -381,7 +383,8 @@ def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray
     4. scipy's methods (no force error estimate): the energy balance (:func:`_energy_check`);
     5. the beam's modal cut-off error (discretisation.modal_cutoff_check);
     6. the BEM patches' own grid-error estimates (discretisation.contact_grid_check);
-    7. auto's reused BEM patches' measured corrections (discretisation.auto_reuse_check).
+    7. auto's reused BEM patches' measured corrections (discretisation.auto_reuse_check);
+    8. auto's patches served on the ellipse against their sampled gap (discretisation.auto_geometry_check).
     """
     scene = result.scene
     settings = scene.integrator
@@ -412,6 +415,7 @@ def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray
     status, message = modal_cutoff_check(result.status, result.message, scene, settings.force_tolerance)
     status, message = contact_grid_check(status, message, result.callback_stats)
     status, message = auto_reuse_check(status, message, result.callback_stats)
+    status, message = auto_geometry_check(status, message, result.auto_geometry())
     return result if status == result.status else replace(result, status=status, message=message)
 
 
