@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import platform
 import sys
 import time
@@ -171,7 +172,7 @@ def _row(label, angle, n, fx, fy, f_main, area, pmax, ref, cpu=None, creep_plane
     cells += [
         f"{(f_main[1] - ref_main[1]) / mu_n:+.3f}",
         f"{(-f_main[2] + ref_main[2]) / ref_main[2] * -1:+.3f}",
-        "" if cpu is None else f"{cpu:.3f}",
+        "" if cpu is None else f"{cpu:.4f}",
     ]
     return "| " + " | ".join(cells) + " |"
 
@@ -261,8 +262,10 @@ def main() -> int:
     lines = [
         "# The curve-flange flange-root patch against CONTACT",
         "",
-        f"Machine: {platform.machine()} {platform.processor() or ''}, Python {platform.python_version()}; CPU seconds",
-        "per evaluation (process time, shared machine). Made by `benchmarks/bench_curve_flange_contact.py`; CONTACT's",
+        f"Machine: {platform.machine()}, {os.cpu_count()} cores (shared), {platform.system()}, Python "
+        f"{platform.python_version()}; CPU seconds per evaluation (process time; the loop's: its second evaluation "
+        "at the state, the BEM's warm start and influence numbers kept from the first; the static case's: the whole "
+        "equilibrium). Made by `benchmarks/bench_curve_flange_contact.py`; CONTACT's",
         "decks and outputs in `tests/data/contact_curve_flange` (SOURCE.md there).",
         "",
         "State: scene `curve-flange` at t = 0 started on its settled flange root (y = -6.28 mm, yaw -4.55 mrad,",
