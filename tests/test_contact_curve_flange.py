@@ -27,6 +27,7 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rigid_dynamics.contact.wheelset_case import WheelsetCase, solve_wheelset_case
@@ -108,3 +109,79 @@ def test_vertical_position_near_the_states(solved, reference):
     right wheel, tests/data/contact_curve_flange/right_planar_curve.out) the approaches agree to 0.01 um."""
     assert reference["Z_WS"] == pytest.approx((STATE["z_m"] + NOMINAL_RADIUS_M) * 1e3, abs=1e-4)
     assert math.isclose(solved.wheel_vertical_position_m["left"], STATE["z_m"], abs_tol=3e-6)
+
+
+@pytest.fixture(scope="module")
+def loop_contact():
+    """The loop's callback (BEM on the sampled gap, patches formed as CONTACT's module 1 forms them) at the state:
+    WheelsetModel.contact, the forces the dynamics uses, on the wheel in the main frame, per side."""
+    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
+    from wheelrail.config import read_toml
+    from wheelrail.scenes import parse_scene, resolve_scene_path
+
+    path = resolve_scene_path("curve-flange")
+    doc = read_toml(path, "scene file")
+    doc["settling_distance_m"], doc["contact_model"] = 0.0, "bem"
+    doc["initial"] = {**doc.get("initial", {}), "lateral_displacement_m": STATE["y_m"], "yaw_rad": STATE["yaw_rad"]}
+    scene = parse_scene(doc, base_dir=path.parent)
+    model = WheelsetModel(scene, build_provider(scene), get_contact_model("bem"), model_options("bem", scene))
+    state = np.zeros(12)
+    state[1:5] = STATE["y_m"], STATE["z_m"], STATE["yaw_rad"], STATE["roll_rad"]
+    state[6], state[11] = STATE["x_velocity_m_per_s"], STATE["spin_rate_rad_per_s"]
+    cs = model.contact(state, record=True, keep_search_memory=True)
+    out = {}
+    for i, side in enumerate(cs.side):
+        values = {k: float(np.asarray(v)[i]) for k, v in cs.values.items()}
+        out["left" if side == 0 else "right"] = {"force_main_N": np.asarray(cs.force_N[i], float), **values}
+    return out
+
+
+def _contact_frame(angle_rad: float, side: str):
+    """Columns e_x, e_y, n (on the wheel, wheelrail's convention) of the plane at the contact angle."""
+    sgn = -1.0 if side == "right" else 1.0
+    n = np.array([0.0, sgn * math.sin(angle_rad), -math.cos(angle_rad)])
+    e_x = np.array([1.0, 0.0, 0.0])
+    return np.stack([e_x, np.cross(n, e_x), n], -1)
+
+
+def test_loop_flange_root_patch_is_contacts_planar_patch(loop_contact):
+    """The loop's flange-root patch at the state (the same pose, Z_WS prescribed in CONTACT) against CONTACT's planar
+    solution with the loop's kinematics (left_planar_curve.out: curvature 1/R, the state's rates). Resolved in
+    CONTACT's patch frame, the loop's creep force is CONTACT's: a lateral creep force of 0.8 mu N, not the 0.17 mu N
+    the run's record shows (formed_patches.candidate_forces writes it in the candidate's frame, 0.26 rad away).
+    Recorded: F_s 28.66 against 29.25 kN (1.6 % of mu FN), F_x 2.33 against 1.53 kN (2.2 %), FN 117.8 against
+    120.3 kN (-2.1 %), the total force on the wheel 2.1 % (lateral) and 2.0 % (vertical) below CONTACT's, area
+    +0.2 %, p_max -2.9 %. Tolerances: 3 % (FN, total force, p_max, area) and 3 % of mu FN (creep forces): at the same
+    pose CONTACT's planar undeformed distance is 2.3 um deeper than ours (its approach 112.2 um against 109.9 um; on
+    the same 0.5 mm grid at equal vertical force the static case agrees to 0.03 %, above); the loop's BEM grid is
+    its own (0.35 mm elements here), CONTACT's 0.2 mm."""
+    ref = read_out(DATA / "left_planar_curve.out")[0]
+    patch = ref["patches"][0]
+    mine = loop_contact["left"]
+    frame = _contact_frame(patch["DELTCP(TR)"], "left")
+    f_x, f_s, f_n = frame.T @ mine["force_main_N"]
+    mu_fn = MATERIAL.friction_coefficient * patch["FN"]
+    assert f_n == pytest.approx(patch["FN"], rel=0.03)
+    assert abs(f_s - patch["FS"]) <= 0.03 * mu_fn
+    assert abs(f_x + patch["FX"]) <= 0.03 * mu_fn
+    assert f_s / (MATERIAL.friction_coefficient * f_n) > 0.75  # the creep force in its own plane: 0.81 mu N
+    wheel = -np.asarray([ref["FX(TR)"], ref["FY(TR)"], ref["FZ(TR)"]])
+    assert mine["force_main_N"][1] == pytest.approx(wheel[1], rel=0.03)
+    assert mine["force_main_N"][2] == pytest.approx(wheel[2], rel=0.03)
+    assert mine["max_pressure_Pa"] * 1e-6 == pytest.approx(patch["PMAX"], rel=0.03)
+    assert mine["contact_area_m2"] * 1e6 == pytest.approx(patch["NCON"] * ref["DX"] * ref["DS"], rel=0.03)
+
+
+def test_loop_tread_patch_is_contacts(loop_contact):
+    """The right (inner) wheel's tread patch at the state against CONTACT (right_planar_curve.out): a near-Hertzian
+    patch, the same pose. Recorded: approach 95.01 against 94.99 um, FN and the total lateral force within 0.05 %.
+    Tolerances 0.5 % (FN, lateral and vertical force) and 0.1 um (approach)."""
+    ref = read_out(DATA / "right_planar_curve.out")[0]
+    patch = ref["patches"][0]
+    mine = loop_contact["right"]
+    wheel = -np.asarray([ref["FX(TR)"], ref["FY(TR)"], ref["FZ(TR)"]])
+    assert mine["normal_force_N"] == pytest.approx(patch["FN"], rel=0.005)
+    assert mine["approach_m"] * 1e3 == pytest.approx(patch["APPROACH"], abs=1e-4)
+    assert mine["force_main_N"][1] == pytest.approx(wheel[1], rel=0.005)
+    assert mine["force_main_N"][2] == pytest.approx(wheel[2], rel=0.005)
