@@ -209,6 +209,18 @@ def estimate(
     return out
 
 
+def _add_window_error(info: dict, window: dict | None) -> None:
+    """Add the finest level's fit-window (model) error of the max pressure (fea.model, "Peak box") to its estimate;
+    the max pressure's error becomes unknown (None) when the window's second fit failed.
+    """
+    if window is None or window.get("max_pressure_Pa") is None:
+        return
+    error = window.get("relative_error")
+    info["window_relative_error"] = {"max_pressure": error}
+    mesh = info["relative_error"].get("max_pressure")
+    info["relative_error"]["max_pressure"] = None if error is None or mesh is None else mesh + error
+
+
 def solve_to_tolerance(
     solve_level, opts, *, approach_control: bool, block_estimate: bool, t0: float, measure_order: bool = False
 ):
@@ -267,6 +279,8 @@ def solve_to_tolerance(
         levels.append(_quantities(result))
         records.append({"elements_per_semi_axis": n, "grading": g, "dofs": int(result.extra.get("dofs", 0)),
                         "wall_time_s": time.perf_counter() - t_level, **levels[-1]})  # fmt: skip
+        if result.extra.get("max_pressure_window") is not None:
+            records[-1]["window_relative_error"] = result.extra["max_pressure_window"].get("relative_error")
         if k == 0 and block_estimate and not balanced:  # load-balanced: the fixed second-order term instead
             wide = dataclasses.replace(level_opts, domain_factor=2.0 * opts.block_factor, stresses=False)
             wide_result, _ = solve_level(wide)
@@ -289,6 +303,7 @@ def solve_to_tolerance(
         if k >= 1:
             block_level = 1 if records[0].get("order_level") else 0  # the block check's mesh is the first level's
             info.update(estimate(levels, block, approach_control, balanced, opts.block_factor, block_level))
+            _add_window_error(info, result.extra.get("max_pressure_window"))
             info["estimated"] = True
             worst = {name: info["relative_error"].get(name) for name in judged}
             if all(e is not None and e <= tol for e in worst.values()):
