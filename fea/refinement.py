@@ -220,11 +220,26 @@ def estimate(
     return out
 
 
-def _add_window_error(info: dict, window: dict | None) -> None:
-    """Add the finest level's fit-window (model) error of the max pressure (fea.model, "Peak box") to its estimate;
-    the max pressure's error becomes unknown (None) when the window's second fit failed.
+def _window_record(result) -> dict:
+    """A level's record of its fixed-window max pressure (fea.model, "Peak box"): empty without a peak box."""
+    window = result.extra.get("max_pressure_window")
+    if window is None:
+        return {}
+    fitted = window.get("max_pressure_Pa") is not None
+    return {"window_fit": fitted, "window_relative_error": window.get("relative_error")}
+
+
+def _add_window_error(info: dict, window: dict | None, records: list[dict] = ()) -> None:
+    """Add the finest level's fit-window (model) error of the max pressure (fea.model, "Peak box") to its estimate.
+    The max pressure's error becomes unknown (None) when the window's second fit failed on the finest level, or when
+    a level's window fit failed and it reported the shrinking-radius fit instead (two estimators in one series).
     """
-    if window is None or window.get("max_pressure_Pa") is None:
+    if window is None:
+        return
+    if window.get("max_pressure_Pa") is None or not all(r.get("window_fit", True) for r in records):
+        info["window_relative_error"] = {"max_pressure": None}
+        info["relative_error"]["max_pressure"] = None
+        info["window_note"] = "the fixed-window fit failed on a level: max pressure error not estimated"
         return
     error = window.get("relative_error")
     info["window_relative_error"] = {"max_pressure": error}
@@ -290,8 +305,7 @@ def solve_to_tolerance(
         levels.append(_quantities(result))
         records.append({"elements_per_semi_axis": n, "grading": g, "dofs": int(result.extra.get("dofs", 0)),
                         "wall_time_s": time.perf_counter() - t_level, **levels[-1]})  # fmt: skip
-        if result.extra.get("max_pressure_window") is not None:
-            records[-1]["window_relative_error"] = result.extra["max_pressure_window"].get("relative_error")
+        records[-1].update(_window_record(result))
         if k == 0 and block_estimate and not balanced:  # load-balanced: the fixed second-order term instead
             wide = dataclasses.replace(level_opts, domain_factor=2.0 * opts.block_factor, stresses=False)
             wide_result, _ = solve_level(wide)
@@ -308,13 +322,14 @@ def solve_to_tolerance(
                 levels.insert(0, _quantities(coarse))
                 records.insert(0, {"elements_per_semi_axis": n0 / ratio, "grading": g0 * ratio,
                                    "dofs": int(coarse.extra.get("dofs", 0)), "order_level": True,
-                                   "wall_time_s": time.perf_counter() - t_level, **levels[0]})  # fmt: skip
+                                   "wall_time_s": time.perf_counter() - t_level, **levels[0],
+                                   **_window_record(coarse)})  # fmt: skip
             else:
                 info["order_level"] = f"not used: {coarse.status} ({coarse.message})"
         if k >= 1:
             block_level = 1 if records[0].get("order_level") else 0  # the block check's mesh is the first level's
             info.update(estimate(levels, block, approach_control, balanced, opts.block_factor, block_level))
-            _add_window_error(info, result.extra.get("max_pressure_window"))
+            _add_window_error(info, result.extra.get("max_pressure_window"), records)
             info["estimated"] = True
             worst = {name: info["relative_error"].get(name) for name in judged}
             if all(e is not None and e <= tol for e in worst.values()):

@@ -390,6 +390,9 @@ def test_the_window_error_is_added_to_the_max_pressure_s_and_unknown_when_its_se
     failed = {"relative_error": {"max_pressure": 0.01}}
     _add_window_error(failed, {"max_pressure_Pa": 9e8, "relative_error": None})
     assert failed["relative_error"]["max_pressure"] is None
+    mixed = {"relative_error": {"max_pressure": 0.01}}
+    _add_window_error(mixed, {"max_pressure_Pa": 9e8, "relative_error": 0.004}, [{"window_fit": False}, {}])
+    assert mixed["relative_error"]["max_pressure"] is None
     untouched = {"relative_error": {"max_pressure": 0.01}}
     _add_window_error(untouched, None)
     assert untouched == {"relative_error": {"max_pressure": 0.01}}
