@@ -529,6 +529,7 @@ def run_compare(named, out_dir, models=COMPARE_MODELS, options=None, fea_options
             "resolution": _fea_resolution(fea_result),
             "stated_errors": stated_errors(fea_result),
             "element_size_m": fea_result.extra.get("element_size_m"),
+            "error_parts": _fea_error_parts(fea_result),
         }
         solved["fea"]["agreement_with_bem"] = _fea_bem_agreement(solved["fea"], bem_main)
         solved["fea"]["verdict_why"] = _fea_bem_why(solved["fea"], solved.get("bem", {}))
@@ -560,11 +561,40 @@ def _fea_resolution(result) -> str:
     mesh = result.extra.get("mesh") or {}
     cells = mesh.get("element_count") or mesh.get("cells") or mesh.get("n_cells")
     text = f"element size {size * 1e3:.3g} mm at the patch" if size else "mesh not reported"
-    levels = (result.extra.get("discretisation_error") or {}).get("levels") or []
+    info = result.extra.get("discretisation_error") or {}
+    levels = info.get("levels") or []
     if levels:
         finest = levels[-1]["elements_per_semi_axis"]
         text += f", finest of {len(levels)} refinement levels ({finest:.3g} per semi-axis)"
+    box = (info.get("peak_box") or {}).get("box_m")
+    window = result.extra.get("max_pressure_window") or {}
+    if size and box and window.get("max_pressure_Pa") is not None:
+        refinement = info["peak_box"]["refinement"]
+        text += (
+            f", {size / refinement * 1e3:.3g} mm in a {2e3 * box[2]:.3g} x {2e3 * box[3]:.3g} mm box at the pressure "
+            f"peak (max pressure fitted over a {window['radius_m'] * 1e3:.3g} mm disc)"
+        )
     return text + (f", {cells} cells" if cells else "")
+
+
+def _fea_error_parts(result) -> dict:
+    """The parts of the FEA's stated relative errors (fea.refinement): mesh (Richardson), block size and, for the max
+    pressure of a patch with a peak box, the fit window's model error; and each level's max pressure and area.
+    """
+    info = result.extra.get("discretisation_error") or {}
+    parts = {}
+    for name in ("max_pressure", "contact_area", "normal_force"):
+        parts[name] = {
+            "mesh": (info.get("mesh_relative_error") or {}).get(name),
+            "block_size": (info.get("block_size_relative_error") or {}).get(name),
+            "window": (info.get("window_relative_error") or {}).get(name),
+            "observed_order": (info.get("observed_order") or {}).get(name),
+        }
+    levels = [
+        {k: level.get(k) for k in ("elements_per_semi_axis", "dofs", "max_pressure", "contact_area", "normal_force")}
+        for level in info.get("levels") or []
+    ]
+    return {"parts": parts, "levels": levels}
 
 
 def _source_file(named) -> str | None:

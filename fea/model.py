@@ -19,6 +19,24 @@ Formulations (option ``formulation``):
 Frictionless in all cases: creep forces are None (``extra["tangential"]`` says why: the rolling solver of
 :mod:`fea.friction` does not yet state its 3-D error).
 
+Peak box (sampled patches, rigid formulation, solved to ``mesh_tolerance``). The pressure top of a sampled patch can
+be much narrower than the patch: at the demo's peak (polygonal-wheel, 98 kN) a ridge about 2 mm wide across a patch
+20 mm long, 1.4 mm from its edge, where the isotropic mesh of the patch box put 2-4 elements (0.47-1.07 mm) and the
+max pressure converged at order 0.29 (benchmarks/results/fea_peak_pressure.md). Before the series, one solve a
+refinement step coarser than its first level locates the peak: the nodes whose patch-averaged pressure is at least
+``PEAK_LEVEL`` (0.85) of the largest, their bounding box padded by that solve's element size. Every level of the
+series then meshes this box (fixed across the levels) ``peak_refinement`` (3) times finer than the patch
+(``meshing.hertz`` ``peak_boxes_m``: the size grows with the same grading away from it), at about 35 % more unknowns
+on that patch. The max pressure is the peak of the quadric cap fitted to p^2 = (N_i / w_i)^2, weighted by w_i, over
+a disc of fixed radius R = ``WINDOW_FRACTION`` (0.6) times the box's smaller half-width (fea.postprocess.window_peak):
+a fixed region, so the value converges with the mesh as the pressure's weighted averages do, to the continuous fit
+whose model error is O(R^4) on a smooth non-quadric top (zero on Hertz's p^2); that model error is estimated from a
+second fit over R / 1.5 centred at the first one's top, |p(R) - p(R/1.5)| / (1 - 1.5^-4), and added to the max
+pressure's Richardson estimate (``discretisation_error.window_relative_error``). Chosen over a fit radius that
+shrinks with h (its bias fell as h^(1/2) on the ridge) and over a fixed-count radius (r = 3-6 local elements: the
+nodal scatter of a few per cent then does not average out, level-to-level changes of 0.5-2 % of either sign), by the
+measured series of benchmarks/results/fea_peak_pressure.md.
+
 Frame: contact frame of the patch (x rolling, y lateral, z normal rail -> wheel); the block stands
 for the body below the contact plane, the pressure acts on the wheel along +z. Units SI.
 
@@ -90,6 +108,9 @@ class FeaOptions:
         load_balanced: the caller balances the load with this solve's force under approach control (a wheelset
             equilibrium, :meth:`FeaModel.load_balanced_options`): the max pressure and area are judged at the
             finest level's force and the force is not judged (fea.refinement, load-balanced use).
+        peak_refinement: a sampled patch solved to ``mesh_tolerance`` (rigid formulation) is meshed ``peak_refinement``
+            times finer in a box around its pressure peak, located by one coarse solve first (module docstring,
+            "Peak box"); 1: no peak box.
     """
 
     quick: bool = False
@@ -114,6 +135,7 @@ class FeaOptions:
     max_dofs: int = 200_000
     grading: float = 0.4
     load_balanced: bool = False
+    peak_refinement: float = 3.0
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -150,6 +172,8 @@ class FeaOptions:
             raise ValueError(f"mesh_tolerance = {self.mesh_tolerance!r}: expected a finite number > 0 or None")
         if not (math.isfinite(self.grading) and self.grading > 0):
             raise ValueError(f"grading = {self.grading!r}: expected a finite number > 0")
+        if not (math.isfinite(self.peak_refinement) and self.peak_refinement >= 1):
+            raise ValueError(f"peak_refinement = {self.peak_refinement!r}: expected a finite number >= 1")
         if self.stress_points_m is not None:
             pts = np.asarray(self.stress_points_m, dtype=float)
             if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
@@ -214,6 +238,11 @@ OPTIONS = declare_dataclass(
         "load_balanced": {
             "help": "the caller balances the load with the force (approach control): judge p and area "
             "at the finest level's force, not the force"
+        },
+        "peak_refinement": {
+            "help": "sampled patches solved to mesh_tolerance: element size at the pressure peak / in the patch "
+            "(1: no peak box)",
+            "minimum": 1,
         },
     },
 )
@@ -285,15 +314,32 @@ class FeaModel:
             return self._empty(geometry, creepage, "no-contact", "approach_m <= 0: the surfaces do not touch", t0)
         from fea.refinement import solve_to_tolerance
 
+        peak: dict = {"box": None}
+
         def solve_level(level_opts):
-            return self._solve_level(geometry, creepage, material, normal_force_N, level_opts, comm, t0)
+            result, write = self._solve_level(
+                geometry, creepage, material, normal_force_N, level_opts, comm, t0, peak_box=peak["box"]
+            )
+            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
+            return result, write
 
         key = None
         if opts.load_balanced and normal_force_N is None and opts.mesh_tolerance is not None:
             key = (_series_key(geometry, material, options), math.degrees(geometry.contact_angle_rad))
+            memo = self._memo_entry(key)
+            peak["box"] = memo.get("peak_box") if memo is not None else None
             reused = self._reuse_series(key, solve_level, t0)
             if reused is not None:
                 return reused
+        use_peak_box = (
+            geometry.undeformed is not None
+            and opts.formulation == "rigid"
+            and opts.mesh_tolerance is not None
+            and opts.peak_refinement > 1
+        )
+        locator = None
+        if use_peak_box:
+            peak["box"], locator = self._locate_peak(solve_level, opts, peak)
         result = solve_to_tolerance(
             solve_level,
             opts,
@@ -303,6 +349,8 @@ class FeaModel:
             measure_order=geometry.undeformed is not None,
         )
         info = result.extra.get("discretisation_error") or {}
+        if use_peak_box:
+            info["peak_box"] = locator
         previous = self._memo_entry(key) if key is not None else None
         if previous is not None and "rerun" in previous:
             info["series_rerun"] = previous["rerun"]  # why the previous series was not reused
@@ -326,8 +374,41 @@ class FeaModel:
                 "info": info,
                 "normal_force_N": result.normal_force_N,
                 "mesh": mesh,
+                "peak_box": peak["box"],
             })  # fmt: skip
         return result
+
+    @staticmethod
+    def _locate_peak(solve_level, opts, peak) -> tuple[tuple | None, dict]:
+        """The peak box of a sampled patch (module docstring, "Peak box"): one solve without it, one refinement step
+        coarser than the series' first level; the box holds the nodes whose patch-averaged pressure is at least
+        ``PEAK_LEVEL`` of the largest, padded by that solve's element size.
+
+        Returns:
+            ((x_c, y_c, a, b) or None when the locating solve failed, a record for ``discretisation_error``).
+        """
+        from fea.refinement import REFINEMENT_RATIO
+
+        n = max(opts.n_per_semi_axis / REFINEMENT_RATIO, 2.0)
+        level = dataclasses.replace(
+            opts, elements_per_semi_axis=n, mesh_size_factor=1.0, grading=opts.grading * REFINEMENT_RATIO,
+            stresses=False, mesh_tolerance=None, output_dir=None,
+        )  # fmt: skip
+        peak["box"] = None
+        t = time.perf_counter()
+        result, _ = solve_level(level)
+        record = {"elements_per_semi_axis": n, "refinement": opts.peak_refinement, "level": PEAK_LEVEL,
+                  "wall_time_s": time.perf_counter() - t}  # fmt: skip
+        nodes = peak.get("nodes")
+        if result.status != "ok" or nodes is None or not len(nodes):
+            record["box_m"] = None
+            record["why"] = f"locating solve {result.status}: {result.message}"
+            return None, record
+        pad = result.extra["element_size_m"]
+        lo, hi = nodes.min(axis=0) - pad, nodes.max(axis=0) + pad
+        box = (*(0.5 * (lo + hi)).tolist(), *(0.5 * (hi - lo)).tolist())
+        record["box_m"] = list(box)
+        return tuple(box), record
 
     def _memo_entry(self, key) -> dict | None:
         """The memorised series of the patch ``key`` = (identity, contact angle in degrees): the entry of that
@@ -384,7 +465,7 @@ class FeaModel:
             extra={**result.extra, "discretisation_error": info},
         )
 
-    def _solve_level(self, geometry, creepage, material, normal_force_N, opts, comm, t0):
+    def _solve_level(self, geometry, creepage, material, normal_force_N, opts, comm, t0, peak_box=None):
         """One solve on the mesh of ``opts``: (ContactResult with status "ok" or a failure, write()), ``write()``
         writing the VTU grid and the PNGs of this level when ``opts.output_dir`` is set.
         """
@@ -473,6 +554,9 @@ class FeaModel:
             symmetry="quarter" if quadric and opts.formulation != "profiles" and not opts.surface_traction else "full",
             refine_boxes_m=boxes,
         )
+        if peak_box is not None and spec.symmetry == "full" and opts.formulation == "rigid":
+            spec = dataclasses.replace(spec, peak_boxes_m=((*peak_box, spec.contact_size_m / opts.peak_refinement),))
+        h_local = spec.contact_size_m / (opts.peak_refinement if spec.peak_boxes_m else 1.0)
         t_mesh = time.perf_counter()
         limits = QualityLimits(opts.min_mesh_quality, opts.max_elements)
         settings = SolverSettings(
@@ -576,21 +660,32 @@ class FeaModel:
         usable = in_contact_nodes & (weight > 1e-9 * weight.max())
         nodal = np.where(usable, force / np.where(usable, weight, 1.0), 0.0)
         peak = (
-            post.peak_pressure(xy, nodal, usable, xy[int(np.argmax(pressure))], _peak_fit_radius(spec))
+            post.peak_pressure(xy, nodal, usable, xy[int(np.argmax(pressure))], _peak_fit_radius(spec, h_local))
             if pressure.size
             else None
         )
         extra["max_pressure_filtered_Pa"] = max_pressure
         extra["max_pressure_peak_fit_Pa"] = peak
+        window = _window_peak(spec, xy, force, weight, usable, h_local, post) if spec.peak_boxes_m else None
+        extra["peak_nodes_m"] = xy[pressure >= PEAK_LEVEL * max_pressure] if max_pressure > 0 else None
         if peak is not None:
             max_pressure = peak
+        if window is not None:
+            extra["max_pressure_window"] = window
+            if window["max_pressure_Pa"] is not None:
+                max_pressure = window["max_pressure_Pa"]
         area_nodal = float(sol.node_weight_m2[sol.active].sum()) * domain.symmetry_factor
         weighted = sol.node_weight_m2 > 1e-9 * sol.node_weight_m2.max()
         extra["max_nodal_pressure_Pa"] = float((sol.node_force_N[weighted] / sol.node_weight_m2[weighted]).max())
         extra["contact_area_nodal_m2"] = area_nodal
         extra["max_pressure_definition"] = (
-            "peak of a quadric fitted to the squared nodal pressures N_i / w_i within "
-            f"{_peak_fit_radius(spec) * 1e3:.3g} mm of the largest patch average (fea.postprocess.peak_pressure): the "
+            f"peak of a quadric fitted to the squared nodal pressures N_i / w_i, weighted by w_i, over a disc of fixed "
+            f"radius {window['radius_m'] * 1e3:.3g} mm in the peak box meshed {opts.peak_refinement:g} times finer "
+            "(fea.postprocess.window_peak; fea.model, 'Peak box')"
+            if window is not None and window["max_pressure_Pa"] is not None
+            else "peak of a quadric fitted to the squared nodal pressures N_i / w_i within "
+            f"{_peak_fit_radius(spec, h_local) * 1e3:.3g} mm of the largest patch average "
+            "(fea.postprocess.peak_pressure): the "
             "nodal values scatter by several per cent from node to node and their maximum is biased upwards "
             "(max_nodal_pressure_Pa); the largest patch average (max_pressure_filtered_Pa) is below the top"
             if peak is not None
@@ -685,6 +780,16 @@ class FeaModel:
         )
 
 
+WINDOW_FRACTION = 0.6
+"""The radius of the max-pressure fit in a peak box: this fraction of the box's smaller half-width (module docstring,
+"Peak box")."""
+WINDOW_RATIO = 1.5
+"""The fit's model error is estimated from a second fit over a disc this many times smaller (module docstring)."""
+WINDOW_ORDER = 4.0
+"""Order in the radius of the model error of a quadric-cap fit centred at a smooth top (module docstring)."""
+PEAK_LEVEL = 0.85
+"""The peak box holds the locating solve's nodes whose patch-averaged pressure is at least this fraction of the
+largest (module docstring, "Peak box")."""
 REUSE_ANGLE_DEG = 1.0
 """A load-balanced solve reuses the series of the same side's patch whose contact angle is within this, degrees."""
 REUSE_FORCE_CHANGE = 0.1
@@ -727,12 +832,39 @@ def _mesh_box(semi, center):
     return rounded, tuple(round(c / unit) * unit for c in center)
 
 
-def _peak_fit_radius(spec) -> float:
+def _window_peak(spec, xy, force, weight, usable, h_local, post) -> dict:
+    """The max pressure of a patch with a peak box (module docstring, "Peak box"): the weighted quadric-cap fit over
+    a disc of radius ``WINDOW_FRACTION`` times the box's smaller half-width (fixed across the refinement series),
+    first centred at the largest patch average within the box (radius 1.5 local element sizes), and its model error
+    |p(R) - p(R / WINDOW_RATIO)| / (1 - WINDOW_RATIO^-WINDOW_ORDER) relative to p(R), the second fit centred at the
+    first one's top. Values None where a fit failed (fewer than 12 nodes, no cap, top outside its disc).
+    """
+    xc, yc, a, b, _ = spec.peak_boxes_m[0]
+    radius = WINDOW_FRACTION * min(a, b)
+    out = {"radius_m": radius, "max_pressure_Pa": None, "small_disc_Pa": None, "relative_error": None}
+    inside = usable & (np.abs(xy[:, 0] - xc) <= a) & (np.abs(xy[:, 1] - yc) <= b)
+    if not inside.any():
+        return out
+    pts, f, w = xy[usable], force[usable], weight[usable]
+    average = post.filtered_pressure(pts, f, w, xy[inside], 1.5 * h_local)
+    big = post.window_peak(pts, f, w, xy[inside][int(np.argmax(average))], radius)
+    if big is None:
+        return out
+    out["max_pressure_Pa"] = big[0]
+    out["top_m"] = big[1].tolist()
+    small = post.window_peak(pts, f, w, big[1], radius / WINDOW_RATIO)
+    if small is not None:
+        out["small_disc_Pa"] = small[0]
+        out["relative_error"] = abs(big[0] - small[0]) / (1.0 - WINDOW_RATIO**-WINDOW_ORDER) / big[0]
+    return out
+
+
+def _peak_fit_radius(spec, h_local) -> float:
     """Radius of the peak-pressure fit (fea.postprocess.peak_pressure): sqrt(3 h_c min(a, b)), 0.71 min(a, b) at 6
     elements per semi-axis, shrinking as h^(1/2): the fit's bias O(r^4) then falls as h^2 while the number of nodes
     it averages grows as 1/h. min(a, b) = n h_c: the narrowest region's for a patch of separate regions.
     """
-    return math.sqrt(3.0 * spec.contact_size_m**2 * spec.elements_per_semi_axis)
+    return math.sqrt(3.0 * h_local * spec.contact_size_m * spec.elements_per_semi_axis)
 
 
 REGION_FLOOR = 1.0 / 3.0

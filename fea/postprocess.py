@@ -231,3 +231,43 @@ def quadric_cap_peak(scaled_xy: np.ndarray, pressure: np.ndarray) -> float | Non
         return None
     value = float(c[0] + c[1:3] @ top + 0.5 * top @ hessian @ top)
     return math.sqrt(value) if value > 0 else None
+
+
+def window_peak(
+    xy: np.ndarray, force: np.ndarray, weight: np.ndarray, centre_m: np.ndarray, radius_m: float
+) -> tuple[float, np.ndarray] | None:
+    """Peak of the quadric cap fitted to p^2 over a disc of fixed physical radius, weighted by the nodes' areas.
+
+    p_i = N_i / w_i of the nodes within ``radius_m`` of ``centre_m``; p^2 = c0 + c1 x + c2 y + c3 x^2 + c4 x y +
+    c5 y^2 by least squares with weights w_i (the discrete form of the continuous L2 fit over the disc, so the
+    fitted value converges with the mesh as the integrals of the pressure do, and the nodes of small area, whose
+    N_i / w_i scatter most, count as little as their area). Against :func:`peak_pressure` (a radius shrinking with
+    the mesh): the value converges at the order of the pressure's weighted averages to the continuous fit over the
+    disc, whose own (model) error on a non-quadric top is O(radius^4) and is estimated by the caller from a second
+    radius (fea.model, "Peak box").
+
+    Args:
+        xy: (n, 2) node positions in contact, m. force, weight: (n,) N_i (N) and w_i > 0 (m^2).
+        centre_m: (2,) first centre (the largest patch average), m. radius_m: the disc's radius, m.
+
+    Returns:
+        (peak pressure in Pa, the fitted top in m), or None (fewer than 12 nodes, not a cap, top outside).
+    """
+    centre = np.asarray(centre_m, float)
+    d = xy - centre
+    near = np.hypot(d[:, 0], d[:, 1]) <= radius_m
+    if near.sum() < 12:
+        return None
+    x, y = d[near, 0] / radius_m, d[near, 1] / radius_m
+    root_w = np.sqrt(weight[near])
+    p2 = (force[near] / weight[near]) ** 2
+    matrix = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
+    c, *_ = np.linalg.lstsq(matrix * root_w[:, None], p2 * root_w, rcond=None)
+    hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+    if not np.all(np.linalg.eigvalsh(hessian) < 0):
+        return None
+    top = np.linalg.solve(hessian, -c[1:3])
+    if np.hypot(*top) > 1.0:
+        return None
+    value = float(c[0] + c[1:3] @ top + 0.5 * top @ hessian @ top)
+    return (math.sqrt(value), centre + top * radius_m) if value > 0 else None

@@ -57,6 +57,9 @@ class HertzBlockSpec:
         symmetry: "quarter" or "full".
         refine_boxes_m: ((x_c, y_c, a_i, b_i), ...), separate regions of the patch, each refined in its own box
             (module docstring); empty: the one box of the semi-axes above.
+        peak_boxes_m: ((x_c, y_c, a_i, b_i, h_i), ...), boxes |x - x_c| <= a_i, |y - y_c| <= b_i, |z| <= min(a_i, b_i)
+            meshed at the element size h_i (smaller than h_c), the size growing by g away from them (the pressure
+            peak of a sampled patch, fea.model: the module docstring's "Peak box").
     """
 
     semi_axis_long_m: float
@@ -68,6 +71,7 @@ class HertzBlockSpec:
     center_m: tuple[float, float] = (0.0, 0.0)
     symmetry: str = "quarter"
     refine_boxes_m: tuple = ()
+    peak_boxes_m: tuple = ()
 
     def __post_init__(self) -> None:
         for name in ("semi_axis_long_m", "semi_axis_lat_m", "refine_radius", "grading"):
@@ -87,6 +91,11 @@ class HertzBlockSpec:
         for box in self.refine_boxes_m:
             if len(box) != 4 or not all(math.isfinite(v) for v in box) or min(box[2:]) <= 0:
                 raise ValueError(f"refine_boxes_m entry {box!r}: expected (x_c, y_c, a > 0, b > 0)")
+        for box in self.peak_boxes_m:
+            if len(box) != 5 or not all(math.isfinite(v) for v in box) or min(box[2:]) <= 0:
+                raise ValueError(f"peak_boxes_m entry {box!r}: expected (x_c, y_c, a > 0, b > 0, h > 0)")
+        if self.peak_boxes_m and self.symmetry == "quarter":
+            raise ValueError("peak_boxes_m: expected symmetry 'full'")
         if self.refine_boxes_m and self.symmetry == "quarter":
             raise ValueError("refine_boxes_m: expected symmetry 'full' (separate regions have no quarter symmetry)")
 
@@ -216,6 +225,11 @@ def _size_field(model, spec: HertzBlockSpec) -> None:
         dy = f"max(abs(y-({num(yc)}))-{num(r0 * b)},0)"
         dz = f"max(abs(z)-{num(r0 * min(a, b))},0)"
         terms.append(f"{num(spec.contact_size_m)}+{num(spec.grading)}*sqrt({dx}^2+{dy}^2+{dz}^2)")
+    for xc, yc, a, b, size in spec.peak_boxes_m:
+        dx = f"max(abs(x-({num(xc)}))-{num(a)},0)"
+        dy = f"max(abs(y-({num(yc)}))-{num(b)},0)"
+        dz = f"max(abs(z)-{num(min(a, b))},0)"
+        terms.append(f"{num(size)}+{num(spec.grading)}*sqrt({dx}^2+{dy}^2+{dz}^2)")
     expression = num(h_max)
     for term in terms:  # gmsh's MathEval min takes two arguments
         expression = f"min({expression},{term})"

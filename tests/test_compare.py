@@ -131,3 +131,30 @@ def test_pressure_maps_zoom_to_the_patch_with_equal_or_stated_aspect(tmp_path):
     names = compare._plot_pressures([("hertz", field(3e-3, 2e-3)), ("bem", field(3e-3, 2.1e-3))], None, tmp_path)
     info = Image.open(tmp_path / names[0]).info
     assert "MPa" in info["Description"] and "mm" in info["Description"]
+
+
+def test_the_fea_entry_names_its_peak_box_and_the_parts_of_its_stated_error():
+    """Regression test of the report's FEA entry (comparisons.compare): the resolution names the peak box's element
+    size and fit disc, and the error parts (mesh, block size, window) and the levels come from the series' record."""
+    from comparisons.compare import _fea_error_parts, _fea_resolution
+    from rigid_dynamics.contact.types import ContactResult, Creepage
+
+    info = {
+        "levels": [{"elements_per_semi_axis": 6.0, "dofs": 18000, "max_pressure": 9.77e8, "contact_area": 1.88e-4},
+                   {"elements_per_semi_axis": 9.0, "dofs": 54000, "max_pressure": 9.67e8, "contact_area": 1.87e-4}],
+        "peak_box": {"box_m": [0.0, -0.0118, 0.003, 0.002], "refinement": 3.0},
+        "mesh_relative_error": {"max_pressure": 0.013, "contact_area": 0.003},
+        "block_size_relative_error": {"max_pressure": 0.005},
+        "window_relative_error": {"max_pressure": 0.003},
+    }  # fmt: skip
+    extra = {"element_size_m": 4.74e-4, "discretisation_error": info,
+             "max_pressure_window": {"radius_m": 1.21e-3, "max_pressure_Pa": 9.67e8}}  # fmt: skip
+    result = ContactResult(method="fea", success=True, status="ok", message="", normal_force_N=1e5,
+                           max_pressure_Pa=9.67e8, contact_area_m2=1.87e-4, approach_m=1e-4, creepage=Creepage(),
+                           extra=extra)  # fmt: skip
+    text = _fea_resolution(result)
+    assert "0.474 mm at the patch" in text and "0.158 mm in a 6 x 4 mm box" in text and "1.21 mm disc" in text
+    parts = _fea_error_parts(result)
+    assert parts["parts"]["max_pressure"] == {"mesh": 0.013, "block_size": 0.005, "window": 0.003,
+                                              "observed_order": None}  # fmt: skip
+    assert [level["dofs"] for level in parts["levels"]] == [18000, 54000]
