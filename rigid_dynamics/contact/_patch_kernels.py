@@ -113,7 +113,7 @@ def _wheel(alpha, y, rot, centre, surf, out):
     return r
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _wheel_tangents(alpha, y, rot, centre, surf, out):
     """:func:`_wheel`'s point and tangents t_a, t_y alone (out[W_POINT:W_X_AA], the same arithmetic); return R."""
     r, r_y, _ = _table(y, *surf.wheel)
@@ -134,7 +134,7 @@ def _wheel_tangents(alpha, y, rot, centre, surf, out):
     return r
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rail(x, y, surf):
     """(N, N_x, N_y) at main-frame (x, y), y clipped to the rail's range."""
     yc = min(max(y, surf.rail_range[0]), surf.rail_range[1])
@@ -386,7 +386,7 @@ def out_of_round_locus_reference(lats, alpha_start, half_window, scan_points, in
             overlap_x[k, 0], overlap_x[k, 1] = point[k, 0], point[k, 0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _point_gap(ca, sa, r, y, rot, centre, surf, p):
     """Vertical gap N(x, y) - z of the wheel point of radius r at (cos a, sin a) = (ca, sa) and y_d = y (filled into
     p (3,)); +inf off the rail. The point's arithmetic is :func:`_wheel`'s, operation for operation.
@@ -404,7 +404,7 @@ def _point_gap(ca, sa, r, y, rot, centre, surf, p):
     return n - p[2]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _angle_gap(a, y, r_id, rot, centre, surf, p):
     """:func:`_point_gap` at the angle a with R = r_id + R_irr(a) (as :func:`_wheel` sums it)."""
     v, _, _ = wheel_irregularity(a, surf.wheel_irr)
@@ -474,7 +474,7 @@ def gap_curvature_bound(rot, surf):
     return n_x * x2 + n_y * s * x2 + x2 + n_xx * x1 * x1 + 2.0 * n_xy * x1 * s * x1 + n_yy * (s * x1) ** 2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _gap_slope(a, y, rot, centre, surf, w):
     """(g, dg/da, d2g/da2) of the vertical gap g = N(x, y) - z of the wheel point (a, y_d) (filled into w); (+inf,
     nan, nan) off the rail. g is :func:`_vertical_gap`'s; the second derivative takes the rail table's tabulated
@@ -518,11 +518,19 @@ def _newton_minimum(a, lo, hi, y, rot, centre, surf, w):
 @njit(cache=True)
 def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_points, coarse_stride, newton, rot,
                        centre, surf, right, out, line):  # fmt: skip
-    """Contact locus of an out-of-round wheel: :func:`out_of_round_locus_reference`'s scan, golden-section
-    refinement and integral with the same arithmetic at every angle, evaluated for less: the point alone (no
-    tangents or second derivatives), the ideal radius R_id(y_d) once per y_d (a surface of revolution plus a radial
-    irregularity of the angle alone), and the scan angles' cosines, sines and R_irr once per call (the same angles
-    for every y_d). Each gap is the reference's to the last bit (tests/test_oor_locus_fast.py).
+    """Contact locus of an out-of-round wheel: :func:`out_of_round_locus_reference`'s results for less.
+
+    * Each gap with the reference's arithmetic, evaluated for less: the point alone (no tangents or second
+      derivatives; the helpers inlined), the ideal radius R_id(y_d) once per y_d (a surface of revolution plus a
+      radial irregularity of the angle alone), the scan angles' cosines, sines and R_irr once per call.
+    * The scan at every ``coarse_stride``-th angle (and the last), then at every angle of an interval only where the
+      gap may dip below the smallest found or below 0: by at most :func:`gap_curvature_bound` (stride step)^2 / 8
+      under its lower end (every angle of an interval with an end off the rail). The smallest scanned gap and the
+      first and last negative one are the full scan's.
+    * ``newton``: the minimum by Newton's steps on dg/da (:func:`_newton_minimum`) from the previous y_d's angle, the
+      golden section where they fail; the reference's golden section stops at its rounding (its last steps compare
+      gaps closer than their round-off, about 2e-8 rad). Without ``newton`` every output is the reference's to the
+      last bit; with it the gap agrees to 1e-15 m, the angle to 1e-7 rad (tests/test_oor_locus_fast.py).
     """
     alpha, point, gap, rail_z, angle = out
     weight, weighted_x, overlap_x = line
