@@ -188,6 +188,29 @@ def contact_locus(lats, alpha_start, rot, centre, surf, right, iterations, out):
         angle[k] = math.atan2(tilt, 1.0 / norm)
 
 
+@njit(cache=True, inline="always")
+def _interp(x, xp, fp, j):
+    """np.interp(x, xp, fp) with numba's arithmetic (a facsimile of numpy's arr_interp), given j =
+    searchsorted(xp, x, "right") - 1: one search for the three start values of :func:`plane_gap`, no allocation.
+    """
+    n = xp.shape[0]
+    if math.isnan(x):
+        return x
+    if j < 0:
+        return fp[0]
+    if j >= n - 1:
+        return fp[n - 1]
+    if xp[j] == x:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    value = slope * (x - xp[j]) + fp[j]
+    if math.isnan(value):
+        value = slope * (x - xp[j + 1]) + fp[j + 1]
+        if math.isnan(value) and fp[j] == fp[j + 1]:
+            value = fp[j]
+    return value
+
+
 @njit(cache=True)
 def plane_gap(xs, ys, origin, frame, starts, rot, centre, surf, iterations, out):
     """Fill the :class:`PlaneGap` ``out`` at the plane points (xs[k], ys[k]) of the plane (origin, frame: columns
@@ -224,10 +247,11 @@ def plane_gap(xs, ys, origin, frame, starts, rot, centre, surf, iterations, out)
             gap[k], alpha_out[k], lat_out[k] = math.inf, math.nan, math.nan
             continue
         # wheel: start at the locus point of the same track y
-        lat = np.interp(b1, loc_y, loc_lat)
-        a = np.interp(b1, loc_y, loc_alpha)
+        j = np.searchsorted(loc_y, b1, side="right") - 1
+        lat = _interp(b1, loc_y, loc_lat, j)
+        a = _interp(b1, loc_y, loc_alpha, j)
         r = _wheel_tangents(a, lat, rot, centre, surf, w)
-        a += (b0 - np.interp(b1, loc_y, loc_x)) / r
+        a += (b0 - _interp(b1, loc_y, loc_x, j)) / r
         _wheel_tangents(a, lat, rot, centre, surf, w)
         s = n0 * (w[0] - b0) + n1 * (w[1] - b1) + n2 * (w[2] - b2)
         converged = False
