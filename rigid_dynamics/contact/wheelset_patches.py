@@ -140,6 +140,10 @@ OUT_OF_ROUND_WINDOW_RAD = 0.2
 compute_oor_whl, which meshes the wheel over -pitch +- 0.2 rad)."""
 OUT_OF_ROUND_SCAN_POINTS = 161  # 2.5e-3 rad apart: 1.15 mm along a 0.46 m wheel
 OUT_OF_ROUND_INTEGRATION_POINTS = 65
+OUT_OF_ROUND_COARSE_STRIDE = 8
+"""The compiled scan evaluates every 8th angle first, then every angle only where a bound of the gap's curvature
+lets it dip below the smallest gap found or below 0 (_patch_kernels.out_of_round_locus): the same minimum and overlap
+ends as the full scan."""
 OUT_OF_ROUND_SCREEN_M = 2.0e-4
 """Only the y_d whose round-wheel gap is below the irregularity's largest radius increase plus this are scanned
 (elsewhere the gap is the round one minus that increase: a lower bound, far from contact)."""
@@ -153,6 +157,26 @@ def _out_of_round(geo: _SideGeometry) -> bool:
     return bool(getattr(geo.wheel, "irregularities", ()))
 
 
+_RISES: dict = {}
+"""The largest radius increase of each irregularity set met (:func:`_largest_rise`), by its rows' bytes."""
+
+
+def _largest_rise(wheel) -> float:
+    """The irregularities' largest radius increase over 4097 angles of the turn (>= 0), m; the same for every pose,
+    so computed once per set of irregularity rows (a tabulated wheel's closed forms).
+    """
+    from rigid_dynamics.contact.search import _irregularity_sum
+
+    key = wheel.irregularity_rows.tobytes()
+    rise = _RISES.get(key)
+    if rise is None:
+        turns = np.linspace(-math.pi, math.pi, 4097)
+        rise = max(float(_irregularity_sum(wheel.irregularities, turns, np.zeros_like(turns))[0].max()), 0.0)
+        if len(_RISES) < 64:
+            _RISES[key] = rise
+    return rise
+
+
 def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float) -> ContactLocus:
     """Contact locus of an out-of-round wheel (CONTACT meshes such a wheel in 3-D, compute_oor_whl, instead of
     assuming a surface of revolution): for each y_d the wheel angle of the smallest vertical gap over a window
@@ -164,7 +188,6 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
     half, scan, m = OUT_OF_ROUND_WINDOW_RAD, OUT_OF_ROUND_SCAN_POINTS, OUT_OF_ROUND_INTEGRATION_POINTS
     if _compiled(geo):
         from rigid_dynamics.contact import _patch_kernels as kern
-        from rigid_dynamics.contact.search import _irregularity_sum
 
         # the round wheel's locus screens the y_d that can touch
         alpha, point = np.empty(n), np.empty((n, 3))
@@ -174,9 +197,7 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
             lat, alpha_start, geo.rot, geo.centre, surf._replace(wheel_irr=np.zeros((0, 7))), geo.side == "right", 6,
             kern.Locus(alpha, point, gap, rail_z, angle),
         )  # fmt: skip
-        turns = np.linspace(-math.pi, math.pi, 4097)
-        rise = max(float(_irregularity_sum(geo.wheel.irregularities, turns, np.zeros_like(turns))[0].max()), 0.0)
-        gap = gap - rise
+        gap = gap - _largest_rise(geo.wheel)
         near = np.flatnonzero(np.isfinite(gap) & (gap < OUT_OF_ROUND_SCREEN_M))
         weight, weighted_x = np.zeros(n), np.full(n, np.nan)
         overlap = np.full((n, 2), np.nan)
@@ -185,8 +206,8 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
             out = [np.empty(k), np.empty((k, 3)), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k),
                    np.empty((k, 2))]  # fmt: skip
             kern.out_of_round_locus(
-                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, geo.rot, geo.centre, surf,
-                geo.side == "right", kern.Locus(*out[:5]), kern.OverlapLine(*out[5:]),
+                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, OUT_OF_ROUND_COARSE_STRIDE, True, geo.rot,
+                geo.centre, surf, geo.side == "right", kern.Locus(*out[:5]), kern.OverlapLine(*out[5:]),
             )  # fmt: skip
             for target, value in zip((alpha, point, gap, rail_z, angle, weight, weighted_x, overlap), out, strict=True):
                 target[near] = value
