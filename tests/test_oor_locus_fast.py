@@ -71,7 +71,7 @@ def _both(wheel, rail, pose, newton):
                 wp.OUT_OF_ROUND_INTEGRATION_POINTS)  # fmt: skip
         tail = (geo.rot, geo.centre, surf, True, kern.Locus(*out[:5]), kern.OverlapLine(*out[5:]))
         if fast:
-            kern.out_of_round_locus(*args, wp.OUT_OF_ROUND_COARSE_STRIDE, newton, *tail)
+            kern.out_of_round_locus(*args, kern.FastScan(wp.OUT_OF_ROUND_COARSE_STRIDE, newton), *tail)
         else:
             kern.out_of_round_locus_reference(*args, *tail)
         outputs.append(out)
@@ -119,7 +119,7 @@ def test_formed_patches_are_the_full_scans(wheel_rail, monkeypatch):
         pose = _pose(wheel, rail, offset, 2e-4)
         fast, _ = wp.wheel_patches(wheel, rail, pose, "right", **kwargs)
         with monkeypatch.context() as m:
-            m.setattr(kern, "out_of_round_locus", lambda *a: kern.out_of_round_locus_reference(*a[:5], *a[7:]))
+            m.setattr(kern, "out_of_round_locus", lambda *a: kern.out_of_round_locus_reference(*a[:5], *a[6:]))
             ref, _ = wp.wheel_patches(wheel, rail, pose, "right", **kwargs)
         assert len(fast) == len(ref) >= 1
         for p, q in zip(fast, ref, strict=True):

@@ -79,6 +79,15 @@ class SortedLocus(NamedTuple):
     x: np.ndarray
 
 
+class FastScan(NamedTuple):
+    """:func:`out_of_round_locus`'s settings: the coarse scan's stride (every stride-th angle first) and whether the
+    minimum is found by Newton's steps on dg/da (else the reference's golden section).
+    """
+
+    coarse_stride: int
+    newton: bool
+
+
 class PlaneGap(NamedTuple):
     """:func:`plane_gap`'s outputs per plane point: gap (k,) m, the wheel parameters alpha (k,) rad, y_d (k,) m."""
 
@@ -540,13 +549,15 @@ def _newton_minimum(a, lo, hi, y, rot, centre, surf, w):
 
 
 @njit(cache=True)
-def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_points, coarse_stride, newton, rot,
-                       centre, surf, right, out, line):  # fmt: skip
+def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_points, fast, rot, centre, surf, right,
+                       out, line):  # fmt: skip
     """Contact locus of an out-of-round wheel: :func:`out_of_round_locus_reference`'s results for less.
 
     * Each gap with the reference's arithmetic, evaluated for less: the point alone (no tangents or second
       derivatives; the helpers inlined), the ideal radius R_id(y_d) once per y_d (a surface of revolution plus a
       radial irregularity of the angle alone), the scan angles' cosines, sines and R_irr once per call.
+    ``fast`` (:class:`FastScan`): the coarse scan's stride and whether the minimum is found by Newton's steps.
+
     * The scan at every ``coarse_stride``-th angle (and the last), then at every angle of an interval only where the
       gap may dip below the smallest found or below 0: by at most :func:`gap_curvature_bound` (stride step)^2 / 8
       under its lower end (every angle of an interval with an end off the rail). The smallest scanned gap and the
@@ -571,6 +582,7 @@ def out_of_round_locus(lats, alpha_start, half_window, scan_points, integration_
         scan_irr[i] = wheel_irregularity(a, surf.wheel_irr)[0]
     # the scan at every stride-th angle (and the last), then every angle of the intervals where the gap may dip
     # below the smallest found or below 0: by at most curvature * (stride * step)^2 / 8 under the lower end
+    coarse_stride, newton = fast
     stride = max(int(coarse_stride), 1)
     dip = gap_curvature_bound(rot, surf) * (stride * step) ** 2 / 8.0 * (1.0 + 1e-9) + 1e-15
     if not math.isfinite(dip):

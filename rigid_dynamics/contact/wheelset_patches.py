@@ -205,9 +205,10 @@ def _out_of_round_locus(geo: _SideGeometry, lat: np.ndarray, alpha_start: float)
         if k:
             out = [np.empty(k), np.empty((k, 3)), np.empty(k), np.empty(k), np.empty(k), np.empty(k), np.empty(k),
                    np.empty((k, 2))]  # fmt: skip
+            fast = kern.FastScan(OUT_OF_ROUND_COARSE_STRIDE, True)
             kern.out_of_round_locus(
-                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, OUT_OF_ROUND_COARSE_STRIDE, True, geo.rot,
-                geo.centre, surf, geo.side == "right", kern.Locus(*out[:5]), kern.OverlapLine(*out[5:]),
+                np.ascontiguousarray(lat[near]), alpha_start, half, scan, m, fast, geo.rot, geo.centre, surf,
+                geo.side == "right", kern.Locus(*out[:5]), kern.OverlapLine(*out[5:]),
             )  # fmt: skip
             for target, value in zip((alpha, point, gap, rail_z, angle, weight, weighted_x, overlap), out, strict=True):
                 target[near] = value
