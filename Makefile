@@ -2,6 +2,9 @@
 VENV := .venv
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?= --durations=25  # the slowest tests printed: where the suite's time goes (issue 27)
+# two pytest-xdist workers; each test file is one xdist group (its module fixtures computed once), the MPI tests
+# share one group, the longest groups go first (tests/conftest.py); PYTEST_WORKERS=0: one process
+PYTEST_WORKERS ?= 2
 
 .PHONY: demo test lint docs setup clean clean-numba
 
@@ -14,7 +17,7 @@ demo: $(STAMP)
 	$(VENV)/bin/wheelrail demo
 
 test: $(STAMP)
-	$(VENV)/bin/python -m pytest -q $(PYTEST_ARGS)
+	$(VENV)/bin/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup --no-loadscope-reorder $(PYTEST_ARGS)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .
