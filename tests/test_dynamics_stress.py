@@ -185,6 +185,8 @@ def _exit_on_nan(task):
 
 def test_dead_worker_is_a_record_not_the_end_of_the_sweep():
     import dask
+    import distributed  # noqa: F401 (imported before the config.set: a set of a distributed.* key before distributed's
+    # first import removes the whole distributed section when it exits, and a later Client fails with KeyError)
 
     tasks = [(BASE, "speed_m_per_s", 20.0), (BASE, "speed_m_per_s", float("nan"))]
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}), local_dask_client(1) as client:
