@@ -1,10 +1,10 @@
 """Regression tests (two code paths): the out-of-round contact locus's fast kernel against its full scan.
 
 _patch_kernels.out_of_round_locus (the point alone per angle, the scan at every 8th angle refined where a bound of
-the gap's curvature lets it dip, Newton on dg/da for the minimum) against out_of_round_locus_reference (every one of
-the 161 angles with the whole wheel point and derivatives, 30 golden-section steps), on a 3rd-order polygon of
-0.3 mm and a 50 mm rounded flat (depth 0.34 mm; the flat's two lowest points along x and the hump between), S1002 on
-UIC60 1:40, several wheel angles, with yaw:
+the gap's curvature lets it dip, Newton on dg/da for the minimum) against the full scan (tests/oor_reference.py:
+every one of the 161 angles with the whole wheel point and derivatives, 30 golden-section steps), on a 3rd-order
+polygon of 0.3 mm and a 50 mm rounded flat (depth 0.34 mm; the flat's two lowest points along x and the hump
+between), S1002 on UIC60 1:40, several wheel angles, with yaw:
 
 * with the golden section kept (``newton`` False) every output equals the reference's to the last bit;
 * with Newton the gap agrees to 1e-15 m, the angle to 1e-7 rad (the golden section's own resolution: its last
@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 import pytest
+from oor_reference import _vertical_gap, out_of_round_locus_reference
 
 from rigid_dynamics.contact import _patch_kernels as kern
 from rigid_dynamics.contact import wheelset_patches as wp
@@ -73,7 +74,7 @@ def _both(wheel, rail, pose, newton):
         if fast:
             kern.out_of_round_locus(*args, kern.FastScan(wp.OUT_OF_ROUND_COARSE_STRIDE, newton), *tail)
         else:
-            kern.out_of_round_locus_reference(*args, *tail)
+            out_of_round_locus_reference(*args, *tail)
         outputs.append(out)
     return outputs
 
@@ -119,7 +120,7 @@ def test_formed_patches_are_the_full_scans(wheel_rail, monkeypatch):
         pose = _pose(wheel, rail, offset, 2e-4)
         fast, _ = wp.wheel_patches(wheel, rail, pose, "right", **kwargs)
         with monkeypatch.context() as m:
-            m.setattr(kern, "out_of_round_locus", lambda *a: kern.out_of_round_locus_reference(*a[:5], *a[6:]))
+            m.setattr(kern, "out_of_round_locus", lambda *a: out_of_round_locus_reference(*a[:5], *a[6:]))
             ref, _ = wp.wheel_patches(wheel, rail, pose, "right", **kwargs)
         assert len(fast) == len(ref) >= 1
         for p, q in zip(fast, ref, strict=True):
@@ -151,7 +152,7 @@ def test_curvature_bound_holds_on_the_gap(wheel_rail):
     w = np.empty(kern.W_LEN)
     worst = 0.0
     for y in lats:
-        g = np.array([kern._vertical_gap(a, y, geo.rot, geo.centre, surf, w) for a in angles])
+        g = np.array([_vertical_gap(a, y, geo.rot, geo.centre, surf, w) for a in angles])
         second = (g[2:] - 2 * g[1:-1] + g[:-2]) / h**2
         worst = max(worst, float(np.max(np.abs(second[np.isfinite(second)]))))
     assert 0.3 < worst <= bound, (name, worst, bound)
