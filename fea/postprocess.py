@@ -218,11 +218,20 @@ def quadric_cap_peak(scaled_xy: np.ndarray, pressure: np.ndarray) -> float | Non
         scaled_xy: (k, 2) the window's nodes, scaled positions relative to its centre. pressure: (k,) their nodal
         pressures, Pa.
     """
+    fit = _cap_top(scaled_xy, pressure)
+    return None if fit is None else fit[0]
+
+
+def _cap_top(scaled_xy: np.ndarray, pressure: np.ndarray, weight: np.ndarray | None = None):
+    """(peak pressure in Pa, the top in the scaled coordinates) of the quadric cap fitted to p^2 as
+    :func:`quadric_cap_peak` fits it, by least squares weighted by ``weight`` when given; None as there.
+    """
     if len(scaled_xy) < 12:
         return None
     x, y, p2 = scaled_xy[:, 0], scaled_xy[:, 1], pressure**2
+    root_w = np.ones_like(x) if weight is None else np.sqrt(weight)
     matrix = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
-    c, *_ = np.linalg.lstsq(matrix, p2, rcond=None)
+    c, *_ = np.linalg.lstsq(matrix * root_w[:, None], p2 * root_w, rcond=None)
     hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
     if not np.all(np.linalg.eigvalsh(hessian) < 0):
         return None
@@ -230,7 +239,7 @@ def quadric_cap_peak(scaled_xy: np.ndarray, pressure: np.ndarray) -> float | Non
     if np.hypot(*top) > 1.0:
         return None
     value = float(c[0] + c[1:3] @ top + 0.5 * top @ hessian @ top)
-    return math.sqrt(value) if value > 0 else None
+    return (math.sqrt(value), top) if value > 0 else None
 
 
 def window_peak(
@@ -258,16 +267,5 @@ def window_peak(
     near = np.hypot(d[:, 0], d[:, 1]) <= radius_m
     if near.sum() < 12:
         return None
-    x, y = d[near, 0] / radius_m, d[near, 1] / radius_m
-    root_w = np.sqrt(weight[near])
-    p2 = (force[near] / weight[near]) ** 2
-    matrix = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
-    c, *_ = np.linalg.lstsq(matrix * root_w[:, None], p2 * root_w, rcond=None)
-    hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
-    if not np.all(np.linalg.eigvalsh(hessian) < 0):
-        return None
-    top = np.linalg.solve(hessian, -c[1:3])
-    if np.hypot(*top) > 1.0:
-        return None
-    value = float(c[0] + c[1:3] @ top + 0.5 * top @ hessian @ top)
-    return (math.sqrt(value), centre + top * radius_m) if value > 0 else None
+    fit = _cap_top(d[near] / radius_m, force[near] / weight[near], weight[near])
+    return None if fit is None else (fit[0], centre + fit[1] * radius_m)
