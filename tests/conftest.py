@@ -7,8 +7,8 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-# `make test PYTEST_WORKERS=2` runs the suite on two pytest-xdist workers with `--dist loadgroup`. Each test file
-# is one group (its module-scoped fixtures are computed once, on one worker), except the tests that start
+# `make test` runs the suite on two pytest-xdist workers (PYTEST_WORKERS, default 2) with `--dist loadgroup`. Each
+# test file is one group (its module-scoped fixtures are computed once, on one worker), except the tests that start
 # `mpiexec -n 2`: they share the group MPI_GROUP with the whole of test_fea_field_files.py (whose two-rank test uses
 # the file's fixture), so two MPI jobs never run at once. Every test writes only under its tmp_path, or atomically
 # into the numba and table caches.
