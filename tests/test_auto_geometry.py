@@ -71,6 +71,9 @@ def test_the_check_leaves_other_statuses_and_clean_runs_alone():
     assert auto_geometry_check("step-unstable", "m", outside) == ("step-unstable", "m")
     status, message = auto_geometry_check("ok", "reached t = 1 s", outside)
     assert status == "warning" and "3 of 4 recorded patches" in message and "1.5 at t = 0.25 s" in message
+    # a run already warned (e.g. for its BEM grid) names this too: one warning does not hide another
+    status, message = auto_geometry_check("warning", "reached t = 1 s; BEM grid-error estimate ...", outside)
+    assert status == "warning" and "BEM grid-error estimate" in message and "3 of 4 recorded patches" in message
 
 
 def test_the_demo_offers_the_scene_keys_patch_geometries():

@@ -146,11 +146,12 @@ def modal_cutoff_error(scene) -> dict:
 
 def modal_cutoff_check(status: str, message: str, scene, tolerance: float) -> tuple[str, str]:
     """(status, message) with the modal cut-off judged: an "ok" run ends "warning" when the rule's estimate exceeds
-    ``tolerance`` (force_tolerance), the message naming the cut-off and the cut-off that meets it.
+    ``tolerance`` (force_tolerance), the message naming the cut-off and the cut-off that meets it; a run already
+    warned names it too (as every check here: one warning does not hide another).
     """
     stated = modal_cutoff_error(scene)
     estimate = stated["estimate"]
-    if status != "ok" or estimate is None or estimate <= tolerance:
+    if status not in ("ok", "warning") or estimate is None or estimate <= tolerance:
         return status, message
     need = cutoff_meeting(tolerance, stated["impact_frequency_Hz"])
     return "warning", (
@@ -162,10 +163,16 @@ def modal_cutoff_check(status: str, message: str, scene, tolerance: float) -> tu
 
 def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, str]:
     """(status, message) with the BEM's grid judged: an "ok" run whose BEM patches were solved coarser than their
-    ``grid_tolerance`` asks (the largest force estimate of a solve above it) ends "warning", naming the estimate.
+    ``grid_tolerance`` asks (the largest force estimate of a solve above it) ends "warning", naming the estimate; a
+    run already warned names it too.
     """
     grid = (callback_stats or {}).get("bem_grid_error")
-    if status != "ok" or not grid or not grid["estimated"] or grid["largest_force"] <= grid["tolerance"]:
+    if (
+        status not in ("ok", "warning")
+        or not grid
+        or not grid["estimated"]
+        or grid["largest_force"] <= grid["tolerance"]
+    ):
         return status, message
     return "warning", (
         f"{message}; BEM grid-error estimate of the patch forces {grid['largest_force']:.3g} (t = {grid['t_s']:.6g} s) "
@@ -178,10 +185,11 @@ def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, 
 def auto_reuse_check(status: str, message: str, callback_stats) -> tuple[str, str]:
     """(status, message) with ``auto``'s reuse of its BEM patches judged (wheelset/auto_reuse.py): an "ok" run ends
     "warning" when a correction measured at a re-solve departed from the fresh BEM solution by more than the
-    tolerance (the patches served between re-solves are not measured; those near such a re-solve may be as far off).
+    tolerance (the patches served between re-solves are not measured; those near such a re-solve may be as far off);
+    a run already warned names it too.
     """
     reuse = (callback_stats or {}).get("auto_reuse")
-    if status != "ok" or not reuse or not reuse.get("errors_above_tolerance"):
+    if status not in ("ok", "warning") or not reuse or not reuse.get("errors_above_tolerance"):
         return status, message
     return "warning", (
         f"{message}; auto's reused BEM patches: {reuse['errors_above_tolerance']} of {reuse['errors_measured']} "
@@ -236,9 +244,10 @@ def auto_geometry(result, fastsim_grid) -> dict | None:
 
 def auto_geometry_check(status: str, message: str, geometry: dict | None) -> tuple[str, str]:
     """(status, message) with :func:`auto_geometry` judged: an "ok" run of ``auto`` that served recorded patches on
-    the ellipse outside their rung's measured ellipticity box ends "warning", naming how many and the largest.
+    the ellipse outside their rung's measured ellipticity box ends "warning", naming how many and the largest; a run
+    already warned names it too.
     """
-    if status != "ok" or not geometry or not geometry["outside_box"]:
+    if status not in ("ok", "warning") or not geometry or not geometry["outside_box"]:
         return status, message
     return "warning", (
         f"{message}; auto served {geometry['outside_box']} of {geometry['checked']} recorded patches on Hertz's "
