@@ -201,9 +201,8 @@ def estimate(
         error, order, observed = richardson_error(series)
         mesh = _relative(error, finest[name])
         block_error = None
-        if balanced and name in LOAD_CONTROL_BLOCK_ERROR:
-            block_error = LOAD_CONTROL_BLOCK_ERROR[name] * (20.0 / block_factor) ** 2
-        elif block is not None and name == "max_pressure" and not approach_control:  # fixed load: second order
+        fixed_load = block is not None and name == "max_pressure" and not approach_control  # second order there
+        if (balanced and name in LOAD_CONTROL_BLOCK_ERROR) or fixed_load:
             block_error = LOAD_CONTROL_BLOCK_ERROR[name] * (20.0 / block_factor) ** 2
         elif block is not None and name in BLOCK_SENSITIVE and block.get(name) is not None:
             base = levels[block_level]

@@ -219,13 +219,11 @@ def _size_field(model, spec: HertzBlockSpec) -> None:
     r0 = spec.refine_radius
     h_max = spec.half_width_m / 3.0
     boxes = spec.refine_boxes_m or ((*spec.center_m, spec.semi_axis_long_m, spec.semi_axis_lat_m),)
+    # every box as (x_c, y_c, half-width along x, along y, element size): the patch boxes widened by r0 at h_c, the
+    # peak boxes as given
+    sized = [(xc, yc, r0 * a, r0 * b, spec.contact_size_m) for xc, yc, a, b in boxes] + list(spec.peak_boxes_m)
     terms = []
-    for xc, yc, a, b in boxes:
-        dx = f"max(abs(x-({num(xc)}))-{num(r0 * a)},0)"
-        dy = f"max(abs(y-({num(yc)}))-{num(r0 * b)},0)"
-        dz = f"max(abs(z)-{num(r0 * min(a, b))},0)"
-        terms.append(f"{num(spec.contact_size_m)}+{num(spec.grading)}*sqrt({dx}^2+{dy}^2+{dz}^2)")
-    for xc, yc, a, b, size in spec.peak_boxes_m:
+    for xc, yc, a, b, size in sized:
         dx = f"max(abs(x-({num(xc)}))-{num(a)},0)"
         dy = f"max(abs(y-({num(yc)}))-{num(b)},0)"
         dz = f"max(abs(z)-{num(min(a, b))},0)"
