@@ -143,6 +143,9 @@ contact angle, the rail-profile lateral coordinate of the contact point, or ``ge
 CONTACT does for a planar patch (CONTACT's V = 1, 2). Falling friction is solved for steady rolling only.
 """
 
+GRID_OPTIONS = ("nx", "ny", "element_size_m", "dx_m", "dy_m")
+"""The options by which a caller names the grid: solved as named, never refined."""
+
 PROBLEMS = ("rolling", "shift", "transient")
 """Tangential problems of the option ``problem``."""
 
@@ -319,7 +322,7 @@ def _options(options: Mapping | None) -> dict:
     opts["element_sizes_m"] = size
     if size is None:
         _grid_budget(opts["nx"], opts["ny"], "nx, ny", (opts["nx"], opts["ny"]))
-    opts["grid_named"] = any(k in options for k in ("nx", "ny", "element_size_m", "dx_m", "dy_m"))
+    opts["grid_named"] = any(k in options for k in GRID_OPTIONS)
     if opts["extrapolate"] and size is None and (opts["nx"] % 2 or opts["ny"] % 2 or opts["nx"] < 4):
         raise ValueError(
             f"option extrapolate = true with nx = {opts['nx']!r}, ny = {opts['ny']!r}: expected even element counts "
