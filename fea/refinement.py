@@ -116,6 +116,10 @@ and by a load-balanced series for both (module docstring)."""
 ORDER_LEVEL_MIN_N = 2.0
 """With ``measure_order``, the level one coarser than the first is solved when it has at least this many elements per
 semi-axis (module docstring, "Measured order")."""
+FIRST_LEVEL_BUDGET_COARSER = 2
+"""When the first level is already the finest ``max_dofs`` affords (a narrow patch: a22-flange's first level has
+1.7e5 unknowns), this many coarser levels are solved before it so that it is still estimated (at the observed order
+of three levels) instead of ending "not estimated"."""
 LOAD_SHARE = 0.25
 """A load-balanced equilibrium accepts a wheel's load within this fraction of ``mesh_tolerance`` (module docstring)."""
 
@@ -246,6 +250,29 @@ def _add_window_error(info: dict, window: dict | None, records: list[dict] = ())
     info["relative_error"]["max_pressure"] = None if error is None or mesh is None else mesh + error
 
 
+def _insert_coarser(solve_level, opts, levels: list, records: list, info: dict, count: int) -> None:
+    """Solve up to ``count`` levels coarser than the first (``n0 / r``, ``n0 / r^2``, ...; at least
+    ``ORDER_LEVEL_MIN_N`` elements per semi-axis) and put them before it, marked ``order_level``; a level that
+    fails is left out and said in ``info["order_level"]`` (module docstring, "Measured order").
+    """
+    n0, g0, ratio = opts.n_per_semi_axis, opts.grading, REFINEMENT_RATIO
+    for j in range(1, count + 1):
+        n = n0 / ratio**j
+        if n < ORDER_LEVEL_MIN_N:
+            return
+        level_opts = dataclasses.replace(opts, elements_per_semi_axis=n, mesh_size_factor=1.0, grading=g0 * ratio**j)
+        t_level = time.perf_counter()
+        coarse, _ = solve_level(level_opts)
+        if coarse.status != "ok":
+            info["order_level"] = f"not used: {coarse.status} ({coarse.message})"
+            return
+        levels.insert(0, _quantities(coarse))
+        records.insert(0, {"elements_per_semi_axis": n, "grading": g0 * ratio**j,
+                           "dofs": int(coarse.extra.get("dofs", 0)), "order_level": True,
+                           "wall_time_s": time.perf_counter() - t_level, **levels[0],
+                           **_window_record(coarse)})  # fmt: skip
+
+
 def solve_to_tolerance(
     solve_level, opts, *, approach_control: bool, block_estimate: bool, t0: float, measure_order: bool = False
 ):
@@ -312,21 +339,15 @@ def solve_to_tolerance(
                 block = _quantities(wide_result)
                 info["block_size_check"] = {"domain_factor": 2.0 * opts.block_factor, **block}
         if k == 1 and measure_order and n0 / ratio >= ORDER_LEVEL_MIN_N:
-            coarse_opts = dataclasses.replace(
-                opts, elements_per_semi_axis=n0 / ratio, mesh_size_factor=1.0, grading=g0 * ratio
-            )
-            t_level = time.perf_counter()
-            coarse, _ = solve_level(coarse_opts)
-            if coarse.status == "ok":
-                levels.insert(0, _quantities(coarse))
-                records.insert(0, {"elements_per_semi_axis": n0 / ratio, "grading": g0 * ratio,
-                                   "dofs": int(coarse.extra.get("dofs", 0)), "order_level": True,
-                                   "wall_time_s": time.perf_counter() - t_level, **levels[0],
-                                   **_window_record(coarse)})  # fmt: skip
-            else:
-                info["order_level"] = f"not used: {coarse.status} ({coarse.message})"
-        if k >= 1:
-            block_level = 1 if records[0].get("order_level") else 0  # the block check's mesh is the first level's
+            _insert_coarser(solve_level, opts, levels, records, info, 1)
+        dofs = records[-1]["dofs"]
+        growth = dofs / records[-2]["dofs"] if len(records) >= 2 and records[-2]["dofs"] > 0 else ratio**3
+        last = dofs * growth > opts.max_dofs
+        if k == 0 and last:
+            # the first level is the finest the budget affords: the levels below it give its estimate
+            _insert_coarser(solve_level, opts, levels, records, info, FIRST_LEVEL_BUDGET_COARSER)
+        if len(levels) >= 2:
+            block_level = sum(1 for r in records if r.get("order_level"))  # the block check's mesh: the first's
             info.update(estimate(levels, block, approach_control, balanced, opts.block_factor, block_level))
             _add_window_error(info, result.extra.get("max_pressure_window"), records)
             info["estimated"] = True
@@ -334,11 +355,9 @@ def solve_to_tolerance(
             if all(e is not None and e <= tol for e in worst.values()):
                 status, verdict = "ok", f"discretisation error within {tol:g}"
                 break
-        dofs = records[-1]["dofs"]
-        growth = dofs / records[-2]["dofs"] if k >= 1 and records[-2]["dofs"] > 0 else ratio**3
-        if dofs * growth > opts.max_dofs:
+        if last:
             status = "mesh-tolerance-not-met"
-            if k == 0:
+            if len(levels) < 2:
                 verdict = (f"discretisation error not estimated: the second level (~{dofs * growth:.3g} unknowns) "
                            f"exceeds max_dofs = {opts.max_dofs}")  # fmt: skip
             else:

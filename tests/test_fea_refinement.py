@@ -440,3 +440,24 @@ def test_a_sampled_hertz_gap_with_a_peak_box_states_an_error_that_brackets_the_t
         true = abs(levels[k]["max_pressure"] / p0 - 1)
         assert true <= stated, f"level {k}: true {true:.4%} > stated {stated:.4%}"
     assert abs(r.max_pressure_Pa / p0 - 1) <= info["relative_error"]["max_pressure"]
+
+
+def test_a_first_level_that_exhausts_the_budget_is_estimated_from_coarser_levels():
+    """a22-flange (narrow patch): the first level (6 elements per semi-axis) already has 1.7e5 unknowns, the next
+    would exceed max_dofs. Instead of ending "not estimated", the two coarser levels (4, 2.67) are solved before it
+    and the first level is stated with the error of the three-level series (Richardson at the observed order, the
+    block's fixed term added for the max pressure at a fixed load); the status follows that error."""
+    from fea.model import FeaOptions
+    from fea.refinement import solve_to_tolerance
+
+    values = {2.666667: (2800e6, 7.50e-6), 4.0: (2700e6, 7.35e-6), 6.0: (2644e6, 7.26e-6)}
+    dofs = {2.666667: 16000, 4.0: 51000, 6.0: 170643}
+    for tolerance, status in ((0.02, "mesh-tolerance-not-met"), (0.05, "ok")):
+        opts = FeaOptions.from_mapping({"mesh_tolerance": tolerance, "stresses": False})
+        r = solve_to_tolerance(_fake_level(values, dofs), opts, approach_control=False, block_estimate=True, t0=0.0)
+        info = r.extra["discretisation_error"]
+        assert [level["elements_per_semi_axis"] for level in info["levels"]] == pytest.approx([6 / 2.25, 4.0, 6.0])
+        assert info["estimated"] and r.max_pressure_Pa == 2644e6
+        # differences 100 and 56 MPa: observed order 1.43, used 1 (ORDER_BOUNDS): 56 / 0.5 = 112 MPa, plus 0.5 %
+        assert info["relative_error"]["max_pressure"] == pytest.approx(112 / 2644 + 0.005, rel=1e-3)
+        assert r.status == status, r.message
