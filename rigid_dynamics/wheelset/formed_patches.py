@@ -24,20 +24,22 @@ pose the candidate carries (once per side and pose) and
   the candidate's frame, and M_z is the moment about the candidate's normal through its point (the moment of the
   offset p' - p included). The components of that offset's moment about the candidate's tangents (at most the
   offset, millimetres, times the force) are left out: the compiled code applies a patch's force at its point;
-* the record of the run (the time series' ``patch_*`` columns, WheelsetModel.contact's ``record``) holds the formed
+* the record of the run (its per-patch columns, SimulationResult.patches; ContactState.record) holds the formed
   patch's own quantities (:func:`own_quantities`, layout.FORMED_PATCH_FIELDS): N', T_x', T_y' and M_z' in its own
   contact frame, the creepages transported to it, its approach, reference point (y, main frame; the point on the
   rail where CONTACT puts it), the wheel's lateral coordinate and rolling radius at its wheel point p', and its
   contact angle; the semi-axes, area, max pressure and ellipticity residual were always the formed patch's (the
   model's result on its gap). The compiled loop keeps the candidate's values in the patch record's first columns for
   what it does with them (the forces it applies, its contact switches, force checks and error estimate, the traction
-  controller) and the formed patch's in columns of their own, which the record writers put in their place
-  (:func:`recorded`). So the forces the loop applies and the trajectory are those of before, and the record reads
-  as the patch was solved: on curve-flange's conformal flange root (tests/test_loop_sampled_curve.py) the contact
-  angle 0.81 rad and a lateral creep force of 0.8 mu N, where the candidate's frame (0.55 rad) read -2.4 kN. A
-  candidate whose region was joined into a deeper candidate's patch records no force (the joined patch is in that
-  candidate's record); ``auto``'s BEM patches served by their anchor's correction (auto_reuse.py) are recorded in
-  the candidate's frame (the anchor keeps the candidate's forces).
+  controller, the run's stops and its flange-contact event) and the formed patch's in columns of their own, which
+  the record writers put in their place (:func:`recorded`: recorder.Recorder, for the compiled loop's tables,
+  drivers.patch_tables, and the Python drivers' samples alike; WheelsetModel.contact's ContactState.record). So
+  the forces the loop applies and the trajectory are those of before, and the record reads as the patch was
+  solved: on curve-flange's conformal flange root (tests/test_loop_formed_record.py, against CONTACT's planar
+  solution) the contact angle 0.81 rad and a creep force of 0.81 mu N, where the candidate's frame (0.55 rad) read
+  a lateral creep force of -2.4 kN. A candidate whose region was joined into a deeper candidate's patch records no
+  force (the joined patch is in that candidate's record); ``auto``'s BEM patches served by their anchor's
+  correction (auto_reuse.py) are recorded in the candidate's frame (the anchor keeps the candidate's forces).
 """
 
 from __future__ import annotations
