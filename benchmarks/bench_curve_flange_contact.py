@@ -213,10 +213,11 @@ def verdict(records, conformal, planar) -> list[str]:
         f"{(-bem['force_main_N'][2] + planar['force_main_N'][2]) / 1e3:+.1f} kN vertically (N 2 % lower: our exact "
         "plane gap is 2.3 um shallower than CONTACT's grid-interpolated one, whose approach itself moves by 0.5 um "
         "between 0.5 and 0.2 mm elements; at CONTACT's vertical force the static case agrees to 0.2 %, table (a)). "
-        "The loop records the formed patch's forces in the candidate's frame (formed_patches.candidate_forces, a "
+        "The loop applies the formed patch's forces in the candidate's frame (formed_patches.candidate_forces, a "
         "correct rotation by the 0.26 rad between the planes): there the lateral creep force is "
-        f"{cand[1] / 1e3:+.2f} kN, a component of the normal force, not a smaller creep force. No defect in "
-        "transported_creepage or the formed frame was found."
+        f"{cand[1] / 1e3:+.2f} kN, a component of the normal force, not a smaller creep force; the run's record "
+        "holds the formed patch's own forces, angle and creepages (formed_patches.recorded, "
+        "tests/test_loop_formed_record.py). No defect in transported_creepage or the formed frame was found."
     )
     point_2 = (
         "2. **What differs is the plane, and with it the direction of the whole force.** FASTSIM and KPEC on the "

@@ -251,7 +251,10 @@ def test_layout_constants_follow_their_names():
         assert getattr(layout, name.upper()) == layout.N_PATCH + k, name
     assert layout.AUTO_FEATURES == layout.N_PATCH + 4
     assert layout.AUTO_PATCH_FIELDS[4:] == tuple(f"auto_{f}" for f in layout.AUTO_FEATURE_NAMES)
-    assert layout.N_FIELDS == len(layout.PATCH_FIELDS) + len(layout.AUTO_PATCH_FIELDS)
+    assert layout.FORMED == len(layout.PATCH_FIELDS) + len(layout.AUTO_PATCH_FIELDS)
+    assert layout.FORMED_PATCH_FIELDS == tuple(f"formed_{n}" for n in layout.PATCH_FIELDS[: layout.N_FORMED])
+    assert layout.N_FIELDS == layout.FORMED + layout.N_FORMED
+    assert layout.N_FORMED == 12  # compiled_rhs._external's objmode type UniTuple(float64, 12) spells it out
 
     geometry = {
         "approach_m": "G_APPROACH", "lever_x_m": "G_LEVER", "normal_x": "G_NORMAL",

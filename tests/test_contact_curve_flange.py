@@ -149,7 +149,8 @@ def test_loop_flange_root_patch_is_contacts_planar_patch(loop_contact):
     """The loop's flange-root patch at the state (the same pose, Z_WS prescribed in CONTACT) against CONTACT's planar
     solution with the loop's kinematics (left_planar_curve.out: curvature 1/R, the state's rates). Resolved in
     CONTACT's patch frame, the loop's creep force is CONTACT's: a lateral creep force of 0.8 mu N, not the 0.17 mu N
-    the run's record shows (formed_patches.candidate_forces writes it in the candidate's frame, 0.26 rad away).
+    it reads in the candidate's frame (0.26 rad away), where formed_patches.candidate_forces applies it (the run's
+    record holds the patch's own: tests/test_loop_formed_record.py).
     Recorded: F_s 28.66 against 29.25 kN (1.6 % of mu FN), F_x 2.33 against 1.53 kN (2.2 %), FN 117.8 against
     120.3 kN (-2.1 %), the total force on the wheel 2.1 % (lateral) and 2.0 % (vertical) below CONTACT's, area
     +0.2 %, p_max -2.9 %. Tolerances: 3 % (FN, total force, p_max, area) and 3 % of mu FN (creep forces): at the same

@@ -505,6 +505,8 @@ class WheelPatch:
             the material point whose velocity gives the creepages (CONTACT's rolling radius is the wheel's).
         angle_turn_rad: how far the contact angle was turned towards a neighbouring patch's (D_SEP <= d <=
             D_TURN, :func:`turned_angles`), rad; 0 when not turned.
+        wheel_lateral_m: the wheel surface's lateral coordinate y_d of ``wheel_point_m`` (the search's
+            ``wheel_lateral_m``), m.
     """
 
     geometry: ContactGeometry
@@ -515,6 +517,7 @@ class WheelPatch:
     min_vertical_gap_m: float
     wheel_point_m: np.ndarray
     angle_turn_rad: float = 0.0
+    wheel_lateral_m: float = math.nan
 
 
 def _curvatures(geo_exact: _SideGeometry, alpha0: float, y0: float, rail_xy, frame):
@@ -694,6 +697,8 @@ def wheel_patches(
             deep_profile = tuple(float(v) for v in exact_rail.to_profile_coordinates(p_deep[1], p_deep[2]))
         wheel_point = geo.wheel_point(np.array([alpha0]), np.array([lat0]))[0][0]
         patches.append(
-            WheelPatch(geometry, group, how, p_deep, deep_profile, deepest.min_gap_m, wheel_point, float(turn))
+            WheelPatch(
+                geometry, group, how, p_deep, deep_profile, deepest.min_gap_m, wheel_point, float(turn), float(lat0)
+            )
         )
     return patches, locus

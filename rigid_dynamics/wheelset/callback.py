@@ -11,8 +11,8 @@ import time
 import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
-from rigid_dynamics.wheelset.compiled_rhs import CallbackOutcome
-from rigid_dynamics.wheelset.formed_patches import PatchFormer, candidate_forces, transported_creepage
+from rigid_dynamics.wheelset.compiled_rhs import NOT_FORMED, CallbackOutcome
+from rigid_dynamics.wheelset.formed_patches import PatchFormer, candidate_forces, own_quantities, transported_creepage
 from rigid_dynamics.wheelset.layout import PATCH_ELLIPSE, PATCH_SAMPLED
 from rigid_dynamics.wheelset.providers import SIDES
 
@@ -30,7 +30,8 @@ class PatchCallback:
     to the rigid overlap, so the element size of a solver that fills the box follows the patch), unless the
     provider gave one. The side's patches are formed as the static wheelset case forms them (``patches``
     "contact", the default: CONTACT's module 1, formed_patches.py: interpenetration regions joined or split, each
-    patch solved in the plane of its weighted reference point, the forces returned in the candidate's frame) or
+    patch solved in the plane of its weighted reference point, the forces returned in the candidate's frame and the
+    patch's own quantities beside them for the record: CallbackOutcome.own) or
     (``patches`` "search", and on an elastic track) each candidate on its own plane at its deepest point
     (search.patch_undeformed_distance); ``patches`` "auto" (auto's BEM rung: the other candidates keep their own
     rungs) forms the patch as "contact" when it holds the candidate's region alone, else samples the candidate on
@@ -192,8 +193,11 @@ class PatchCallback:
                 geometry.ellipse_angle_rad, geometry.approach_m,
             )  # fmt: skip
         forces = (result.normal_force_N, result.creep_force_long_N, result.creep_force_lat_N, result.spin_moment_Nm)
-        if target is not False and result.status != "no-contact":
-            forces = candidate_forces(patch, target, result)
+        own = NOT_FORMED
+        if target is not False:  # recorded in its own frame; applied in the candidate's
+            own = own_quantities(target, result, creepage)
+            if result.status != "no-contact":
+                forces = candidate_forces(patch, target, result)
         return CallbackOutcome(
             *(float(v or 0.0) for v in forces),
             _number(result.semi_axis_long_m),
@@ -203,6 +207,7 @@ class PatchCallback:
             PATCH_SAMPLED if sampled else PATCH_ELLIPSE,
             float(residual),
             0,
+            own,
         )
 
     def _formed(self, patch):
@@ -303,9 +308,9 @@ def _solves_gap(model) -> bool:
     return bool(getattr(model, "solves_undeformed_distance", getattr(model, "name", "") in FIELD_MODELS))
 
 
-_FAILED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_ELLIPSE, np.nan, 1)
+_FAILED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_ELLIPSE, np.nan, 1, NOT_FORMED)
 """The callback's answer for a patch whose contact model failed (its message kept in PatchCallback.message)."""
-_JOINED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_SAMPLED, np.nan, 0)
+_JOINED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_SAMPLED, np.nan, 0, NOT_FORMED)
 """The answer for a candidate whose interpenetration region is joined into a patch a deeper candidate serves."""
 
 

@@ -66,6 +66,7 @@ from rigid_dynamics.wheelset.layout import (
     CREEPAGE_LONG,
     CREEPAGES_UNDEFINED,
     ELLIPTICITY_RESIDUAL,
+    FORMED,
     G_APPROACH,
     G_CONTACT_ANGLE,
     G_CURVATURE_LAT,
@@ -79,6 +80,7 @@ from rigid_dynamics.wheelset.layout import (
     GEOMETRY_TABLES,
     MAX_PRESSURE,
     N_FIELDS,
+    N_FORMED,
     N_GEO,
     N_SCRATCH,
     NORMAL_FORCE,
@@ -161,7 +163,9 @@ class CallbackOutcome(NamedTuple):
     """What the callback gives back per patch (callback.PatchCallback.solve): forces on the wheel in the
     contact frame (N, T_x, T_y: N; M_z: N m), the semi-axes (or the equivalent ellipse's) a, b (m), contact area
     (m^2), max pressure (Pa), the geometry the model saw (layout.PATCH_ELLIPSE / PATCH_SAMPLED) and its ellipticity
-    residual (NaN for an ellipse), and the status (0 solved, 1 failed: the callback keeps its message).
+    residual (NaN for an ellipse), the status (0 solved, 1 failed: the callback keeps its message), and ``own``: for
+    a candidate that served a formed patch, that patch's own quantities in the order of layout.FORMED_PATCH_FIELDS
+    (recorded, not applied: the forces above are the candidate's), else :data:`NOT_FORMED`.
     """
 
     normal_force_N: float
@@ -175,6 +179,11 @@ class CallbackOutcome(NamedTuple):
     patch_geometry: int
     ellipticity_residual: float
     status: int
+    own: tuple
+
+
+NOT_FORMED = (math.nan,) * N_FORMED
+"""CallbackOutcome.own of a candidate that served no formed patch (and of every patch a compiled law solved)."""
 
 
 _CALLBACK = [None]
@@ -197,10 +206,11 @@ def _external(t, y, c, side, g, creep, frame):
     """The one callback boundary: candidate c of ``side`` at time t (its geometry row g, layout.GEOMETRY_FIELDS;
     creep = (rolling speed, xi, eta, spin); frame = (e_x, e_y) of the contact frame, main frame) handed to Python
     (numba objmode) as a :class:`CallbackPatch` and a :class:`CallbackOutcome`'s values taken back (N, T_x, T_y,
-    M_z, a, b, area, max pressure, patch geometry code, ellipticity residual, status); status != 0: the contact
-    model failed (the callback keeps its message). Overhead measured here: 2.0-2.1 us per objmode call of a trivial
-    Python function; 25 us per patch through callback.PatchCallback with a model returning constant forces
-    (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes about 20 ms.
+    M_z, a, b, area, max pressure, patch geometry code, ellipticity residual, status, the formed patch's own
+    quantities); status != 0: the contact model failed (the callback keeps its message). Overhead measured here:
+    2.0-2.1 us per objmode call of a trivial Python function; 25 us per patch through callback.PatchCallback with a
+    model returning constant forces (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes
+    about 20 ms.
     """
     speed, xi, eta, spin = creep
     ex, ey = frame
@@ -211,15 +221,17 @@ def _external(t, y, c, side, g, creep, frame):
     radius, angle, lateral = g[G_ROLLING_RADIUS], g[G_CONTACT_ANGLE], g[G_WHEEL_LATERAL]
     centre = (y[X], y[Y], y[Z])
     yaw, roll, turn = y[YAW], y[ROLL], y[SPIN]
+    # own: the formed patch's own quantities, layout.N_FORMED (12) of them (a literal: numba reads the types)
     with objmode(normal_force="float64", tx="float64", ty="float64", mz="float64", sa="float64", sb="float64",
-                 area="float64", pmax="float64", geom="int64", resid="float64", st="int64"):  # fmt: skip
-        normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _dispatch(
+                 area="float64", pmax="float64", geom="int64", resid="float64", st="int64",
+                 own="UniTuple(float64, 12)"):  # fmt: skip
+        normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own = _dispatch(
             CallbackPatch(
                 c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, e_x, e_y, radius, angle, lateral,
                 centre, yaw, roll, turn,
             )
         )  # fmt: skip
-    return normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st
+    return normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own
 
 
 @njit(cache=True, _nrt=False)
@@ -228,7 +240,7 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     region (auto_reuse.reuse_serve; recorded as rung layout.AUTO_BEM_CORRECTED, law compiled_laws.LAW_BEM_CORRECTED),
     else solved by the callback (:func:`_external`) and made the candidate's anchor (auto_reuse.reuse_anchor).
     Arguments as :func:`_external`'s; laws = (par, tables, dummy, where, rec, record). Returns _external's values
-    and the law code.
+    and the law code (a served patch: no formed patch's own quantities, :data:`NOT_FORMED`).
     """
     par, tables, dummy, where, rec, record = laws
     _, xi, eta, spin = creep
@@ -238,12 +250,12 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     if served:
         if record:
             rec[c, AUTO_RUNG] = AUTO_BEM_CORRECTED
-        return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, 0, LAW_BEM_CORRECTED
-    normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(t, y, c, side, g, creep, frame)
+        return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, 0, NOT_FORMED, LAW_BEM_CORRECTED
+    normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own = _external(t, y, c, side, g, creep, frame)
     if st == 0:
         solved = (normal, tx, ty, mz, sa, sb, area, pmax, geom, resid)
         reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved)
-    return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, LAW_CALLBACK
+    return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, LAW_CALLBACK
 
 
 @njit(cache=True, _nrt=False)
@@ -337,8 +349,9 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
         if not speed > 0.0:
             return CREEPAGES_UNDEFINED
         where = (_friction_place(tables.friction.varies_code, y, g), speed)
+        own = NOT_FORMED
         if par.model_code == LAW_CALLBACK:
-            normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st = _external(
+            normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own = _external(
                 t, y, c, side, g, (speed, xi, eta, spin), (ex, ey)
             )
             law = LAW_CALLBACK
@@ -366,7 +379,7 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
                 resid = field.residual[c]
             law = _served_law(par, rec, c, record)
             if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): its anchor or the callback
-                normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, law = _auto_bem(
+                normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, law = _auto_bem(
                     t, y, c, side, g, (speed, xi, eta, spin), (ex, ey), (par, tables, dummy, where, rec, record)
                 )
                 if st != 0:
@@ -407,6 +420,9 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
             rec[c, PATCH_GEOMETRY] = geom
             rec[c, ELLIPTICITY_RESIDUAL] = resid
             rec[c, CONTACT_LAW] = law
+            if not math.isnan(own[0]):  # a formed patch: its own quantities beside the candidate's (recorded)
+                for k in range(N_FORMED):
+                    rec[c, FORMED + k] = own[k]
     _assemble(t, y, par, force, moment, p_con, (rail_f0, rail_f1, rail_fy0, rail_fy1), om, rzx, out)
     if record:
         for sd in range(2):

@@ -20,8 +20,11 @@ from rigid_dynamics.wheelset.layout import (
     CALLBACK_FAILED,
     CREEP_FORCE_LONG,
     CREEPAGE_LONG,
+    FORMED,
+    FORMED_PATCH_FIELDS,
     MAX_SLOTS,
     N_FIELDS,
+    N_PATCH,
     NORMAL_FORCE,
     PATCH_FIELDS,
     UNDERFLOW,
@@ -377,14 +380,17 @@ def run_scipy(fun, y0, duration, settings, out_times, recorder, report, model) -
 
 def patch_tables(model, block, sides, slots) -> dict:
     """The compiled loop's records of a block of output samples (n, candidates + 2, layout.N_FIELDS) as the
-    recorder's per-patch tables: field -> (n, 2 sides, MAX_SLOTS), NaN where no candidate sits (PATCH_FIELDS, and
-    AUTO_PATCH_FIELDS for ``auto``).
+    recorder's per-patch tables: field -> (n, 2 sides, MAX_SLOTS), NaN where no candidate sits (PATCH_FIELDS,
+    AUTO_PATCH_FIELDS for ``auto``, and FORMED_PATCH_FIELDS: the recorder puts a formed patch's own quantities in
+    place of its candidate's, formed_patches.recorded).
     """
-    fields_ = PATCH_FIELDS + (AUTO_PATCH_FIELDS if model.auto else ())
-    tables = {name: np.full((len(block), 2, MAX_SLOTS), np.nan) for name in fields_}
+    columns = list(enumerate(PATCH_FIELDS)) + [(FORMED + k, name) for k, name in enumerate(FORMED_PATCH_FIELDS)]
+    if model.auto:
+        columns += [(N_PATCH + k, name) for k, name in enumerate(AUTO_PATCH_FIELDS)]
+    tables = {name: np.full((len(block), 2, MAX_SLOTS), np.nan) for _, name in columns}
     for c in range(len(sides)):
         if slots[c] < MAX_SLOTS:
-            for f, name in enumerate(fields_):
+            for f, name in columns:
                 tables[name][:, sides[c], slots[c]] = block[:, c, f]
     return tables
 

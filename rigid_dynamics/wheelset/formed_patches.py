@@ -1,6 +1,7 @@
 """The patches of the dynamics loop formed as the static wheelset case forms them (CONTACT's module 1,
 rigid_dynamics.contact.wheelset_patches): which formed patch a compiled contact candidate serves, the creepages at
-the formed patch's reference point and its forces in the candidate's contact frame.
+the formed patch's reference point, its forces in the candidate's contact frame (applied) and its own quantities
+(recorded).
 
 The compiled 3-D search gives each side's candidates at the local minima of the normal gap, with the contact plane
 at the deepest point (at most two per side). The static case (equal to CONTACT) instead splits the vertical gap
@@ -22,7 +23,23 @@ pose the candidate carries (once per side and pose) and
 * the forces on the wheel (N', T_x', T_y' in the formed frame, spin moment M_z' about n' at p') are returned in
   the candidate's frame, and M_z is the moment about the candidate's normal through its point (the moment of the
   offset p' - p included). The components of that offset's moment about the candidate's tangents (at most the
-  offset, millimetres, times the force) are left out: the compiled code applies a patch's force at its point.
+  offset, millimetres, times the force) are left out: the compiled code applies a patch's force at its point;
+* the record of the run (its per-patch columns, SimulationResult.patches; ContactState.record) holds the formed
+  patch's own quantities (:func:`own_quantities`, layout.FORMED_PATCH_FIELDS): N', T_x', T_y' and M_z' in its own
+  contact frame, the creepages transported to it, its approach, reference point (y, main frame; the point on the
+  rail where CONTACT puts it), the wheel's lateral coordinate and rolling radius at its wheel point p', and its
+  contact angle; the semi-axes, area, max pressure and ellipticity residual were always the formed patch's (the
+  model's result on its gap). The compiled loop keeps the candidate's values in the patch record's first columns for
+  what it does with them (the forces it applies, its contact switches, force checks and error estimate, the traction
+  controller, the run's stops and its flange-contact event) and the formed patch's in columns of their own, which
+  the record writers put in their place (:func:`recorded`: recorder.Recorder, for the compiled loop's tables,
+  drivers.patch_tables, and the Python drivers' samples alike; WheelsetModel.contact's ContactState.record). So
+  the forces the loop applies and the trajectory are those of before, and the record reads as the patch was
+  solved: on curve-flange's conformal flange root (tests/test_loop_formed_record.py, against CONTACT's planar
+  solution) the contact angle 0.81 rad and a creep force of 0.81 mu N, where the candidate's frame (0.55 rad) read
+  a lateral creep force of -2.4 kN. A candidate whose region was joined into a deeper candidate's patch records no
+  force (the joined patch is in that candidate's record); ``auto``'s BEM patches served by their anchor's
+  correction (auto_reuse.py) are recorded in the candidate's frame (the anchor keeps the candidate's forces).
 """
 
 from __future__ import annotations
@@ -30,6 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from rigid_dynamics.contact.types import Creepage
+from rigid_dynamics.wheelset.layout import FORMED_PATCH_FIELDS, N_FORMED, PATCH_FIELDS
 
 MATCH_DISTANCE_M = 5.0e-3
 """Largest lateral distance from a candidate's contact point to an interpenetration region it may serve, m."""
@@ -107,3 +125,43 @@ def candidate_forces(patch, target, result) -> tuple[float, float, float, float]
     offset = np.asarray(target.geometry.point_m, float) - np.asarray(patch.point_m, float)
     moment = (result.spin_moment_Nm or 0.0) * frame[:, 2] + np.cross(offset, force)
     return float(force @ n), float(force @ e_x), float(force @ e_y), float(moment @ n)
+
+
+def own_quantities(target, result, creepage: Creepage) -> tuple:
+    """The formed patch ``target``'s own quantities in the order of layout.FORMED_PATCH_FIELDS (N', T_x', T_y', M_z'
+    of the model's ``result`` in its own contact frame; the transported ``creepage``; its approach, reference
+    point's y, the wheel's lateral coordinate and rolling radius at its wheel point, its contact angle).
+    """
+    geometry = target.geometry
+    return (
+        float(result.normal_force_N or 0.0),
+        float(result.creep_force_long_N or 0.0),
+        float(result.creep_force_lat_N or 0.0),
+        float(result.spin_moment_Nm or 0.0),
+        float(creepage.longitudinal),
+        float(creepage.lateral),
+        float(creepage.spin_1_per_m),
+        float(geometry.approach_m),
+        float(np.asarray(geometry.point_m, float)[1]),
+        float(target.wheel_lateral_m),
+        float(geometry.rolling_radius_m),
+        float(geometry.contact_angle_rad),
+    )
+
+
+def recorded(table: dict) -> dict:
+    """The record of a patch table (name -> array over samples / sides / slots / candidates, as the compiled
+    record's columns: PATCH_FIELDS, AUTO_PATCH_FIELDS, FORMED_PATCH_FIELDS): where a candidate served a formed
+    patch (``formed_normal_force_N`` finite) that patch's own quantities in place of the candidate's, and without
+    the FORMED_PATCH_FIELDS. A table without them is returned as it is (a copy of the dict).
+    """
+    out = {name: value for name, value in table.items() if name not in FORMED_PATCH_FIELDS}
+    own = table.get(FORMED_PATCH_FIELDS[0])
+    if own is None:
+        return out
+    formed = np.isfinite(np.asarray(own, float))
+    if not np.any(formed):
+        return out
+    for name, formed_name in zip(PATCH_FIELDS[:N_FORMED], FORMED_PATCH_FIELDS, strict=True):
+        out[name] = np.where(formed, np.asarray(table[formed_name], float), np.asarray(table[name], float))
+    return out

@@ -8,7 +8,8 @@ filled.
 * The parameter record (``par``, :data:`PARAMETERS`, one numpy record of named float64 fields, SI units:
   :data:`PARAMETER_FIELDS`, with the track's fields from track.PARAMETER_FIELDS).
 * The patch record (``rec``, (candidates + 2, :data:`N_FIELDS`)): one row per contact candidate with the
-  :data:`PATCH_FIELDS` (what the results store per patch), then for ``auto`` the :data:`AUTO_PATCH_FIELDS`; the
+  :data:`PATCH_FIELDS` (what the results store per patch), then for ``auto`` the :data:`AUTO_PATCH_FIELDS`, then
+  a formed patch's own quantities (:data:`FORMED_PATCH_FIELDS`, recorded in place of its candidate's); the
   last two rows hold the summed contact force per side (:data:`SIDE_FORCE_ROWS`, columns 0-2: x, y, z, main
   frame, N).
 * The candidate geometry (``cg``, (candidates, :data:`N_GEO`)): :data:`GEOMETRY_FIELDS`, what the tables, the
@@ -84,7 +85,19 @@ level), ``auto_deciding_feature`` the index in auto.FEATURES of the feature whos
 that threshold, then the patch's features (rigid_dynamics.contact.auto.patch_features)."""
 AUTO_RUNG, AUTO_LEVEL, AUTO_DECIDING_FEATURE, AUTO_DECIDING_THRESHOLD, AUTO_FEATURES = range(N_PATCH, N_PATCH + 5)
 """Columns of the auto record; AUTO_FEATURES is the first of the five features (AUTO_FEATURE_NAMES' order)."""
-N_FIELDS = N_PATCH + len(AUTO_PATCH_FIELDS)
+N_FORMED = 12
+"""The patch record's first columns (normal force to contact angle) that a formed patch gives in its own frame."""
+FORMED_PATCH_FIELDS = tuple(f"formed_{name}" for name in PATCH_FIELDS[:N_FORMED])
+"""Per candidate that serves a formed patch (wheelset/formed_patches.py: a gap-solving model with patches formed as
+CONTACT's module 1 forms them): the formed patch's own quantities in place of PATCH_FIELDS[:N_FORMED], which hold the
+candidate's (the forces the loop applies, in the candidate's contact frame, and its geometry and creepages): N', T_x',
+T_y' and M_z' in the formed patch's contact frame, the creepages transported to its reference point, its approach,
+the reference point's y (main frame), the wheel's lateral coordinate and rolling radius there and its contact angle.
+NaN (``formed_normal_force_N`` NaN) for any other candidate. Not results of their own: the record writers put them
+in place of the candidate's (formed_patches.recorded)."""
+FORMED = N_PATCH + len(AUTO_PATCH_FIELDS)
+"""The first column of the formed patch's own quantities: rec[c, FORMED + k] is PATCH_FIELDS[k]'s, k < N_FORMED."""
+N_FIELDS = FORMED + N_FORMED
 SIDE_FORCE_ROWS = 2
 """Rows after the candidates' rows: the summed contact force on the left and the right wheel."""
 

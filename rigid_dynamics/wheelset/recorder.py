@@ -9,7 +9,8 @@ import math
 
 import numpy as np
 
-from rigid_dynamics.wheelset.layout import AUTO_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS
+from rigid_dynamics.wheelset.formed_patches import recorded
+from rigid_dynamics.wheelset.layout import AUTO_PATCH_FIELDS, FORMED_PATCH_FIELDS, MAX_SLOTS, PATCH_FIELDS
 from rigid_dynamics.wheelset.parameters import DynamicsScene
 from rigid_dynamics.wheelset.providers import SIDES
 from rigid_dynamics.wheelset.state import TRACK
@@ -67,12 +68,12 @@ class Recorder:
         if not np.all(np.isfinite(full_state)):
             raise Stop("blow-up", f"non-finite state at t = {t:.6g} s", t, state)
         contact = self.model.contact(state, record=True, track=full_state[TRACK] if self.model.elastic else None)
-        table = {name: np.full((2, MAX_SLOTS), np.nan) for name in self.fields}
+        table = {name: np.full((2, MAX_SLOTS), np.nan) for name in self.fields + FORMED_PATCH_FIELDS}
         for k in range(len(contact.side)):
             side, slot = int(contact.side[k]), int(contact.slot[k])
             if slot >= MAX_SLOTS:
                 continue
-            for name in self.fields:
+            for name in table:
                 if name in contact.values:
                     table[name][side, slot] = contact.values[name][k]
         forces = np.zeros((2, 3))
@@ -83,7 +84,9 @@ class Recorder:
         self, t: float, full_state: np.ndarray, table: dict, forces: np.ndarray, error: float = math.nan
     ) -> None:
         """Check and store one sample (patch table: PATCH_FIELDS -> (2, 2); forces per side (2, 3); the force error
-        estimate of the step ending there, relative to the static wheel load).
+        estimate of the step ending there, relative to the static wheel load). The checks and events read the
+        candidates' values (the loop's, as the compiled loop's own checks); the table is stored as the record
+        (formed_patches.recorded: a formed patch's own quantities from the table's FORMED_PATCH_FIELDS).
         """
         state = full_state[:12]
         normal = np.nansum(table["normal_force_N"], axis=1)
@@ -130,6 +133,7 @@ class Recorder:
         self.in_contact, self.flange = touching, flange
         self.t.append(np.array([t], float))
         self.states.append(state[None].copy())
+        table = recorded(table)
         for name in self.fields:
             self.patches[name].append(np.asarray(table.get(name, np.full((2, MAX_SLOTS), np.nan)), float)[None])
         self.forces.append(np.asarray(forces, float)[None])
@@ -151,7 +155,9 @@ class Recorder:
         self.errors[-1] = np.array([error], float)
 
     def append_many(self, times, full_states, tables: dict, forces, errors) -> None:
-        """Vectorised :meth:`append` for many samples (tables: name -> (n, 2, 2); forces (n, 2, 3); errors (n,))."""
+        """Vectorised :meth:`append` for many samples (tables: name -> (n, 2, 2); forces (n, 2, 3); errors (n,)), its
+        checks, events and record as :meth:`append`'s.
+        """
         n = len(times)
         if n == 0:
             return
@@ -199,6 +205,7 @@ class Recorder:
         states = full_states[:, :12]
         self.t.append(np.asarray(times, float).copy())
         self.states.append(states.copy())
+        tables = recorded(tables)
         for name in self.fields:
             self.patches[name].append(np.asarray(tables.get(name, np.full((n, 2, MAX_SLOTS), np.nan)), float).copy())
         self.forces.append(np.asarray(forces, float).copy())

@@ -70,6 +70,8 @@ from rigid_dynamics.wheelset.layout import (
     CREEP_FORCE_LAT,
     CREEP_FORCE_LONG,
     CREEPAGES_UNDEFINED,
+    FORMED,
+    FORMED_PATCH_FIELDS,
     G_APPROACH,
     G_CONTACT_ANGLE,
     G_CURVATURE_LAT,
@@ -154,7 +156,16 @@ class ContactState:
     moment_Nm: np.ndarray  # (n, 3) main frame, about the contact point
     lever_m: np.ndarray  # (n, 3)
     point_velocity_m_per_s: np.ndarray  # (n, 3)
-    values: dict | None  # PATCH_FIELDS -> (n,) when recorded
+    values: dict | None  # PATCH_FIELDS (the candidates'), FORMED_PATCH_FIELDS -> (n,) when recorded
+
+    @property
+    def record(self) -> dict | None:
+        """The per-patch values as the run records them: ``values`` with a formed patch's own quantities in place of
+        its candidate's (formed_patches.recorded); None when not recorded.
+        """
+        from rigid_dynamics.wheelset.formed_patches import recorded
+
+        return None if self.values is None else recorded(self.values)
 
 
 def _patch_surfaces(scene: DynamicsScene, provider):
@@ -403,10 +414,11 @@ class WheelsetModel:
         """Contact of every candidate (approach, geometry; forces where approach > 0) at a 12-state, for inspection
         and recording: the compiled right-hand side's candidates with their contact frames.
 
-        With ``record`` the per-patch values (PATCH_FIELDS, and AUTO_PATCH_FIELDS for ``auto``) are filled, else
-        ``values`` is None. ``track``: the elastic track's states; None: ``track_rest`` (rigid track: ignored).
-        ``keep_search_memory``: leave the compiled search's warm starts as they were (a look that must not change the
-        run).
+        With ``record`` the per-patch values (PATCH_FIELDS, and AUTO_PATCH_FIELDS for ``auto``: the candidates', the
+        loop's; FORMED_PATCH_FIELDS: a formed patch's own, NaN for other candidates) are filled, else ``values`` is
+        None; ContactState.record is what the run records (a formed patch's own quantities in place). ``track``: the
+        elastic track's states; None: ``track_rest`` (rigid track: ignored). ``keep_search_memory``: leave the
+        compiled search's warm starts as they were (a look that must not change the run).
         """
         full = self.full_state(state)
         if self.elastic and track is not None:
@@ -443,6 +455,7 @@ class WheelsetModel:
             names = PATCH_FIELDS + (AUTO_PATCH_FIELDS if self.auto else ())
             values = {name: rec[:, f].copy() for f, name in enumerate(names)}
             values["contact_point_y_m"] = centre[1] + lever[:, 1]
+            values.update({name: rec[:, FORMED + k].copy() for k, name in enumerate(FORMED_PATCH_FIELDS)})
         return ContactState(sides[present], slots[present], force, moment, lever.copy(), velocity, values)
 
     def derivative(self, t: float, state: np.ndarray) -> np.ndarray:

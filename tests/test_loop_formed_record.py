@@ -1,0 +1,200 @@
+"""The record of a formed patch (issue 28): a gap-solving model's patches formed as CONTACT's module 1 forms them
+(rigid_dynamics/wheelset/formed_patches.py) are recorded in their own plane, while the loop applies the same forces
+as before (in the candidate's frame).
+
+Reference: CONTACT (E.A.H. Vollebregt, J.J. Kalker; Apache-2.0, revision 2707), module 1, planar contact approach,
+at curve-flange's state with the loop's kinematics (tests/data/contact_curve_flange/left_planar_curve.out; SOURCE.md
+there, benchmarks/results/curve_flange_contact.md). CONTACT's flange-root patch lies in the plane at 0.8124 rad
+with FN 120.3 kN and a creep force of 0.81 mu FN (F_s 29.25, F_x -1.53 kN on the rail); the compiled candidate's
+plane is at 0.554 rad, where the same force reads as a lateral creep force of -2.40 kN.
+
+At the state (the loop's contact, ``WheelsetModel.contact(...).record``), recorded against CONTACT's planar patch:
+contact angle 0.8124 against 0.8124 rad, FN 117.81 against 120.3 kN (-2.1 %), F_s 28.66 against 29.25 kN (1.6 % of
+mu FN), F_x 2.33 against 1.53 kN (2.2 % of mu FN), creep force 0.812 against 0.812 mu FN, reference point y 0.3 um
+apart, approach 109.93 against 112.24 um (-2.1 %), creepages eta -0.007304 against -0.007264, spin -1.5740 against
+-1.562 1/m, xi -0.002503 against -0.00248. Tolerances as tests/test_contact_curve_flange.py's loop test (3 % on FN
+and the approach, 3 % of mu FN on the creep forces: CONTACT's planar gap is 2.3 um deeper than ours at the same
+pose, and its grid 0.2 mm against the loop's 0.35 mm), 0.005 rad on the angle, 0.2 mm on the point, 1 % on eta and
+the spin (0.5-0.8 % is the speed they are divided by: our |v_p|, CONTACT's mean rolling speed), 1e-4 on xi.
+
+In a run (2 ms, RK4, the formed patches of curve-flange's flange root) the record holds the formed plane (0.787
+rad at t = 0, the run's own equilibrium sits 15 um lower than CONTACT's deck) and a creep force of 0.815 mu N;
+the wheel's contact force (main frame) is the record's own-frame force turned by its contact angle, and is the run's
+of before the record changed (regression against the values written by the parent commit, 9bc4443: states and
+wheel forces bit-identical there, compared here to 1e-10).
+"""
+
+import math
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rigid_dynamics.materials import Material
+
+DATA = Path(__file__).parent / "data" / "contact_curve_flange"
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+
+from contact_out import read_out  # noqa: E402
+from make_contact_curve_flange import STATE  # noqa: E402
+
+MU = Material(shear_modulus_Pa=82.0e9, poisson_ratio=0.28, friction_coefficient=0.3).friction_coefficient
+
+
+def _frame(angle_rad: float, side: int) -> np.ndarray:
+    """Columns e_x, e_y, n (on the wheel) of a formed patch's plane at its contact angle (wheel_patches' frame for
+    the rolling direction x)."""
+    sgn = -1.0 if side == 1 else 1.0
+    n = np.array([0.0, sgn * math.sin(angle_rad), -math.cos(angle_rad)])
+    e_x = np.array([1.0, 0.0, 0.0])
+    return np.stack([e_x, np.cross(n, e_x), n], -1)
+
+
+@pytest.fixture(scope="module")
+def at_state():
+    """The loop's contact (BEM, patches formed) at CONTACT's deck state, and the model."""
+    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
+    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
+    from wheelrail.config import read_toml
+    from wheelrail.scenes import parse_scene, resolve_scene_path
+
+    path = resolve_scene_path("curve-flange")
+    doc = read_toml(path, "scene file")
+    doc["settling_distance_m"], doc["contact_model"] = 0.0, "bem"
+    doc["initial"] = {**doc.get("initial", {}), "lateral_displacement_m": STATE["y_m"], "yaw_rad": STATE["yaw_rad"]}
+    scene = parse_scene(doc, base_dir=path.parent)
+    model = WheelsetModel(scene, build_provider(scene), get_contact_model("bem"), model_options("bem", scene))
+    state = np.zeros(12)
+    state[1:5] = STATE["y_m"], STATE["z_m"], STATE["yaw_rad"], STATE["roll_rad"]
+    state[6], state[11] = STATE["x_velocity_m_per_s"], STATE["spin_rate_rad_per_s"]
+    return model, state, model.contact(state, record=True, keep_search_memory=True)
+
+
+def _left(contact) -> int:
+    (k,) = np.flatnonzero((contact.side == 0) & (np.nan_to_num(contact.values["normal_force_N"]) > 0))
+    return int(k)
+
+
+def test_formed_flange_root_record_is_contacts_planar_patch(at_state):
+    _, _, contact = at_state
+    ref = read_out(DATA / "left_planar_curve.out")[0]
+    patch = ref["patches"][0]
+    k = _left(contact)
+    record = {name: float(v[k]) for name, v in contact.record.items()}
+    mu_fn = MU * patch["FN"]
+    assert record["contact_angle_rad"] == pytest.approx(patch["DELTCP(TR)"], abs=0.005)
+    assert record["normal_force_N"] == pytest.approx(patch["FN"], rel=0.03)
+    # forces on the wheel: F_x = -FX (CONTACT's on the rail), F_y = +FS (s = -e_y on either side)
+    assert abs(record["creep_force_lat_N"] - patch["FS"]) <= 0.03 * mu_fn
+    assert abs(record["creep_force_long_N"] + patch["FX"]) <= 0.03 * mu_fn
+    creep = math.hypot(record["creep_force_long_N"], record["creep_force_lat_N"]) / (MU * record["normal_force_N"])
+    assert creep == pytest.approx(math.hypot(patch["FX"], patch["FS"]) / mu_fn, abs=0.03)  # 0.81 mu N
+    assert record["contact_point_y_m"] * 1e3 == pytest.approx(patch["YCP(TR)"], abs=0.2)
+    assert record["approach_m"] * 1e3 == pytest.approx(patch["APPROACH"], rel=0.03)
+    assert record["creepage_lat"] == pytest.approx(patch["CETA"], rel=0.01)
+    assert record["spin_creepage_1_per_m"] == pytest.approx(patch["CPHI"] * 1e3, rel=0.01)
+    assert abs(record["creepage_long"] + patch["CKSI"]) <= 1e-4
+
+
+def test_record_is_the_applied_force_in_the_formed_plane(at_state):
+    """The loop still applies the candidate's frame (``values``: the candidate's plane at 0.554 rad, a lateral creep
+    force of -2.4 kN); the record's own-frame force turned by its angle is the force the wheel gets (to rounding).
+    The wheel's lateral coordinate moves with the reference point (2.3 mm along the axle here)."""
+    _, _, contact = at_state
+    k = _left(contact)
+    values, record = contact.values, contact.record
+    assert values["contact_angle_rad"][k] == pytest.approx(0.554, abs=0.005)
+    assert values["creep_force_lat_N"][k] == pytest.approx(-2.40e3, abs=0.05e3)
+    assert record["contact_angle_rad"][k] - values["contact_angle_rad"][k] == pytest.approx(0.26, abs=0.01)
+    own = np.array([record[n][k] for n in ("creep_force_long_N", "creep_force_lat_N", "normal_force_N")])
+    force = _frame(record["contact_angle_rad"][k], 0) @ own
+    np.testing.assert_allclose(force, contact.force_N[k], rtol=0, atol=1e-9 * np.linalg.norm(force))
+    moved = record["contact_point_y_m"][k] - values["contact_point_y_m"][k]
+    assert record["wheel_lateral_m"][k] - values["wheel_lateral_m"][k] == pytest.approx(moved, abs=2e-4)
+    assert "formed_normal_force_N" not in record
+    for name in ("semi_axis_long_m", "contact_area_m2", "max_pressure_Pa", "ellipticity_residual"):
+        np.testing.assert_array_equal(record[name], values[name])  # the formed patch's result all along
+
+
+def test_python_recorder_stores_the_record(at_state):
+    """The Python drivers' recorder (scipy methods) stores ``record``, as the compiled loop's tables."""
+    from rigid_dynamics.wheelset.recorder import Recorder
+
+    model, state, contact = at_state
+    recorder = Recorder(model, model.scene)
+    recorder.record(0.0, model.full_state(state))
+    k = _left(contact)
+    for name in ("contact_angle_rad", "normal_force_N", "creep_force_lat_N", "creepage_lat"):
+        assert recorder.patches[name][-1][0, 0, 0] == pytest.approx(contact.record[name][k], rel=1e-6), name
+
+
+# the parent commit's run (9bc4443, before the record changed): wheel forces (left x, y, z, right x, y, z; main
+# frame, N) at t = 0, 1, 2 ms and the state at 2 ms; written from result.to_dataframe() and result.states
+BEFORE_WHEEL_FORCES_N = np.array(
+    [
+        [-1703.2684600992875, 66269.25627585802, -108677.9006965729, 2884.6252762019703, -22026.964491305927,
+         -72159.2452441729],
+        [-3504.489743052872, 55899.6952702068, -100756.60430141767, 2875.1484542618437, -22338.568966631243,
+         -72730.50283895298],
+        [-5150.258945081018, 37520.42667169039, -84893.8153777949, 3797.848356304777, -23721.94261311259,
+         -77567.57655586327],
+    ]
+)  # fmt: skip
+BEFORE_FINAL_STATE = np.array(
+    [0.027777773847654737, -0.006244230701592905, -0.46018343636843845, -0.004541981990900907,
+     0.0007004208057133055, 0.059997957219598046, 13.888407093794322, 0.02954455906780925, 0.008770034586533436,
+     0.006966076253571798, -0.0034880747134001366, 30.00212818883418]
+)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def run():
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.scenes import load_scene, resolve_scene_path
+
+    scene = load_scene(resolve_scene_path("curve-flange"))
+    scene = replace(
+        scene, contact_model="bem", patch_geometry="sampled", duration_s=0.002, settling_distance_m=0.0,
+        initial=replace(scene.initial, lateral_displacement_m=-0.00628, yaw_rad=-0.00455),
+    )  # fmt: skip
+    return simulate(scene)
+
+
+def test_run_records_the_formed_plane(run):
+    from rigid_dynamics.contact.search import WheelsetPose
+    from rigid_dynamics.wheelset.formed_patches import PatchFormer
+    from rigid_dynamics.wheelset.simulate import build_provider
+
+    assert run.status == "ok", run.message
+    p = run.patches
+    angle = p["contact_angle_rad"][:, 0, 0]
+    assert np.all(angle > 0.65) and angle[0] == pytest.approx(0.787, abs=0.005)
+    # the angle is the formed patch's plane at the recorded state (formed again here from the surfaces)
+    former = PatchFormer(build_provider(run.scene).surfaces)  # the search provider's surfaces, as the callback's
+    (formed,) = former.patches("left", WheelsetPose(*(float(v) for v in run.states[0, :6])))
+    assert angle[0] == pytest.approx(formed.geometry.contact_angle_rad, abs=1e-9)
+    creep = np.hypot(p["creep_force_long_N"][0, 0, 0], p["creep_force_lat_N"][0, 0, 0])
+    assert creep / (MU * p["normal_force_N"][0, 0, 0]) == pytest.approx(0.81, abs=0.03)
+
+
+def test_run_wheel_forces_are_the_records_and_the_former_ones(run):
+    """The wheel's contact force is each touching patch's recorded force turned by its recorded angle (to
+    rounding), and the run's trajectory and wheel forces are the parent commit's (regression)."""
+    frame = run.to_dataframe()
+    p = run.patches
+    for side, name in enumerate(("left", "right")):
+        wheel = frame[[f"{name}_wheel_contact_force_{a}_N" for a in "xyz"]].to_numpy()
+        for i in range(len(run.t)):
+            total = np.zeros(3)
+            for slot in range(2):
+                if np.nan_to_num(p["normal_force_N"][i, side, slot]) > 0:
+                    own = [p[n][i, side, slot] for n in ("creep_force_long_N", "creep_force_lat_N", "normal_force_N")]
+                    total += _frame(p["contact_angle_rad"][i, side, slot], side) @ np.array(own)
+            np.testing.assert_allclose(wheel[i], total, rtol=0, atol=1e-9 * np.linalg.norm(total))
+    forces = frame[[f"{s}_wheel_contact_force_{a}_N" for s in ("left", "right") for a in "xyz"]].to_numpy()
+    np.testing.assert_allclose(forces, BEFORE_WHEEL_FORCES_N, rtol=1e-10)
+    for block in (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)):
+        scale = np.max(np.abs(BEFORE_FINAL_STATE[block]))
+        np.testing.assert_allclose(run.states[-1, block], BEFORE_FINAL_STATE[block], rtol=0, atol=1e-10 * scale)
