@@ -37,6 +37,16 @@ def _workers(pid: int) -> int:
     return count
 
 
+def _catches_sigint(pid: int) -> bool:
+    """Whether the process ``pid`` has a handler installed for SIGINT (its SigCgt mask in /proc)."""
+    try:
+        with open(f"/proc/{pid}/status") as handle:
+            caught = next(line for line in handle if line.startswith("SigCgt:"))
+    except (OSError, StopIteration):
+        return False
+    return bool(int(caught.split()[1], 16) & (1 << (signal.SIGINT - 1)))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("command", ["sweep", "stress"])
 def test_ctrl_c_to_the_process_group_ends_quietly_with_130(tmp_path, command):
@@ -49,7 +59,9 @@ def test_ctrl_c_to_the_process_group_ends_quietly_with_130(tmp_path, command):
     try:
         # the two worker processes are up (while the cluster starts, SIGINT is ignored: its workers inherit that)
         assert wait_for(lambda: _workers(proc.pid) >= 2, 240.0), "no workers"
-        wait_for(lambda: False, 1.0)  # the cluster has started (a quick stress run ends a few s later)
+        # the cluster has started when the command catches SIGINT again (a fixed 1 s after the workers appeared
+        # fell inside that window on a fast machine: the interrupt was ignored and the run ended 0)
+        assert wait_for(lambda: _catches_sigint(proc.pid), 120.0), "SIGINT still ignored"
         assert proc.poll() is None, "ended before the interrupt"
         os.killpg(proc.pid, signal.SIGINT)
         _, err = proc.communicate(timeout=120)
