@@ -287,8 +287,15 @@ def test_loose_tolerance_is_flagged():
     provider = build_provider(scene)
     loose = simulate(_adaptive(scene, rtol=1e-2, atol=1e-6), provider=provider)
     assert loose.status == "warning", loose.message
-    assert "at a tenth of the tolerances" in loose.message and "tighten relative_tolerance = 0.01" in loose.message
-    assert loose.half_step_peak_difference > 0.25 * scene.integrator.force_tolerance
+    assert "tighten relative_tolerance = 0.01" in loose.message
+    # flagged by the local estimate or, below it, by the check at a tenth of the tolerances: with numpy 2.5.5 /
+    # numba 0.68.1 (2026-11-29) the loose run's local estimate is 2.43 % at t = 0.1839 s (a located contact switch),
+    # above force_tolerance, so the check is not needed to flag it (before: 0.89 %, flagged by the check)
+    if loose.half_step_peak_difference is None:
+        assert loose.summary()["force_error_estimate"] > scene.integrator.force_tolerance, loose.message
+    else:
+        assert "at a tenth of the tolerances" in loose.message
+        assert loose.half_step_peak_difference > 0.25 * scene.integrator.force_tolerance
     tight = simulate(_adaptive(scene, rtol=1e-5, atol=1e-8), provider=provider)
     assert tight.status == "ok" and tight.summary()["force_error_estimate"] < 0.01, tight.message
     # the wheel lifts after the flat's impact: as for RK4 (its half-step check), the run is repeated at a tenth of
