@@ -106,8 +106,12 @@ def test_conicity_command(capsys):
 
 @pytest.mark.fea
 def test_contact_fea_plot_writes_stress_maps(tmp_path, capsys):
+    """The FEA's files and subsurface maxima reach the output folder and the summary (of the quick mesh refined to
+    5 %, two levels: the claim is the files, not the accuracy; measured 7.1 s CPU against 9.5 s with the default
+    series, issue 27)."""
     out = tmp_path / "fea-out"
-    argv = ["contact", "hertz-quadric", "--method", "fea", "--json", "--plot", "--out", str(out)]
+    quick = ["--set", "solver.quick=true", "--set", "solver.mesh_tolerance=0.05"]
+    argv = ["contact", "hertz-quadric", "--method", "fea", *quick, "--json", "--plot", "--out", str(out)]
     code, record = run_json(capsys, *argv)
     assert code == 0
     (patch,) = record["patches"]
