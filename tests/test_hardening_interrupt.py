@@ -37,6 +37,12 @@ def _workers(pid: int) -> int:
     return count
 
 
+def _sigint_default() -> None:
+    """In the command's process before exec: SIGINT to its default, as in a terminal (a suite run as a background
+    job inherits SIGINT ignored, and Python then installs no handler: the interrupt would be lost)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _catches_sigint(pid: int) -> bool:
     """Whether the process ``pid`` has a handler installed for SIGINT (its SigCgt mask in /proc)."""
     try:
@@ -55,7 +61,7 @@ def test_ctrl_c_to_the_process_group_ends_quietly_with_130(tmp_path, command):
         argv = ["sweep", write(tmp_path, SWEEP, "sweep.toml"), "--workers", "2", "--quiet"]
     else:
         argv = ["stress", "hunting-conical", "--quick", "--workers", "2"]
-    proc = cli_subprocess(*argv, "--out", out, start_new_session=True)
+    proc = cli_subprocess(*argv, "--out", out, start_new_session=True, preexec_fn=_sigint_default)
     try:
         # the two worker processes are up (while the cluster starts, SIGINT is ignored: its workers inherit that)
         assert wait_for(lambda: _workers(proc.pid) >= 2, 240.0), "no workers"
