@@ -55,20 +55,9 @@ def _frame(angle_rad: float, side: int) -> np.ndarray:
 @pytest.fixture(scope="module")
 def at_state():
     """The loop's contact (BEM, patches formed) at CONTACT's deck state, and the model."""
-    from rigid_dynamics.wheelset.simulate import build_provider, get_contact_model, model_options
-    from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
-    from wheelrail.config import read_toml
-    from wheelrail.scenes import parse_scene, resolve_scene_path
+    from loop_helpers import curve_flange_bem_at
 
-    path = resolve_scene_path("curve-flange")
-    doc = read_toml(path, "scene file")
-    doc["settling_distance_m"], doc["contact_model"] = 0.0, "bem"
-    doc["initial"] = {**doc.get("initial", {}), "lateral_displacement_m": STATE["y_m"], "yaw_rad": STATE["yaw_rad"]}
-    scene = parse_scene(doc, base_dir=path.parent)
-    model = WheelsetModel(scene, build_provider(scene), get_contact_model("bem"), model_options("bem", scene))
-    state = np.zeros(12)
-    state[1:5] = STATE["y_m"], STATE["z_m"], STATE["yaw_rad"], STATE["roll_rad"]
-    state[6], state[11] = STATE["x_velocity_m_per_s"], STATE["spin_rate_rad_per_s"]
+    model, state = curve_flange_bem_at(STATE)
     return model, state, model.contact(state, record=True, keep_search_memory=True)
 
 
