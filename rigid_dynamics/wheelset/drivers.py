@@ -16,18 +16,14 @@ import numpy as np
 
 from rigid_dynamics.wheelset.equilibrium import contact_force_sums
 from rigid_dynamics.wheelset.layout import (
-    AUTO_PATCH_FIELDS,
     CALLBACK_FAILED,
     CREEP_FORCE_LONG,
     CREEPAGE_LONG,
-    FORMED,
-    FORMED_PATCH_FIELDS,
     MAX_SLOTS,
     N_FIELDS,
-    N_PATCH,
     NORMAL_FORCE,
-    PATCH_FIELDS,
     UNDERFLOW,
+    record_columns,
     status_name,
 )
 from rigid_dynamics.wheelset.recorder import Stop
@@ -384,9 +380,7 @@ def patch_tables(model, block, sides, slots) -> dict:
     AUTO_PATCH_FIELDS for ``auto``, and FORMED_PATCH_FIELDS: the recorder puts a formed patch's own quantities in
     place of its candidate's, formed_patches.recorded).
     """
-    columns = list(enumerate(PATCH_FIELDS)) + [(FORMED + k, name) for k, name in enumerate(FORMED_PATCH_FIELDS)]
-    if model.auto:
-        columns += [(N_PATCH + k, name) for k, name in enumerate(AUTO_PATCH_FIELDS)]
+    columns = record_columns(model.auto)
     tables = {name: np.full((len(block), 2, MAX_SLOTS), np.nan) for _, name in columns}
     for c in range(len(sides)):
         if slots[c] < MAX_SLOTS:

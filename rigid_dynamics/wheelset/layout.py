@@ -98,6 +98,18 @@ in place of the candidate's (formed_patches.recorded)."""
 FORMED = N_PATCH + len(AUTO_PATCH_FIELDS)
 """The first column of the formed patch's own quantities: rec[c, FORMED + k] is PATCH_FIELDS[k]'s, k < N_FORMED."""
 N_FIELDS = FORMED + N_FORMED
+
+
+def record_columns(auto: bool) -> list[tuple[int, str]]:
+    """(column of the patch record, field name) of what a run records per candidate: PATCH_FIELDS, AUTO_PATCH_FIELDS
+    for ``auto``, and FORMED_PATCH_FIELDS (formed_patches.recorded puts them in place of the candidate's).
+    """
+    columns = list(enumerate(PATCH_FIELDS))
+    if auto:
+        columns += [(N_PATCH + k, name) for k, name in enumerate(AUTO_PATCH_FIELDS)]
+    return columns + [(FORMED + k, name) for k, name in enumerate(FORMED_PATCH_FIELDS)]
+
+
 SIDE_FORCE_ROWS = 2
 """Rows after the candidates' rows: the summed contact force on the left and the right wheel."""
 

@@ -65,13 +65,10 @@ from rigid_dynamics.wheelset.compiled_motion import (
 )
 from rigid_dynamics.wheelset.compiled_records import law_code, model_parameters, pack
 from rigid_dynamics.wheelset.layout import (
-    AUTO_PATCH_FIELDS,
     CALLBACK_FAILED,
     CREEP_FORCE_LAT,
     CREEP_FORCE_LONG,
     CREEPAGES_UNDEFINED,
-    FORMED,
-    FORMED_PATCH_FIELDS,
     G_APPROACH,
     G_CONTACT_ANGLE,
     G_CURVATURE_LAT,
@@ -86,8 +83,8 @@ from rigid_dynamics.wheelset.layout import (
     N_FIELDS,
     N_GEO,
     NORMAL_FORCE,
-    PATCH_FIELDS,
     SPIN_MOMENT,
+    record_columns,
     status_name,
 )
 from rigid_dynamics.wheelset.parameters import DynamicsScene
@@ -452,10 +449,8 @@ class WheelsetModel:
         moment[~active] = 0.0
         values = None
         if record:
-            names = PATCH_FIELDS + (AUTO_PATCH_FIELDS if self.auto else ())
-            values = {name: rec[:, f].copy() for f, name in enumerate(names)}
+            values = {name: rec[:, f].copy() for f, name in record_columns(self.auto)}
             values["contact_point_y_m"] = centre[1] + lever[:, 1]
-            values.update({name: rec[:, FORMED + k].copy() for k, name in enumerate(FORMED_PATCH_FIELDS)})
         return ContactState(sides[present], slots[present], force, moment, lever.copy(), velocity, values)
 
     def derivative(self, t: float, state: np.ndarray) -> np.ndarray:
