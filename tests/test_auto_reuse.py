@@ -15,6 +15,7 @@ import wheelrail as wr
 RADII = (0.46, 0.3)
 LOAD_N = 1.0e5
 ANCHOR_CREEP = (2.0e-3, -1.0e-3, 0.8)  # |F| ~0.65 mu N with spin: auto gives such a patch to BEM at 5 %
+NOT_FORMED = ((math.nan,) * 12, (math.nan,) * 12, 0.0)  # reuse_anchor's ``formed`` of a patch solved on its own plane
 
 
 def _setup():
@@ -72,7 +73,7 @@ def test_the_correction_against_fresh_bem_solves():
     par, hk, g = _setup()
     where, dummy = (0.0, 20.0), np.zeros((1, 1))
     anchor = _bem(ANCHOR_CREEP)
-    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, _solved(anchor))
+    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, _solved(anchor), NOT_FORMED)
     same = reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0)
     assert same[0]
     assert same[1:5] == pytest.approx(_solved(anchor)[:4], rel=1e-9, abs=1e-9)
@@ -110,14 +111,16 @@ def test_the_radius_follows_the_measured_error():
     par, hk, g = _setup()
     where, dummy = (0.0, 20.0), np.zeros((1, 1))
     anchor = _solved(_bem(ANCHOR_CREEP))
-    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, anchor)
+    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, anchor, NOT_FORMED)
     near = tuple(c * 1.15 for c in ANCHOR_CREEP)  # beyond the radius 0.1, within twice it
     assert not reuse_serve(par, hk, dummy, g, near, where, 0)[0]
     wrong = list(anchor)
     wrong[1] *= 1.5  # a "BEM" solution 50 % off the anchor's correction: the radius halves
-    reuse_anchor(par, hk, dummy, g, near, where, 0, 1.0, tuple(wrong))
+    reuse_anchor(par, hk, dummy, g, near, where, 0, 1.0, tuple(wrong), NOT_FORMED)
     assert hk.reuse[-1, T_CHECKED] == 1 and hk.reuse[0, R_RADIUS] == pytest.approx(0.05)
-    reuse_anchor(par, hk, dummy, g, near, where, 0, 2.0, tuple(wrong))  # the same solution again: error 0, grows
+    reuse_anchor(
+        par, hk, dummy, g, near, where, 0, 2.0, tuple(wrong), NOT_FORMED
+    )  # the same solution again: error 0, grows
     assert hk.reuse[0, R_RADIUS] == pytest.approx(0.075)
     assert reuse_serve(par, hk, dummy, g, near, where, 0)[0]
     assert hk.reuse[-1, T_SERVED] == 1 and hk.reuse[-1, T_SOLVED] == 3

@@ -187,3 +187,77 @@ def test_run_wheel_forces_are_the_records_and_the_former_ones(run):
     for block in (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)):
         scale = np.max(np.abs(BEFORE_FINAL_STATE[block]))
         np.testing.assert_allclose(run.states[-1, block], BEFORE_FINAL_STATE[block], rtol=0, atol=1e-10 * scale)
+
+
+# auto's run below at the parent commit (7fa3e78, before served patches were recorded in the formed plane): wheel
+# forces (left x, y, z, right x, y, z; main frame, N) at t = 0, 3, 6 ms and the state at 6 ms
+AUTO_BEFORE_WHEEL_FORCES_N = np.array(
+    [
+        [-1161.7362010222998, 65843.4750916655, -108654.85551916344, 3294.9504018773314, -21675.812592934933,
+         -72181.84688451361],
+        [-6008.648767993912, 27571.268225725147, -80558.63954994352, 5048.825131393027, -26783.793450561156,
+         -88298.68543035412],
+        [-9056.115826683914, 26522.765169276598, -111206.4353520126, 6936.3589386476215, -23775.411171390424,
+         -80277.04269436392],
+    ]
+)  # fmt: skip
+AUTO_BEFORE_FINAL_STATE = np.array(
+    [0.08332836015837966, -0.0061411664350304205, -0.46012786775118303, -0.004514166604135174, 0.000628970483395162,
+     0.18005725029413655, 13.885698995178481, 0.019306178414024894, 0.003237221188683482, 0.003237818465834746,
+     -0.01634999838025894, 30.026243192169428]
+)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def auto_run():
+    """``auto`` (5 %, its BEM patches reused: auto_reuse.py) on the sampled gap from curve-flange's flange root, 6 ms:
+    the flange patch goes to BEM and is served by its anchor's correction at the recorded samples to 4 ms, then by
+    Vermeulen-Johnson on the ellipse as the wheelset leaves the root."""
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.scenes import load_scene, resolve_scene_path
+
+    scene = load_scene(resolve_scene_path("curve-flange"))
+    scene = replace(
+        scene, contact_model="auto", patch_geometry="sampled", duration_s=0.006, settling_distance_m=0.0,
+        initial=replace(scene.initial, lateral_displacement_m=-0.00628, yaw_rad=-0.00455),
+    )  # fmt: skip
+    return simulate(scene)
+
+
+def test_auto_records_its_served_bem_patches_in_the_formed_plane(auto_run):
+    """A BEM patch ``auto`` serves by its anchor's correction is recorded in the plane of the formed patch the
+    anchor was (auto_reuse.reuse_own), not in the compiled candidate's: referee, the patch formed again from the
+    surfaces at each recorded state (formed_patches.PatchFormer, as the static case forms it). Measured: contact angle
+    within 0.0019 rad and approach within 0.03 um of it at every served sample (0.785 -> 0.559 rad over 4 ms), where
+    the candidate's plane read 0.54 -> 0.47 rad and a lateral creep force of -0.3 kN at t = 0 (now 30.3 kN, 0.82 mu
+    N, as the BEM run above). The record's force turned by its angle is the wheel's force to 3.3e-6 relative (the
+    candidate's frame moves within the trust region; exact for the solved patches); the applied forces and the
+    trajectory are the parent commit's (regression, bit-identical when written)."""
+    from rigid_dynamics.contact.search import WheelsetPose
+    from rigid_dynamics.wheelset.compiled_laws import LAW_BEM_CORRECTED
+    from rigid_dynamics.wheelset.formed_patches import PatchFormer
+    from rigid_dynamics.wheelset.simulate import build_provider
+
+    run = auto_run
+    p = run.patches
+    served = p["contact_law_code"][:, 0, 0] == LAW_BEM_CORRECTED
+    assert served[:5].all() and not served[5:].any(), p["contact_law_code"][:, 0, 0]
+    former = PatchFormer(build_provider(run.scene).surfaces)
+    for i in np.flatnonzero(served):
+        (formed,) = former.patches("left", WheelsetPose(*(float(v) for v in run.states[i, :6])))
+        assert p["contact_angle_rad"][i, 0, 0] == pytest.approx(formed.geometry.contact_angle_rad, abs=0.003)
+        assert p["approach_m"][i, 0, 0] == pytest.approx(formed.geometry.approach_m, abs=0.1e-6)
+    assert p["contact_angle_rad"][0, 0, 0] == pytest.approx(0.785, abs=0.005)
+    creep = np.hypot(p["creep_force_long_N"][0, 0, 0], p["creep_force_lat_N"][0, 0, 0])
+    assert creep / (MU * p["normal_force_N"][0, 0, 0]) == pytest.approx(0.81, abs=0.03)
+    frame = run.to_dataframe()
+    wheel = frame[[f"left_wheel_contact_force_{a}_N" for a in "xyz"]].to_numpy()
+    for i in range(len(run.t)):
+        own = [p[n][i, 0, 0] for n in ("creep_force_long_N", "creep_force_lat_N", "normal_force_N")]
+        total = _frame(p["contact_angle_rad"][i, 0, 0], 0) @ np.array(own)
+        np.testing.assert_allclose(wheel[i], total, rtol=0, atol=1e-5 * np.linalg.norm(total))
+    forces = frame[[f"{s}_wheel_contact_force_{a}_N" for s in ("left", "right") for a in "xyz"]].to_numpy()
+    np.testing.assert_allclose(forces[[0, 3, 6]], AUTO_BEFORE_WHEEL_FORCES_N, rtol=1e-10)
+    for block in (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)):
+        scale = np.max(np.abs(AUTO_BEFORE_FINAL_STATE[block]))
+        np.testing.assert_allclose(run.states[-1, block], AUTO_BEFORE_FINAL_STATE[block], rtol=0, atol=1e-10 * scale)

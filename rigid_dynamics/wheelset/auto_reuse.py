@@ -25,6 +25,12 @@ tolerance level the candidate's radius halves (down to ``radius_min``), below an
 in the store's last row (:data:`STATS` columns) and reported in summary.json (callback.PatchCallback.stats,
 ``auto_reuse``).
 
+A BEM patch formed as the static case forms it (formed_patches.py: solved in its own plane, its forces applied in
+the candidate's frame) makes an anchor that also keeps the map from the candidate's frame to the formed patch's and
+the formed patch's geometry as departures from the candidate's; a patch it serves is then recorded in that plane
+(:func:`reuse_own`), as the patches the callback solves are, so that a run's record does not switch frames between
+the samples the callback solved and those the anchor served (the forces applied are unchanged).
+
 The store (:func:`reuse_store`) is an array of the run (compiled_laws.HertzKalkerTables.reuse): one row per
 candidate (:data:`ANCHOR` columns), the statistics row last. Off (par.auto_reuse 0, scene key ``auto_reuse``; and
 for a tolerance below every measured level, where auto asks for BEM on every patch): every BEM patch is solved by
@@ -40,20 +46,42 @@ from numba import njit
 
 from rigid_dynamics.contact.creep_table import normalised_creepages
 from rigid_dynamics.wheelset.compiled_laws import LAW_FASTSIM, _creep_law, _hertz_kalker, patch_friction
-from rigid_dynamics.wheelset.layout import G_APPROACH, G_CURVATURE_LAT, G_CURVATURE_LONG, G_WHEEL_LATERAL
+from rigid_dynamics.wheelset.layout import (
+    G_APPROACH,
+    G_CONTACT_ANGLE,
+    G_CURVATURE_LAT,
+    G_CURVATURE_LONG,
+    G_ROLLING_RADIUS,
+    G_WHEEL_LATERAL,
+    N_FORMED,
+    N_FRAME_MAP,
+)
 
 ANCHOR = (
     "valid", "creep_star_long", "creep_star_lat", "creep_star_spin", "log_ab", "log_approach", "wheel_lateral_m",
     "half_width_m", "radius", "normal_ratio", "force_long_departure", "force_lat_departure", "moment_departure",
     "semi_axis_long_ratio", "semi_axis_lat_ratio", "area_ratio", "max_pressure_ratio", "patch_geometry",
-    "ellipticity_residual",
+    "ellipticity_residual", "formed",
+    *(f"frame_map_{k}" for k in range(N_FRAME_MAP)),
+    "formed_creepage_long_rigid", "formed_creepage_lat_rigid", "formed_spin_departure_1_per_m",
+    "formed_approach_departure_m", "formed_point_y_departure_m", "formed_wheel_lateral_departure_m",
+    "formed_rolling_radius_departure_m", "formed_contact_angle_departure_rad",
 )  # fmt: skip
-"""Columns of a candidate's row: its anchor (valid 1/0), the anchor's inputs, the trust radius, the corrections and
-the anchor's patch geometry code and ellipticity residual (module docstring)."""
+"""Columns of a candidate's row: its anchor (valid 1/0), the anchor's inputs, the trust radius, the corrections,
+the anchor's patch geometry code and ellipticity residual, and for an anchor that was a formed patch (``formed``
+1/0; formed_patches.py) what records a served patch in that patch's plane (:func:`reuse_own`): the frame map
+(formed_patches.frame_map), the rigid motion's part of the transported creepages (k_x, k_y and the spin's
+departure), and the departures of the formed patch's approach, reference point y, wheel lateral coordinate,
+rolling radius and contact angle from the candidate's."""
 (
     R_VALID, R_XS, R_YS, R_PS, R_LOG_AB, R_LOG_Q, R_WHEEL_Y, R_HALF_WIDTH, R_RADIUS, R_NORMAL_RATIO, R_DFX, R_DFY,
-    R_DMZ, R_A_RATIO, R_B_RATIO, R_AREA_RATIO, R_PMAX_RATIO, R_GEOMETRY, R_RESIDUAL,
-) = range(len(ANCHOR))  # fmt: skip
+    R_DMZ, R_A_RATIO, R_B_RATIO, R_AREA_RATIO, R_PMAX_RATIO, R_GEOMETRY, R_RESIDUAL, R_FORMED,
+) = range(20)  # fmt: skip
+R_MAP = R_FORMED + 1
+"""The first of the frame map's columns (Q row by row, then w: formed_patches.frame_map)."""
+R_OWN = R_MAP + N_FRAME_MAP
+"""The first of the formed patch's departures (k_x, k_y, spin, approach, point y, wheel lateral, rolling radius,
+contact angle)."""
 STATS = (
     "served",
     "solved",
@@ -230,10 +258,68 @@ def _measure(st, radius, errors, level, t):
 
 
 @njit(cache=True, _nrt=False)
-def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
+def _keep_formed(row, creep, g, formed):
+    """Keep in the anchor ``row`` what records a served patch in the formed patch's plane (:data:`ANCHOR`), from
+    formed = (the formed patch's own quantities, layout.FORMED_PATCH_FIELDS' order; the frame map; the candidate's
+    point y), or mark the anchor as not formed (own quantities NaN: the candidate served no formed patch).
+    """
+    own, fmap, point_y = formed
+    if math.isnan(own[0]) or math.isnan(fmap[0]):
+        row[R_FORMED] = 0.0
+        return
+    row[R_FORMED] = 1.0
+    for k in range(N_FRAME_MAP):
+        row[R_MAP + k] = fmap[k]
+    xi, eta, spin = creep
+    row[R_OWN] = own[4] - (fmap[0] * xi + fmap[3] * eta)
+    row[R_OWN + 1] = own[5] - (fmap[1] * xi + fmap[4] * eta)
+    row[R_OWN + 2] = own[6] - spin
+    row[R_OWN + 3] = own[7] - g[G_APPROACH]
+    row[R_OWN + 4] = own[8] - point_y
+    row[R_OWN + 5] = own[9] - g[G_WHEEL_LATERAL]
+    row[R_OWN + 6] = own[10] - g[G_ROLLING_RADIUS]
+    row[R_OWN + 7] = own[11] - g[G_CONTACT_ANGLE]
+
+
+_NOT_FORMED = (math.nan,) * N_FORMED
+"""reuse_own's answer for an anchor that was not a formed patch (compiled_rhs.NOT_FORMED)."""
+
+
+@njit(cache=True, _nrt=False)
+def reuse_own(store, c, forces, creep, g, point_y):
+    """The own quantities (layout.FORMED_PATCH_FIELDS' order) of the formed patch candidate c serves by its anchor's
+    correction, at the served ``forces`` (N, T_x, T_y, M_z in the candidate's frame), the candidate's ``creep`` =
+    (xi, eta, phi), geometry row g and point y: the forces turned into the anchor's formed plane by the kept frame
+    map (formed_patches.frame_map: (T_x', T_y', N') = Q^T (T_x, T_y, N), M_z' = (M_z - w . (T_x, T_y, N)) /
+    Q[2][2], the inverse of what the loop applies), the creepages transported with the anchor's rigid-motion part,
+    the geometry as the candidate's plus the anchor's departures. All NaN when the anchor was not a formed patch
+    (the record keeps the candidate's). Recorded, not applied.
+    """
+    row = store[c]
+    if row[R_FORMED] <= 0.0:
+        return _NOT_FORMED
+    q = row[R_MAP : R_MAP + 9]
+    w = row[R_MAP + 9 : R_MAP + 12]
+    normal, tx, ty, mz = forces
+    own_x = q[0] * tx + q[3] * ty + q[6] * normal
+    own_y = q[1] * tx + q[4] * ty + q[7] * normal
+    own_n = q[2] * tx + q[5] * ty + q[8] * normal
+    own_mz = (mz - (w[0] * tx + w[1] * ty + w[2] * normal)) / q[8]
+    xi, eta, spin = creep
+    k = row[R_OWN : R_OWN + 8]
+    return (
+        own_n, own_x, own_y, own_mz, q[0] * xi + q[3] * eta + k[0], q[1] * xi + q[4] * eta + k[1], spin + k[2],
+        g[G_APPROACH] + k[3], point_y + k[4], g[G_WHEEL_LATERAL] + k[5], g[G_ROLLING_RADIUS] + k[6],
+        g[G_CONTACT_ANGLE] + k[7],
+    )  # fmt: skip
+
+
+@njit(cache=True, _nrt=False)
+def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed):
     """Candidate c solved by the callback at this input (solved = (N, T_x, T_y, M_z, a, b, area, max pressure,
-    patch geometry code, ellipticity residual)): measure the old anchor's correction against it when the input is
-    within twice the old radius (adapting the radius), then make it the anchor (module docstring).
+    patch geometry code, ellipticity residual); formed = (the formed patch's own quantities, NaN if none; the frame
+    map; the candidate's point y): :func:`_keep_formed`): measure the old anchor's correction against it when the
+    input is within twice the old radius (adapting the radius), then make it the anchor (module docstring).
     """
     store = tables.reuse
     if not _enabled(par, store, c):
@@ -273,3 +359,4 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved):
     pmax_h = 1.5 * normal_h / area_h
     row[R_PMAX_RATIO] = pmax_b / pmax_h if math.isfinite(pmax_b) else 1.0
     row[R_GEOMETRY], row[R_RESIDUAL] = geom, resid
+    _keep_formed(row, creep, g, formed)

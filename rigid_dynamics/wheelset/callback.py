@@ -11,8 +11,14 @@ import time
 import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
-from rigid_dynamics.wheelset.compiled_rhs import NOT_FORMED, CallbackOutcome
-from rigid_dynamics.wheelset.formed_patches import PatchFormer, candidate_forces, own_quantities, transported_creepage
+from rigid_dynamics.wheelset.compiled_rhs import NOT_FORMED, NOT_MAPPED, CallbackOutcome
+from rigid_dynamics.wheelset.formed_patches import (
+    PatchFormer,
+    candidate_forces,
+    frame_map,
+    own_quantities,
+    transported_creepage,
+)
 from rigid_dynamics.wheelset.layout import PATCH_ELLIPSE, PATCH_SAMPLED
 from rigid_dynamics.wheelset.providers import SIDES
 
@@ -193,9 +199,10 @@ class PatchCallback:
                 geometry.ellipse_angle_rad, geometry.approach_m,
             )  # fmt: skip
         forces = (result.normal_force_N, result.creep_force_long_N, result.creep_force_lat_N, result.spin_moment_Nm)
-        own = NOT_FORMED
+        own, mapped = NOT_FORMED, NOT_MAPPED
         if target is not False:  # recorded in its own frame; applied in the candidate's
             own = own_quantities(target, result, creepage)
+            mapped = frame_map(patch, target)
             if result.status != "no-contact":
                 forces = candidate_forces(patch, target, result)
         return CallbackOutcome(
@@ -208,6 +215,7 @@ class PatchCallback:
             float(residual),
             0,
             own,
+            mapped,
         )
 
     def _formed(self, patch):

@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit, objmode
 
 from rigid_dynamics.contact.friction import VARIES_ALONG_TRACK, VARIES_WITH_INCLINATION
-from rigid_dynamics.wheelset.auto_reuse import reuse_anchor, reuse_serve
+from rigid_dynamics.wheelset.auto_reuse import reuse_anchor, reuse_own, reuse_serve
 from rigid_dynamics.wheelset.compiled_laws import (
     LAW_AUTO,
     LAW_BEM_CORRECTED,
@@ -81,6 +81,7 @@ from rigid_dynamics.wheelset.layout import (
     MAX_PRESSURE,
     N_FIELDS,
     N_FORMED,
+    N_FRAME_MAP,
     N_GEO,
     N_SCRATCH,
     NORMAL_FORCE,
@@ -165,7 +166,9 @@ class CallbackOutcome(NamedTuple):
     (m^2), max pressure (Pa), the geometry the model saw (layout.PATCH_ELLIPSE / PATCH_SAMPLED) and its ellipticity
     residual (NaN for an ellipse), the status (0 solved, 1 failed: the callback keeps its message), and ``own``: for
     a candidate that served a formed patch, that patch's own quantities in the order of layout.FORMED_PATCH_FIELDS
-    (recorded, not applied: the forces above are the candidate's), else :data:`NOT_FORMED`.
+    (recorded, not applied: the forces above are the candidate's), else :data:`NOT_FORMED`; ``frame_map``: then the
+    map from the candidate's frame to the formed patch's (formed_patches.frame_map; kept by ``auto``'s anchors),
+    else :data:`NOT_MAPPED`.
     """
 
     normal_force_N: float
@@ -180,10 +183,13 @@ class CallbackOutcome(NamedTuple):
     ellipticity_residual: float
     status: int
     own: tuple
+    frame_map: tuple = (math.nan,) * N_FRAME_MAP
 
 
 NOT_FORMED = (math.nan,) * N_FORMED
 """CallbackOutcome.own of a candidate that served no formed patch (and of every patch a compiled law solved)."""
+NOT_MAPPED = (math.nan,) * N_FRAME_MAP
+"""CallbackOutcome.frame_map of a candidate that served no formed patch."""
 
 
 _CALLBACK = [None]
@@ -207,9 +213,10 @@ def _external(t, y, c, side, g, creep, frame):
     creep = (rolling speed, xi, eta, spin); frame = (e_x, e_y) of the contact frame, main frame) handed to Python
     (numba objmode) as a :class:`CallbackPatch` and a :class:`CallbackOutcome`'s values taken back (N, T_x, T_y,
     M_z, a, b, area, max pressure, patch geometry code, ellipticity residual, status, the formed patch's own
-    quantities); status != 0: the contact model failed (the callback keeps its message). Overhead measured here:
-    2.0-2.1 us per objmode call of a trivial Python function; 25 us per patch through callback.PatchCallback with a
-    model returning constant forces (its ContactGeometry and Creepage built per patch); a BEM patch at 40 x 40 takes
+    quantities and the frame map); status != 0: the contact model failed (the callback keeps its message). Overhead
+    measured here: 2.0-2.1 us per objmode call of a trivial Python function; 25 us per patch through
+    callback.PatchCallback with a model returning constant forces (its ContactGeometry and Creepage built per
+    patch); a BEM patch at 40 x 40 takes
     about 20 ms.
     """
     speed, xi, eta, spin = creep
@@ -221,17 +228,18 @@ def _external(t, y, c, side, g, creep, frame):
     radius, angle, lateral = g[G_ROLLING_RADIUS], g[G_CONTACT_ANGLE], g[G_WHEEL_LATERAL]
     centre = (y[X], y[Y], y[Z])
     yaw, roll, turn = y[YAW], y[ROLL], y[SPIN]
-    # own: the formed patch's own quantities, layout.N_FORMED (12) of them (a literal: numba reads the types)
+    # own: the formed patch's own quantities, layout.N_FORMED (12) of them, fmap: layout.N_FRAME_MAP (12) (literals:
+    # numba reads the types)
     with objmode(normal_force="float64", tx="float64", ty="float64", mz="float64", sa="float64", sb="float64",
                  area="float64", pmax="float64", geom="int64", resid="float64", st="int64",
-                 own="UniTuple(float64, 12)"):  # fmt: skip
-        normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own = _dispatch(
+                 own="UniTuple(float64, 12)", fmap="UniTuple(float64, 12)"):  # fmt: skip
+        normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, fmap = _dispatch(
             CallbackPatch(
                 c, side, t, q, ca, cb, xi, eta, spin, speed, point, normal, e_x, e_y, radius, angle, lateral,
                 centre, yaw, roll, turn,
             )
         )  # fmt: skip
-    return normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own
+    return normal_force, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, fmap
 
 
 @njit(cache=True, _nrt=False)
@@ -240,21 +248,25 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     region (auto_reuse.reuse_serve; recorded as rung layout.AUTO_BEM_CORRECTED, law compiled_laws.LAW_BEM_CORRECTED),
     else solved by the callback (:func:`_external`) and made the candidate's anchor (auto_reuse.reuse_anchor).
     Arguments as :func:`_external`'s; laws = (par, tables, dummy, where, rec, record). Returns _external's values
-    and the law code (a served patch: no formed patch's own quantities, :data:`NOT_FORMED`).
+    (without the frame map) and the law code; a served patch whose anchor was a formed patch gives the formed
+    patch's own quantities at the served forces (auto_reuse.reuse_own; when ``record``), else :data:`NOT_FORMED`.
     """
     par, tables, dummy, where, rec, record = laws
     _, xi, eta, spin = creep
+    point_y = y[Y] + g[G_LEVER + 1]
     served, normal, tx, ty, mz, sa, sb, area, pmax, geom, resid = reuse_serve(
         par, tables, dummy, g, (xi, eta, spin), where, c
     )
     if served:
+        own = NOT_FORMED
         if record:
             rec[c, AUTO_RUNG] = AUTO_BEM_CORRECTED
-        return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, 0, NOT_FORMED, LAW_BEM_CORRECTED
-    normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own = _external(t, y, c, side, g, creep, frame)
+            own = reuse_own(tables.reuse, c, (normal, tx, ty, mz), (xi, eta, spin), g, point_y)
+        return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, 0, own, LAW_BEM_CORRECTED
+    normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, fmap = _external(t, y, c, side, g, creep, frame)
     if st == 0:
         solved = (normal, tx, ty, mz, sa, sb, area, pmax, geom, resid)
-        reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved)
+        reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved, (own, fmap, point_y))
     return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, LAW_CALLBACK
 
 
@@ -351,7 +363,7 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
         where = (_friction_place(tables.friction.varies_code, y, g), speed)
         own = NOT_FORMED
         if par.model_code == LAW_CALLBACK:
-            normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own = _external(
+            normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, _ = _external(
                 t, y, c, side, g, (speed, xi, eta, spin), (ex, ey)
             )
             law = LAW_CALLBACK

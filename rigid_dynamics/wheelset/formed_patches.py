@@ -39,7 +39,9 @@ pose the candidate carries (once per side and pose) and
   solution) the contact angle 0.81 rad and a creep force of 0.81 mu N, where the candidate's frame (0.55 rad) read
   a lateral creep force of -2.4 kN. A candidate whose region was joined into a deeper candidate's patch records no
   force (the joined patch is in that candidate's record); ``auto``'s BEM patches served by their anchor's
-  correction (auto_reuse.py) are recorded in the candidate's frame (the anchor keeps the candidate's forces).
+  correction (auto_reuse.py) are recorded in the formed plane of their anchor: the anchor keeps the map from the
+  candidate's frame to the formed patch's (:func:`frame_map`) and the formed patch's geometry as departures from
+  the candidate's (auto_reuse.reuse_own).
 """
 
 from __future__ import annotations
@@ -125,6 +127,24 @@ def candidate_forces(patch, target, result) -> tuple[float, float, float, float]
     offset = np.asarray(target.geometry.point_m, float) - np.asarray(patch.point_m, float)
     moment = (result.spin_moment_Nm or 0.0) * frame[:, 2] + np.cross(offset, force)
     return float(force @ n), float(force @ e_x), float(force @ e_y), float(moment @ n)
+
+
+def frame_map(patch, target) -> tuple:
+    """The map from the candidate's contact frame to the formed patch ``target``'s (layout.N_FRAME_MAP values):
+    Q[i][j] = C_i . F_j row by row (C = the candidate's e_x, e_y, n; F = the formed patch's frame columns e_x', e_y',
+    n'), then w_i = C_i . (n x o) with o the offset p' - p of the formed patch's point from the candidate's. So the
+    forces of :func:`candidate_forces`, (T_x, T_y, N) = Q (T_x', T_y', N') and M_z = Q[2][2] M_z' + w . (T_x, T_y,
+    N), turn back into the formed patch's own by Q's transpose (both frames orthonormal), and the creepages at the
+    formed patch's point (:func:`transported_creepage`) are xi' = Q[0][0] xi + Q[1][0] eta + k_x, eta' = Q[0][1] xi
+    + Q[1][1] eta + k_y with k the rigid motion's part, fixed by the pose (auto_reuse.reuse_own: a patch ``auto``
+    serves by its anchor's correction is recorded in the formed plane of that anchor).
+    """
+    candidate = np.array([patch.e_x, patch.e_y, patch.normal], float)
+    frame = np.asarray(target.geometry.frame, float)
+    offset = np.asarray(target.geometry.point_m, float) - np.asarray(patch.point_m, float)
+    q = candidate @ frame
+    w = candidate @ np.cross(candidate[2], offset)
+    return tuple(float(v) for v in q.ravel()) + tuple(float(v) for v in w)
 
 
 def own_quantities(target, result, creepage: Creepage) -> tuple:

@@ -95,6 +95,9 @@ T_y' and M_z' in the formed patch's contact frame, the creepages transported to 
 the reference point's y (main frame), the wheel's lateral coordinate and rolling radius there and its contact angle.
 NaN (``formed_normal_force_N`` NaN) for any other candidate. Not results of their own: the record writers put them
 in place of the candidate's (formed_patches.recorded)."""
+N_FRAME_MAP = 12
+"""Values of the map from a candidate's contact frame to the formed patch's it serves (formed_patches.frame_map: the
+3 x 3 direction cosines and the offset's moment arm), which ``auto``'s anchors keep (auto_reuse.reuse_own)."""
 FORMED = N_PATCH + len(AUTO_PATCH_FIELDS)
 """The first column of the formed patch's own quantities: rec[c, FORMED + k] is PATCH_FIELDS[k]'s, k < N_FORMED."""
 N_FIELDS = FORMED + N_FORMED
