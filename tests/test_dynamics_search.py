@@ -49,6 +49,9 @@ def test_search_sees_the_polygon():
 
 
 def test_klingel_through_the_search():
+    """Klingel's wavelength 2 pi sqrt(r0 e / lambda) (closed form) through the Python 3-D search. The step, 1.5 ms, is
+    0.92 of RK4's stability limit here (1.63 ms; 2 ms derails at 0.05 s, the run says so); the wavelength equals the
+    1 ms run's to 1e-9 (16.5441 m, +0.24 %) at 0.72 of its CPU time."""
     scene = DynamicsScene(
         track=TRACK,
         speed_m_per_s=30.0,
@@ -56,7 +59,7 @@ def test_klingel_through_the_search():
         contact_model="linear",
         contact_provider="search",
         initial=InitialConditions(lateral_displacement_m=0.003),
-        integrator=IntegratorSettings(method="RK4", fixed_step_s=1e-3, output_step_s=2e-3),
+        integrator=IntegratorSettings(method="RK4", fixed_step_s=1.5e-3, output_step_s=3e-3),
     )
     provider = SearchProvider(scene.wheelset, scene.track, options={"profile_only": True})
     result = simulate(scene, provider=provider)
