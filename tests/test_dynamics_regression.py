@@ -109,13 +109,19 @@ CASES["curve-default"] = (("curve", 0.05), None)
 # at every re-solve; on this case one of 29 measured corrections is 5.6 % of the creep force against contact_tolerance
 # 5 %, and the run says so with `warning` (discretisation.auto_reuse_check) -- an honest status, kept here
 EXPECTED_STATUS = {"polygonal-wheel-tables-auto-reuse-compiled": "warning"}
+# cases the suite runs over the first part of their written duration, compared with that prefix of the written
+# samples (a fixed-step run is the same over its first part: measured 5.7e-14 of the block at 0.02 of 0.05 s); the
+# auto case without reuse solves every BEM patch (about 1 400 over 0.05 s: 84 s CPU, 30 s over 0.02 s)
+SUITE_DURATION_S = {"polygonal-wheel-tables-auto-compiled": 0.02}
 
 
-def _run(name):
+def _run(name, duration_s=None):
     from rigid_dynamics.wheelset import simulate
 
     args, compiled = CASES[name]
     scene = _scene(*args)
+    if duration_s is not None:
+        scene = replace(scene, duration_s=duration_s)
     if args[0] == "wheel-flat":  # the data were written at the scene's earlier 5 kHz cut-off and 25 us step
         scene = replace(
             scene,
@@ -127,11 +133,13 @@ def _run(name):
 
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_same_states_as_before(name):
-    ref = np.load(DATA / f"{name}.npz")
-    result = _run(name)
+    written = np.load(DATA / f"{name}.npz")
+    result = _run(name, SUITE_DURATION_S.get(name))
     assert result.status == EXPECTED_STATUS.get(name, "ok"), result.message
     if result.status == "warning":
         assert "auto's reused BEM patches" in result.message
+    n = len(result.t) if name in SUITE_DURATION_S else len(written["t"])
+    ref = {"t": written["t"][:n], "states": written["states"][:n]}
     assert result.t.shape == ref["t"].shape
     np.testing.assert_array_equal(result.t, ref["t"])
     assert result.states.shape == ref["states"].shape
