@@ -19,11 +19,12 @@ the new anchor.
 The radius adapts to the error it causes, measured in the run: at each re-solve from inside twice the radius the
 corrected value the old anchor would have served is compared with the fresh BEM solution (the correction's error at
 the trust region's edge, where it is largest: the error grows with the distance): the creep force by the bench's
-definition |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM) and the normal force |N - N_BEM| / N_BEM. Above half the
-tolerance level the candidate's radius halves (down to ``radius_min``), below an eighth of it it grows by half
-(up to ``radius_max``; :data:`DEFAULTS`). The run's largest observed errors, the served and solved counts are kept
-in the store's last row (:data:`STATS` columns) and reported in summary.json (callback.PatchCallback.stats,
-``auto_reuse``).
+definition |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM) and the normal force |N - N_BEM| / N_BEM, in the plane the
+fresh solution was solved in (a formed patch's own, below; else the candidate's: :func:`_correction_errors`).
+Above half the tolerance level the candidate's radius halves (down to ``radius_min``), below an eighth of it it
+grows by half (up to ``radius_max``; :data:`DEFAULTS`). The run's largest observed errors, the served and solved
+counts are kept in the store's last row (:data:`STATS` columns) and reported in summary.json
+(callback.PatchCallback.stats, ``auto_reuse``).
 
 A BEM patch formed as the static case forms it (formed_patches.py: solved in its own plane, its forces applied in
 the candidate's frame) makes an anchor that also keeps the map from the candidate's frame to the formed patch's and
@@ -315,6 +316,32 @@ def reuse_own(store, c, forces, creep, g, point_y):
 
 
 @njit(cache=True, _nrt=False)
+def _correction_errors(served, fresh, mu_n, fmap):
+    """(creep, normal) error of the ``served`` (N, T_x, T_y) against the ``fresh`` BEM solution (candidate's frame;
+    mu_n: mu times the fresh N): the creep force by the bench's definition |F - F_BEM| / max(|F_BEM|, 0.01 mu N_BEM)
+    and the normal force |N - N_BEM| / N_BEM, in the plane the patch was solved in: the formed patch's (both forces
+    turned by its frame map ``fmap``, formed_patches.frame_map) when the fresh solution was one, else the
+    candidate's. (On a conformal flange root the candidate's plane lies 0.26 rad off the formed patch's: there its
+    creep force is mostly a component of the normal force, a few per cent of the patch's own, and an error of the
+    normal force read as tens of times that error of the creep force.)
+    """
+    n, tx, ty = served
+    n_b, tx_b, ty_b = fresh
+    if not math.isnan(fmap[0]):
+        mu_n *= (fmap[2] * tx_b + fmap[5] * ty_b + fmap[8] * n_b) / n_b
+        n, tx, ty = (
+            fmap[2] * tx + fmap[5] * ty + fmap[8] * n, fmap[0] * tx + fmap[3] * ty + fmap[6] * n,
+            fmap[1] * tx + fmap[4] * ty + fmap[7] * n,
+        )  # fmt: skip
+        n_b, tx_b, ty_b = (
+            fmap[2] * tx_b + fmap[5] * ty_b + fmap[8] * n_b, fmap[0] * tx_b + fmap[3] * ty_b + fmap[6] * n_b,
+            fmap[1] * tx_b + fmap[4] * ty_b + fmap[7] * n_b,
+        )  # fmt: skip
+    e_f = math.hypot(tx - tx_b, ty - ty_b) / max(math.hypot(tx_b, ty_b), 0.01 * mu_n)
+    return e_f, abs(n - n_b) / n_b
+
+
+@njit(cache=True, _nrt=False)
 def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed):
     """Candidate c solved by the callback at this input (solved = (N, T_x, T_y, M_z, a, b, area, max pressure,
     patch geometry code, ellipticity residual); formed = (the formed patch's own quantities, NaN if none; the frame
@@ -338,9 +365,8 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed):
     radius = row[R_RADIUS]
     if row[R_VALID] > 0.0 and _distance(row, star, log_ab, g, store[-1]) <= 2.0 * radius:
         n, tx, ty, _, _, _, _, _ = _corrected(row, hertz, forces)
-        mu_nb = mu_n * n_b / normal_h
-        e_f = math.hypot(tx - tx_b, ty - ty_b) / max(math.hypot(tx_b, ty_b), 0.01 * mu_nb)
-        radius = _measure(store[-1], radius, (e_f, abs(n - n_b) / n_b), par.auto_level, t)
+        errors = _correction_errors((n, tx, ty), (n_b, tx_b, ty_b), mu_n * n_b / normal_h, formed[1])
+        radius = _measure(store[-1], radius, errors, par.auto_level, t)
     ratio = n_b / normal_h
     mu_nb = mu_n * ratio
     fx, fy, mz = forces
