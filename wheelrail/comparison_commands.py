@@ -36,7 +36,8 @@ sampled gap is not known there) and the demo stops after it."""
 DEMO_FEA_OPTIONS = {"domain_factor": 40.0}
 """The demo's FEA (fea.model options): a block of 40 semi-axes instead of the default 20. Under load control the block's
 truncation enters the max pressure at second order, stated as 0.5 % (20 / D)^2 (fea.refinement,
-LOAD_CONTROL_BLOCK_ERROR): 0.125 % at 40 for about 2 % more unknowns (4878 against 4785 on the demo's coarse locating solve)."""
+LOAD_CONTROL_BLOCK_ERROR): 0.125 % at 40 for about 2 % more unknowns (4878 against 4785 on the demo's coarse
+locating solve)."""
 
 PATCH_GEOMETRIES = ("sampled", "ellipse")
 """The values of ``--patch-geometry`` (rigid_dynamics.wheelset.parameters.PATCH_GEOMETRIES, not imported here: the
