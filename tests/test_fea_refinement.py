@@ -461,3 +461,88 @@ def test_a_first_level_that_exhausts_the_budget_is_estimated_from_coarser_levels
         # differences 100 and 56 MPa: observed order 1.43, used 1 (ORDER_BOUNDS): 56 / 0.5 = 112 MPa, plus 0.5 %
         assert info["relative_error"]["max_pressure"] == pytest.approx(112 / 2644 + 0.005, rel=1e-3)
         assert r.status == status, r.message
+
+
+def _ridge_and_top(xy):
+    """A pressure field with the shape of the demo's peak patch (polygonal-wheel, 99 kN; the half-space BEM's
+    profile): a ridge 960 MPa high and about 1.5 mm wide at 0.85 of its top, at y = -11.3 mm, and a broad second top
+    of 744 MPa (0.77 of the ridge) at y = +2.3 mm."""
+    x, y = xy[:, 0], xy[:, 1]
+    ridge = 960e6 * np.exp(-(((y + 11.3e-3) / 1.3e-3) ** 2)) * np.exp(-((x / 9e-3) ** 2))
+    top = 744e6 * np.exp(-(((y - 2.3e-3) / 8e-3) ** 2)) * np.exp(-((x / 9e-3) ** 2))
+    return np.maximum(ridge, top)
+
+
+def test_the_peak_box_is_located_by_averages_over_the_box_s_elements_not_the_patch_s():
+    """fea.model._peak_nodes on a synthetic patch meshed at 1.6 mm with a box around the ridge meshed at 0.53 mm:
+    averaged over the patch's radius (2.4 mm, 1.5 patch elements), the ridge is spread below 0.85 / 0.77 of the
+    second top and the >= 0.85 nodes reach it (the box of the demo grew to 8 x 18.7 mm); averaged over 1.5 of the
+    box's elements inside the box, only the ridge's nodes remain."""
+    from types import SimpleNamespace
+
+    import fea.postprocess as post
+    from fea.model import PEAK_LEVEL, _peak_nodes
+
+    h, box = 1.6e-3, (0.0, -11.3e-3, 4e-3, 2.3e-3)
+    coarse = np.stack([g.ravel() for g in np.meshgrid(np.arange(-8e-3, 8.01e-3, h), np.arange(-14e-3, 9e-3, h))], 1)
+    outside = (np.abs(coarse[:, 0] - box[0]) > box[2]) | (np.abs(coarse[:, 1] - box[1]) > box[3])
+    fine_axes = (np.arange(-box[2], box[2] + 1e-9, h / 3), box[1] + np.arange(-box[3], box[3] + 1e-9, h / 3))
+    fine = np.stack([g.ravel() for g in np.meshgrid(*fine_axes)], 1)
+    xy = np.vstack([coarse[outside], fine])
+    weight = np.concatenate([np.full(outside.sum(), h * h), np.full(len(fine), (h / 3) ** 2)])
+    force = _ridge_and_top(xy) * weight
+    contact = np.ones(len(xy), bool)
+    radius = 1.5 * h
+    pressure = post.filtered_pressure(xy, force, weight, xy, radius)
+    old = xy[pressure >= PEAK_LEVEL * pressure.max()]
+    assert old[:, 1].max() > 0.0  # the defect: the patch's average reaches the second top
+    spec = SimpleNamespace(peak_boxes_m=((*box, h / 3),), contact_size_m=h)
+    nodes = _peak_nodes(spec, xy, force, weight, contact, pressure, radius, post)
+    assert len(nodes) and np.all(np.abs(nodes[:, 1] + 11.3e-3) < 1.5e-3)
+
+
+@pytest.mark.fea
+def test_the_demo_s_peak_box_is_a_property_of_the_patch_not_of_the_block():
+    """The demo's peak patch (polygonal-wheel, contact_tolerance 0.1, 99 kN): the peak box located with blocks of 20
+    and 40 semi-axes is the same to a fraction of the patch's element size (before, the coarse solve's node
+    placement gave 5.96 x 4.03 mm at D = 20 and 8 x 18.7 mm at 19, 21, 25, 40), and it holds the region where the
+    independent half-space solution (the BEM on the same gap and force) is at least 0.85 of its top."""
+    import dataclasses
+    import time
+
+    from comparisons.demo import peak_patch_case
+    from fea.model import PEAK_LEVEL, FeaModel, FeaOptions
+    from rigid_dynamics.contact.registry import get_model
+    from rigid_dynamics.wheelset import simulate
+    from wheelrail.comparison_commands import DEMO_PATCH_GEOMETRY, DEMO_TOLERANCE
+    from wheelrail.scenes import load_scene, resolve_scene_path
+
+    scene = dataclasses.replace(
+        load_scene(resolve_scene_path("polygonal-wheel")), contact_model="auto", contact_tolerance=DEMO_TOLERANCE,
+        patch_geometry=DEMO_PATCH_GEOMETRY,
+    )  # fmt: skip
+    patch = peak_patch_case(simulate(scene))
+    model, boxes = FeaModel(), []
+    for factor in (20.0, 40.0):
+        opts = FeaOptions.from_mapping({"stresses": False, "domain_factor": factor})
+        peak = {"box": None}
+
+        def solve_level(level, peak=peak):
+            result, write = model._solve_level(
+                patch.geometry, patch.creepage, patch.material, patch.normal_force_N, level, None,
+                time.perf_counter(), peak_box=peak["box"],
+            )  # fmt: skip
+            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
+            return result, write
+
+        box, record = model._locate_peak(solve_level, opts, peak)
+        assert box is not None, record
+        boxes.append(np.array(box))
+    pad = 1.6e-3  # the patch's element size at the locating level (4 per semi-axis)
+    assert np.all(np.abs(boxes[0] - boxes[1]) < 0.25 * pad), boxes
+    bem = get_model("bem").solve(patch.geometry, patch.creepage, patch.material, normal_force_N=patch.normal_force_N)
+    gx, gy = np.meshgrid(bem.fields.x_m, bem.fields.y_m)
+    top = bem.fields.pressure_Pa >= PEAK_LEVEL * bem.fields.pressure_Pa.max()
+    for xc, yc, a, b in boxes:
+        assert np.all(np.abs(gx[top] - xc) <= a) and np.all(np.abs(gy[top] - yc) <= b)
+        assert a < 3 * (np.ptp(gx[top]) / 2 + pad) and b < 3 * (np.ptp(gy[top]) / 2 + pad)
