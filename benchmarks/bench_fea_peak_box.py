@@ -18,7 +18,6 @@ import json
 import os
 import platform
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -57,16 +56,7 @@ def main(factors: list[float]) -> dict:
     model = FeaModel()
     for factor in factors:
         opts = FeaOptions.from_mapping({"stresses": False, "domain_factor": factor})
-        peak = {"box": None}
-
-        def solve_level(level, peak=peak):
-            result, write = model._solve_level(
-                patch.geometry, patch.creepage, patch.material, patch.normal_force_N, level, None,
-                time.perf_counter(), peak_box=peak["box"],
-            )  # fmt: skip
-            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
-            return result, write
-
+        solve_level, peak = model.level_solver((patch.geometry, patch.creepage, patch.material, patch.normal_force_N))
         box, record = model._locate_peak(solve_level, opts, peak)
         out["rows"].append({"domain_factor": factor, **record})
         print(factor, record, flush=True)

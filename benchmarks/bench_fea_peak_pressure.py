@@ -105,16 +105,7 @@ def series(name: str, max_n: float) -> dict:
     out = {"case": name, "reference_Pa": reference, "reference": label, "normal_force_N": patch.normal_force_N}
     for refinement in (1.0, 3.0):
         opts = FeaOptions.from_mapping({"stresses": False, "peak_refinement": max(refinement, 1.0)})
-        peak = {"box": None}
-
-        def solve_level(level, peak=peak):
-            result, write = model._solve_level(
-                patch.geometry, patch.creepage, patch.material, patch.normal_force_N, level, None,
-                time.perf_counter(), peak_box=peak["box"],
-            )  # fmt: skip
-            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
-            return result, write
-
+        solve_level, peak = model.level_solver((patch.geometry, patch.creepage, patch.material, patch.normal_force_N))
         box = None
         if refinement > 1:
             box, record = model._locate_peak(solve_level, opts, peak)

@@ -320,15 +320,7 @@ class FeaModel:
             return self._empty(geometry, creepage, "no-contact", "approach_m <= 0: the surfaces do not touch", t0)
         from fea.refinement import solve_to_tolerance
 
-        peak: dict = {"box": None}
-
-        def solve_level(level_opts):
-            result, write = self._solve_level(
-                geometry, creepage, material, normal_force_N, level_opts, comm, t0, peak_box=peak["box"]
-            )
-            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
-            return result, write
-
+        solve_level, peak = self.level_solver((geometry, creepage, material, normal_force_N), comm, t0)
         key = None
         if opts.load_balanced and normal_force_N is None and opts.mesh_tolerance is not None:
             key = (_series_key(geometry, material, options), math.degrees(geometry.contact_angle_rad))
@@ -383,6 +375,25 @@ class FeaModel:
                 "peak_box": peak["box"],
             })  # fmt: skip
         return result
+
+    def level_solver(self, patch: tuple, comm=None, t0: float | None = None):
+        """(solve_level, peak) for one patch = (geometry, creepage, material, normal force or None): solve_level(level
+        options) solves one refinement level (``_solve_level``) with the peak box ``peak["box"]`` (None: none yet) and
+        keeps that level's peak nodes in ``peak["nodes"]`` (for :meth:`_locate_peak`); the series, the peak locator,
+        the tests and the benchmarks share it.
+        """
+        geometry, creepage, material, normal_force_N = patch
+        t0 = time.perf_counter() if t0 is None else t0
+        peak: dict = {"box": None}
+
+        def solve_level(level_opts):
+            result, write = self._solve_level(
+                geometry, creepage, material, normal_force_N, level_opts, comm, t0, peak_box=peak["box"]
+            )
+            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
+            return result, write
+
+        return solve_level, peak
 
     @staticmethod
     def _locate_peak(solve_level, opts, peak) -> tuple[tuple | None, dict]:

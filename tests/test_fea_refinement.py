@@ -508,7 +508,6 @@ def test_the_demo_s_peak_box_is_a_property_of_the_patch_not_of_the_block():
     placement gave 5.96 x 4.03 mm at D = 20 and 8 x 18.7 mm at 19, 21, 25, 40), and it holds the region where the
     independent half-space solution (the BEM on the same gap and force) is at least 0.85 of its top."""
     import dataclasses
-    import time
 
     from comparisons.demo import peak_patch_case
     from fea.model import PEAK_LEVEL, FeaModel, FeaOptions
@@ -525,16 +524,7 @@ def test_the_demo_s_peak_box_is_a_property_of_the_patch_not_of_the_block():
     model, boxes = FeaModel(), []
     for factor in (20.0, 40.0):
         opts = FeaOptions.from_mapping({"stresses": False, "domain_factor": factor})
-        peak = {"box": None}
-
-        def solve_level(level, peak=peak):
-            result, write = model._solve_level(
-                patch.geometry, patch.creepage, patch.material, patch.normal_force_N, level, None,
-                time.perf_counter(), peak_box=peak["box"],
-            )  # fmt: skip
-            peak["nodes"] = result.extra.pop("peak_nodes_m", None)
-            return result, write
-
+        solve_level, peak = model.level_solver((patch.geometry, patch.creepage, patch.material, patch.normal_force_N))
         box, record = model._locate_peak(solve_level, opts, peak)
         assert box is not None, record
         boxes.append(np.array(box))

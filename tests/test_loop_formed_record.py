@@ -138,17 +138,22 @@ BEFORE_FINAL_STATE = np.array(
 )  # fmt: skip
 
 
-@pytest.fixture(scope="module")
-def run():
+def _root_run(contact_model: str, duration_s: float):
+    """curve-flange from the flange root (CONTACT's deck state's y and yaw, no settling) on the sampled gap."""
     from rigid_dynamics.wheelset import simulate
     from wheelrail.scenes import load_scene, resolve_scene_path
 
     scene = load_scene(resolve_scene_path("curve-flange"))
     scene = replace(
-        scene, contact_model="bem", patch_geometry="sampled", duration_s=0.002, settling_distance_m=0.0,
+        scene, contact_model=contact_model, patch_geometry="sampled", duration_s=duration_s, settling_distance_m=0.0,
         initial=replace(scene.initial, lateral_displacement_m=-0.00628, yaw_rad=-0.00455),
     )  # fmt: skip
     return simulate(scene)
+
+
+@pytest.fixture(scope="module")
+def run():
+    return _root_run("bem", 0.002)
 
 
 def test_run_records_the_formed_plane(run):
@@ -193,15 +198,7 @@ def test_run_wheel_forces_are_the_records_and_the_former_ones(run):
 def auto_run():
     """``auto`` (5 %, its BEM patches reused: auto_reuse.py) on the sampled gap from curve-flange's flange root, 6 ms:
     the flange patch goes to BEM, and every recorded sample of it is served by its anchor's correction."""
-    from rigid_dynamics.wheelset import simulate
-    from wheelrail.scenes import load_scene, resolve_scene_path
-
-    scene = load_scene(resolve_scene_path("curve-flange"))
-    scene = replace(
-        scene, contact_model="auto", patch_geometry="sampled", duration_s=0.006, settling_distance_m=0.0,
-        initial=replace(scene.initial, lateral_displacement_m=-0.00628, yaw_rad=-0.00455),
-    )  # fmt: skip
-    return simulate(scene)
+    return _root_run("auto", 0.006)
 
 
 def test_auto_records_its_served_bem_patches_in_the_formed_plane(auto_run, at_state):
