@@ -53,6 +53,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.fft
 
+try:  # scipy.fft's own transform functions, without its dispatch layer: the same code on the same data, same bits
+    from scipy.fft._duccfft import pyduccfft as _DIRECT
+except ImportError:  # pragma: no cover - older scipy (pocketfft, same signatures) or a layout without either
+    try:
+        from scipy.fft._pocketfft import pypocketfft as _DIRECT
+    except ImportError:
+        _DIRECT = None
+
 KERNELS = ("zz", "xx", "yy", "xy", "zx", "zy", "xz", "yz")
 """Names of the influence kernels A_ij: first index displacement, second traction component."""
 
@@ -233,6 +241,20 @@ def strip_influence(
     }
 
 
+def period_rfft2(values: np.ndarray) -> np.ndarray:
+    """``scipy.fft.rfft2(values)`` (the last two axes; no padding), by scipy's transform function directly."""
+    if _DIRECT is None:
+        return scipy.fft.rfft2(values)
+    return _DIRECT.r2c(np.asarray(values, float), (values.ndim - 2, values.ndim - 1), True, 0, None, 1)
+
+
+def period_irfft2(spectrum: np.ndarray, nx: int) -> np.ndarray:
+    """``scipy.fft.irfft2(spectrum, s=(ny, nx))`` with ny = spectrum.shape[-2], by scipy's function directly."""
+    if _DIRECT is None:
+        return scipy.fft.irfft2(spectrum, s=(spectrum.shape[-2], nx))
+    return _DIRECT.c2r(spectrum, (spectrum.ndim - 2, spectrum.ndim - 1), nx, False, 2, None, 1)
+
+
 SHARED_CACHE_GRIDS = 16
 """Number of grids (by nx, ny, dx, dy and elastic constants) whose coefficients and spectra are kept for reuse."""
 SHARED_CACHE_ELEMENTS = 100_000
@@ -384,20 +406,48 @@ class InfluenceGrid:
         """rfft2 of (..., ny, nx) fields zero-padded to the period (ly, lx), shape (..., ly, lx/2 + 1).
 
         Done as two 1-D passes so that the padding rows are not transformed along x (about 30 % less work
-        than ``rfft2`` of the padded array; same result to rounding).
+        than ``rfft2`` of the padded array; same result to rounding). With scipy's transform functions called
+        directly (:data:`_DIRECT`), the padded input and the spectrum live in buffers kept per grid and field
+        shape (no dispatch, no new zero-padded arrays: the same transforms of the same numbers, the same bits as
+        ``scipy.fft.rfft``/``fft``): the returned spectrum is valid until the next call for that shape.
         """
         ly, lx = self._cache["shape"]
-        spec = scipy.fft.rfft(np.asarray(field_values, float), n=lx, axis=-1)
+        values = np.asarray(field_values, float)
+        if _DIRECT is None:
+            spec = scipy.fft.rfft(values, n=lx, axis=-1)
+            if ly == 1:
+                return spec
+            return scipy.fft.fft(spec, n=ly, axis=-2, overwrite_x=True)
+        key = ("forward", values.shape)
+        buffers = self._cache.get(key)
+        if buffers is None:
+            real = np.zeros((*values.shape[:-1], lx))
+            spec = np.zeros((*values.shape[:-2], ly, lx // 2 + 1), complex) if ly > 1 else None
+            buffers = self._cache[key] = (real, spec)
+        real, spec = buffers
+        last = values.ndim - 1
+        real[..., : values.shape[-1]] = values
         if ly == 1:
-            return spec
-        return scipy.fft.fft(spec, n=ly, axis=-2, overwrite_x=True)
+            return _DIRECT.r2c(real, (last,), True, 0, None, 1)
+        ny = values.shape[-2]
+        spec[..., ny:, :] = 0.0
+        _DIRECT.r2c(real, (last,), True, 0, spec[..., :ny, :], 1)
+        return _DIRECT.c2c(spec, (last - 1,), True, 0, spec, 1)
 
     def _backward(self, spectrum: np.ndarray) -> np.ndarray:
-        """Inverse of :meth:`_forward`, cropped to (..., ny, nx); only the ny kept rows are transformed along x."""
+        """Inverse of :meth:`_forward`, cropped to (..., ny, nx); only the ny kept rows are transformed along x.
+
+        ``spectrum`` (complex, C-contiguous, owned by the caller's computation) may be overwritten.
+        """
         ly, lx = self._cache["shape"]
+        if _DIRECT is None:
+            if ly > 1:
+                spectrum = scipy.fft.ifft(spectrum, axis=-2)[..., : self.ny, :]
+            return scipy.fft.irfft(spectrum, n=lx, axis=-1)[..., : self.nx]
+        last = spectrum.ndim - 1
         if ly > 1:
-            spectrum = scipy.fft.ifft(spectrum, axis=-2)[..., : self.ny, :]
-        return scipy.fft.irfft(spectrum, n=lx, axis=-1)[..., : self.nx]
+            spectrum = _DIRECT.c2c(spectrum, (last - 1,), False, 2, spectrum, 1)[..., : self.ny, :]
+        return _DIRECT.c2r(spectrum, (last,), lx, False, 2, None, 1)[..., : self.nx]
 
     def apply(self, name: str, field_values: np.ndarray, rolling: bool = False) -> np.ndarray:
         """Convolution ``sum_K C_name(I - K) t[K]`` of one kernel with a (ny, nx) field."""
@@ -427,9 +477,9 @@ class InfluenceGrid:
             symbol = scipy.fft.rfft2(self._folded_period("zz")).real
             floor = 1e-6 * float(np.abs(symbol).max())
             self._cache["prec"] = 1.0 / np.maximum(symbol, floor)
-        spec = scipy.fft.rfft2(residual_m)
+        spec = period_rfft2(residual_m)
         spec *= self._cache["prec"]
-        return scipy.fft.irfft2(spec, s=(self.ny, self.nx))
+        return period_irfft2(spec, self.nx)
 
     def _folded_period(self, name: str) -> np.ndarray:
         """Kernel ``name`` (static) folded onto the grid's own period (ny, nx): the coefficients of the 2 ny x 2 nx

@@ -49,9 +49,8 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-import scipy.fft
 
-from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.influence import InfluenceGrid, period_irfft2, period_rfft2
 
 
 @numba.njit(cache=True, fastmath=True)
@@ -514,8 +513,8 @@ def solve_tang(
 
         def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, ahead_g=ahead_g, size=size):
             _spread_adhesion(v, kind, idx, nh, buf)
-            _mix(scipy.fft.rfft2(buf), *k_inv, mixed_p)
-            u = scipy.fft.irfft2(mixed_p, s=shape)
+            _mix(period_rfft2(buf), *k_inv, mixed_p)
+            u = period_irfft2(mixed_p, shape[1])
             out = np.empty(size)
             _precondition_out(u, v, kind, idx, nh, self_g, ahead_g, influence.dx_m, rolling, out)
             return out
