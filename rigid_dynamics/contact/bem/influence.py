@@ -241,18 +241,24 @@ def strip_influence(
     }
 
 
-def period_rfft2(values: np.ndarray) -> np.ndarray:
-    """``scipy.fft.rfft2(values)`` (the last two axes; no padding), by scipy's transform function directly."""
+def period_rfft2(values: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``scipy.fft.rfft2(values)`` (the last two axes; no padding), by scipy's transform function directly.
+
+    ``out``: a complex (..., ny, nx/2 + 1) array to write the spectrum into (returned), or None (a new one).
+    """
     if _DIRECT is None:
         return scipy.fft.rfft2(values)
-    return _DIRECT.r2c(np.asarray(values, float), (values.ndim - 2, values.ndim - 1), True, 0, None, 1)
+    return _DIRECT.r2c(np.asarray(values, float), (values.ndim - 2, values.ndim - 1), True, 0, out, 1)
 
 
-def period_irfft2(spectrum: np.ndarray, nx: int) -> np.ndarray:
-    """``scipy.fft.irfft2(spectrum, s=(ny, nx))`` with ny = spectrum.shape[-2], by scipy's function directly."""
+def period_irfft2(spectrum: np.ndarray, nx: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``scipy.fft.irfft2(spectrum, s=(ny, nx))`` with ny = spectrum.shape[-2], by scipy's function directly.
+
+    ``out``: a float (..., ny, nx) array to write the result into (returned), or None (a new one).
+    """
     if _DIRECT is None:
         return scipy.fft.irfft2(spectrum, s=(spectrum.shape[-2], nx))
-    return _DIRECT.c2r(spectrum, (spectrum.ndim - 2, spectrum.ndim - 1), nx, False, 2, None, 1)
+    return _DIRECT.c2r(spectrum, (spectrum.ndim - 2, spectrum.ndim - 1), nx, False, 2, out, 1)
 
 
 SHARED_CACHE_GRIDS = 16
@@ -434,10 +440,12 @@ class InfluenceGrid:
         _DIRECT.r2c(real, (last,), True, 0, spec[..., :ny, :], 1)
         return _DIRECT.c2c(spec, (last - 1,), True, 0, spec, 1)
 
-    def _backward(self, spectrum: np.ndarray) -> np.ndarray:
+    def _backward(self, spectrum: np.ndarray, reuse: bool = False) -> np.ndarray:
         """Inverse of :meth:`_forward`, cropped to (..., ny, nx); only the ny kept rows are transformed along x.
 
-        ``spectrum`` (complex, C-contiguous, owned by the caller's computation) may be overwritten.
+        ``spectrum`` (complex, C-contiguous, owned by the caller's computation) may be overwritten. ``reuse``: the
+        result is written into a buffer kept per grid and shape, valid until the next such call (for a product
+        consumed at once, as in the solvers' iterations).
         """
         ly, lx = self._cache["shape"]
         if _DIRECT is None:
@@ -447,23 +455,34 @@ class InfluenceGrid:
         last = spectrum.ndim - 1
         if ly > 1:
             spectrum = _DIRECT.c2c(spectrum, (last - 1,), False, 2, spectrum, 1)[..., : self.ny, :]
-        return _DIRECT.c2r(spectrum, (last,), lx, False, 2, None, 1)[..., : self.nx]
+        out = None
+        if reuse:
+            key = ("backward", spectrum.shape[:-1])
+            out = self._cache.get(key)
+            if out is None:
+                out = self._cache[key] = np.empty((*spectrum.shape[:-1], lx))
+        return _DIRECT.c2r(spectrum, (last,), lx, False, 2, out, 1)[..., : self.nx]
 
     def apply(self, name: str, field_values: np.ndarray, rolling: bool = False) -> np.ndarray:
         """Convolution ``sum_K C_name(I - K) t[K]`` of one kernel with a (ny, nx) field."""
         return self._backward(self._kernel_fft(name, rolling) * self._forward(field_values))
 
-    def normal(self, pressure_Pa: np.ndarray, traction_x_Pa=None, traction_y_Pa=None) -> np.ndarray:
-        """Normal displacement difference u_z (m) from the pressure (and, if K != 0, the tractions)."""
+    def normal(
+        self, pressure_Pa: np.ndarray, traction_x_Pa=None, traction_y_Pa=None, reuse: bool = False
+    ) -> np.ndarray:
+        """Normal displacement difference u_z (m) from the pressure (and, if K != 0, the tractions).
+
+        ``reuse``: the result lives in a buffer of the grid, valid until the next ``reuse`` product (:meth:`_backward`).
+        """
         spec = self._kernel_fft("zz", False) * self._forward(pressure_Pa)
         if self.difference_parameter != 0.0:
             if traction_x_Pa is not None:
                 spec = spec + self._kernel_fft("zx", False) * self._forward(traction_x_Pa)
             if traction_y_Pa is not None:
                 spec = spec + self._kernel_fft("zy", False) * self._forward(traction_y_Pa)
-        return self._backward(spec)
+        return self._backward(spec, reuse)
 
-    def normal_preconditioner(self, residual_m: np.ndarray) -> np.ndarray:
+    def normal_preconditioner(self, residual_m: np.ndarray, reuse: bool = False) -> np.ndarray:
         """Approximate inverse of the normal operator A_zz: pressure (Pa) for a displacement field (m).
 
         The inverse of the circulant on the period (ny, nx) of the grid itself (no padding: a quarter of the
@@ -477,9 +496,19 @@ class InfluenceGrid:
             symbol = scipy.fft.rfft2(self._folded_period("zz")).real
             floor = 1e-6 * float(np.abs(symbol).max())
             self._cache["prec"] = 1.0 / np.maximum(symbol, floor)
-        spec = period_rfft2(residual_m)
+        if not reuse:
+            spec = period_rfft2(residual_m)
+            spec *= self._cache["prec"]
+            return period_irfft2(spec, self.nx)
+        if "prec_work" not in self._cache:
+            self._cache["prec_work"] = (
+                np.empty((self.ny, self.nx // 2 + 1), complex),
+                np.empty((self.ny, self.nx)),
+            )
+        spec, out = self._cache["prec_work"]
+        spec = period_rfft2(residual_m, spec)
         spec *= self._cache["prec"]
-        return period_irfft2(spec, self.nx)
+        return period_irfft2(spec, self.nx, out)
 
     def _folded_period(self, name: str) -> np.ndarray:
         """Kernel ``name`` (static) folded onto the grid's own period (ny, nx): the coefficients of the 2 ny x 2 nx
