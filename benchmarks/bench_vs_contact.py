@@ -355,10 +355,13 @@ def goals(s: dict) -> list[str]:
         f"CONTACT's {cw['cpu_s']:.2f} s for its whole two runs ({inproc:.2f}x); the whole process adds "
         f"{rest:.2f} s, of which about {NUMBA_FLOOR_CPU_S} s is the floor of importing numba and loading one cached "
         "kernel (startup.md) and the rest the imports of the contact package and the case set-up. Reaching 1.0x "
-        "needs both the per-case BEM below CONTACT's (Python-level overhead of many small FFTs and of the numpy "
-        "undeformed-distance Newton on the deck's spline surfaces, the two largest items of a profile) and start-up "
-        "without numba's import (ahead-of-time compiled kernels): neither is done. The perfc smallest deck is "
-        "start-up bound the same way (CONTACT's whole run is about 0.03 s CPU, below wheelrail's numba floor "
+        "needs both the per-case BEM below CONTACT's and start-up without numba's import (ahead-of-time compiled "
+        "kernels, not done). In process (cProfile of the sweep after the direct FFT calls, session 17): the FFT "
+        "arithmetic itself (scipy's duccfft r2c/c2c/c2r, about a third), TANG's Newton-loop numpy work and GMRES "
+        "in Python, the undeformed distance on the deck's spline surfaces (plane_gap, contact_locus, about an "
+        "eighth), and the final patches' grid-error estimate (solves on a grid twice as coarse, about a fifth, "
+        "which CONTACT does not do). The perfc smallest deck is start-up bound the same way (CONTACT's whole run "
+        "is about 0.05 s CPU, below wheelrail's numba floor "
         "alone); where an in-process perfc ratio is above 0.5x, its cause was not analysed.",
     ]
 
