@@ -47,6 +47,7 @@ sizes (m). Displacements per unit traction: m/Pa.
 from __future__ import annotations
 
 import math
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -413,9 +414,10 @@ class InfluenceGrid:
 
         Done as two 1-D passes so that the padding rows are not transformed along x (about 30 % less work
         than ``rfft2`` of the padded array; same result to rounding). With scipy's transform functions called
-        directly (:data:`_DIRECT`), the padded input and the spectrum live in buffers kept per grid and field
-        shape (no dispatch, no new zero-padded arrays: the same transforms of the same numbers, the same bits as
-        ``scipy.fft.rfft``/``fft``): the returned spectrum is valid until the next call for that shape.
+        directly (:data:`_DIRECT`), the padded input and the spectrum live in buffers kept per grid, field
+        shape and thread (no dispatch, no new zero-padded arrays: the same transforms of the same numbers, the
+        same bits as ``scipy.fft.rfft``/``fft``): the returned spectrum is valid until the next call for that
+        shape in the thread.
         """
         ly, lx = self._cache["shape"]
         values = np.asarray(field_values, float)
@@ -424,7 +426,7 @@ class InfluenceGrid:
             if ly == 1:
                 return spec
             return scipy.fft.fft(spec, n=ly, axis=-2, overwrite_x=True)
-        key = ("forward", values.shape)
+        key = ("forward", values.shape, threading.get_ident())  # per thread: a grid's cache may be shared
         buffers = self._cache.get(key)
         if buffers is None:
             real = np.zeros((*values.shape[:-1], lx))
@@ -457,7 +459,7 @@ class InfluenceGrid:
             spectrum = _DIRECT.c2c(spectrum, (last - 1,), False, 2, spectrum, 1)[..., : self.ny, :]
         out = None
         if reuse:
-            key = ("backward", spectrum.shape[:-1])
+            key = ("backward", spectrum.shape[:-1], threading.get_ident())
             out = self._cache.get(key)
             if out is None:
                 out = self._cache[key] = np.empty((*spectrum.shape[:-1], lx))
@@ -500,12 +502,10 @@ class InfluenceGrid:
             spec = period_rfft2(residual_m)
             spec *= self._cache["prec"]
             return period_irfft2(spec, self.nx)
-        if "prec_work" not in self._cache:
-            self._cache["prec_work"] = (
-                np.empty((self.ny, self.nx // 2 + 1), complex),
-                np.empty((self.ny, self.nx)),
-            )
-        spec, out = self._cache["prec_work"]
+        key = ("prec_work", threading.get_ident())
+        if key not in self._cache:
+            self._cache[key] = (np.empty((self.ny, self.nx // 2 + 1), complex), np.empty((self.ny, self.nx)))
+        spec, out = self._cache[key]
         spec = period_rfft2(residual_m, spec)
         spec *= self._cache["prec"]
         return period_irfft2(spec, self.nx, out)
