@@ -16,9 +16,16 @@ total force, max pressure and elements in contact against CONTACT's run in the s
 approach), relative.
 
 CONTACT is the open-source program of E.A.H. Vollebregt and J.J. Kalker (Vtech CMCC; Apache-2.0; revision 2707,
-snapshot d431cdb), built outside this repository with gfortran 12 and oneMKL's FFT preconditioner
-(``/work/contact-build``). When that build is missing the script reads CONTACT's times recorded in
-``benchmarks/results/vs_contact.json`` and times only wheelrail (said so in the output).
+snapshot d431cdb), built outside this repository (its code never enters it) in ``$CONTACT_DIR`` (default
+``/work/contact-build``: the snapshot's ``src``, ``examples`` and ``perfc_test``, the executable
+``bin/contact_linux64``) with its makefile (PROD=exe_l64: -O3, OpenMP) and gfortran 12 in place of ifort, and
+with oneMKL's FFT (the ``WITH_MKLFFT`` NORM preconditioner and FFT products; pip's ``mkl-static`` 2026.2,
+sequential, linked statically). gfortran needed small source patches (Intel extensions: logical comparisons,
+``(i)`` formats, ``ifport``), and oneMKL 2026 the explicit real-domain strides of CONTACT's descriptors (the
+lines CONTACT has commented out: without them the back transform is wrong and NORM ends in NaN). The build
+reproduces CONTACT's ``mbench_a22_{left,right}.ref_out`` force lines exactly. When the build is missing the
+script reads CONTACT's times recorded in ``benchmarks/results/vs_contact.json`` and times only wheelrail (said so
+in the output).
 
 Timing: interleaved pairs (CONTACT, then wheelrail, ``PAIRS`` times), one thread each (OMP/MKL/NUMBA/OPENBLAS = 1),
 wall and CPU (user + system of the child process); the machine is shared and noisy, so the ratios come from the
@@ -51,9 +58,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-CONTACT_BUILD = Path("/work/contact-build")
+CONTACT_BUILD = Path(os.environ.get("CONTACT_DIR", "/work/contact-build"))
 CONTACT_EXE = CONTACT_BUILD / "bin" / "contact_linux64"
-CONTACT_SRC = Path("/work/contact-src")
+CONTACT_SRC = CONTACT_BUILD  # decks: CONTACT_SRC/examples, CONTACT_SRC/perfc_test
 RESULTS = ROOT / "benchmarks" / "results"
 PERFC = {"1p": (71, 81, 0.1e-3), "2p": (143, 163, 0.05e-3), "4p": (287, 323, 0.025e-3)}
 PEN_M, RM_M, EPS = 0.02084e-3, 0.483931, 1e-7
@@ -267,7 +274,12 @@ def main() -> None:
         "case": CASE,
         "machine": machine,
         "pairs": pairs,
-        "contact": "run in this script" if have_contact else "recorded times read from the previous vs_contact.json",
+        "contact": f"run in this script ({CONTACT_EXE})"
+        if have_contact
+        else "recorded times read from the previous vs_contact.json",
+        "wheelrail_commit": subprocess.run(
+            ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+        ).stdout.strip(),
         "a22": {
             "contact_whole": contact_whole("a22"),
             "wheelrail_cli_whole": {
@@ -343,10 +355,13 @@ def goals(s: dict) -> list[str]:
         f"CONTACT's {cw['cpu_s']:.2f} s for its whole two runs ({inproc:.2f}x); the whole process adds "
         f"{rest:.2f} s, of which about {NUMBA_FLOOR_CPU_S} s is the floor of importing numba and loading one cached "
         "kernel (startup.md) and the rest the imports of the contact package and the case set-up. Reaching 1.0x "
-        "needs both the per-case BEM below CONTACT's (Python-level overhead of many small FFTs and of the numpy "
-        "undeformed-distance Newton on the deck's spline surfaces, the two largest items of a profile) and start-up "
-        "without numba's import (ahead-of-time compiled kernels): neither is done. The perfc smallest deck is "
-        "start-up bound the same way (CONTACT's whole run is about 0.03 s CPU, below wheelrail's numba floor "
+        "needs both the per-case BEM below CONTACT's and start-up without numba's import (ahead-of-time compiled "
+        "kernels, not done). In process (cProfile of the sweep after the direct FFT calls, session 17): the FFT "
+        "arithmetic itself (scipy's duccfft r2c/c2c/c2r, about a third), TANG's Newton-loop numpy work and GMRES "
+        "in Python, the undeformed distance on the deck's spline surfaces (plane_gap, contact_locus, about an "
+        "eighth), and the final patches' grid-error estimate (solves on a grid twice as coarse, about a fifth, "
+        "which CONTACT does not do). The perfc smallest deck is start-up bound the same way (CONTACT's whole run "
+        "is about 0.05 s CPU, below wheelrail's numba floor "
         "alone); where an in-process perfc ratio is above 0.5x, its cause was not analysed.",
     ]
 

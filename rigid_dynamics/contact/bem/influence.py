@@ -47,11 +47,20 @@ sizes (m). Displacements per unit traction: m/Pa.
 from __future__ import annotations
 
 import math
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.fft
+
+try:  # scipy.fft's own transform functions, without its dispatch layer: the same code on the same data, same bits
+    from scipy.fft._duccfft import pyduccfft as _DIRECT
+except ImportError:  # pragma: no cover - older scipy (pocketfft, same signatures) or a layout without either
+    try:
+        from scipy.fft._pocketfft import pypocketfft as _DIRECT
+    except ImportError:
+        _DIRECT = None
 
 KERNELS = ("zz", "xx", "yy", "xy", "zx", "zy", "xz", "yz")
 """Names of the influence kernels A_ij: first index displacement, second traction component."""
@@ -233,6 +242,26 @@ def strip_influence(
     }
 
 
+def period_rfft2(values: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``scipy.fft.rfft2(values)`` (the last two axes; no padding), by scipy's transform function directly.
+
+    ``out``: a complex (..., ny, nx/2 + 1) array to write the spectrum into (returned), or None (a new one).
+    """
+    if _DIRECT is None:
+        return scipy.fft.rfft2(values)
+    return _DIRECT.r2c(np.asarray(values, float), (values.ndim - 2, values.ndim - 1), True, 0, out, 1)
+
+
+def period_irfft2(spectrum: np.ndarray, nx: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``scipy.fft.irfft2(spectrum, s=(ny, nx))`` with ny = spectrum.shape[-2], by scipy's function directly.
+
+    ``out``: a float (..., ny, nx) array to write the result into (returned), or None (a new one).
+    """
+    if _DIRECT is None:
+        return scipy.fft.irfft2(spectrum, s=(spectrum.shape[-2], nx))
+    return _DIRECT.c2r(spectrum, (spectrum.ndim - 2, spectrum.ndim - 1), nx, False, 2, out, 1)
+
+
 SHARED_CACHE_GRIDS = 16
 """Number of grids (by nx, ny, dx, dy and elastic constants) whose coefficients and spectra are kept for reuse."""
 SHARED_CACHE_ELEMENTS = 100_000
@@ -384,36 +413,78 @@ class InfluenceGrid:
         """rfft2 of (..., ny, nx) fields zero-padded to the period (ly, lx), shape (..., ly, lx/2 + 1).
 
         Done as two 1-D passes so that the padding rows are not transformed along x (about 30 % less work
-        than ``rfft2`` of the padded array; same result to rounding).
+        than ``rfft2`` of the padded array; same result to rounding). With scipy's transform functions called
+        directly (:data:`_DIRECT`), the padded input and the spectrum live in buffers kept per grid, field
+        shape and thread (no dispatch, no new zero-padded arrays: the same transforms of the same numbers, the
+        same bits as ``scipy.fft.rfft``/``fft``): the returned spectrum is valid until the next call for that
+        shape in the thread.
         """
         ly, lx = self._cache["shape"]
-        spec = scipy.fft.rfft(np.asarray(field_values, float), n=lx, axis=-1)
+        values = np.asarray(field_values, float)
+        if _DIRECT is None:
+            spec = scipy.fft.rfft(values, n=lx, axis=-1)
+            if ly == 1:
+                return spec
+            return scipy.fft.fft(spec, n=ly, axis=-2, overwrite_x=True)
+        key = ("forward", values.shape, threading.get_ident())  # per thread: a grid's cache may be shared
+        buffers = self._cache.get(key)
+        if buffers is None:
+            real = np.zeros((*values.shape[:-1], lx))
+            spec = np.zeros((*values.shape[:-2], ly, lx // 2 + 1), complex) if ly > 1 else None
+            buffers = self._cache[key] = (real, spec)
+        real, spec = buffers
+        last = values.ndim - 1
+        real[..., : values.shape[-1]] = values
         if ly == 1:
-            return spec
-        return scipy.fft.fft(spec, n=ly, axis=-2, overwrite_x=True)
+            return _DIRECT.r2c(real, (last,), True, 0, None, 1)
+        ny = values.shape[-2]
+        spec[..., ny:, :] = 0.0
+        _DIRECT.r2c(real, (last,), True, 0, spec[..., :ny, :], 1)
+        return _DIRECT.c2c(spec, (last - 1,), True, 0, spec, 1)
 
-    def _backward(self, spectrum: np.ndarray) -> np.ndarray:
-        """Inverse of :meth:`_forward`, cropped to (..., ny, nx); only the ny kept rows are transformed along x."""
+    def _backward(self, spectrum: np.ndarray, reuse: bool = False) -> np.ndarray:
+        """Inverse of :meth:`_forward`, cropped to (..., ny, nx); only the ny kept rows are transformed along x.
+
+        ``spectrum`` (complex, C-contiguous, owned by the caller's computation) may be overwritten. ``reuse``: the
+        result is written into a buffer kept per grid and shape, valid until the next such call (for a product
+        consumed at once, as in the solvers' iterations).
+        """
         ly, lx = self._cache["shape"]
+        if _DIRECT is None:
+            if ly > 1:
+                spectrum = scipy.fft.ifft(spectrum, axis=-2)[..., : self.ny, :]
+            return scipy.fft.irfft(spectrum, n=lx, axis=-1)[..., : self.nx]
+        last = spectrum.ndim - 1
         if ly > 1:
-            spectrum = scipy.fft.ifft(spectrum, axis=-2)[..., : self.ny, :]
-        return scipy.fft.irfft(spectrum, n=lx, axis=-1)[..., : self.nx]
+            spectrum = _DIRECT.c2c(spectrum, (last - 1,), False, 2, spectrum, 1)[..., : self.ny, :]
+        out = None
+        if reuse:
+            key = ("backward", spectrum.shape[:-1], threading.get_ident())
+            out = self._cache.get(key)
+            if out is None:
+                out = self._cache[key] = np.empty((*spectrum.shape[:-1], lx))
+        return _DIRECT.c2r(spectrum, (last,), lx, False, 2, out, 1)[..., : self.nx]
 
     def apply(self, name: str, field_values: np.ndarray, rolling: bool = False) -> np.ndarray:
         """Convolution ``sum_K C_name(I - K) t[K]`` of one kernel with a (ny, nx) field."""
         return self._backward(self._kernel_fft(name, rolling) * self._forward(field_values))
 
-    def normal(self, pressure_Pa: np.ndarray, traction_x_Pa=None, traction_y_Pa=None) -> np.ndarray:
-        """Normal displacement difference u_z (m) from the pressure (and, if K != 0, the tractions)."""
+    def normal(
+        self, pressure_Pa: np.ndarray, traction_x_Pa=None, traction_y_Pa=None, reuse: bool = False
+    ) -> np.ndarray:
+        """Normal displacement difference u_z (m) from the pressure (and, if K != 0, the tractions).
+
+        ``reuse``: the result lives in a buffer of the grid, valid until the next ``reuse`` product (:meth:`_backward`).
+        """
         spec = self._kernel_fft("zz", False) * self._forward(pressure_Pa)
         if self.difference_parameter != 0.0:
             if traction_x_Pa is not None:
                 spec = spec + self._kernel_fft("zx", False) * self._forward(traction_x_Pa)
             if traction_y_Pa is not None:
                 spec = spec + self._kernel_fft("zy", False) * self._forward(traction_y_Pa)
-        return self._backward(spec)
+        return self._backward(spec, reuse)
 
-    def normal_preconditioner(self, residual_m: np.ndarray) -> np.ndarray:
+    def normal_preconditioner(self, residual_m: np.ndarray, reuse: bool = False) -> np.ndarray:
         """Approximate inverse of the normal operator A_zz: pressure (Pa) for a displacement field (m).
 
         The inverse of the circulant on the period (ny, nx) of the grid itself (no padding: a quarter of the
@@ -427,9 +498,17 @@ class InfluenceGrid:
             symbol = scipy.fft.rfft2(self._folded_period("zz")).real
             floor = 1e-6 * float(np.abs(symbol).max())
             self._cache["prec"] = 1.0 / np.maximum(symbol, floor)
-        spec = scipy.fft.rfft2(residual_m)
+        if not reuse:
+            spec = period_rfft2(residual_m)
+            spec *= self._cache["prec"]
+            return period_irfft2(spec, self.nx)
+        key = ("prec_work", threading.get_ident())
+        if key not in self._cache:
+            self._cache[key] = (np.empty((self.ny, self.nx // 2 + 1), complex), np.empty((self.ny, self.nx)))
+        spec, out = self._cache[key]
+        spec = period_rfft2(residual_m, spec)
         spec *= self._cache["prec"]
-        return scipy.fft.irfft2(spec, s=(self.ny, self.nx))
+        return period_irfft2(spec, self.nx, out)
 
     def _folded_period(self, name: str) -> np.ndarray:
         """Kernel ``name`` (static) folded onto the grid's own period (ny, nx): the coefficients of the 2 ny x 2 nx

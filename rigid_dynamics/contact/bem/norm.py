@@ -476,10 +476,10 @@ def _normcg(influence, h, p, allowed, start_set, force_control, normal_force, ar
     rms_upd = rms_p = math.inf
     it = 0
     for it in range(1, max_iterations + 1):  # noqa: B007 (the count is returned)
-        z = influence.normal_preconditioner(res)
+        z = influence.normal_preconditioner(res, reuse=True)  # both consumed at once: in the grid's buffers
         rz = _pcg_direction(z, res, r_prv, v, active, force_control, rz, restart)
         restart = False
-        q = influence.normal(v)
+        q = influence.normal(v, reuse=True)
         _alpha, rms_upd, rms_p, n_removed = _pcg_step(q, v, res, p, u, r_prv, active, removed)
         if n_removed:
             if n_removed <= SPARSE_CORRECTION_LIMIT:

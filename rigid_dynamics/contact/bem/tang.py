@@ -49,9 +49,8 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-import scipy.fft
 
-from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.influence import InfluenceGrid, period_irfft2, period_rfft2
 
 
 @numba.njit(cache=True, fastmath=True)
@@ -389,6 +388,8 @@ def solve_tang(
     buf = np.zeros((2, *shape))  # traction pair on the grid (zero-padded by the pruned FFT passes)
     mixed = np.empty((2, padded[0], padded[1] // 2 + 1), complex)
     mixed_p = np.empty((2, shape[0], shape[1] // 2 + 1), complex)
+    spec_p = np.empty_like(mixed_p)  # the preconditioner's spectrum and result, consumed at once
+    u_p = np.empty((2, *shape))
     k_roll = influence.tangential_spectra(rolling)
     k_inv = influence.inverse_static_period_spectra()
     tx = np.zeros(shape)
@@ -507,15 +508,15 @@ def solve_tang(
         def matvec(v, kind=kind, idx=idx, nh=nh, gex=gex, gey=gey, e=(epx_g, epy_g, diag_g), size=size):
             _spread(v, kind, idx, nh, gex, gey, buf)
             _mix(influence._forward(buf), *k_roll, mixed)
-            u = influence._backward(mixed)
+            u = influence._backward(mixed, reuse=True)
             out = np.empty(size)
             _gather_residual(u, v, kind, idx, nh, *e, out)
             return out
 
         def precondition(v, kind=kind, idx=idx, nh=nh, self_g=self_g, ahead_g=ahead_g, size=size):
             _spread_adhesion(v, kind, idx, nh, buf)
-            _mix(scipy.fft.rfft2(buf), *k_inv, mixed_p)
-            u = scipy.fft.irfft2(mixed_p, s=shape)
+            _mix(period_rfft2(buf, spec_p), *k_inv, mixed_p)
+            u = period_irfft2(mixed_p, shape[1], u_p)
             out = np.empty(size)
             _precondition_out(u, v, kind, idx, nh, self_g, ahead_g, influence.dx_m, rolling, out)
             return out
