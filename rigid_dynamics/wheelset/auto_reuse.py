@@ -80,9 +80,14 @@ rolling radius and contact angle from the candidate's."""
 ) = range(20)  # fmt: skip
 R_MAP = R_FORMED + 1
 """The first of the frame map's columns (Q row by row, then w: formed_patches.frame_map)."""
-R_OWN = R_MAP + N_FRAME_MAP
-"""The first of the formed patch's departures (k_x, k_y, spin, approach, point y, wheel lateral, rolling radius,
-contact angle)."""
+MAP_Q22, MAP_W = 8, 9
+"""Positions in a frame map (formed_patches.frame_map): Q[2][2] = n . n' and the first of w."""
+F_XI, F_ETA, F_SPIN, F_APPROACH, F_POINT_Y, F_LATERAL, F_RADIUS, F_ANGLE = range(
+    R_MAP + N_FRAME_MAP, R_MAP + N_FRAME_MAP + 8
+)
+"""Columns of the formed patch's departures from the candidate's: the transported creepages' rigid-motion parts
+(k_x, k_y) and the spin's departure, then the approach, reference point y, wheel lateral coordinate, rolling radius
+and contact angle."""
 STATS = (
     "served",
     "solved",
@@ -258,6 +263,19 @@ def _measure(st, radius, errors, level, t):
     return radius
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _formed_components(m, vector):
+    """Q^T v: the candidate-frame components ``vector`` (x, y, normal) in the formed patch's frame, Q the direction
+    cosines at the start of the frame map ``m`` (formed_patches.frame_map, row by row).
+    """
+    x, y, z = 0.0, 0.0, 0.0
+    for i, v in enumerate(vector):
+        x += m[3 * i] * v
+        y += m[3 * i + 1] * v
+        z += m[3 * i + 2] * v
+    return x, y, z
+
+
 @njit(cache=True, _nrt=False)
 def _keep_formed(row, creep, g, formed):
     """Keep in the anchor ``row`` what records a served patch in the formed patch's plane (:data:`ANCHOR`), from
@@ -271,15 +289,13 @@ def _keep_formed(row, creep, g, formed):
     row[R_FORMED] = 1.0
     for k in range(N_FRAME_MAP):
         row[R_MAP + k] = fmap[k]
+    _, _, _, _, xi_f, eta_f, spin_f, approach_f, point_y_f, lateral_f, radius_f, angle_f = own
     xi, eta, spin = creep
-    row[R_OWN] = own[4] - (fmap[0] * xi + fmap[3] * eta)
-    row[R_OWN + 1] = own[5] - (fmap[1] * xi + fmap[4] * eta)
-    row[R_OWN + 2] = own[6] - spin
-    row[R_OWN + 3] = own[7] - g[G_APPROACH]
-    row[R_OWN + 4] = own[8] - point_y
-    row[R_OWN + 5] = own[9] - g[G_WHEEL_LATERAL]
-    row[R_OWN + 6] = own[10] - g[G_ROLLING_RADIUS]
-    row[R_OWN + 7] = own[11] - g[G_CONTACT_ANGLE]
+    xi_r, eta_r, _ = _formed_components(fmap, (xi, eta, 0.0))
+    row[F_XI], row[F_ETA], row[F_SPIN] = xi_f - xi_r, eta_f - eta_r, spin_f - spin
+    row[F_APPROACH], row[F_POINT_Y] = approach_f - g[G_APPROACH], point_y_f - point_y
+    row[F_LATERAL], row[F_RADIUS] = lateral_f - g[G_WHEEL_LATERAL], radius_f - g[G_ROLLING_RADIUS]
+    row[F_ANGLE] = angle_f - g[G_CONTACT_ANGLE]
 
 
 _NOT_FORMED = (math.nan,) * N_FORMED
@@ -299,19 +315,18 @@ def reuse_own(store, c, forces, creep, g, point_y):
     row = store[c]
     if row[R_FORMED] <= 0.0:
         return _NOT_FORMED
-    q = row[R_MAP : R_MAP + 9]
-    w = row[R_MAP + 9 : R_MAP + 12]
+    m = row[R_MAP : R_MAP + N_FRAME_MAP]
     normal, tx, ty, mz = forces
-    own_x = q[0] * tx + q[3] * ty + q[6] * normal
-    own_y = q[1] * tx + q[4] * ty + q[7] * normal
-    own_n = q[2] * tx + q[5] * ty + q[8] * normal
-    own_mz = (mz - (w[0] * tx + w[1] * ty + w[2] * normal)) / q[8]
+    own_x, own_y, own_n = _formed_components(m, (tx, ty, normal))
+    arm = 0.0
+    for k, component in enumerate((tx, ty, normal)):
+        arm += m[MAP_W + k] * component
     xi, eta, spin = creep
-    k = row[R_OWN : R_OWN + 8]
+    xi_r, eta_r, _ = _formed_components(m, (xi, eta, 0.0))
     return (
-        own_n, own_x, own_y, own_mz, q[0] * xi + q[3] * eta + k[0], q[1] * xi + q[4] * eta + k[1], spin + k[2],
-        g[G_APPROACH] + k[3], point_y + k[4], g[G_WHEEL_LATERAL] + k[5], g[G_ROLLING_RADIUS] + k[6],
-        g[G_CONTACT_ANGLE] + k[7],
+        own_n, own_x, own_y, (mz - arm) / m[MAP_Q22], xi_r + row[F_XI], eta_r + row[F_ETA], spin + row[F_SPIN],
+        g[G_APPROACH] + row[F_APPROACH], point_y + row[F_POINT_Y], g[G_WHEEL_LATERAL] + row[F_LATERAL],
+        g[G_ROLLING_RADIUS] + row[F_RADIUS], g[G_CONTACT_ANGLE] + row[F_ANGLE],
     )  # fmt: skip
 
 
@@ -328,15 +343,10 @@ def _correction_errors(served, fresh, mu_n, fmap):
     n, tx, ty = served
     n_b, tx_b, ty_b = fresh
     if not math.isnan(fmap[0]):
-        mu_n *= (fmap[2] * tx_b + fmap[5] * ty_b + fmap[8] * n_b) / n_b
-        n, tx, ty = (
-            fmap[2] * tx + fmap[5] * ty + fmap[8] * n, fmap[0] * tx + fmap[3] * ty + fmap[6] * n,
-            fmap[1] * tx + fmap[4] * ty + fmap[7] * n,
-        )  # fmt: skip
-        n_b, tx_b, ty_b = (
-            fmap[2] * tx_b + fmap[5] * ty_b + fmap[8] * n_b, fmap[0] * tx_b + fmap[3] * ty_b + fmap[6] * n_b,
-            fmap[1] * tx_b + fmap[4] * ty_b + fmap[7] * n_b,
-        )  # fmt: skip
+        tx_b, ty_b, n_f = _formed_components(fmap, (tx_b, ty_b, n_b))
+        mu_n *= n_f / n_b
+        n_b = n_f
+        tx, ty, n = _formed_components(fmap, (tx, ty, n))
     e_f = math.hypot(tx - tx_b, ty - ty_b) / max(math.hypot(tx_b, ty_b), 0.01 * mu_n)
     return e_f, abs(n - n_b) / n_b
 
