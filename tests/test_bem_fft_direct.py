@@ -64,3 +64,30 @@ def test_products_and_preconditioner_bit_identical(ny, nx):
     assert np.array_equal(period_rfft2(pair, out), scipy.fft.rfft2(pair))
     back = np.empty((2, ny, nx))
     assert np.array_equal(period_irfft2(out, nx, back), scipy.fft.irfft2(out, s=(ny, nx)))
+
+
+def test_a_changed_private_layer_falls_back_to_the_public_functions():
+    """Regression: scipy's private transform functions are used only after a check against the public ones at import;
+    a layer whose signature changed (an exception) or whose result differs is not used."""
+    from rigid_dynamics.contact.bem import influence
+
+    class Moved:
+        @staticmethod
+        def r2c(a, axes, forward, inorm, out, nthreads, extra):  # one more argument: the call raises
+            return a
+
+    class Wrong:
+        @staticmethod
+        def r2c(a, axes, forward, inorm, out, nthreads):
+            return np.zeros((a.shape[0], a.shape[1] // 2 + 1), complex)
+
+        c2c = r2c
+
+        @staticmethod
+        def c2r(a, axes, n, forward, inorm, out, nthreads):
+            return np.zeros((a.shape[0], n))
+
+    assert not influence._direct_agrees(Moved)
+    assert not influence._direct_agrees(Wrong)
+    if influence._DIRECT is not None:
+        assert influence._direct_agrees(influence._DIRECT)
