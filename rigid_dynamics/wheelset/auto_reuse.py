@@ -54,8 +54,8 @@ from rigid_dynamics.wheelset.layout import (
     G_CURVATURE_LONG,
     G_ROLLING_RADIUS,
     G_WHEEL_LATERAL,
-    N_FORMED,
     N_FRAME_MAP,
+    NOT_FORMED,
 )
 
 ANCHOR = (
@@ -298,10 +298,6 @@ def _keep_formed(row, creep, g, formed):
     row[F_ANGLE] = angle_f - g[G_CONTACT_ANGLE]
 
 
-_NOT_FORMED = (math.nan,) * N_FORMED
-"""reuse_own's answer for an anchor that was not a formed patch (compiled_rhs.NOT_FORMED)."""
-
-
 @njit(cache=True, _nrt=False)
 def reuse_own(store, c, forces, creep, g, point_y):
     """The own quantities (layout.FORMED_PATCH_FIELDS' order) of the formed patch candidate c serves by its anchor's
@@ -314,7 +310,7 @@ def reuse_own(store, c, forces, creep, g, point_y):
     """
     row = store[c]
     if row[R_FORMED] <= 0.0:
-        return _NOT_FORMED
+        return NOT_FORMED
     m = row[R_MAP : R_MAP + N_FRAME_MAP]
     normal, tx, ty, mz = forces
     own_x, own_y, own_n = _formed_components(m, (tx, ty, normal))

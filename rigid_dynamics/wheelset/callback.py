@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 from rigid_dynamics.contact.types import ContactGeometry, Creepage
-from rigid_dynamics.wheelset.compiled_rhs import NOT_FORMED, NOT_MAPPED, CallbackOutcome
+from rigid_dynamics.wheelset.compiled_rhs import CallbackOutcome
 from rigid_dynamics.wheelset.formed_patches import (
     PatchFormer,
     candidate_forces,
@@ -19,7 +19,7 @@ from rigid_dynamics.wheelset.formed_patches import (
     own_quantities,
     transported_creepage,
 )
-from rigid_dynamics.wheelset.layout import PATCH_ELLIPSE, PATCH_SAMPLED
+from rigid_dynamics.wheelset.layout import NOT_FORMED, NOT_MAPPED, PATCH_ELLIPSE, PATCH_SAMPLED
 from rigid_dynamics.wheelset.providers import SIDES
 
 

@@ -81,10 +81,11 @@ from rigid_dynamics.wheelset.layout import (
     MAX_PRESSURE,
     N_FIELDS,
     N_FORMED,
-    N_FRAME_MAP,
     N_GEO,
     N_SCRATCH,
     NORMAL_FORCE,
+    NOT_FORMED,
+    NOT_MAPPED,
     OK,
     PATCH_ELLIPSE,
     PATCH_GEOMETRY,
@@ -166,9 +167,9 @@ class CallbackOutcome(NamedTuple):
     (m^2), max pressure (Pa), the geometry the model saw (layout.PATCH_ELLIPSE / PATCH_SAMPLED) and its ellipticity
     residual (NaN for an ellipse), the status (0 solved, 1 failed: the callback keeps its message), and ``own``: for
     a candidate that served a formed patch, that patch's own quantities in the order of layout.FORMED_PATCH_FIELDS
-    (recorded, not applied: the forces above are the candidate's), else :data:`NOT_FORMED`; ``frame_map``: then the
+    (recorded, not applied: the forces above are the candidate's), else layout.NOT_FORMED; ``frame_map``: then the
     map from the candidate's frame to the formed patch's (formed_patches.frame_map; kept by ``auto``'s anchors),
-    else :data:`NOT_MAPPED`.
+    else layout.NOT_MAPPED.
     """
 
     normal_force_N: float
@@ -183,13 +184,7 @@ class CallbackOutcome(NamedTuple):
     ellipticity_residual: float
     status: int
     own: tuple
-    frame_map: tuple = (math.nan,) * N_FRAME_MAP
-
-
-NOT_FORMED = (math.nan,) * N_FORMED
-"""CallbackOutcome.own of a candidate that served no formed patch (and of every patch a compiled law solved)."""
-NOT_MAPPED = (math.nan,) * N_FRAME_MAP
-"""CallbackOutcome.frame_map of a candidate that served no formed patch."""
+    frame_map: tuple = NOT_MAPPED
 
 
 _CALLBACK = [None]
@@ -216,8 +211,7 @@ def _external(t, y, c, side, g, creep, frame):
     quantities and the frame map); status != 0: the contact model failed (the callback keeps its message). Overhead
     measured here: 2.0-2.1 us per objmode call of a trivial Python function; 25 us per patch through
     callback.PatchCallback with a model returning constant forces (its ContactGeometry and Creepage built per
-    patch); a BEM patch at 40 x 40 takes
-    about 20 ms.
+    patch); a BEM patch at 40 x 40 takes about 20 ms.
     """
     speed, xi, eta, spin = creep
     ex, ey = frame
@@ -249,7 +243,7 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     else solved by the callback (:func:`_external`) and made the candidate's anchor (auto_reuse.reuse_anchor).
     Arguments as :func:`_external`'s; laws = (par, tables, dummy, where, rec, record). Returns _external's values
     (without the frame map) and the law code; a served patch whose anchor was a formed patch gives the formed
-    patch's own quantities at the served forces (auto_reuse.reuse_own; when ``record``), else :data:`NOT_FORMED`.
+    patch's own quantities at the served forces (auto_reuse.reuse_own; when ``record``), else layout.NOT_FORMED.
     """
     par, tables, dummy, where, rec, record = laws
     _, xi, eta, spin = creep

@@ -98,6 +98,11 @@ in place of the candidate's (formed_patches.recorded)."""
 N_FRAME_MAP = 12
 """Values of the map from a candidate's contact frame to the formed patch's it serves (formed_patches.frame_map: the
 3 x 3 direction cosines and the offset's moment arm), which ``auto``'s anchors keep (auto_reuse.reuse_own)."""
+NOT_FORMED = (float("nan"),) * N_FORMED
+"""The own quantities of a candidate that served no formed patch (compiled_rhs.CallbackOutcome.own, and of every
+patch a compiled law solved or an anchor not formed served: auto_reuse.reuse_own)."""
+NOT_MAPPED = (float("nan"),) * N_FRAME_MAP
+"""The frame map of a candidate that served no formed patch (compiled_rhs.CallbackOutcome.frame_map)."""
 FORMED = N_PATCH + len(AUTO_PATCH_FIELDS)
 """The first column of the formed patch's own quantities: rec[c, FORMED + k] is PATCH_FIELDS[k]'s, k < N_FORMED."""
 N_FIELDS = FORMED + N_FORMED
