@@ -87,3 +87,37 @@ def test_a_swallowed_sigterm_is_raised_again_at_the_next_progress_report():
     finally:
         cli._TERMINATION["requested"] = False
     close()
+
+
+def test_sigterm_inside_numba_waits_for_the_toolkits_own_code():
+    """SIGTERM landing while numba loads a kernel from its cache aborted a CI run ("free(): double free detected",
+    SIGABRT instead of exit 143): the exception tore through llvmlite between handing a module to LLVM and its own
+    bookkeeping. The handler now raises only outside numba/llvmlite and outside numba's compiler lock; elsewhere it
+    keeps the request and sends the signal again shortly (regression test of the rule, not of numba)."""
+    import sys
+
+    import pytest
+    from numba.core.compiler_lock import global_compiler_lock
+
+    from wheelrail import cli
+
+    own_frame = sys._getframe()
+    assert not cli._unwinding_is_unsafe(own_frame)
+    with global_compiler_lock:
+        assert cli._unwinding_is_unsafe(own_frame)
+
+    numba_module = {"__name__": "numba.core.caching", "sys": sys}  # a frame whose code belongs to numba
+    exec("frame = sys._getframe()", numba_module)
+    assert cli._unwinding_is_unsafe(numba_module["frame"])
+
+    try:
+        with global_compiler_lock:
+            cli._terminate(signal.SIGTERM, own_frame)  # deferred: no exception here
+        assert cli._TERMINATION["requested"] and cli._TERMINATION["redeliver"] is not None
+        cli._TERMINATION["redeliver"].cancel()
+        with pytest.raises(SystemExit) as exc:
+            cli._terminate(signal.SIGTERM, own_frame)  # in the toolkit's own code: unwinds at once
+        assert exc.value.code == cli.EXIT_TERMINATED
+    finally:
+        cli._forget_termination()
+    assert cli._TERMINATION == {"requested": False, "redeliver": None}

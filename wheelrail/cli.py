@@ -861,12 +861,53 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-_TERMINATION = {"requested": False}
+_TERMINATION = {"requested": False, "redeliver": None}
+
+
+def _forget_termination() -> None:
+    """The run is over: no request kept, and no pending redelivery that could outlive the handler."""
+    timer = _TERMINATION["redeliver"]
+    if timer is not None:
+        timer.cancel()
+    _TERMINATION.update(requested=False, redeliver=None)
+
+
+_NATIVE_OWNERS = ("numba", "llvmlite")  # packages whose Python code hands objects to C++ that frees them itself
+_REDELIVER_S = 0.05
+
+
+def _unwinding_is_unsafe(frame) -> bool:
+    """True while an exception raised here could corrupt native state: numba compiling or loading a kernel from its
+    cache (its compiler lock is held), or any frame of numba/llvmlite on the stack (an exception between llvmlite's
+    transfer of a module to LLVM and its Python bookkeeping frees the module twice: "free(): double free detected",
+    SIGABRT, seen in CI), or a finalizer of theirs (where the exception would be printed and swallowed).
+    """
+    lock_module = sys.modules.get("numba.core.compiler_lock")
+    if lock_module is not None and lock_module.global_compiler_lock.is_locked():
+        return True
+    while frame is not None:
+        package = frame.f_globals.get("__name__", "").partition(".")[0]
+        if package in _NATIVE_OWNERS:
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _terminate(signum, frame):
+    """SIGTERM: unwind like Ctrl-C (temporary files removed, lock released, exit status 143). Inside numba's or
+    llvmlite's code the unwinding waits: the request is kept, and the signal is sent again shortly (and the run's
+    next progress report raises it too, :func:`_check_terminated`), until it lands in the toolkit's own code.
+    """
     _TERMINATION["requested"] = True
-    raise SystemExit(EXIT_TERMINATED)  # unwinds like Ctrl-C: temporary files removed, lock released
+    if _unwinding_is_unsafe(frame):
+        import threading
+
+        timer = threading.Timer(_REDELIVER_S, os.kill, (os.getpid(), signum))
+        timer.daemon = True
+        _TERMINATION["redeliver"] = timer
+        timer.start()
+        return
+    raise SystemExit(EXIT_TERMINATED)
 
 
 def _check_terminated() -> None:
@@ -959,7 +1000,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"wheelrail: error: the work failed: {type(exc).__name__}: {exc}", file=sys.stderr)
         return EXIT_FAILED
     finally:
-        _TERMINATION["requested"] = False
+        _forget_termination()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
