@@ -121,3 +121,25 @@ def test_sigterm_inside_numba_waits_for_the_toolkits_own_code():
     finally:
         cli._forget_termination()
     assert cli._TERMINATION == {"requested": False, "redeliver": None}
+
+
+def test_ctrl_c_inside_numba_waits_too():
+    """SIGINT's KeyboardInterrupt would tear through llvmlite as SIGTERM's SystemExit did: the command's SIGINT
+    handler follows the same rule (regression test of the rule)."""
+    import sys
+
+    import pytest
+    from numba.core.compiler_lock import global_compiler_lock
+
+    from wheelrail import cli
+
+    own_frame = sys._getframe()
+    try:
+        with global_compiler_lock:
+            cli._interrupt(signal.SIGINT, own_frame)  # deferred
+        assert cli._TERMINATION["redeliver"] is not None and not cli._TERMINATION["requested"]
+        cli._TERMINATION["redeliver"].cancel()
+        with pytest.raises(KeyboardInterrupt):
+            cli._interrupt(signal.SIGINT, own_frame)
+    finally:
+        cli._forget_termination()

@@ -893,6 +893,15 @@ def _unwinding_is_unsafe(frame) -> bool:
     return False
 
 
+def _redeliver_later(signum) -> None:
+    import threading
+
+    timer = threading.Timer(_REDELIVER_S, os.kill, (os.getpid(), signum))
+    timer.daemon = True
+    _TERMINATION["redeliver"] = timer
+    timer.start()
+
+
 def _terminate(signum, frame):
     """SIGTERM: unwind like Ctrl-C (temporary files removed, lock released, exit status 143). Inside numba's or
     llvmlite's code the unwinding waits: the request is kept, and the signal is sent again shortly (and the run's
@@ -900,14 +909,19 @@ def _terminate(signum, frame):
     """
     _TERMINATION["requested"] = True
     if _unwinding_is_unsafe(frame):
-        import threading
-
-        timer = threading.Timer(_REDELIVER_S, os.kill, (os.getpid(), signum))
-        timer.daemon = True
-        _TERMINATION["redeliver"] = timer
-        timer.start()
+        _redeliver_later(signum)
         return
     raise SystemExit(EXIT_TERMINATED)
+
+
+def _interrupt(signum, frame):
+    """SIGINT (Ctrl-C): KeyboardInterrupt as Python's own handler raises it, but, like SIGTERM, not inside numba's
+    or llvmlite's code (there it waits and the signal is sent again shortly).
+    """
+    if _unwinding_is_unsafe(frame):
+        _redeliver_later(signum)
+        return
+    raise KeyboardInterrupt
 
 
 def _check_terminated() -> None:
@@ -968,9 +982,11 @@ def main(argv: list[str] | None = None) -> int:
     from rigid_dynamics.files import WriteError
 
     start = time.perf_counter()
-    previous = None
+    previous = previous_int = None
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _terminate)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # (left alone when SIGINT is ignored)
+            previous_int = signal.signal(signal.SIGINT, _interrupt)
     try:
         args = build_parser().parse_args(argv)
         args.started_at = start
@@ -1003,6 +1019,8 @@ def main(argv: list[str] | None = None) -> int:
         _forget_termination()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        if previous_int is not None:
+            signal.signal(signal.SIGINT, previous_int)
 
 
 if __name__ == "__main__":
