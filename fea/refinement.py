@@ -449,7 +449,10 @@ def solve_to_tolerance(
                 verdict = (f"discretisation error not estimated: the second level (~{dofs * growth:.3g} unknowns) "
                            f"exceeds max_dofs = {opts.max_dofs}")  # fmt: skip
             else:
-                shown = ", ".join(_parts(info, n, e) for n, e in worst.items())
+                above = {n: e for n, e in worst.items() if e is None or e > tol}
+                shown = ", ".join(_parts(info, n, e) for n, e in above.items())
+                within = [f"{n} {e:.2%}" for n, e in worst.items() if n not in above]
+                shown += f"; within it: {', '.join(within)}" if within else ""
                 verdict = (f"discretisation error above mesh_tolerance = {tol:g} ({shown}); the next level "
                            f"(~{dofs * growth:.3g} unknowns) exceeds max_dofs = {opts.max_dofs}")  # fmt: skip
             break

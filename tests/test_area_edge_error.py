@@ -48,7 +48,7 @@ def test_the_reconstructed_edge_recovers_the_ellipse_s_area_where_the_count_jump
 
 def test_edge_error_adds_the_reconstruction_s_change_at_first_order():
     assert edge_error(10.0, 9.0, None) == pytest.approx(1.0)
-    assert edge_error(10.0, 9.0, 9.5) == pytest.approx(1.5)
+    assert edge_error(10.0, 9.0, 9.5) == pytest.approx(1.5)  # the reconstruction at first order: 0.5 / (2 - 1)
     assert edge_error(10.0, 9.0, 9.5, ratio=1.5) == pytest.approx(2.0)
 
 

@@ -22,16 +22,23 @@ Hertz's at 4-9 elements per semi-axis, so the FEA's nodal area is estimated othe
     e_A = |A - A_edge(h)| + |A_edge(h) - A_edge(r h)| / (r - 1)
 
 times a factor of safety ``EDGE_SAFETY``, is the estimate of the count's error: the first term the edge within its
-cells on this grid, the second the reconstruction's own error (first-order Richardson from its change since the
-grid r times as coarse: the BEM's companion, r = 2). The reconstruction is made along the rows and along the
-columns (the row-wise sum is a midpoint rule across the rows with sub-cell extents along them; the two are
-averaged).
+cells on this grid, the second the reconstruction's own error (Richardson at first order, ``RECONSTRUCTION_ORDER``,
+from its change since the grid r times as coarse: the BEM's companion, r = 2). The reconstruction is made along the
+rows and along the columns (the row-wise sum is a midpoint rule across the rows with sub-cell extents along them;
+the two are averaged).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+RECONSTRUCTION_ORDER = 1.0
+"""Order of the reconstructed area's own error in Richardson's term of :func:`edge_error`. The parabola through the
+last three cells is exact for Hertz's p^2 along a row, so the reconstruction should converge faster than first order
+(the line alone: 1.69, 0.55, 0.14 % off on Hertz's pressure sampled at 16, 32, 64 cells, order 1.6-2.0); but at
+order 2 the estimate fell short of the count's error on that sampled pressure at 24 cells (2.77 % stated, 2.94 %
+true: the reconstruction is not yet asymptotic at 10 cells per semi-axis), so order 1, which bracketed every case
+measured (benchmarks/results/area_edge_error_findings.md)."""
 EDGE_SAFETY = 1.25
 """Factor of safety on :func:`edge_error` (Roache's 1.25 for a grid-convergence index whose order is known): on the
 Hertz closed forms the bare estimate came within 2 % below the true error at 80 and 160 elements (the
@@ -82,9 +89,9 @@ def grid_edge_area(pressure: np.ndarray, contact: np.ndarray, dx: float, dy: flo
 
 
 def edge_error(area: float, edge: float, edge_coarse: float | None, ratio: float = 2.0) -> float:
-    """The estimate e_A = |A - A_edge(h)| + |A_edge(h) - A_edge(r h)| / (r - 1) of the module docstring (absolute;
-    r = 2 the BEM's companion), without ``EDGE_SAFETY``.
+    """The estimate e_A = |A - A_edge(h)| + |A_edge(h) - A_edge(r h)| / (r^p - 1) of the module docstring (absolute;
+    r = 2 the BEM's companion; p ``RECONSTRUCTION_ORDER``), without ``EDGE_SAFETY``.
     """
     if edge_coarse is None:
         return abs(area - edge)
-    return abs(area - edge) + abs(edge - edge_coarse) / (ratio - 1.0)
+    return abs(area - edge) + abs(edge - edge_coarse) / (ratio**RECONSTRUCTION_ORDER - 1.0)
