@@ -670,9 +670,13 @@ def _fea_bem_why(fea_entry: dict, bem_entry: dict) -> str:
             "(fea.postprocess), which flattens the peak on a mesh this coarse; its refinement series states that error."
         )
     if fea_entry.get("status") != "ok":
+        message = fea_entry.get("message", "")
+        start = message.find("discretisation error above")  # by how much, and of what (fea.refinement)
+        said = message[start:] if start >= 0 else message[:240]
         parts.append(
-            f"The FEA ended {fea_entry.get('status')}: {fea_entry.get('message', '')[:240]}; so the agreement holds "
-            "only at its larger stated error, not at its tolerance."
+            f"The FEA ended {fea_entry.get('status')}: {said}; so the agreement holds only at its larger stated error, "
+            "not at its tolerance (mesh: the refinement series; window: the max pressure's fit-window model error; "
+            "block size: the truncated half-space; fea.refinement)."
         )
     return " ".join(parts)
 

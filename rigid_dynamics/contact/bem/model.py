@@ -38,6 +38,7 @@ from rigid_dynamics.contact.bem.influence import InfluenceGrid
 from rigid_dynamics.contact.bem.norm import METHODS as NORM_METHODS
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang, solve_tang_law
+from rigid_dynamics.contact.edge_area import EDGE_SAFETY, edge_error, grid_edge_area
 from rigid_dynamics.contact.options import Option, declare, validate_options
 from rigid_dynamics.contact.options import defaults as option_defaults
 from rigid_dynamics.contact.types import ContactFields, ContactGeometry, ContactResult, Creepage
@@ -654,6 +655,8 @@ class BemModel:
         # pressure need not be elliptic: its area is the element count, as CONTACT's.
         quadric = semi_long is not None and fitted and geometry.undeformed is None
         contact_area = math.pi * semi_long * semi_lat if quadric else contact.sum() * area
+        # the element count's edge within its cells (rigid_dynamics.contact.edge_area): its error estimate
+        edge_area = None if quadric or not contact.any() else grid_edge_area(p, contact, dx, dy)
         success = bool(norm.converged and tang.converged)
         if success:
             status, message = "ok", "NORM and TANG converged"
@@ -693,6 +696,7 @@ class BemModel:
                 "dx_m": float(dx),
                 "dy_m": float(dy),
                 "potential_area_m": [float(x_lim[0]), float(x_lim[1]), float(y_lim[0]), float(y_lim[1])],
+                "contact_area_edge_m2": edge_area,
                 "norm_iterations": int(norm.iterations),
                 "norm_residual": float(norm.residual),
                 "tang_iterations": int(tang.iterations),
@@ -856,7 +860,9 @@ def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
         ``normal_force_N``, ``creep_force_N`` (|(e_x, e_y)| of the two creep-force components),
         ``spin_moment_Nm``, ``max_pressure_Pa``, ``contact_area_m2``; ``relative`` (each against the fine value;
         the creep force against max(|F_t|, 0.01 mu F_N), the scale of ``wheelrail bench``), ``largest_relative``
-        (over :data:`GRID_ERROR_QUANTITIES`) and ``grids`` [[nx, ny], ...]. Each quantity by :func:`_smooth_error`
+        (over :data:`GRID_ERROR_QUANTITIES`) and ``grids`` [[nx, ny], ...]. Each quantity by :func:`_smooth_error`,
+        except the area of a sampled patch (an element count), estimated from where its edge lies within its cells
+        (:mod:`rigid_dynamics.contact.edge_area`; benchmarks/results/area_edge_error.md)
         (measured against Hertz and the converged creep forces of the named cases:
         ``benchmarks/results/bem_grid_error.md``).
     """
@@ -885,6 +891,13 @@ def grid_error_estimate(levels, friction_coefficient: float) -> dict | None:
         "max_pressure_Pa": smooth("max_pressure_Pa"),
         "contact_area_m2": smooth("contact_area_m2"),
     }
+    edge = fine.extra.get("contact_area_edge_m2")
+    if edge is not None:
+        # an element count: the edge's place within its cells (rigid_dynamics.contact.edge_area), not the companions'
+        # differences (the count moves up and down by a fraction of a cell's row as the edge crosses cell centres)
+        absolute["contact_area_m2"] = EDGE_SAFETY * edge_error(
+            fine.contact_area_m2, edge, coarse.extra.get("contact_area_edge_m2"), 2.0
+        )
     creep_scale = max(
         math.hypot(fine.creep_force_long_N or 0.0, fine.creep_force_lat_N or 0.0),
         0.01 * friction_coefficient * fine.normal_force_N,
