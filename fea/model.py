@@ -474,16 +474,20 @@ class FeaModel:
             return None
         write()
         force = memo["normal_force_N"]
+        where = "the same meshes"
+        if mesh != memo["mesh"]:
+            blocks = f"{mesh[1] * 1e3:.4g} mm against the series' {memo['mesh'][1] * 1e3:.4g} mm"
+            where = f"the same patch mesh (block half-width {blocks})"
         info = {
             **memo["info"],
-            "reused": f"series run at this patch's previous solve on the same meshes (force {force:.6g} N)",
+            "reused": f"series run at this patch's previous solve on {where} (force {force:.6g} N)",
         }
         errors = info.get("relative_error", {})
         shown = ", ".join(f"{n} {errors[n]:.2%}" for n in info.get("judged", ()) if errors.get(n) is not None)
         met = "met" if memo["status"] == "ok" else "not met"
         message = (
-            f"{result.message}; discretisation error ({shown}) from the series at force {force:.6g} N on the same "
-            f"meshes, tolerance {info.get('tolerance'):g} {met}"
+            f"{result.message}; discretisation error ({shown}) from the series at force {force:.6g} N on {where}, "
+            f"tolerance {info.get('tolerance'):g} {met}"
         )
         return dataclasses.replace(
             result,

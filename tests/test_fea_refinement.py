@@ -270,7 +270,8 @@ def test_a_load_balanced_patch_reuses_its_series_only_on_the_same_patch_mesh():
     assert "force 10000 N" in reused.extra["discretisation_error"]["reused"]
     assert model._reuse_series(("k", 16.34), level(1.2e4), 0.0) is None
     # the block one rounding step of the larger semi-axis wider (fea.model.MESH_SIZE_STEP), the patch's mesh the same
-    assert model._reuse_series(("k", 16.34), level(1.03e4, block=0.11), 0.0) is not None
+    wider = model._reuse_series(("k", 16.34), level(1.03e4, block=0.11), 0.0)
+    assert "block half-width 110 mm against the series' 100 mm" in wider.extra["discretisation_error"]["reused"]
     assert model._reuse_series(("k", 16.34), level(1.03e4, block=0.1 / 1.1), 0.0) is not None
     assert model._reuse_series(("k", 16.34), level(1.03e4, block=0.1 * 1.1**2), 0.0) is None
     assert model._reuse_series(("k", 16.34), level(1.03e4, size=2e-4), 0.0) is None
