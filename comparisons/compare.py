@@ -570,9 +570,10 @@ def _fea_resolution(result) -> str:
     window = result.extra.get("max_pressure_window") or {}
     if size and box and window.get("max_pressure_Pa") is not None:
         refinement = info["peak_box"]["refinement"]
+        semi = window["semi_axes_m"]
         text += (
             f", {size / refinement * 1e3:.3g} mm in a {2e3 * box[2]:.3g} x {2e3 * box[3]:.3g} mm box at the pressure "
-            f"peak (max pressure fitted over a {window['radius_m'] * 1e3:.3g} mm disc)"
+            f"peak (max pressure fitted over a {2e3 * semi[0]:.3g} x {2e3 * semi[1]:.3g} mm ellipse)"
         )
     return text + (f", {cells} cells" if cells else "")
 

@@ -34,11 +34,14 @@ semi-axes, holding the half-space solution's (the BEM's) >= 0.85 region. Every l
 series then meshes this box (fixed across the levels) ``peak_refinement`` (3) times finer than the patch
 (``meshing.hertz`` ``peak_boxes_m``: the size grows with the same grading away from it), at about 35 % more unknowns
 on that patch. The max pressure is the peak of the quadric cap fitted to p^2 = (N_i / w_i)^2, weighted by w_i, over
-a disc of fixed radius R = ``WINDOW_FRACTION`` (0.6) times the box's smaller half-width (fea.postprocess.window_peak):
-a fixed region, so the value converges with the mesh as the pressure's weighted averages do, to the continuous fit
-whose model error is O(R^4) on a smooth non-quadric top (zero on Hertz's p^2); that model error is estimated from a
-second fit over R / 1.5 centred at the first one's top, |p(R) - p(R/1.5)| / (1 - 1.5^-4), and added to the max
-pressure's Richardson estimate (``discretisation_error.window_relative_error``). Chosen over a fit radius that
+the ellipse of fixed semi-axes R = ``WINDOW_FRACTION`` (0.6) times the box's half-widths (fea.postprocess.window_peak;
+an ellipse of the box's proportions, so that the fit sees the top's fall along a ridge as well as across it: a disc
+of 0.6 times the smaller half-width, 0.36 mm on manchester-a22's 5.2 x 1.2 mm flange box, saw too little of the fall
+along the ridge, and its top fell outside it on some level): a fixed region, so the value converges with the mesh as
+the pressure's weighted averages do, to the continuous fit whose model error is O(R^4) on a smooth non-quadric top
+(zero on Hertz's p^2, at any axes); that model error is estimated from a second fit over R / 1.5 centred at the first
+one's top, |p(R) - p(R/1.5)| / (1 - 1.5^-4), and added to the max pressure's Richardson estimate
+(``discretisation_error.window_relative_error``). Chosen over a fit radius that
 shrinks with h (its bias fell as h^(1/2) on the ridge) and over a fixed-count radius (r = 3-6 local elements: the
 nodal scatter of a few per cent then does not average out, level-to-level changes of 0.5-2 % of either sign), by the
 measured series of benchmarks/results/fea_peak_pressure.md.
@@ -453,7 +456,7 @@ class FeaModel:
 
     def _reuse_series(self, key, solve_level, t0) -> ContactResult | None:
         """A load-balanced solve of a patch whose series ran at a nearby pose: one solve on that series' finest mesh,
-        with its error estimate, when the mesh is the same (the rounded mesh box, :func:`_mesh_box`) and the force
+        with its error estimate, when the mesh at the patch is the same (:func:`_same_patch_mesh`) and the force
         within ``REUSE_FORCE_CHANGE`` of the series' (the wheelset equilibrium's later evaluations: the series costs
         three to four solves, and the relative errors of the max pressure and area at a load a few per cent away are
         the same to their own accuracy). None: run the series.
@@ -463,7 +466,7 @@ class FeaModel:
             return None
         result, write = solve_level(memo["options"])
         mesh = (result.extra.get("element_size_m"), result.extra.get("block_half_width_m"))
-        if result.status != "ok" or mesh != memo["mesh"]:
+        if result.status != "ok" or not _same_patch_mesh(mesh, memo["mesh"]):
             memo["rerun"] = f"mesh changed ({mesh} against {memo['mesh']}) or status {result.status}"
             return None
         if abs(result.normal_force_N / memo["normal_force_N"] - 1.0) > REUSE_FORCE_CHANGE:
@@ -471,16 +474,20 @@ class FeaModel:
             return None
         write()
         force = memo["normal_force_N"]
+        where = "the same meshes"
+        if mesh != memo["mesh"]:
+            blocks = f"{mesh[1] * 1e3:.4g} mm against the series' {memo['mesh'][1] * 1e3:.4g} mm"
+            where = f"the same patch mesh (block half-width {blocks})"
         info = {
             **memo["info"],
-            "reused": f"series run at this patch's previous solve on the same meshes (force {force:.6g} N)",
+            "reused": f"series run at this patch's previous solve on {where} (force {force:.6g} N)",
         }
         errors = info.get("relative_error", {})
         shown = ", ".join(f"{n} {errors[n]:.2%}" for n in info.get("judged", ()) if errors.get(n) is not None)
         met = "met" if memo["status"] == "ok" else "not met"
         message = (
-            f"{result.message}; discretisation error ({shown}) from the series at force {force:.6g} N on the same "
-            f"meshes, tolerance {info.get('tolerance'):g} {met}"
+            f"{result.message}; discretisation error ({shown}) from the series at force {force:.6g} N on {where}, "
+            f"tolerance {info.get('tolerance'):g} {met}"
         )
         return dataclasses.replace(
             result,
@@ -704,8 +711,9 @@ class FeaModel:
         extra["max_nodal_pressure_Pa"] = float((sol.node_force_N[weighted] / sol.node_weight_m2[weighted]).max())
         extra["contact_area_nodal_m2"] = area_nodal
         extra["max_pressure_definition"] = (
-            f"peak of a quadric fitted to the squared nodal pressures N_i / w_i, weighted by w_i, over a disc of fixed "
-            f"radius {window['radius_m'] * 1e3:.3g} mm in the peak box meshed {opts.peak_refinement:g} times finer "
+            f"peak of a quadric fitted to the squared nodal pressures N_i / w_i, weighted by w_i, over a fixed ellipse "
+            f"of semi-axes {window['semi_axes_m'][0] * 1e3:.3g} x {window['semi_axes_m'][1] * 1e3:.3g} mm (0.6 of "
+            f"the peak box's half-widths) in the peak box meshed {opts.peak_refinement:g} times finer "
             "(fea.postprocess.window_peak; fea.model, 'Peak box')"
             if window is not None and window["max_pressure_Pa"] is not None
             else "peak of a quadric fitted to the squared nodal pressures N_i / w_i within "
@@ -806,8 +814,8 @@ class FeaModel:
 
 
 WINDOW_FRACTION = 0.6
-"""The radius of the max-pressure fit in a peak box: this fraction of the box's smaller half-width (module docstring,
-"Peak box")."""
+"""The semi-axes of the max-pressure fit's ellipse in a peak box: this fraction of the box's half-widths (module
+docstring, "Peak box")."""
 WINDOW_RATIO = 1.5
 """The fit's model error is estimated from a second fit over a disc this many times smaller (module docstring)."""
 WINDOW_ORDER = 4.0
@@ -842,6 +850,23 @@ MESH_CENTRE_STEP = 0.25
 """The centre of the refined box is rounded to multiples of this fraction of the smaller rounded semi-axis."""
 
 
+def _same_patch_mesh(mesh, memo_mesh) -> bool:
+    """Whether a solve's mesh (element size at the patch, block half-width) is the one a memorised series' error
+    belongs to (:meth:`FeaModel._reuse_series`): the same element size, and a block of the same size or one rounding
+    step (``MESH_SIZE_STEP``) of the larger semi-axis apart. The block is ``domain_factor`` times the rounded larger
+    semi-axis, and the load-balanced series states its truncation at a fixed load as a term in those semi-axes
+    (fea.refinement, ``LOAD_CONTROL_BLOCK_ERROR``, ten times the measured value), not from the meshes: a block
+    10 % wider with the same patch mesh changes neither. manchester-a22's tread patch crossed that rounding between
+    two evaluations 2.9 % of load apart (block half-width 59.7 against 65.7 mm, element size equal) and its series
+    (two locating solves, three levels) ran again: 374 of the run's 1012 s.
+    """
+    size, block = mesh
+    memo_size, memo_block = memo_mesh
+    if size is None or block is None or memo_size is None or memo_block is None or size != memo_size:
+        return False
+    return abs(math.log(block / memo_block)) <= math.log(MESH_SIZE_STEP) * (1.0 + 1e-9)
+
+
 def _mesh_box(semi, center):
     """The expected patch (semi-axes, centre) that sizes and places the mesh, rounded to a grid.
 
@@ -859,27 +884,35 @@ def _mesh_box(semi, center):
 
 def _window_peak(spec, xy, force, weight, usable, h_local, post) -> dict:
     """The max pressure of a patch with a peak box (module docstring, "Peak box"): the weighted quadric-cap fit over
-    a disc of radius ``WINDOW_FRACTION`` times the box's smaller half-width (fixed across the refinement series),
+    the ellipse of semi-axes ``WINDOW_FRACTION`` times the box's half-widths (fixed across the refinement series),
     first centred at the largest patch average within the box (radius 1.5 local element sizes), and its model error
-    |p(R) - p(R / WINDOW_RATIO)| / (1 - WINDOW_RATIO^-WINDOW_ORDER) relative to p(R), the second fit centred at the
-    first one's top. Values None where a fit failed (fewer than 12 nodes, no cap, top outside its disc).
+    |p(R) - p(R / WINDOW_RATIO)| / (1 - WINDOW_RATIO^-WINDOW_ORDER) relative to p(R), the second fit over the
+    ellipse WINDOW_RATIO times smaller centred at the first one's top. Values None where a fit failed (fewer than 12
+    nodes, no cap, top outside its window).
+
+    The window follows the box's shape, not only its smaller half-width: the box bounds the level set p >=
+    ``PEAK_LEVEL`` p_max, so an ellipse of its proportions sees the same fraction of the top's fall in both
+    directions. A disc of 0.6 times the smaller half-width did not: on manchester-a22's flange patch (box 5.2 x
+    1.2 mm, a ridge along x) the 0.36 mm disc saw p^2 curve 600 times less along the ridge than across it, the
+    scatter of the nodal values set that curvature's sign and size, and the fitted top fell outside the disc (20
+    radii away) on one level or another, so the series had no max-pressure error at all.
     """
     xc, yc, a, b, _ = spec.peak_boxes_m[0]
-    radius = WINDOW_FRACTION * min(a, b)
-    out = {"radius_m": radius, "max_pressure_Pa": None, "small_disc_Pa": None, "relative_error": None}
+    semi = (WINDOW_FRACTION * a, WINDOW_FRACTION * b)
+    out = {"semi_axes_m": list(semi), "max_pressure_Pa": None, "small_window_Pa": None, "relative_error": None}
     inside = usable & (np.abs(xy[:, 0] - xc) <= a) & (np.abs(xy[:, 1] - yc) <= b)
     if not inside.any():
         return out
     pts, f, w = xy[usable], force[usable], weight[usable]
     average = post.filtered_pressure(pts, f, w, xy[inside], 1.5 * h_local)
-    big = post.window_peak(pts, f, w, xy[inside][int(np.argmax(average))], radius)
+    big = post.window_peak(pts, f, w, xy[inside][int(np.argmax(average))], semi)
     if big is None:
         return out
     out["max_pressure_Pa"] = big[0]
     out["top_m"] = big[1].tolist()
-    small = post.window_peak(pts, f, w, big[1], radius / WINDOW_RATIO)
+    small = post.window_peak(pts, f, w, big[1], (semi[0] / WINDOW_RATIO, semi[1] / WINDOW_RATIO))
     if small is not None:
-        out["small_disc_Pa"] = small[0]
+        out["small_window_Pa"] = small[0]
         out["relative_error"] = abs(big[0] - small[0]) / (1.0 - WINDOW_RATIO**-WINDOW_ORDER) / big[0]
     return out
 

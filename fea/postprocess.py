@@ -243,29 +243,32 @@ def _cap_top(scaled_xy: np.ndarray, pressure: np.ndarray, weight: np.ndarray | N
 
 
 def window_peak(
-    xy: np.ndarray, force: np.ndarray, weight: np.ndarray, centre_m: np.ndarray, radius_m: float
+    xy: np.ndarray, force: np.ndarray, weight: np.ndarray, centre_m: np.ndarray, window_m
 ) -> tuple[float, np.ndarray] | None:
-    """Peak of the quadric cap fitted to p^2 over a disc of fixed physical radius, weighted by the nodes' areas.
+    """Peak of the quadric cap fitted to p^2 over a window of fixed physical size, weighted by the nodes' areas.
 
-    p_i = N_i / w_i of the nodes within ``radius_m`` of ``centre_m``; p^2 = c0 + c1 x + c2 y + c3 x^2 + c4 x y +
-    c5 y^2 by least squares with weights w_i (the discrete form of the continuous L2 fit over the disc, so the
+    p_i = N_i / w_i of the nodes within the window around ``centre_m``; p^2 = c0 + c1 x + c2 y + c3 x^2 + c4 x y +
+    c5 y^2 by least squares with weights w_i (the discrete form of the continuous L2 fit over the window, so the
     fitted value converges with the mesh as the integrals of the pressure do, and the nodes of small area, whose
     N_i / w_i scatter most, count as little as their area). Against :func:`peak_pressure` (a radius shrinking with
     the mesh): the value converges at the order of the pressure's weighted averages to the continuous fit over the
-    disc, whose own (model) error on a non-quadric top is O(radius^4) and is estimated by the caller from a second
-    radius (fea.model, "Peak box").
+    window, whose own (model) error on a non-quadric top is O(size^4) and is estimated by the caller from a second
+    window (fea.model, "Peak box"). The quadric family is closed under the axes' scaling, so an ellipse fits Hertz's
+    p^2 (a quadric, Johnson 1985 eq 3.63) as exactly as a disc.
 
     Args:
         xy: (n, 2) node positions in contact, m. force, weight: (n,) N_i (N) and w_i > 0 (m^2).
-        centre_m: (2,) first centre (the largest patch average), m. radius_m: the disc's radius, m.
+        centre_m: (2,) first centre (the largest patch average), m.
+        window_m: the disc's radius (a number), or the ellipse's semi-axes along x and y (a pair), m.
 
     Returns:
         (peak pressure in Pa, the fitted top in m), or None (fewer than 12 nodes, not a cap, top outside).
     """
     centre = np.asarray(centre_m, float)
-    d = xy - centre
-    near = np.hypot(d[:, 0], d[:, 1]) <= radius_m
+    semi = np.broadcast_to(np.asarray(window_m, float), (2,))
+    scaled = (xy - centre) / semi
+    near = np.hypot(scaled[:, 0], scaled[:, 1]) <= 1.0
     if near.sum() < 12:
         return None
-    fit = _cap_top(d[near] / radius_m, force[near] / weight[near], weight[near])
-    return None if fit is None else (fit[0], centre + fit[1] * radius_m)
+    fit = _cap_top(scaled[near], force[near] / weight[near], weight[near])
+    return None if fit is None else (fit[0], centre + fit[1] * semi)

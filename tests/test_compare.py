@@ -140,7 +140,7 @@ def test_pressure_maps_zoom_to_the_patch_with_equal_or_stated_aspect(tmp_path):
 
 def test_the_fea_entry_names_its_peak_box_and_the_parts_of_its_stated_error():
     """Regression test of the report's FEA entry (comparisons.compare): the resolution names the peak box's element
-    size and fit disc, and the error parts (mesh, block size, window) and the levels come from the series' record."""
+    size and fit ellipse, and the error parts (mesh, block size, window) and the levels come from the series' record."""
     from comparisons.compare import _fea_error_parts, _fea_resolution
     from rigid_dynamics.contact.types import ContactResult, Creepage
 
@@ -153,12 +153,12 @@ def test_the_fea_entry_names_its_peak_box_and_the_parts_of_its_stated_error():
         "window_relative_error": {"max_pressure": 0.003},
     }  # fmt: skip
     extra = {"element_size_m": 4.74e-4, "discretisation_error": info,
-             "max_pressure_window": {"radius_m": 1.21e-3, "max_pressure_Pa": 9.67e8}}  # fmt: skip
+             "max_pressure_window": {"semi_axes_m": [1.8e-3, 1.2e-3], "max_pressure_Pa": 9.67e8}}  # fmt: skip
     result = ContactResult(method="fea", success=True, status="ok", message="", normal_force_N=1e5,
                            max_pressure_Pa=9.67e8, contact_area_m2=1.87e-4, approach_m=1e-4, creepage=Creepage(),
                            extra=extra)  # fmt: skip
     text = _fea_resolution(result)
-    assert "0.474 mm at the patch" in text and "0.158 mm in a 6 x 4 mm box" in text and "1.21 mm disc" in text
+    assert "0.474 mm at the patch" in text and "0.158 mm in a 6 x 4 mm box" in text and "3.6 x 2.4 mm ellipse" in text
     parts = _fea_error_parts(result)
     assert parts["parts"]["max_pressure"] == {"mesh": 0.013, "block_size": 0.005, "window": 0.003,
                                               "observed_order": None}  # fmt: skip
