@@ -85,8 +85,9 @@ the BEM's pose (N_f 10484 N; 2.67, 4, 6 elements per semi-axis, the two coarser 
 N_f are 15.53, 15.85, 16.00 mm2 and 1653.6, 1606.7, 1576.6 MPa, stated 2.92 % and 4.56 % (mesh 3.81 %); Hertz's
 scaling had made them 15.86, 16.20, 16.00 mm2 (an oscillation) and 1629.8, 1597.3, 1576.6 MPa, stating 3.11 % and
 3.37 %. The two coarser levels' solves at their own and at N_f give the exponents 0.216 / 0.215 (p) and 0.84 / 1.12
-(area). Cost: the levels solved before the finest are solved once more (one coarse level for a first estimate of two
-levels, a load-control solve costs what an approach-control one does: one factorisation per active-set iteration).
+(area). Cost: a load-control solve costs what an approach-control one does (one factorisation per active-set iteration);
+a level coarser than a new finest level is solved once more at its force (one coarse solve for a first estimate of two
+levels; the flange root's two coarser levels, put before the first, none).
 Measuring the exponents on the coarsest mesh instead (one more solve there at another approach) was tried and left:
 the max pressure's came out right (0.215-0.226 on the flange root, 0.31-0.34 on the Hertz quadric), but the area's
 moves by whole boundary nodes on that mesh (0.71 to 1.41 on the flange root for 14 to 38 % less force, against the
