@@ -348,6 +348,7 @@ class FeaModel:
             block_estimate=opts.formulation != "profiles",
             t0=t0,
             measure_order=geometry.undeformed is not None,
+            finest_force=True,
         )
         info = result.extra.get("discretisation_error") or {}
         if use_peak_box:
@@ -381,18 +382,21 @@ class FeaModel:
 
     def level_solver(self, patch: tuple, comm=None, t0: float | None = None):
         """(solve_level, peak) for one patch = (geometry, creepage, material, normal force or None): solve_level(level
-        options) solves one refinement level (``_solve_level``) with the peak box ``peak["box"]`` (None: none yet) and
-        keeps that level's peak nodes in ``peak["nodes"]`` (for :meth:`_locate_peak`); the series, the peak locator,
-        the tests and the benchmarks share it.
+        options, force_N=None) solves one refinement level (``_solve_level``) with the peak box ``peak["box"]``
+        (None: none yet) and keeps that level's peak nodes in ``peak["nodes"]`` (for :meth:`_locate_peak`); the
+        series, the peak locator, the tests and the benchmarks share it. ``force_N`` (a patch under approach control)
+        solves that level under load control at this force, on the mesh the approach sizes (a load-balanced series'
+        coarser levels at its finest level's force, fea.refinement "Load-balanced use").
         """
         geometry, creepage, material, normal_force_N = patch
         t0 = time.perf_counter() if t0 is None else t0
         peak: dict = {"box": None}
 
-        def solve_level(level_opts):
+        def solve_level(level_opts, force_N=None):
             result, write = self._solve_level(
-                geometry, creepage, material, normal_force_N, level_opts, comm, t0, peak_box=peak["box"]
-            )
+                geometry, creepage, material, normal_force_N, level_opts, comm, t0, peak_box=peak["box"],
+                force_N=force_N,
+            )  # fmt: skip
             peak["nodes"] = result.extra.pop("peak_nodes_m", None)
             return result, write
 
@@ -497,9 +501,11 @@ class FeaModel:
             extra={**result.extra, "discretisation_error": info},
         )
 
-    def _solve_level(self, geometry, creepage, material, normal_force_N, opts, comm, t0, peak_box=None):
+    def _solve_level(self, geometry, creepage, material, normal_force_N, opts, comm, t0, peak_box=None, force_N=None):
         """One solve on the mesh of ``opts``: (ContactResult with status "ok" or a failure, write()), ``write()``
-        writing the VTU grid and the PNGs of this level when ``opts.output_dir`` is set.
+        writing the VTU grid and the PNGs of this level when ``opts.output_dir`` is set. ``force_N`` (with
+        ``normal_force_N`` None): load control at this force on the mesh sized by ``geometry.approach_m`` (the
+        solver starts from that approach).
         """
         import dolfinx_solver  # noqa: F401  (must precede dolfinx/petsc4py/mpi4py)
         from mpi4py import MPI
@@ -512,6 +518,9 @@ class FeaModel:
         from meshing.quality import QualityLimits
 
         comm = MPI.COMM_WORLD if comm is None else comm
+        if force_N is not None and normal_force_N is not None:
+            raise ValueError("force_N: expected a patch under approach control (normal_force_N None)")
+        solver_force = normal_force_N if force_N is None else force_N
         e_star = material.combined_modulus_Pa
         nu = material.poisson_ratio
         a_curv, b_curv = geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m
@@ -608,8 +617,8 @@ class FeaModel:
                 domain,
                 young_body,
                 nu,
-                normal_force_N=normal_force_N,
-                approach_m=None if normal_force_N is not None else geometry.approach_m,
+                normal_force_N=solver_force,
+                approach_m=None if solver_force is not None else geometry.approach_m,
                 initial_approach_m=q0,
                 contact_size_m=spec.contact_size_m,
                 settings=settings,
@@ -631,8 +640,8 @@ class FeaModel:
                 gap0,
                 young_body,
                 nu,
-                normal_force_N=normal_force_N,
-                approach_m=None if normal_force_N is not None else geometry.approach_m,
+                normal_force_N=solver_force,
+                approach_m=None if solver_force is not None else geometry.approach_m,
                 initial_approach_m=q0,
                 initial_active=initial_active if quadric else None,
                 length_scale_m=min(semi),
