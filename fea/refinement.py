@@ -367,6 +367,15 @@ def _add_window_error(info: dict, window: dict | None, records: list[dict] = ())
     info["relative_error"]["max_pressure"] = None if error is None or mesh is None else mesh + error
 
 
+def _level_options(opts, elements_per_semi_axis: float, grading: float):
+    """The options of one level of the series: ``opts`` at this element count per semi-axis and grading (the
+    series sets the mesh by these, not by ``mesh_size_factor``).
+    """
+    return dataclasses.replace(
+        opts, elements_per_semi_axis=elements_per_semi_axis, mesh_size_factor=1.0, grading=grading
+    )
+
+
 def _insert_coarser(solve_level, opts, levels: list, records: list, info: dict, count: int, force=None) -> None:
     """Solve up to ``count`` levels coarser than the first (``n0 / r``, ``n0 / r^2``, ...; at least
     ``ORDER_LEVEL_MIN_N`` elements per semi-axis) and put them before it, marked ``order_level``; a level that
@@ -378,7 +387,7 @@ def _insert_coarser(solve_level, opts, levels: list, records: list, info: dict, 
         n = n0 / ratio**j
         if n < ORDER_LEVEL_MIN_N:
             return
-        level_opts = dataclasses.replace(opts, elements_per_semi_axis=n, mesh_size_factor=1.0, grading=g0 * ratio**j)
+        level_opts = _level_options(opts, n, g0 * ratio**j)
         t_level = time.perf_counter()
         coarse, _ = solve_level(level_opts) if force is None else solve_level(level_opts, force_N=force)
         if coarse.status != "ok":
@@ -410,8 +419,7 @@ def _at_finest_force(solve_level, opts, levels: list, records: list, info: dict)
         if levels[j].get(FORCE_KEY) == force:
             continue
         record = records[j]
-        level_opts = dataclasses.replace(opts, elements_per_semi_axis=record["elements_per_semi_axis"],
-                                         mesh_size_factor=1.0, grading=record["grading"])  # fmt: skip
+        level_opts = _level_options(opts, record["elements_per_semi_axis"], record["grading"])
         t_level = time.perf_counter()
         result, _ = solve_level(level_opts, force_N=force)
         if result.status != "ok":  # this level and the coarser ones leave the series (its levels stay consecutive)
@@ -483,7 +491,7 @@ def solve_to_tolerance(
     k = 0
     while True:
         n, g = n0 * ratio**k, g0 / ratio**k
-        level_opts = dataclasses.replace(opts, elements_per_semi_axis=n, mesh_size_factor=1.0, grading=g)
+        level_opts = _level_options(opts, n, g)
         t_level = time.perf_counter()
         result, write = solve_level(level_opts)
         if result.status != "ok":
