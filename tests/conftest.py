@@ -1,7 +1,16 @@
+import os
 import sys
 from pathlib import Path
 
-import pytest
+# One BLAS/OpenMP thread per test process, set before anything imports numpy (pytest loads this file first; the CLI
+# tests' subprocesses inherit it). `make test` runs two xdist workers on two cores: with OpenBLAS's default of one
+# thread per core, four threads share two cores and OpenBLAS's waiting threads spin. Measured on the 2-core machine
+# at load ~3: a 198 x 198 complex `numpy.linalg.solve` 18 ms with two threads against 1.7 ms with one, and
+# test_dynamics_beam.py's Timoshenko receptance test 233 s against 3.7 s (benchmarks/results/suite_time.md).
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
