@@ -376,7 +376,8 @@ def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray
        settling distance against ``force_tolerance`` (drivers.force_error_check, "warning" above it);
     2. RK4 from a consistent start (``probe``: a callable giving the model whose Jacobian is linearised; None when
        the start was not consistent): the step against RK4's stability limit at the start, or at the recorded state
-       of the largest contact force when the run failed within the start's limit (:func:`_limit_at_largest_force`);
+       of the largest contact force when the run failed, or ended above ``force_tolerance`` in step 1, within the
+       start's limit (:func:`_limit_at_largest_force`);
        a numerical-looking failure beyond the limit becomes "step-unstable" (stability.judge_fixed_step);
     3. a run with a force error estimate in which a wheel lifted after the settling distance: the run again at half
        the step or a tenth of the tolerances (:func:`_half_step_check`);
@@ -402,8 +403,11 @@ def judge_step(result: SimulationResult, rerun: _Rerun, probe, full0: np.ndarray
             limit = None
         diverged = checked and bool(np.any(np.nan_to_num(result.force_error_estimate, nan=0.0) > STEP_ERROR_DIVERGED))
         failed = status in NUMERICAL_LOOKING or diverged
-        if limit is not None and failed and not settings.fixed_step_s > limit.max_step_s:
-            limit = _limit_at_largest_force(model, result, limit)
+        # a run that reached its end with its force error above force_tolerance may owe it to the step's stability
+        # at its largest force, as a failed one does: it stays "warning", with that limit in its message
+        inaccurate = checked and status == "warning" and result.status == "ok"
+        if limit is not None and (failed or inaccurate) and not settings.fixed_step_s > limit.max_step_s:
+            limit = _limit_at_largest_force(model, result, limit, failed)
         if limit is not None:
             status, message = judge_fixed_step(status, message, settings.fixed_step_s, limit, diverged)
     if (status, message) != (result.status, result.message):
@@ -459,7 +463,7 @@ def _adhesion(scene, t, patches) -> list[tuple]:
     return adhesion_events(t, patches)
 
 
-def _limit_at_largest_force(model, result: SimulationResult, start_limit):
+def _limit_at_largest_force(model, result: SimulationResult, start_limit, failed: bool = True):
     """RK4's stability limit at the recorded state of the largest contact force, if smaller than ``start_limit``.
 
     A fixed-step run that failed (blow-up, force anomaly, derailment, solver failure) with a step within the limit
@@ -467,7 +471,10 @@ def _limit_at_largest_force(model, result: SimulationResult, start_limit):
     the static load the contact mode is k^(1/6) faster and the limit that much smaller (wheel-flat on the elastic
     track at 0.5 ms: within the start's 0.568 ms, derailed after its first impact; step_sensitivity.md). The state
     of the largest normal force recorded before the failure is a state the run visited; beyond the limit there the
-    failure is the integrator's too. Returns ``start_limit`` when that limit is not smaller or cannot be computed.
+    failure is the integrator's too. A run that reached its end with its force error above ``force_tolerance``
+    (``failed`` False) is judged at the same state: the same run at the default ``max_force_factor`` ends with an
+    estimate of 1.38 static loads, its step 2 x the limit at its largest force. Returns ``start_limit`` when that
+    limit is not smaller or cannot be computed.
     """
     t, states, patches = result.t, result.states, result.patches
     work_contact, work_exterior, track_states = result.work_contact_J, result.work_exterior_J, result.track_full_states
@@ -486,7 +493,8 @@ def _limit_at_largest_force(model, result: SimulationResult, start_limit):
         return start_limit
     if not limit.max_step_s < start_limit.max_step_s:
         return start_limit
-    where = f"at t = {t[k]:.6g} s, the largest contact force ({normal[k]:.4g} N) before the failure"
+    where = f"at t = {t[k]:.6g} s, the largest contact force ({normal[k]:.4g} N)"
+    where += " before the failure" if failed else ""
     return replace(limit, where=where)
 
 
