@@ -46,18 +46,6 @@ shrinks with h (its bias fell as h^(1/2) on the ridge) and over a fixed-count ra
 nodal scatter of a few per cent then does not average out, level-to-level changes of 0.5-2 % of either sign), by the
 measured series of benchmarks/results/fea_peak_pressure.md.
 
-Load-balanced degree (the wheelset equilibrium's full solves, :meth:`FeaModel.load_balanced_options`). Unless
-``degree`` is given, the rigid formulation's load-balanced series is P2 from ``LOAD_BALANCED_ELEMENTS_PER_SEMI_AXIS``
-(2.67) elements per semi-axis; the coarse phase (:meth:`FeaModel.coarse_options`) stays P1. On manchester-a22's
-flange-root patch (a strip 1.4 mm wide, peak box 5.2 x 1.2 mm) at CONTACT's force, 9619 N, on the BEM equilibrium's
-gap, P1's max pressure went 1619.2, 1576.7, 1547.1 MPa and its area 14.24, 13.93, 14.72 mm2 at 9.5e3, 2.8e4, 8.6e4
-unknowns (2.67, 4, 6 elements per semi-axis; order 0.9: about 1e6 unknowns for 2 %), P2's 1520.1, 1522.1, 1521.1 MPa
-and 15.20, 15.16, 15.33 mm2 at 3.0e4, 7.1e4, 2.2e5 (1.78, 2.67, 4), against our BEM's converged 1521.2 MPa and
-15.05 mm2 (edge reconstruction; 15.14 by element count at 0.025 mm) on the same gap and force
-(benchmarks/results/fea_flange_root_p2.md). The P2 pressure's top is resolved where P1's nodal pressures are not
-(the strip's 2-5 P1 elements across its half-width); its area, a sum of the active nodes' lumped areas, is still a
-first-order quantity (+0.7 to +1.8 % from the BEM's).
-
 Frame: contact frame of the patch (x rolling, y lateral, z normal rail -> wheel); the block stands
 for the body below the contact plane, the pressure acts on the wheel along +z. Units SI.
 
@@ -292,16 +280,10 @@ class FeaModel:
     @staticmethod
     def load_balanced_options(options: Mapping | None) -> dict:
         """Options of the solves of an iteration that balances a load with this model's force under approach control
-        (the wheelset equilibrium's full solves): ``load_balanced`` True (fea.refinement, load-balanced use), and for
-        the rigid formulation, unless ``degree`` is given, P2 from ``LOAD_BALANCED_ELEMENTS_PER_SEMI_AXIS`` elements
-        per semi-axis (module docstring, "Load-balanced degree"; the coarse phase, :meth:`coarse_options`, stays P1).
+        (the wheelset equilibrium's full solves): ``load_balanced`` True (fea.refinement, load-balanced use).
         """
-        opts = FeaOptions.from_mapping(options)
-        out = {**(options or {}), "load_balanced": True}
-        if opts.formulation == "rigid" and "degree" not in out:  # module docstring, "Load-balanced degree"
-            out["degree"] = LOAD_BALANCED_DEGREE
-            out.setdefault("elements_per_semi_axis", LOAD_BALANCED_ELEMENTS_PER_SEMI_AXIS)
-        return out
+        FeaOptions.from_mapping(options)
+        return {**(options or {}), "load_balanced": True}
 
     @staticmethod
     def check_options(options: Mapping | None) -> None:
@@ -432,7 +414,7 @@ class FeaModel:
         """
         from fea.refinement import REFINEMENT_RATIO
 
-        n = max(opts.n_per_semi_axis / REFINEMENT_RATIO, 2.0 / opts.degree)  # P2: nodes at mid-edge
+        n = max(opts.n_per_semi_axis / REFINEMENT_RATIO, 2.0)
         level = dataclasses.replace(
             opts, elements_per_semi_axis=n, mesh_size_factor=1.0, grading=opts.grading * REFINEMENT_RATIO,
             stresses=False, mesh_tolerance=None, output_dir=None,
@@ -850,13 +832,6 @@ WINDOW_ORDER = 4.0
 PEAK_LEVEL = 0.85
 """The peak box holds the locating solve's nodes whose patch-averaged pressure is at least this fraction of the
 largest (module docstring, "Peak box")."""
-LOAD_BALANCED_DEGREE = 2
-"""Displacement degree of a load-balanced series (the wheelset equilibrium's full solves) when ``degree`` is not given
-(module docstring, "Load-balanced degree")."""
-LOAD_BALANCED_ELEMENTS_PER_SEMI_AXIS = 6.0 / 1.5**2
-"""First level of a load-balanced P2 series when ``elements_per_semi_axis`` is not given: the P1 ladder 6 r^k at k = -2
-(2.67; with the peak box about 7e4 unknowns on the A-2.2 flange root, so the series solves 1.78 and 1.19 before it,
-fea.refinement ``FIRST_LEVEL_BUDGET_COARSER``)."""
 REUSE_ANGLE_DEG = 1.0
 """A load-balanced solve reuses the series of the same side's patch whose contact angle is within this, degrees."""
 REUSE_FORCE_CHANGE = 0.1

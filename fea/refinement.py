@@ -169,8 +169,7 @@ measured on the Hertz case (module docstring); scaled by (20 / D)^2. Used under 
 and by a load-balanced series for both (module docstring)."""
 ORDER_LEVEL_MIN_N = 2.0
 """With ``measure_order``, the level one coarser than the first is solved when it has at least this many elements per
-semi-axis (module docstring, "Measured order"), divided by the displacement degree (P2 puts a node at mid-edge: its
-n elements have the 2 n node intervals of P1's 2 n)."""
+semi-axis (module docstring, "Measured order")."""
 FIRST_LEVEL_BUDGET_COARSER = 2
 """When the first level is already the finest ``max_dofs`` affords (a narrow patch: a22-flange's first level has
 1.7e5 unknowns), this many coarser levels are solved before it so that it is still estimated (at the observed order
@@ -386,7 +385,7 @@ def _insert_coarser(solve_level, opts, levels: list, records: list, info: dict, 
     n0, g0, ratio = opts.n_per_semi_axis, opts.grading, REFINEMENT_RATIO
     for j in range(1, count + 1):
         n = n0 / ratio**j
-        if n < ORDER_LEVEL_MIN_N / opts.degree:
+        if n < ORDER_LEVEL_MIN_N:
             return
         level_opts = _level_options(opts, n, g0 * ratio**j)
         t_level = time.perf_counter()
@@ -510,7 +509,7 @@ def solve_to_tolerance(
                 block = _quantities(wide_result)
                 info["block_size_check"] = {"domain_factor": 2.0 * opts.block_factor, **block}
         common = levels[-1]["normal_force"] if balanced and finest_force else None
-        if k == 1 and measure_order and n0 / ratio >= ORDER_LEVEL_MIN_N / opts.degree:
+        if k == 1 and measure_order and n0 / ratio >= ORDER_LEVEL_MIN_N:
             _insert_coarser(solve_level, opts, levels, records, info, 1, common)
         dofs = records[-1]["dofs"]
         growth = dofs / records[-2]["dofs"] if len(records) >= 2 and records[-2]["dofs"] > 0 else ratio**3
