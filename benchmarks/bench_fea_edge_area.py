@@ -8,7 +8,8 @@ control at 1e5 N, E 210 GPa, nu 0.3): per level, the nodal area (sum of the acti
 Usage::
 
     nice .venv/bin/python benchmarks/bench_fea_edge_area.py run CASE DEGREE N [N ...]   # appends to the raw jsonl
-    nice .venv/bin/python benchmarks/bench_fea_edge_area.py --report                  # writes md / json
+    nice .venv/bin/python benchmarks/bench_fea_edge_area.py --report     # fea_edge_area_runs.md / .json
+    nice .venv/bin/python benchmarks/bench_fea_edge_area.py flange-root 2 1.778 2.667   # A-2.2 flange root
 
 CASE: circle (R 0.3 / 0.3 m) or ellipse (R 0.46 / 0.15 m, the tests' quadric).
 """
@@ -125,7 +126,7 @@ def flange_root(degree: int, levels: list[float]) -> None:
 
 def _order(errors, ratio):
     out = []
-    for e0, e1 in zip(errors, errors[1:]):
+    for e0, e1 in zip(errors, errors[1:], strict=False):
         out.append(math.log(abs(e0) / abs(e1)) / math.log(ratio) if e0 and e1 else None)
     return out
 
@@ -176,9 +177,11 @@ def report() -> None:
             )
         lines.append("")
         summary[f"{case}-P{degree}"] = rows
-    (OUT / "fea_edge_area.json").write_text(json.dumps(summary, indent=1) + "\n")
-    md = OUT / "fea_edge_area.md"
-    notes = md.read_text().split("<!-- findings -->", 1)[1] if md.exists() and "<!-- findings -->" in md.read_text() else ""
+    (OUT / "fea_edge_area_runs.json").write_text(json.dumps(summary, indent=1) + "\n")
+    md = OUT / "fea_edge_area_runs.md"
+    notes = (
+        md.read_text().split("<!-- findings -->", 1)[1] if md.exists() and "<!-- findings -->" in md.read_text() else ""
+    )
     md.write_text("\n".join(lines) + "\n<!-- findings -->" + notes)
 
 

@@ -298,6 +298,7 @@ def edge_reconstructed_area(
     samples_per_element: int = 8,
     skip: float = 2.0,
     points: int = 2,
+    weight_m2: np.ndarray | None = None,
 ) -> dict:
     """Contact area inside the edge reconstructed from the deformed separation of the free face nodes (issue 22).
 
@@ -321,36 +322,84 @@ def edge_reconstructed_area(
         xy: (n, 2) face node positions of the full patch (mirrored for a quarter model), m.
         gap_m: (n,) deformed separation d_i, m (<= 0 or any value at the active nodes).
         active: (n,) bool, nodes in contact.
+        weight_m2: (n,) lumped face weights, m^2 (optional): a region whose rays fail (fewer than 3 nodes, or a ray
+            finds no all-active triangle before a free one: a region thinner than the triangles) then counts its
+            nodal area instead (``nodal_fallback_m2``); without weights such a region makes the result nan.
 
     Returns:
         dict: area_m2 (nan when it fails), rays_clamped (fraction of rays whose zero fell outside the mixed
         triangles), rays_fallback (fraction with no usable pair of samples: edge put midway through the mixed
         triangles), element_size_m (the median length of the face-mesh edges that cross the contact edge).
     """
-    from scipy.spatial import Delaunay
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import Delaunay, QhullError
 
     nan = float("nan")
-    fail = {"area_m2": nan, "rays_clamped": nan, "rays_fallback": nan, "element_size_m": nan}
+    fail = {"area_m2": nan, "rays_clamped": nan, "rays_fallback": nan, "element_size_m": nan, "regions": 0}
     xy = np.asarray(xy, float)
     active = np.asarray(active, bool)
+    gap = np.asarray(gap_m, float)
     scale = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-300)
     keys = np.round(xy / (scale * 1e-9)).astype(np.int64)
     _, first = np.unique(keys, axis=0, return_index=True)
-    xy, active = xy[first], active[first]
-    f = np.where(active, 0.0, np.clip(np.asarray(gap_m, float)[first], 0.0, None) ** (2.0 / 3.0))
+    xy, active, gap = xy[first], active[first], gap[first]
+    weight = None if weight_m2 is None else np.asarray(weight_m2, float)[first]
+    # a free node with d = 0 has no gap value (fea.solver: outside the sampled gap): unknown, not in contact
+    f = np.where(active, 0.0, np.where(gap > 0, np.clip(gap, 0.0, None), np.nan) ** (2.0 / 3.0))
     if active.sum() < 3 or (~active).sum() < 3:
         return fail
-    centre = xy[active].mean(axis=0)
-    reach = float(np.hypot(*(xy[active] - centre).T).max())
-    tri = Delaunay(xy)
+    try:
+        tri = Delaunay(xy)
+    except QhullError:
+        return fail
     simplices = tri.simplices
-    act_v = active[simplices]
-    # face-mesh (Delaunay) edges that join an active and a free node: the element size at the edge
     pairs = np.concatenate([simplices[:, [0, 1]], simplices[:, [1, 2]], simplices[:, [2, 0]]])
     crossing = active[pairs[:, 0]] != active[pairs[:, 1]]
     if not crossing.any():
         return fail
+    # face-mesh (Delaunay) edges that join an active and a free node: the node spacing at the edge
     h = float(np.median(np.hypot(*(xy[pairs[crossing, 0]] - xy[pairs[crossing, 1]]).T)))
+    # separate contact regions (connected through active-active edges) get their own rays
+    both = active[pairs[:, 0]] & active[pairs[:, 1]]
+    graph = coo_matrix((np.ones(both.sum()), (pairs[both, 0], pairs[both, 1])), shape=(len(xy), len(xy)))
+    _, label = connected_components(graph, directed=False)
+    total, clamped, fallback, rays, regions, nodal = 0.0, 0.0, 0.0, 0, 0, 0.0
+    for lab in np.unique(label[active]):
+        member = active & (label == lab)
+        out = None
+        if member.sum() >= 3:
+            out = _ray_edge_area(tri, f, active, xy[member], h, n_rays, samples_per_element, skip, points)
+        if out is None:
+            if weight is None:
+                return {**fail, "element_size_m": h}
+            nodal += float(weight[member].sum())
+            continue
+        total += out[0]
+        clamped += out[1] * n_rays
+        fallback += out[2] * n_rays
+        rays += n_rays
+        regions += 1
+    if rays == 0:
+        return {**fail, "element_size_m": h}
+    return {
+        "area_m2": total + nodal,
+        "rays_clamped": clamped / rays,
+        "rays_fallback": fallback / rays,
+        "element_size_m": h,
+        "regions": regions,
+        "nodal_fallback_m2": nodal,
+    }
+
+
+def _ray_edge_area(tri, f, active, region_xy, h, n_rays, samples_per_element, skip, points):
+    """(area, clamped fraction, fallback fraction) of one contact region by the rays of
+    :func:`edge_reconstructed_area` from its centroid, or None (a ray finds no free triangle).
+    """
+    simplices = tri.simplices
+    act_v = active[simplices]
+    centre = region_xy.mean(axis=0)
+    reach = float(np.hypot(*(region_xy - centre).T).max())
     step = h / samples_per_element
     s = np.arange(0.0, reach + 4.0 * h, step)
     theta = (np.arange(n_rays) + 0.5) * (2.0 * np.pi / n_rays)
@@ -369,11 +418,11 @@ def edge_reconstructed_area(
     all_active = np.where(simplex >= 0, act_v[np.maximum(simplex, 0)].all(axis=1), False).reshape(n_rays, -1)
     all_free = np.where(simplex >= 0, ~act_v[np.maximum(simplex, 0)].any(axis=1), False).reshape(n_rays, -1)
     idx = np.arange(len(s))
-    # the first free point beyond the last all-active one
-    last_active = np.where(all_active, idx[None, :], -1).max(axis=1)
-    after = all_free & (idx[None, :] > last_active[:, None])
-    has_free = after.any(axis=1) & (last_active >= 0)
-    first_free = np.where(has_free, np.argmax(after, axis=1), 0)
+    # the first free point along the ray and the last all-active one before it (another region further out along
+    # the ray is not this one's)
+    first_free = np.argmax(all_free, axis=1)
+    last_active = np.where(all_active & (idx[None, :] < first_free[:, None]), idx[None, :], -1).max(axis=1)
+    has_free = all_free.any(axis=1) & (last_active >= 0)
     s0 = s[np.maximum(last_active, 0)]
     s1 = s[first_free]
     base = s1 + skip * h
@@ -402,11 +451,6 @@ def edge_reconstructed_area(
     clamped = usable & ((edge < s0) | (edge > s1))
     edge = np.clip(edge, s0, s1)
     if not has_free.all():
-        return {**fail, "element_size_m": h}
+        return None
     area = 0.5 * float(np.sum(edge**2)) * (2.0 * np.pi / n_rays)
-    return {
-        "area_m2": area,
-        "rays_clamped": float(clamped.mean()),
-        "rays_fallback": float((~usable).mean()),
-        "element_size_m": h,
-    }
+    return area, float(clamped.mean()), float((~usable).mean())

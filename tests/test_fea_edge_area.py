@@ -60,7 +60,9 @@ def test_p2_edge_area_is_within_half_a_percent_of_hertz_where_the_nodal_area_is_
     options = {"degree": 2, "elements_per_semi_axis": 4.5, "mesh_tolerance": None, "stresses": False}
     r = FeaModel().solve(geo, Creepage(), steel, normal_force_N=1e5, options=options)
     assert r.success, r.message
-    ref = hertz_elliptic(geo.curvature_long_1_per_m, geo.curvature_lat_1_per_m, r.normal_force_N, steel.combined_modulus_Pa)
+    ref = hertz_elliptic(
+        geo.curvature_long_1_per_m, geo.curvature_lat_1_per_m, r.normal_force_N, steel.combined_modulus_Pa
+    )
     exact = math.pi * ref.semi_axis_long_m * ref.semi_axis_lat_m
     assert r.extra["contact_area_edge_m2"] == pytest.approx(exact, rel=rel)
     assert abs(r.extra["contact_area_nodal_m2"] / exact - 1) > 0.015
