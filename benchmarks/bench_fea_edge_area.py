@@ -44,7 +44,13 @@ def run(case: str, degree: int, levels: list[float]) -> None:
     ref = hertz_elliptic(geo.curvature_long_1_per_m, geo.curvature_lat_1_per_m, FORCE_N, steel.combined_modulus_Pa)
     exact = math.pi * ref.semi_axis_long_m * ref.semi_axis_lat_m
     for n in levels:
-        opts = {"degree": degree, "elements_per_semi_axis": n, "mesh_tolerance": None, "stresses": False}
+        opts = {
+            "degree": degree,
+            "elements_per_semi_axis": n,
+            "mesh_tolerance": None,
+            "stresses": False,
+            "edge_area": True,
+        }
         t0, c0 = time.perf_counter(), time.process_time()
         r = FeaModel().solve(geo, Creepage(), steel, normal_force_N=FORCE_N, options=opts)
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -92,7 +98,7 @@ def flange_root(degree: int, levels: list[float]) -> None:
     from fea.refinement import REFINEMENT_RATIO, _level_options
 
     case, patch = _patch()
-    base = {"stresses": False, "mesh_tolerance": 0.02, "load_balanced": True}
+    base = {"stresses": False, "mesh_tolerance": 0.02, "load_balanced": True, "edge_area": True}
     model = FeaModel()
     solve_level, peak = model.level_solver((patch.geometry, patch.creepage, case.material, None))
     box, _ = model._locate_peak(solve_level, FeaOptions.from_mapping(base), peak)

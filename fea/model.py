@@ -93,6 +93,10 @@ class FeaOptions:
         grid_points: points per side of the regular output grid of the pressure.
         filter_radius_factor: pressure averaging radius in element sizes (see fea.postprocess).
         stresses: compute subsurface stresses.
+        edge_area: also reconstruct the contact area inside the edge from the free nodes' separation
+            (fea.postprocess.edge_reconstructed_area; ``extra['contact_area_edge_m2']``), a measured diagnostic,
+            not the reported area (benchmarks/results/fea_edge_area.md); off by default: it costs up to seconds
+            per level.
         output_dir: folder for the VTU grid and PNG output, or None.
         min_mesh_quality: smallest accepted minSICN. max_elements: largest accepted element count.
         surface_traction: tangential tractions ON THE WHEEL on a grid of the contact plane, as a mapping with
@@ -135,6 +139,7 @@ class FeaOptions:
     grid_points: int = 64
     filter_radius_factor: float = 1.5
     stresses: bool = True
+    edge_area: bool = False
     output_dir: str | None = None
     min_mesh_quality: float = 0.05
     max_elements: int = 2_000_000
@@ -225,6 +230,7 @@ OPTIONS = declare_dataclass(
         "grid_points": {"help": "points per side of the output pressure grid", "minimum": 8},
         "filter_radius_factor": {"help": "pressure averaging radius in element sizes", "minimum": 0},
         "stresses": {"help": "compute subsurface stresses"},
+        "edge_area": {"help": "also reconstruct the area inside the edge (a diagnostic, not the reported area)"},
         "output_dir": {"help": "folder for the VTU grid and PNG output"},
         "min_mesh_quality": {"help": "smallest accepted minSICN", "minimum": 0, "maximum": 1},
         "max_elements": {"help": "largest accepted element count", "minimum": 1},
@@ -719,14 +725,14 @@ class FeaModel:
         weighted = sol.node_weight_m2 > 1e-9 * sol.node_weight_m2.max()
         extra["max_nodal_pressure_Pa"] = float((sol.node_force_N[weighted] / sol.node_weight_m2[weighted]).max())
         extra["contact_area_nodal_m2"] = area_nodal
-        gap_xy, gap, gap_active, gap_weight = sol.node_xy_m, sol.node_gap_m, sol.active, sol.node_weight_m2
-        if spec.symmetry == "quarter":
-            gap_xy, gap, gap_active, gap_weight = post.mirror_quarter(gap_xy, gap, gap_active, gap_weight)
-        t_edge = time.perf_counter()
-        # issue 22, measured (benchmarks/results/fea_edge_area.md): not the reported area
-        edge = post.edge_reconstructed_area(gap_xy, gap, gap_active.astype(bool), weight_m2=gap_weight)
-        extra["contact_area_edge"] = {**edge, "time_s": time.perf_counter() - t_edge}
-        extra["contact_area_edge_m2"] = edge["area_m2"] if math.isfinite(edge["area_m2"]) else None
+        if opts.edge_area:  # issue 22, measured (benchmarks/results/fea_edge_area.md): not the reported area
+            gap_xy, gap, gap_active, gap_weight = sol.node_xy_m, sol.node_gap_m, sol.active, sol.node_weight_m2
+            if spec.symmetry == "quarter":
+                gap_xy, gap, gap_active, gap_weight = post.mirror_quarter(gap_xy, gap, gap_active, gap_weight)
+            t_edge = time.perf_counter()
+            edge = post.edge_reconstructed_area(gap_xy, gap, gap_active.astype(bool), weight_m2=gap_weight)
+            extra["contact_area_edge"] = {**edge, "time_s": time.perf_counter() - t_edge}
+            extra["contact_area_edge_m2"] = edge["area_m2"] if math.isfinite(edge["area_m2"]) else None
         extra["max_pressure_definition"] = (
             f"peak of a quadric fitted to the squared nodal pressures N_i / w_i, weighted by w_i, over a fixed ellipse "
             f"of semi-axes {window['semi_axes_m'][0] * 1e3:.3g} x {window['semi_axes_m'][1] * 1e3:.3g} mm (0.6 of "

@@ -57,7 +57,7 @@ def test_p2_edge_area_is_within_half_a_percent_of_hertz_where_the_nodal_area_is_
 
     steel = Material.from_young(210e9, 0.3, 0.3)
     geo = ContactGeometry.quadric(*radii_m)
-    options = {"degree": 2, "elements_per_semi_axis": 4.5, "mesh_tolerance": None, "stresses": False}
+    options = {"degree": 2, "elements_per_semi_axis": 4.5, "mesh_tolerance": None, "stresses": False, "edge_area": True}
     r = FeaModel().solve(geo, Creepage(), steel, normal_force_N=1e5, options=options)
     assert r.success, r.message
     ref = hertz_elliptic(
