@@ -102,9 +102,7 @@ def pressure_on_grid(
     """
     from scipy.spatial import Delaunay, cKDTree
 
-    scale = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-300)
-    keys = np.round(xy / (scale * 1e-9)).astype(np.int64)
-    _, first = np.unique(keys, axis=0, return_index=True)
+    first = _distinct_nodes(xy)
     nodes, values = xy[first], pressure[first]
     # only the nodes near the grid enter the triangulation: a Delaunay triangle of all nodes stays one of a subset
     # that holds its vertices, and those of the triangles that hold grid points lie within an element of the grid
@@ -118,7 +116,7 @@ def pressure_on_grid(
     )
     if near.sum() >= 16:
         nodes, values = nodes[near], values[near]
-        scale = max(np.ptp(nodes[:, 0]), np.ptp(nodes[:, 1]), 1e-300)
+    scale = max(np.ptp(nodes[:, 0]), np.ptp(nodes[:, 1]), 1e-300)
     gx, gy = np.meshgrid(x_m, y_m)
     points = np.column_stack([gx.ravel(), gy.ravel()])
     _, nearest = cKDTree(nodes).query(points)
@@ -133,6 +131,15 @@ def pressure_on_grid(
     linear = np.einsum("ni,ni->n", values[tri.simplices[np.maximum(simplex, 0)]], weights)
     grid = np.clip(np.where(simplex >= 0, linear, 0.0).reshape(gx.shape), 0.0, None)
     return np.where(in_contact, grid, 0.0), in_contact
+
+
+def _distinct_nodes(xy: np.ndarray) -> np.ndarray:
+    """Indices of the first of each set of coincident face nodes (positions equal to 1e-9 of the face's span: a node
+    listed once per cell, or mirrored onto a symmetry plane of a quarter model).
+    """
+    scale = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-300)
+    keys = np.round(xy / (scale * 1e-9)).astype(np.int64)
+    return np.unique(keys, axis=0, return_index=True)[1]
 
 
 def principal_measures(stress: np.ndarray) -> dict[str, np.ndarray]:
@@ -340,9 +347,7 @@ def edge_reconstructed_area(
     xy = np.asarray(xy, float)
     active = np.asarray(active, bool)
     gap = np.asarray(gap_m, float)
-    scale = max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]), 1e-300)
-    keys = np.round(xy / (scale * 1e-9)).astype(np.int64)
-    _, first = np.unique(keys, axis=0, return_index=True)
+    first = _distinct_nodes(xy)
     xy, active, gap = xy[first], active[first], gap[first]
     weight = None if weight_m2 is None else np.asarray(weight_m2, float)[first]
     # a free node with d = 0 has no gap value (fea.solver: outside the sampled gap): unknown, not in contact
