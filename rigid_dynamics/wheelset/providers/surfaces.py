@@ -70,6 +70,15 @@ class ConicalWheelSurface:
         lo, hi = self.e0 - half_width_m, self.e0 + half_width_m
         self.y_range_m = (lo, hi) if sign > 0 else (-hi, -lo)
 
+    def ideal_radius(self, y_d_m):
+        """The cone's profile (R, dR/dy_d, d2R/dy_d2) at ``y_d_m`` without irregularities (m, -, 1/m).
+
+        With it an ideal cone is tabulated for the compiled search (contact.search.fast_surfaces).
+        """
+        y_d = np.asarray(y_d_m, float)
+        r = self.r0 + self.lam * (self.e0 - self.sign * y_d)
+        return r, np.full_like(r, -self.sign * self.lam), np.zeros_like(r)
+
     def evaluate(self, angle_rad, y_d_m):
         alpha, y_d = np.broadcast_arrays(np.asarray(angle_rad, float), np.asarray(y_d_m, float))
         r = self.r0 + self.lam * (self.e0 - self.sign * y_d)
@@ -91,6 +100,15 @@ class CircularRailSurface:
         self.yc, self.zc, self.rr, self.sign = centre_y_m, centre_z_m, radius_m, float(sign)
         self.irregularities = tuple(irregularities)
         self.y_range_m = (centre_y_m - half_width_m, centre_y_m + half_width_m)
+
+    deflection = None
+    """No rail deflection (the compiled search's tabulated rail: contact.search.fast_surfaces)."""
+
+    def ideal_height(self, y_m):
+        """The rail head's profile (N, dN/dy, d2N/dy2) at ``y_m`` without irregularities (m, -, 1/m)."""
+        u = np.asarray(y_m, float) - self.yc
+        w = np.sqrt(self.rr**2 - u**2)
+        return self.zc - w, u / w, self.rr**2 / w**3
 
     def evaluate(self, x_m, y_m):
         x, y = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
