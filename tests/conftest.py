@@ -16,42 +16,44 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-# `make test` runs the suite on two pytest-xdist workers (PYTEST_WORKERS, default 2) with `--dist loadgroup`. Each
-# test file is one group (its module-scoped fixtures are computed once, on one worker), except the tests that start
-# `mpiexec -n 2`: they share the group MPI_GROUP with the whole of test_fea_field_files.py (whose two-rank test uses
-# the file's fixture), so two MPI jobs never run at once. Every test writes only under its tmp_path, or atomically
-# into the numba and table caches.
-MPI_GROUP = "mpi"
-MPI_FILES = {"test_fea_field_files"}
-MPI_TESTS = {"test_fea_contact.py::test_two_ranks_agree_with_one_rank"}
+# `make test` runs the suite on two pytest-xdist workers (PYTEST_WORKERS, default 2) with `--dist loadfile`: each test
+# file runs on one worker, so its module-scoped fixtures are computed once. (`--dist loadgroup` with an xdist_group
+# mark per file was used until 2026-11-29 and never grouped anything: pytest-xdist 3.8 appends the group to
+# `item._nodeid`, which pytest 9 no longer reads, so every test was its own unit and a module fixture used by tests
+# on both workers was computed twice.) The tests that start `mpiexec -n 2` take the `mpi_lock` fixture, so two MPI
+# jobs never run at once. Every test writes only under its tmp_path, or atomically into the numba and table caches.
 FIRST = (
+    "test_fea_refinement",
     "test_fea_contact",
-    MPI_GROUP,
-    "test_compare",
-    "test_examples",
-    "test_dynamics_regression",
     "test_docs",
-    "test_dynamics_search",
-    "test_contact_force_control",
-    "test_geometry_slices",
+    "test_dynamics_regression",
+    "test_dynamics_stress",
+    "test_search_flange",
+    "test_fea_field_files",
+    "test_hardening_results",
+    "test_traction_control",
+    "test_fea_friction",
+    "test_loop_sampled_run",
 )
-"""The groups that take longest (measured, benchmarks/results/suite_time.md), handed out first so that the two
+"""The files that take longest (measured: the suite with --durations=0, 2026-11-29), handed out first so that the two
 workers end together; the others follow in file order. Only the balance depends on this list."""
-
-
-def _group(item) -> str:
-    path = Path(str(item.fspath))
-    if path.stem in MPI_FILES or f"{path.name}::{item.name}" in MPI_TESTS:
-        return MPI_GROUP
-    return path.stem
 
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
-    if getattr(config.option, "dist", "no") != "loadgroup":
+    """On an xdist worker: the files of FIRST first (the scheduler hands out files in collection order)."""
+    if not hasattr(config, "workerinput"):
         return
-    for item in items:
-        if not any(item.iter_markers("xdist_group")):
-            item.add_marker(pytest.mark.xdist_group(_group(item)))
     rank = {name: i for i, name in enumerate(FIRST)}
-    items.sort(key=lambda item: rank.get(_group(item), len(FIRST)))  # stable: file order within and after
+    items.sort(key=lambda item: rank.get(Path(str(item.fspath)).stem, len(FIRST)))  # stable within and after
+
+
+@pytest.fixture
+def mpi_lock(tmp_path_factory):
+    """Holds an advisory lock for the test, shared by the xdist workers of the run (their base temporary folders
+    have one parent): a test that starts `mpiexec -n 2` takes both cores, and two at once would run at half speed."""
+    import fcntl
+
+    with open(tmp_path_factory.getbasetemp().parent / "wheelrail-mpi.lock", "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield

@@ -273,7 +273,7 @@ RANKS_TWO_BODY = {"formulation": "two-body", "quick": True, "stresses": False, "
 
 
 @pytest.mark.skipif(_mpiexec() is None, reason="mpiexec not found")
-def test_two_ranks_agree_with_one_rank():
+def test_two_ranks_agree_with_one_rank(mpi_lock):
     """Regression (our one-rank and two-rank runs of the same solves): forces, p0, semi-axes, approach, von Mises
     and the two-body pairing's p0 and approach agree to 1e-6."""
     script = (

@@ -79,7 +79,7 @@ def _mpiexec():
 
 
 @pytest.mark.skipif(_mpiexec() is None, reason="mpiexec not found")
-def test_two_ranks_write_the_same_grid(fea_run, tmp_path):
+def test_two_ranks_write_the_same_grid(fea_run, tmp_path, mpi_lock):
     import meshio
 
     script = (
