@@ -1,9 +1,9 @@
 """Every shipped scene (wheelrail/scenes/*.toml) at its defaults against its converged reference, with the run's own
 statement of its discretisation errors (summary.json ``discretisation_errors``) beside the measured difference.
 
-The reference of a scene: the step / 8 (RK4; scipy's RK45: both tolerances / 100), FASTSIM 40 x 40, the 3-D search as
-the geometry (scenes that ship the conical provider keep it: it is exact for the cone), and the beam's modes to
-20 kHz. ``wheel-flat``'s reference is not re-run here (its 20 kHz run costs about 300 s wall under load): the
+The reference of a scene: the step / 8 (RK4; an embedded pair: both tolerances / 100), FASTSIM 40 x 40, the 3-D
+search as the geometry (on a conical track the analytic conical provider with scipy's RK45: the cone's closed form,
+the geometry of Klingel's formula), and the beam's modes to 20 kHz. ``wheel-flat``'s reference is not re-run here (its 20 kHz run costs about 300 s wall under load): the
 20 kHz row of benchmarks/results/wheelflat_cutoff.md (bench_wheelflat_cutoff.py) is read instead; its default run
 is timed here.
 
@@ -49,7 +49,10 @@ def reference(scene):
             integ, relative_tolerance=integ.relative_tolerance / 100, absolute_tolerance=integ.absolute_tolerance / 100
         )
     changes = {"integrator": integ, "fastsim_elements_per_strip": 40, "fastsim_strips": 40}
-    if scene.contact_provider != "conical" and not scene.track.is_conical:
+    if scene.track.is_conical:
+        changes["contact_provider"] = "conical"
+        changes["integrator"] = replace(integ, method="RK45")
+    else:
         changes["contact_provider"] = "search"
     if scene.track_dynamics.model == "beam":
         changes["track_dynamics"] = replace(scene.track_dynamics, cutoff_frequency_Hz=20000.0)

@@ -321,7 +321,9 @@ def test_step_size_underflow_is_a_named_status(monkeypatch):
 def test_python_path_runs_the_same_pair_in_scipy():
     """A scene the compiled loop cannot run (the conical provider) runs DP54 as scipy's RK45, the same pair."""
     scene = load_scene("hunting-conical")
-    scene = replace(scene, duration_s=0.2, integrator=replace(scene.integrator, method="DP54"))
+    scene = replace(
+        scene, duration_s=0.2, contact_provider="conical", integrator=replace(scene.integrator, method="DP54")
+    )
     result = simulate(scene)
     assert result.status == "ok" and not result.compiled, result.message
     assert result.method == "DP54"

@@ -115,7 +115,8 @@ if __name__ == "__main__":  # pragma: no cover
 def test_scipy_step_companion_states_and_judges_the_step():
     """scipy's RK45 (hunting-conical, 0.6 s): the step companion at 10x the tolerances is stated; at rtol 1e-6 it
     passes, at rtol 1e-2 (deliberately loose) it exceeds force_tolerance and the run ends "warning"."""
-    scene = replace(load_scene("hunting-conical"), duration_s=0.6)
+    scene = replace(load_scene("hunting-conical"), duration_s=0.6, contact_provider="conical")
+    scene = replace(scene, integrator=replace(scene.integrator, method="RK45"))
     tight = simulate(scene)
     step = tight.summary()["discretisation_errors"]["step"]
     assert tight.status == "ok" and 0 < step["estimate"] < scene.integrator.force_tolerance, step

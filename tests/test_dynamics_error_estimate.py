@@ -256,7 +256,7 @@ def test_python_rk4_estimates_between_output_samples():
     still carries the estimate of the steps since the previous sample, so the status is judged on them."""
     scene = _at_step("hunting-conical", 3e-4, 0.01)
     scene = replace(scene, integrator=replace(scene.integrator, output_step_s=1e-3), settling_distance_m=0.0)
-    result = simulate(scene)
+    result = simulate(replace(scene, contact_provider="conical"))  # the analytic cone: the Python path
     assert not result.compiled and result.status == "ok", result.message
     estimates = result.force_error_estimate
     assert np.isnan(estimates[0]) and np.all(np.isfinite(estimates[2:]))

@@ -15,7 +15,9 @@ from test_hardening_kill import wait_for
 from wheelrail.output import LOCK_NAME
 
 SWEEP = (
-    'scene = "hunting-conical"\n[set]\nduration_s = 2.0\n'
+    # the analytic cone with scipy's RK45 (seconds per point; the scene's compiled default takes 0.1 s): points are
+    # still running when the interrupt comes
+    'scene = "hunting-conical"\n[set]\nduration_s = 2.0\ncontact_provider = "conical"\n"integrator.method" = "RK45"\n'
     "[grid]\nspeed_m_per_s = [10.0, 11.0, 12.0, 13.0, 14.0, 15.0, 16.0, 17.0]\n"
 )
 

@@ -49,7 +49,7 @@ def scene_text(name: str, *replacements: tuple[str, str]) -> str:
         ("hunting-conical", [("duration_s = 3.0", "duration_s = -1.0")], ["duration_s", "-1.0"]),
         (
             "hunting-conical",
-            [('contact_provider = "conical"', 'contact_provider = "search"')],
+            [('contact_provider = "tables"', 'contact_provider = "search"')],
             ["'contact_provider' = 'search'", "analytic conical wheel"],
         ),
         ("wheel-flat", [("gauge_m = 1.435", "gauge_m = 1e30")], ["'track.gauge_m' = 1e+30", "0.1 to 3"]),

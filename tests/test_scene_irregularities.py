@@ -22,8 +22,8 @@ BASE = embedded_scenes()["hunting-conical"].read_text()
 
 def _scene(tmp_path, extra: str, *, duration="0.01", provider="auto", method="RK4"):
     text = BASE.replace("duration_s = 3.0", f"duration_s = {duration}")
-    text = text.replace('contact_provider = "conical"', f'contact_provider = "{provider}"')
-    text = text.replace('method = "RK45"', f'method = "{method}"\nfixed_step_s = 0.001')
+    text = text.replace('contact_provider = "tables"', f'contact_provider = "{provider}"')
+    text = text.replace('method = "DP54"', f'method = "{method}"\nfixed_step_s = 0.001')
     path = tmp_path / "scene.toml"
     path.write_text(text + "\n" + extra)
     return path

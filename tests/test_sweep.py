@@ -29,6 +29,8 @@ speed_m_per_s = [10.0, 30.0]
 [[points]]
 speed_m_per_s = 20.0
 "integrator.max_rhs_evaluations" = 20
+contact_provider = "conical"  # the Python path checks the budget at every evaluation (the compiled loop per chunk)
+"integrator.method" = "RK45"
 """
 
 

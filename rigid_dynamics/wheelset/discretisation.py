@@ -433,7 +433,7 @@ def geometry_error(result, companions: Companions) -> dict:
     from rigid_dynamics.wheelset.wheelset_model import ContactFailure
 
     try:
-        if scene.irregularities.joint_dip_angle_rad > 0 or scene.track.is_conical:
+        if scene.irregularities.joint_dip_angle_rad > 0:
             return {"estimate": None, "method": "not estimated (the 3-D search does not serve this geometry)"}
         tables = companions.model_for(companions.provider)
         key = (scene.wheelset, scene.track, scene.irregularities)

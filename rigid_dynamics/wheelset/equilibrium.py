@@ -68,6 +68,12 @@ def rolling_radii(sides, normal_N, radius_m) -> np.ndarray:
     return out
 
 
+MAX_STATIC_APPROACH_SHARE = 0.01
+"""The largest static approach accepted, as a share of the nominal wheel radius (4.6 mm at 0.46 m; steel wheels on
+steel rails: about 0.1 mm). Beyond it the patch is no small region of two half-spaces; the start is refused
+(a material with G = 1 Pa put the cone's tabulated wheel 2.3 km into the rail and the run said ok)."""
+
+
 def elastic_start(model: WheelsetModel, state: np.ndarray, derivative=None, deepest=None, rolling=None):
     """:func:`consistent_start` with the elastic track at rest under the wheels (the rigid track: that alone).
 
@@ -124,8 +130,20 @@ def consistent_start(model: WheelsetModel, state: np.ndarray, derivative=None, d
     state, ok, why = model.static_state(state, derivative, deepest)
     if not ok:
         return state, ok, why
+    contact = model.contact(state[:12], record=True)  # on model.track_rest
+    approach = float(np.nanmax(contact.values["approach_m"], initial=0.0))
+    r0 = model.scene.wheelset.nominal_radius_m
+    if approach > MAX_STATIC_APPROACH_SHARE * r0:
+        return (
+            state,
+            False,
+            (
+                f"the static approach {approach:.3g} m is {approach / r0:.3g} of the wheel radius (more than "
+                f"{MAX_STATIC_APPROACH_SHARE:g}): the contact laws' elastic half-space does not hold there (is the "
+                f"shear modulus {model.scene.material.shear_modulus_Pa:.3g} Pa meant?)"
+            ),
+        )
     if rolling is None:
-        contact = model.contact(state[:12], record=True)  # on model.track_rest
         radii = rolling_radii(contact.side, contact.values["normal_force_N"], contact.values["rolling_radius_m"])
     else:
         radii = rolling(state)
