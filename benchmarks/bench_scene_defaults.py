@@ -3,9 +3,9 @@ statement of its discretisation errors (summary.json ``discretisation_errors``) 
 
 The reference of a scene: the step / 8 (RK4; an embedded pair: both tolerances / 100), FASTSIM 40 x 40, the 3-D
 search as the geometry (on a conical track the analytic conical provider with scipy's RK45: the cone's closed form,
-the geometry of Klingel's formula), and the beam's modes to 20 kHz. ``wheel-flat``'s reference is not re-run here (its 20 kHz run costs about 300 s wall under load): the
-20 kHz row of benchmarks/results/wheelflat_cutoff.md (bench_wheelflat_cutoff.py) is read instead; its default run
-is timed here.
+the geometry of Klingel's formula), and the beam's modes to 20 kHz. ``wheel-flat``'s reference is not re-run here
+(its 20 kHz run costs about 300 s wall under load): the 20 kHz row of benchmarks/results/wheelflat_cutoff.md
+(bench_wheelflat_cutoff.py) is read instead; its default run is timed here.
 
 Measured per scene: wall time of the default and of the reference run, status, the stated errors, and the largest
 difference of the settled peaks (normal, longitudinal and lateral creep force per wheel) relative to the static
