@@ -130,12 +130,16 @@ def main(names) -> None:
             ref_peaks, ref_status = peaks(ref.summary()), ref.status
         record.update(reference_status=ref_status, reference_wall_s=ref_wall, reference_peaks=ref_peaks)
         record["static_wheel_load_N"] = scene.static_wheel_load_N
+        record["run"] = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "load_start": os.getloadavg()}
         compare(record)
         records.append(record)
         print(name, record["status"], f"{wall:.1f} s", record["worst_of_static_load"], record["stated"], flush=True)
     previous = OUT.with_suffix(".json")
     if previous.exists() and set(names) != set(SCENES):  # a subset re-run keeps the other scenes' records
-        kept = [r for r in json.loads(previous.read_text(encoding="utf-8"))["records"] if r["scene"] not in names]
+        before = json.loads(previous.read_text(encoding="utf-8"))
+        kept = [r for r in before["records"] if r["scene"] not in names]
+        for r in kept:  # a record written before records carried their own run: the file's machine line was theirs
+            r.setdefault("run", {"date": before["machine"]["date"], "load_start": before["machine"]["load_start"]})
         records = sorted(kept + records, key=lambda r: r["scene"])
     machine = {
         "platform": platform.platform(),
@@ -161,6 +165,12 @@ def render(machine, records) -> str:
         f"Machine: {machine['platform']}, {machine['cpus']} CPUs, Python {machine['python']}; load average at start "
         f"{[round(x, 2) for x in machine['load_start']]}, at end {[round(x, 2) for x in machine['load_end']]} (shared "
         f"machine: wall times scatter); {machine['date']}.",
+        "",
+        "Rows run: "
+        + "; ".join(
+            f"{r['scene']} {r['run']['date']} (load {r['run']['load_start'][0]:.2f})" for r in records if "run" in r
+        )
+        + ".",
         "",
         "| scene | status | default wall s | reference wall s | stated: step | grid | modal | geometry | "
         "measured: largest peak diff / static load | (peak) | largest diff / own peak | (peak) |",
