@@ -63,8 +63,9 @@ def _klingel_scene(duration_s):
 def test_klingel_through_the_search():
     """Klingel's wavelength 2 pi sqrt(r0 e / lambda) (closed form) through the 3-D search, which on the ideal cone
     runs compiled (its surfaces tabulated). The step, 1.5 ms, is 0.92 of RK4's stability limit here (1.63 ms; 2 ms
-    derails at 0.05 s, the run says so). Measured: 16.5244 m, +0.12 % (the Python search with its profile-only
-    option, which keeps the contact on the wheel's lowest line, gave 16.5441 m, +0.24 %, at 30x the CPU time)."""
+    derails at 0.05 s, the run says so). Measured: 16.5244 m, +0.12 %, in under a second (the Python search with its
+    profile-only option, which keeps the contact on the wheel's lowest line, gave 16.5441 m, +0.24 %, in 46-155 s of
+    the suite's runs)."""
     result = simulate(_klingel_scene(1.2))
     assert result.success, result.message
     assert result.provider == "search" and result.summary()["compiled"] is True
