@@ -2,9 +2,11 @@
 VENV := .venv
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?= --durations=25  # the slowest tests printed: where the suite's time goes (issue 27)
-# two pytest-xdist workers, each test file on one worker (`--dist loadfile`: its module fixtures computed once), the
-# MPI tests one at a time (a lock), the longest files first (tests/conftest.py); PYTEST_WORKERS=0: one process.
-# 1570 tests in 402 s wall (756 s CPU) against 768 s in one process (benchmarks/results/suite_time.md)
+# two pytest-xdist workers (`--dist worksteal`: each takes one half of the tests in file order, the longest files
+# first, and steals from the other's end when idle, so a file's module fixtures are computed once unless the two
+# halves meet in it), the MPI tests one at a time (a lock; tests/conftest.py); PYTEST_WORKERS=0: one process.
+# Clean-clone runs, 2026-11-29: 568 s of pytest with worksteal against 675 s with loadfile
+# (benchmarks/results/suite_time.md)
 PYTEST_WORKERS ?= 2
 
 .PHONY: demo test lint docs setup clean clean-numba
@@ -21,7 +23,7 @@ demo: $(STAMP)
 # process compile our modules from source and pytest rewrite every test file's asserts again (collection 15 s CPU
 # per worker instead of 6 s); the bytecode goes to the __pycache__ folders git ignores
 test: $(STAMP)
-	PYTHONDONTWRITEBYTECODE= $(VENV)/bin/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder $(PYTEST_ARGS)
+	PYTHONDONTWRITEBYTECODE= $(VENV)/bin/python -m pytest -q -n $(PYTEST_WORKERS) --dist worksteal $(PYTEST_ARGS)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check . && $(VENV)/bin/ruff format --check .

@@ -16,12 +16,15 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-# `make test` runs the suite on two pytest-xdist workers (PYTEST_WORKERS, default 2) with `--dist loadfile`: each test
-# file runs on one worker, so its module-scoped fixtures are computed once. (`--dist loadgroup` with an xdist_group
-# mark per file was used until 2026-11-29 and never grouped anything: pytest-xdist 3.8 appends the group to
-# `item._nodeid`, which pytest 9 no longer reads, so every test was its own unit and a module fixture used by tests
-# on both workers was computed twice.) The tests that start `mpiexec -n 2` take the `mpi_lock` fixture, so two MPI
-# jobs never run at once. Every test writes only under its tmp_path, or atomically into the numba and table caches.
+# `make test` runs the suite on two pytest-xdist workers (PYTEST_WORKERS, default 2) with `--dist worksteal`: each
+# worker takes one half of the tests in the order below and, when idle, steals from the end of the other's queue, so
+# a file's module-scoped fixtures are computed once unless the halves meet in it. Measured in clean-clone CI runs on
+# 2026-11-29: 568 s of pytest with worksteal, 675 s with `--dist loadfile` (whole files: the last file left one
+# worker idle). `--dist loadgroup` with an xdist_group mark per file was used until then and grouped nothing:
+# pytest-xdist 3.8 appends the group to `item._nodeid`, which pytest 9 no longer reads, so it scheduled test by test
+# and module fixtures used on both workers were computed twice. The tests that start `mpiexec -n 2` take the
+# `mpi_lock` fixture, so two MPI jobs never run at once. Every test writes only under its tmp_path, or atomically
+# into the numba and table caches.
 FIRST = (
     "test_fea_refinement",
     "test_fea_contact",
@@ -35,13 +38,13 @@ FIRST = (
     "test_fea_friction",
     "test_loop_sampled_run",
 )
-"""The files that take longest (measured: the suite with --durations=0, 2026-11-29), handed out first so that the two
-workers end together; the others follow in file order. Only the balance depends on this list."""
+"""The files that take longest (measured: the suite with --durations=0, 2026-11-29), first in the order the workers
+take; the others follow in file order. Only the balance depends on this list."""
 
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
-    """On an xdist worker: the files of FIRST first (the scheduler hands out files in collection order)."""
+    """On an xdist worker: the files of FIRST first (the scheduler hands out tests in collection order)."""
     if not hasattr(config, "workerinput"):
         return
     rank = {name: i for i, name in enumerate(FIRST)}
