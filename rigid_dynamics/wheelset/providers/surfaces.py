@@ -81,9 +81,9 @@ class ConicalWheelSurface:
 
     def evaluate(self, angle_rad, y_d_m):
         alpha, y_d = np.broadcast_arrays(np.asarray(angle_rad, float), np.asarray(y_d_m, float))
-        r = self.r0 + self.lam * (self.e0 - self.sign * y_d)
+        r, r_y, r_yy = self.ideal_radius(y_d)
         zero = np.zeros_like(r)
-        out = [r, zero.copy(), np.full_like(r, -self.sign * self.lam), zero.copy(), zero.copy(), zero.copy()]
+        out = [r, zero.copy(), r_y, zero.copy(), zero.copy(), r_yy]
         for item in self.irregularities:
             for k, v in enumerate(item.evaluate(alpha, y_d)):
                 out[k] = out[k] + v
@@ -112,10 +112,10 @@ class CircularRailSurface:
 
     def evaluate(self, x_m, y_m):
         x, y = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        n, n_y, n_yy = self.ideal_height(y)
+        zero = np.zeros_like(n)
+        out = [n, zero.copy(), n_y, zero.copy(), zero.copy(), n_yy]
         u = y - self.yc
-        w = np.sqrt(self.rr**2 - u**2)
-        zero = np.zeros_like(w)
-        out = [self.zc - w, zero.copy(), u / w, zero.copy(), zero.copy(), self.rr**2 / w**3]
         for item in self.irregularities:
             # rail irregularities take the lateral coordinate relative to the rail-head centre
             for k, v in enumerate(item.evaluate(x, self.sign * u)):
