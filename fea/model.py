@@ -726,11 +726,10 @@ class FeaModel:
         extra["max_nodal_pressure_Pa"] = float((sol.node_force_N[weighted] / sol.node_weight_m2[weighted]).max())
         extra["contact_area_nodal_m2"] = area_nodal
         if opts.edge_area:  # issue 22, measured (benchmarks/results/fea_edge_area.md): not the reported area
-            gap_xy, gap, gap_active, gap_weight = sol.node_xy_m, sol.node_gap_m, sol.active, sol.node_weight_m2
-            if spec.symmetry == "quarter":
-                gap_xy, gap, gap_active, gap_weight = post.mirror_quarter(gap_xy, gap, gap_active, gap_weight)
+            # the nodes, activity and weights mirrored above for the pressure field; the gap mirrored the same way
+            gap = np.tile(sol.node_gap_m, 4) if len(xy) == 4 * len(sol.active) else sol.node_gap_m
             t_edge = time.perf_counter()
-            edge = post.edge_reconstructed_area(gap_xy, gap, gap_active.astype(bool), weight_m2=gap_weight)
+            edge = post.edge_reconstructed_area(xy, gap, in_contact_nodes.astype(bool), weight_m2=weight)
             extra["contact_area_edge"] = {**edge, "time_s": time.perf_counter() - t_edge}
             extra["contact_area_edge_m2"] = edge["area_m2"] if math.isfinite(edge["area_m2"]) else None
         extra["max_pressure_definition"] = (
