@@ -49,8 +49,8 @@ def scene_text(name: str, *replacements: tuple[str, str]) -> str:
         ("hunting-conical", [("duration_s = 3.0", "duration_s = -1.0")], ["duration_s", "-1.0"]),
         (
             "hunting-conical",
-            [('contact_provider = "tables"', 'contact_provider = "search"')],
-            ["'contact_provider' = 'search'", "analytic conical wheel"],
+            [('contact_provider = "tables"', 'contact_provider = "spline"')],
+            ["contact_provider = 'spline'", "expected one of auto, conical, tables, search"],
         ),
         ("wheel-flat", [("gauge_m = 1.435", "gauge_m = 1e30")], ["'track.gauge_m' = 1e+30", "0.1 to 3"]),
         ("hunting-conical", [("output_step_s = 0.002", "output_step_s = 1e-30")], ["'integrator.output_step_s'"]),

@@ -27,7 +27,7 @@ def check_scene(scene: DynamicsScene) -> None:
             with Coulomb friction only (contact.creep_table: falling friction is not tabulated).
         creep_table: true only with contact_model "auto".
         contact_provider: "conical" only with wheel_profile "conical" and rail_profile "circular" (the analytic
-            pair); "search" only with profiles (the analytic pair has no surface to search).
+            pair). ("search" serves both: on the analytic pair it searches the ideal cone and circular rail head.)
         irregularities.flat_length_m: L < 2 r0 (a flat is a chord of the wheel).
         irregularities.flat_depth_m: d < r0; the derived d = L^2/(16 r0) is then < r0/4.
         irregularities.polygon_amplitude_m: A < r0, and A n^2 < r0 (the radius of curvature of
@@ -48,10 +48,6 @@ def check_scene(scene: DynamicsScene) -> None:
             "'auto', 'tables' or 'search' for the profiles "
             f"{track.wheel_profile!r} / {track.rail_profile!r} (the analytic 'conical' provider serves only "
             "track.wheel_profile = 'conical' with track.rail_profile = 'circular')",
-        )
-    if scene.contact_provider == "search" and track.is_conical:
-        raise SceneError(
-            "contact_provider", scene.contact_provider, "'auto', 'conical' or 'tables' for the analytic conical wheel"
         )
     if irr.flat_length_m >= 2.0 * r0:
         raise SceneError(
