@@ -362,16 +362,7 @@ class FastsimModel(HertzianModel):
 
             material = material.with_friction(law_at_place(material.friction, _patch_place(geometry, material)))
         result = super().solve(geometry, creepage, material, normal_force_N=normal_force_N, options=options)
-        estimate, tolerance = result.extra.get("discretisation_error_estimate"), result.extra.get("tolerance")
-        if result.status == "ok" and estimate is not None and tolerance is not None and estimate > tolerance:
-            return dataclasses.replace(
-                result,
-                status="warning",
-                message=f"{result.message}; FASTSIM's grid {result.extra['nx']} x {result.extra['ny']} has an "
-                f"estimated creep-force error of {100 * estimate:.3g} % (against the grid of half the elements), "
-                f"above the tolerance {100 * tolerance:g} %: refine nx, ny",
-            )
-        return result
+        return grid_warning(result, "FASTSIM's grid", "against the grid of half the elements")
 
     def tangential(self, hertz, creepage, material, opts):
         from rigid_dynamics.contact.fastsim import fastsim_fields
@@ -426,6 +417,23 @@ class FastsimModel(HertzianModel):
             "flexibility": opts["flexibility"],
         }
         return forces, extra
+
+
+def grid_warning(result: ContactResult, grid: str, how: str) -> ContactResult:
+    """``result`` with status ``warning`` when its ``extra["discretisation_error_estimate"]`` (relative creep-force
+    error of the grid ``extra["nx"]`` x ``extra["ny"]``) exceeds ``extra["tolerance"]``; ``grid`` names the grid
+    in the message ("FASTSIM's grid"), ``how`` says how the estimate was made.
+    """
+    estimate, tolerance = result.extra.get("discretisation_error_estimate"), result.extra.get("tolerance")
+    if result.status == "ok" and estimate is not None and tolerance is not None and estimate > tolerance:
+        return dataclasses.replace(
+            result,
+            status="warning",
+            message=f"{result.message}; {grid} {result.extra['nx']} x {result.extra['ny']} has an estimated "
+            f"creep-force error of {100 * estimate:.3g} % ({how}), above the tolerance {100 * tolerance:g} %: "
+            "refine nx, ny",
+        )
+    return result
 
 
 AUTO_CHOICES = ("linear", "vermeulen-johnson", "fastsim", "bem")
