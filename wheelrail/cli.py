@@ -543,8 +543,10 @@ def cmd_conicity(args) -> int:
             raise ConfigError(f"{option} {value!r}: {exc}") from None
     from wheelrail.config import check_physical_range
 
-    for option in ("gauge_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
+    for option in ("gauge_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m", "shift_step_m", "tolerance"):
         value = getattr(args, option)
+        if value is None:  # shift_step_m: automatic
+            continue
         if not (value > 0 and value < float("inf")):
             raise ConfigError(f"--{option.replace('_', '-')} {value!r}: expected a finite number > 0")
     for option in ("gauge_m", "gauge_height_m", "flange_back_distance_m", "nominal_radius_m", "amplitude_m"):
@@ -560,6 +562,8 @@ def cmd_conicity(args) -> int:
         nominal_radius_m=args.nominal_radius_m,
         rail_inclination_rad=args.rail_inclination_rad,
         amplitude_m=args.amplitude_m,
+        shift_step_m=args.shift_step_m,
+        tolerance=args.tolerance,
     )
     if args.json:
         from wheelrail.output import to_json
@@ -567,10 +571,12 @@ def cmd_conicity(args) -> int:
         _print(to_json(result))
     else:
         _print(
-            f"equivalent conicity {result['equivalent_conicity']:.4f} at amplitude "
-            f"{1e3 * result['amplitude_m']:.2f} mm ({args.wheel} on {args.rail})"
+            f"{result['status']}: equivalent conicity {result['equivalent_conicity']:.4f} "
+            f"(+- {100 * result['discretisation_error_estimate']:.2g} %, table spacing "
+            f"{1e3 * result['shift_step_m']:g} mm) at amplitude {1e3 * result['amplitude_m']:.2f} mm "
+            f"({args.wheel} on {args.rail}); {result['message']}"
         )
-    return EXIT_OK
+    return EXIT_OK if result["status"] == "ok" else EXIT_FAILED
 
 
 def cmd_manchester(args) -> int:
@@ -734,6 +740,19 @@ def _add_conicity(sub) -> None:
     )
     conicity.add_argument(
         "--amplitude-m", type=number("--amplitude-m"), default=0.003, help="wheelset amplitude (EN 15302: 3 mm)"
+    )
+    conicity.add_argument(
+        "--shift-step-m",
+        type=number("--shift-step-m"),
+        default=None,
+        help="spacing of the Delta r table, m (default: min(0.1 mm, amplitude / 30), halved up to 3 times until the "
+        "tolerance is met)",
+    )
+    conicity.add_argument(
+        "--tolerance",
+        type=number("--tolerance"),
+        default=0.01,
+        help="accepted relative change of the conicities on a table twice as coarse (exit 1 above it)",
     )
     conicity.add_argument("--json", action="store_true")
     conicity.set_defaults(func=cmd_conicity)
