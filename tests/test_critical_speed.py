@@ -135,3 +135,21 @@ def test_linear_speed_takes_the_rungs_slopes_at_zero_creepage():
         assert sens.coefficients().c22 == pytest.approx(float(kalker.c22), rel=3e-3)
     out = linear_critical_speed(dataclasses.replace(scene, contact_model="fastsim"))
     assert out["creep_coefficients"]["rung"] == "fastsim" and out["creep_coefficients"]["kind"] == "central-difference"
+
+
+def test_a_conicity_that_is_not_ok_makes_the_linear_speed_a_warning(monkeypatch):
+    """The real-profile proxy takes the EN 15302 conicity; when that result is not ok (here made "not-converged":
+    a rigid-contact solve of its table failed), the linear speed computed from it is not reported ok."""
+    import rigid_dynamics.contact.conicity as conicity
+
+    real = conicity.equivalent_conicity_from_names
+
+    def failing(*args, **kwargs):
+        out = real(*args, **kwargs)
+        return {**out, "success": False, "status": "not-converged", "message": "rigid contact failed at 1 shift(s)"}
+
+    monkeypatch.setattr(conicity, "equivalent_conicity_from_names", failing)
+    linear = linear_critical_speed(load_scene("polygonal-wheel"))
+    assert linear["status"] == "warning" and not linear["success"]
+    assert "the equivalent conicity is not-converged: rigid contact failed at 1 shift(s)" in linear["message"]
+    assert linear["speed_m_per_s"] > 0 and "+- 0.08 % from its table" in linear["model"]

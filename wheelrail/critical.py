@@ -31,11 +31,12 @@ def linear_critical_speed(scene) -> dict:
     track = scene.track
     note = "conical track"
     proxy = scene
+    conicity_problem = None
     if not track.is_conical:
         from rigid_dynamics.contact.conicity import equivalent_conicity_from_names
         from rigid_dynamics.geometry import load_profile
 
-        conicity = equivalent_conicity_from_names(
+        table = equivalent_conicity_from_names(
             wheel_profile=load_profile(track.wheel_profile, "wheel"),
             rail_profile=load_profile(track.rail_profile, "rail"),
             gauge_m=track.gauge_m,
@@ -44,12 +45,18 @@ def linear_critical_speed(scene) -> dict:
             nominal_radius_m=scene.wheelset.nominal_radius_m,
             rail_inclination_rad=track.rail_inclination_rad,
             amplitude_m=0.003,
-        )["equivalent_conicity"]
+        )
+        conicity = table["equivalent_conicity"]
+        if table["status"] != "ok":
+            conicity_problem = f"the equivalent conicity is {table['status']}: {table['message']}"
         cone = dataclasses.replace(track, wheel_profile="conical", rail_profile="circular", conicity=conicity)
         proxy = dataclasses.replace(
             scene, track=cone, contact_provider="conical", irregularities=type(scene.irregularities)()
         )
-        note = f"cone of the EN 15302 equivalent conicity {conicity:.4f} (3 mm) of the profile pair"
+        note = (
+            f"cone of the EN 15302 equivalent conicity {conicity:.4f} (3 mm, +- "
+            f"{100 * table['discretisation_error_estimate']:.2g} % from its table) of the profile pair"
+        )
     try:
         sensitivities = creep_sensitivities_at_rest(proxy)
     except ValueError as exc:
@@ -59,10 +66,13 @@ def linear_critical_speed(scene) -> dict:
     f11, f22 = float(sum(c.f11_N for c in coef) / len(coef)), float(sum(c.f22_N for c in coef) / len(coef))
     result = critical_speed(linear_model_for_scene(proxy, f11, f22))
     error = [max(float(s.error_estimate[row, row]) for s in sensitivities) for row in (0, 1)]  # dFx/dxi, dFy/deta
+    status, message = result.status, result.message
+    if conicity_problem is not None and status == "ok":  # a number from a conicity that is not ok is not ok
+        status, message = "warning", f"{message}; {conicity_problem}"
     return {
-        "success": result.success,
-        "status": result.status,
-        "message": result.message,
+        "success": status == "ok",
+        "status": status,
+        "message": message,
         "speed_m_per_s": result.speed_m_per_s if math.isfinite(result.speed_m_per_s) else None,
         "frequency_Hz": result.frequency_Hz if math.isfinite(result.frequency_Hz) else None,
         "conicity": proxy.track.conicity,
