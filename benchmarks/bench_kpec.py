@@ -2,7 +2,8 @@
 
 For the three poses of CONTACT's example ``mbench_a22_kpec`` (Manchester A-2.2, right wheel, y_ws = 0, 0.5, 5 mm,
 the deck's roll and pitch rate, 10 kN total vertical force, 0.2 mm elements; tests/data/contact_kpec/SOURCE.md)
-the wheelset case is solved with the ``kpec``, ``analyn`` and ``bem`` rungs (kinematics "deck", CONTACT's grid).
+the wheelset case is solved with the ``kpec``, ``analyn`` and ``bem`` rungs (kinematics "deck", CONTACT's grid,
+the deck's unsmoothed profiles, creepages at CONTACT's wheel point: case option creepage_point = "approach").
 Per case: the differences of our KPEC and ANALYN to CONTACT's (cases 1-3 and 4-6 of the deck), of ours and
 CONTACT's to the full solutions (CONTACT's, cases 7-9, and our BEM), and the KPEC patch solved again by the BEM
 on the same gap, creepages and normal force (the method's own error at one geometry). Times in process, warm
@@ -160,8 +161,9 @@ def cpu_model() -> str:
 
 def main():
     reference = contact_rows()
-    track = build_track(a22_case(0))
-    options = {"model": {"element_size_m": ELEMENT_M}, "sides": ("right",)}
+    # the deck's profiles (SMOOTH = 0) and CONTACT's creepage point (kpec_case3_diagnosis.md)
+    track = build_track(a22_case(0, "deck"))
+    options = {"model": {"element_size_m": ELEMENT_M}, "sides": ("right",), "creepage_point": "approach"}
     kpec, bem, analyn = get_model("kpec"), get_model("bem"), get_model("analyn")
     opts = options["model"]
     strip_opts = dict(opts, tangential="fastrip")

@@ -97,7 +97,7 @@ def contact_cases():
     from rigid_dynamics.contact.track import build_track
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
 
-    track = build_track(a22_case(0))
+    track = build_track(a22_case(0, "deck"))  # the deck's SMOOTH = 0, as tests/test_kpec_contact.py
     out = {}
     for case, step in STEP_OF_CASE.items():
         sol = solve_wheelset_case(a22_case(step, "deck"), MATERIAL, "kpec", OPTIONS, track=track)

@@ -48,7 +48,12 @@ creep forces, ``hertz``, has no moment and keeps V / r0),
 ``"nominal"`` (V / r0) or ``"mean-rolling-radius"`` (V over the mean rolling radius of the wheels' main patches).
 Creepages (eq 39-49, creepage.py) of the wheel's material point on the normal through each patch's reference
 point; centre velocity (V, 0, 0), yaw and roll rates 0; relative to the mean rolling speed of the two bodies as
-Kalker and CONTACT define them (option ``rolling_speed``, see ``_creepage``).
+Kalker and CONTACT define them (option ``rolling_speed``, see ``_creepage``). Which point of that normal (option
+``creepage_point``, patches "contact"): ``"wheel-surface"`` (default) the wheel's surface point, at the local
+interpenetration d from the rail's reference point; ``"approach"`` the point at the patch's approach q from it
+(CONTACT's wheel-rail module: its point Q at PEN from the rail's reference point, m_wr_rigslip). They differ where
+the reference point is not the deepest point (d < q): on Manchester A-2.2 at 5 mm shift d = 0.011 mm,
+q = 0.030 mm, and xi differs by 4e-5 (1.1 %; CONTACT's CKSI is matched to 0.06 % with "approach").
 
 ``approach_m`` instead of ``wheel_load_N`` prescribes the largest approach on each wheel (approach control).
 """
@@ -79,6 +84,7 @@ DEFAULT_CASE_OPTIONS: dict = {
     "patch": None,  # options of wheelset_patches.wheel_patches (angle_separation_rad, distance_*_m, ...)
     "search": None,  # options passed to search.search_side ("search" patches)
     "model": None,  # options passed to the contact model
+    "creepage_point": "wheel-surface",  # the wheel point of the creepages: "wheel-surface" or "approach" (CONTACT)
     "rolling_speed": "mean",  # creepages relative to the bodies' mean rolling speed ("mean", Kalker, CONTACT)
     # or to the wheelset centre's speed ("centre", eq 41); see _creepage
     "sides": SIDES,  # per-wheel kinematics: the wheels to solve (CONTACT's A-2.2 deck solves the right one)
@@ -92,6 +98,8 @@ COARSE_FORCE_TOLERANCE = 1e-3
 differs from the coarse one by its discretisation error, several per cent on the A-2.2 patches, so balancing the
 coarse load further is wasted (manchester-a22: 14 coarse evaluations to 1e-6, the last 6 of them below 1e-3)."""
 SPIN_RATES = ("zero-axle-moment", "nominal", "mean-rolling-radius")
+CREEPAGE_POINTS = ("wheel-surface", "approach")
+"""Option ``creepage_point`` (module docstring): the wheel's material point of a patch's creepages."""
 PATCH_MODES = ("contact", "search")
 
 
@@ -159,6 +167,8 @@ def case_options(method: str, check_model=None) -> dict:
         Option("model", dict, d["model"], f"options of the contact model {method!r}", allow_none=True,
                check=check_model),
         Option("rolling_speed", str, d["rolling_speed"], "creepages relative to", choices=("mean", "centre")),
+        Option("creepage_point", str, d["creepage_point"], "the wheel point of the creepages on the patch normal",
+               choices=CREEPAGE_POINTS),
         Option("sides", tuple, d["sides"], "per-wheel kinematics: the wheels solved"),
         Option("friction_place", str, d["friction_place"], "where a friction law varying in place is evaluated",
                choices=FRICTION_PLACES),
@@ -603,6 +613,11 @@ class _Evaluator:
         geometries, min_gap = self.geometry(pose, side)
         patches, failed = [], []
         for k, (geometry, how, deepest, material_point) in enumerate(geometries):
+            if self.opts["creepage_point"] == "approach":
+                # CONTACT's Q: the approach q from the rail's reference point along the normal, towards the wheel's
+                # overlapping side (where the wheel's surface point lies, at the local interpenetration d <= q)
+                normal = np.asarray(geometry.frame[:, 2], float)
+                material_point = np.asarray(geometry.point_m, float) - float(geometry.approach_m) * normal
             creepage = _creepage(
                 self.case, pose, material_point, geometry.frame[:, 2], omega, self.opts["rolling_speed"]
             )
@@ -771,6 +786,15 @@ def solve_wheelset_case(
         raise ValueError(f"spin_rate = {opts['spin_rate']!r}: expected one of {', '.join(map(repr, SPIN_RATES))}")
     if opts["rolling_speed"] not in ("mean", "centre"):
         raise ValueError(f"rolling_speed = {opts['rolling_speed']!r}: expected 'mean' or 'centre'")
+    if opts["creepage_point"] not in CREEPAGE_POINTS:
+        raise ValueError(
+            f"creepage_point = {opts['creepage_point']!r}: expected one of {', '.join(map(repr, CREEPAGE_POINTS))}"
+        )
+    if opts["creepage_point"] == "approach" and opts["patches"] != "contact":
+        raise ValueError(
+            f"creepage_point = 'approach' with patches = {opts['patches']!r}: expected patches 'contact' (the "
+            "approach point is CONTACT's module-1 definition)"
+        )
     if opts["patches"] not in PATCH_MODES:
         raise ValueError(f"patches = {opts['patches']!r}: expected one of {', '.join(map(repr, PATCH_MODES))}")
     for name in ("max_iterations",):
