@@ -176,12 +176,14 @@ def sweep(
     material=None,
     track_distance_m: float = 0.0,
     patch_options: dict | None = None,
+    creepage_point: str | None = None,
 ) -> list[dict]:
     """Solve the A-2.2 steps; one dict per patch (keys ``COLUMNS``), CONTACT's values on the right wheel.
 
     ``material``: the pair's material (None: the deck's, :data:`MATERIAL`; another friction law for the friction
     variants of the deck); ``track_distance_m``: the wheelset's position along the track (CONTACT's S_WS);
-    ``patch_options``: the case's patch options (A_SEP, D_SEP, D_COMB of another deck; None: the defaults).
+    ``patch_options``: the case's patch options (A_SEP, D_SEP, D_COMB of another deck; None: the defaults);
+    ``creepage_point``: the wheelset case's option of that name (None: its default).
     """
     track = build_track(a22_case(0, kinematics))
     rows = []
@@ -190,6 +192,8 @@ def sweep(
         options["sides"] = tuple(sides)
     if patch_options is not None:
         options["patch"] = dict(patch_options)
+    if creepage_point is not None:
+        options["creepage_point"] = creepage_point
     reference = contact_reference()
     for step in steps:
         case = dataclasses.replace(a22_case(step, kinematics), track_distance_m=track_distance_m)
