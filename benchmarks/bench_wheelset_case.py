@@ -74,7 +74,7 @@ def best_time(func, repeats=5):
 
 
 def per_case():
-    track = build_track(a22_case(0))
+    track = build_track(a22_case(0, "deck"))
     out = {}
     for method in METHODS:
         options = {"model": default_model_options(method), "sides": ("right",)}

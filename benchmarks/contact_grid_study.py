@@ -111,7 +111,7 @@ def bem_rows(grids) -> list[dict]:
     from rigid_dynamics.contact.track import build_track
     from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
 
-    track = build_track(a22_case(0))
+    track = build_track(a22_case(0, "deck"))  # the deck's profiles (SMOOTH = 0)
     rows = []
     for step in STEPS:
         for dx, ds in grids:
