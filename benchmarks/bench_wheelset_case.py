@@ -16,7 +16,8 @@ evaluation.
 Whole process: ``wheelrail manchester --method bem`` (21 steps, both wheels, plots) and ``wheelrail contact
 manchester-a22 --method fastsim --json``, each the second of two runs (warm caches). CONTACT's own time is
 measured when the environment variable CONTACT_EXE names a built CONTACT executable and CONTACT_DECKS a folder with
-its mbench_a22_right.inp / mbench_a22_left.inp (not part of this repository); otherwise the table says so.
+its mbench_a22_right.inp / mbench_a22_left.inp (not part of this repository), and CONTACT_BUILD_NOTE how it was
+built; otherwise the table says so.
 
 Writes benchmarks/results/wheelset_case.json and wheelset_case.md. Run: .venv/bin/python
 benchmarks/bench_wheelset_case.py
@@ -281,10 +282,10 @@ def markdown(result) -> str:
                     f"FN {100 * d.get('fn', math.nan):.2g} %, FX {100 * d.get('fx_over_mu_fn', math.nan):.2g} % of "
                     f"mu FN, PMAX {100 * d.get('pmax', math.nan):.2g} %"
                 )
+        build = os.environ.get("CONTACT_BUILD_NOTE", "its build options not recorded (set CONTACT_BUILD_NOTE)")
         lines.append(
-            "  - CONTACT built locally (outside this repository) with gfortran -O3 -march=native and without the "
-            "MKL FFT option (its FFT path needs Intel's compiler here), so its NORM runs without the FFT "
-            "preconditioner; the build and the decks are not part of this repository."
+            f"  - CONTACT built locally (outside this repository): {build}; the build and the decks are not part of "
+            "this repository."
         )
     else:
         lines.append("- CONTACT itself was not timed on this run (CONTACT_EXE / CONTACT_DECKS not set).")
