@@ -99,3 +99,24 @@ def test_blended_patch_equals_contact_with_its_sub_patch_interaction():
     assert full["diff_creep_force_long"] == pytest.approx(0.0108, abs=1e-3)
     assert full["diff_max_pressure"] == pytest.approx(0.022, abs=2e-3)
     assert full["diff_contact_area"] == pytest.approx(-0.049, abs=3e-3)
+
+
+def test_blended_patch_sub_patches_are_contacts():
+    """Case 11's sub-patches against CONTACT's debug print at its converged position (IPLAN = 4, locate debug 3;
+    CONTACT's s_p is lateral with the opposite sign on the right wheel): factor 0.391 (ours 0.395: d 6.749 mm against
+    6.763); rectangles x_c = [-6.681, 6.784] and [-5.133, 3.037] mm (tread, flange root; ours within 0.02 mm),
+    s_p = [-3.217, 2.560] and [6.275, 13.715] mm (ours within 0.03 mm on the tread; on the flange root 0.2-0.4 mm
+    inside, CONTACT projecting the rail's y by 1/cos(roll) where the profile curves away from the plane: both
+    rectangles hold the contact with 1.6 mm to spare)."""
+    from comparisons.manchester import a22_case
+    from rigid_dynamics.contact.wheelset_case import solve_wheelset_case
+
+    options = {"model": {"element_size_m": 2.0e-4}, "sides": ("right",)}
+    (patch,) = [p for p in solve_wheelset_case(a22_case(10, "deck"), MATERIAL, "bem", options).patches]
+    und = patch.geometry.undeformed
+    assert und.sub_patch_factors[0, 1] == pytest.approx(0.391, abs=0.006)
+    tread, flange = und.sub_patches_m * 1e3
+    assert tread[:2] == pytest.approx([-6.681, 6.784], abs=0.02)
+    assert flange[:2] == pytest.approx([-5.133, 3.037], abs=0.02)
+    assert -tread[[3, 2]] == pytest.approx([-3.217, 2.560], abs=0.03)
+    assert -flange[[3, 2]] == pytest.approx([6.275, 13.715], abs=0.4)
