@@ -311,7 +311,7 @@ A22 = {
     "a22-tread": (6, "tread contact", ("wheelset", "tread")),
     "a22-flange-root": (
         11,
-        "flange root: two patches in our search, one combined patch in CONTACT",
+        "flange root: two interpenetration regions, one patch of two sub-patches in both codes",
         ("wheelset", "flange-root", "two-patch"),
     ),
     "a22-flange": (17, "flange contact", ("wheelset", "flange")),
@@ -319,18 +319,28 @@ A22 = {
 
 
 A22_NOTES = {
-    11: "\nA difference of models, not of grids, remains here: on the same deck with square elements of CONTACT's "
-    "size (benchmarks/results/contact_grid.md) our BEM's max pressure lies 3.1-3.2 % below CONTACT's and its area "
-    "1.7 % above at 0.1 and 0.05 mm (0.2 mm: -1.7 %, +0.5 %); the forces agree within 0.5 % of mu N. The two "
-    "interpenetration regions 4-8 mm apart form one patch in both, but CONTACT attenuates their interaction "
-    "(its patch blending) and we keep it whole (tests/test_wheelset_case_contact_reference.py). Below ~3 % in max "
-    "pressure the bench measures that difference, not a discretisation error.\n",
+    11: "\nThe case's inputs are the deck's: its profiles interpolated (SMOOTH = 0: `profile_smoothing_m = 0`) and "
+    "its prescribed roll angle and pitch rate of case 11 (added 2026-11-29; before, the 2 mm default smoothing and a "
+    "free roll moved the flange-root region's gap by about 1 um and the patch with it). The two interpenetration "
+    "regions (6.75 mm apart, between D_COMB = 4 and D_SEP = 8 mm) form one patch of two sub-patches in both codes, "
+    "whose normal interaction CONTACT scales by ((D_SEP - d)/(D_SEP - D_COMB))^0.8 (0.391; its m_wr_locatecp, "
+    "m_solvpn) and our `bem` by default too (option `subpatch_interaction`, 0.395; "
+    "tests/test_wheelset_case_contact_reference.py). With both, our BEM at the default grid (320 x 320) gives N "
+    "9618.6 N, Fx 759.9 N, Fy -2738.5 N, max pressure 1573.3 MPa, area 14.94 mm^2 on the wheel: within 0.1 % of "
+    "this reference in max pressure and area, 0.1 % of mu N in the forces. Joining the regions fully "
+    '(`subpatch_interaction = "full"`, the behaviour before) gives max pressure +1.0 %, area -4.8 %, Fx +1.1 % of '
+    "mu N; before the inputs were the deck's, the bench's BEM measured max pressure -3.3 % and area +1.6 % here, "
+    "which an earlier note here took for a difference of models (CONTACT's sub-patch interaction and these inputs "
+    "together).\n",
     17: "\nOn the same deck with square elements of CONTACT's size our BEM agrees with CONTACT within 0.15 % in max "
     "pressure and area at every size from 0.2 to 0.025 mm (benchmarks/results/contact_grid.md).\n",
     6: "\nOn the same deck with square elements of CONTACT's size our BEM agrees with CONTACT within 0.26 % in max "
     "pressure and area at 0.2, 0.1 and 0.05 mm (benchmarks/results/contact_grid.md).\n",
 }
 """Per A-2.2 case: how our BEM compares with CONTACT at the same element size (SOURCE.md)."""
+
+A22_DECK_INPUTS = {11: (-0.0003554, -4.3353637)}
+"""Per A-2.2 case whose case.toml takes the deck's inputs: (roll angle, pitch rate) of mbench_a22_right.inp."""
 
 
 def make_a22(name, case_no, what, tags):
@@ -339,19 +349,31 @@ def make_a22(name, case_no, what, tags):
     shift = 0.5e-3 * (case_no - 1)
     yaw = 1.2e-3 * (case_no - 1)
     folder = CASES / name
+    case_text = wheelset_case(
+        name,
+        f"Manchester A-2.2 case {case_no}, {what}",
+        "MBench_S1002_v3",
+        "MBench_UIC60_v3",
+        shift,
+        yaw,
+        math.atan(1 / 40),
+    )
+    if case_no in A22_DECK_INPUTS:  # the deck's interpolated profiles and prescribed roll and pitch rate
+        roll, pitch_rate = A22_DECK_INPUTS[case_no]
+        case_text = case_text.replace(
+            "rail_inclination_rad = 0.02499479361892016\n",
+            "rail_inclination_rad = 0.02499479361892016\nprofile_smoothing_m = 0.0  # the deck's SMOOTH = 0 "
+            "(CONTACT interpolates the profiles)\n",
+        ).replace(
+            "rolling_speed_m_per_s = 2.0\n",
+            f"rolling_speed_m_per_s = 2.0\nroll_rad = {roll!r}  # the deck's prescribed roll angle and pitch rate of "
+            f"case {case_no}\npitch_rate_rad_per_s = {pitch_rate!r}\n",
+        )
     write(
         folder / "case.toml",
         f"# Manchester Contact Benchmark A-2.2, case {case_no} ({what}): shift {shift * 1e3:g} mm, yaw "
         f"{yaw * 1e3:g} mrad.\n# MBench_UIC60_v3 is already canted 1:40 (see wheelrail/cases/manchester-a22.toml).\n"
-        + wheelset_case(
-            name,
-            f"Manchester A-2.2 case {case_no}, {what}",
-            "MBench_S1002_v3",
-            "MBench_UIC60_v3",
-            shift,
-            yaw,
-            math.atan(1 / 40),
-        ),
+        + case_text,
     )
     write(
         folder / "contact_reference.csv",

@@ -63,6 +63,13 @@ class UndeformedDistance:
     negative gap (the rigid overlap), hence the whole contact area of quasi-identical elastic bodies (their
     normal surface displacements under pressure are compressive everywhere): solvers use it as their
     potential contact area.
+
+    ``sub_patches_m`` (n, 4) and ``sub_patch_factors`` (n, n), when given (a patch joining interpenetration regions
+    D_COMB < d <= D_SEP apart, rigid_dynamics.contact.wheelset_patches): the sub-patches' rectangles (x_min, x_max,
+    y_min, y_max) on the plane, m, a later one taking the elements it shares with an earlier one, and the factors
+    f_ij that scale the normal displacement of sub-patch j's elements due to sub-patch i's pressure (f_ii = 1):
+    CONTACT's reduced interaction of sub-patches (IPLAN = 4). Elements in no rectangle are outside the potential
+    contact area. The ``bem`` rung applies them unless its option ``subpatch_interaction`` is "full".
     """
 
     x_m: np.ndarray
@@ -70,8 +77,19 @@ class UndeformedDistance:
     distance_m: np.ndarray
     exact: Callable | None = None
     potential_area_m: tuple[float, float, float, float] | None = None
+    sub_patches_m: np.ndarray | None = None
+    sub_patch_factors: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        if (self.sub_patches_m is None) != (self.sub_patch_factors is None):
+            raise ValueError("sub_patches_m and sub_patch_factors: expected both or neither")
+        if self.sub_patches_m is not None:
+            n = len(self.sub_patches_m)
+            if np.shape(self.sub_patches_m) != (n, 4) or np.shape(self.sub_patch_factors) != (n, n):
+                raise ValueError(
+                    f"sub_patches_m shape {np.shape(self.sub_patches_m)}, sub_patch_factors shape "
+                    f"{np.shape(self.sub_patch_factors)}: expected (n, 4) and (n, n)"
+                )
         nx, ny = len(self.x_m), len(self.y_m)
         if self.distance_m.shape != (ny, nx):
             raise ValueError(

@@ -9,9 +9,11 @@ at the deepest point. CONTACT's module 1 (E.A.H. Vollebregt, J.J. Kalker; open s
    the track; with yaw it leaves the plane x = 0) as a function of the track's lateral coordinate y;
 2. splits {g < 0} into interpenetration regions (intervals of y);
 3. joins regions that lie close: regions whose distance d (between their end points on the rail surface, in the
-   y-z plane) is at most D_COMB and whose contact angles differ by at most A_SEP are solved as one patch, with
-   their elastic interaction (CONTACT blends regions with D_COMB < d <= D_SEP; here they are joined fully and
-   the patch says so in ``combination``), regions further apart are separate patches;
+   y-z plane) is at most D_SEP and whose contact angles differ by at most A_SEP are solved as one patch, with
+   their elastic interaction: in full for regions at most D_COMB apart, reduced by the factor
+   f = ((D_SEP - d)/(D_SEP - D_COMB))^0.8 between sub-patches D_COMB < d <= D_SEP apart ("blended", CONTACT's
+   IPLAN = 4: :func:`sub_patches`, carried by the geometry's ``undeformed``; the ``bem`` rung's option
+   ``subpatch_interaction = "full"`` joins them fully instead); regions further apart are separate patches;
 4. places each patch's *contact reference point* at the interpenetration's weighted centre and its contact plane
    at the weighted contact angle, turned towards a neighbouring patch's when the two lie between D_SEP and D_TURN
    apart (:func:`turned_angles`; a small patch beside a large one takes most of the large one's angle). With the
@@ -439,6 +441,66 @@ def turned_angles(groups: list[list[InterpenetrationRegion]], options) -> list[t
     return [(a + t, t) for a, t in zip(own, turn, strict=True)]
 
 
+SUB_PATCH_MARGIN = 0.4
+"""Margin of a sub-patch's rectangle around its interpenetration, in D_COMB (CONTACT's safety 0.4 D_COMB)."""
+
+
+def _region_x_range(region: InterpenetrationRegion, locus: ContactLocus, a_long: float) -> tuple[float, float]:
+    """Track-x range of a region's interpenetration: x_i -+ sqrt(c_i / a) over its locus points (or the
+    out-of-round overlap's own rows).
+    """
+    sl = slice(region.start, region.stop)
+    if locus.overlap_x_m is not None:
+        rows = locus.overlap_x_m[sl]
+        rows = rows[np.all(np.isfinite(rows), axis=1)]
+        if len(rows):
+            return float(rows[:, 0].min()), float(rows[:, 1].max())
+    c = np.clip(-locus.gap_m[sl], 0.0, None)
+    half = np.sqrt(c / a_long)
+    x = locus.point_m[sl, 0]
+    return float((x - half).min()), float((x + half).max())
+
+
+def sub_patches(group, locus, a_long: float, origin, frame, options):
+    """CONTACT's sub-patches of a patch (module docstring, step 3): (rectangles (n, 4), factors (n, n)), or
+    (None, None) when all its regions lie within D_COMB of their neighbours (one sub-patch, joined fully).
+
+    Regions within D_COMB of each other form one sub-patch; neighbouring sub-patches lie D_COMB < d <= D_SEP
+    apart. Each sub-patch's rectangle on the plane is its interpenetration's extent (x: _region_x_range less the
+    origin's x; y: its regions' end points projected on e_y) widened by SUB_PATCH_MARGIN D_COMB on each side; the
+    factor between sub-patches i and j is f = (max(0, D_SEP - d) / (D_SEP - D_COMB))^0.8 with d the distance
+    between their bounding boxes (track x of the interpenetration; rail-surface y, z of the facing end points),
+    as CONTACT's m_wr_locatecp forms them.
+    """
+    d_comb, d_sep = options["distance_combination_m"], options["distance_separation_m"]
+    subs = [[group[0]]]
+    for prev, region in zip(group[:-1], group[1:], strict=True):
+        if float(np.hypot(*(region.ends_m[0] - prev.ends_m[1]))) <= d_comb:
+            subs[-1].append(region)
+        else:
+            subs.append([region])
+    if len(subs) == 1:
+        return None, None
+    pad = SUB_PATCH_MARGIN * d_comb
+    limits, boxes = [], []
+    for sub in subs:
+        x_ranges = [_region_x_range(r, locus, a_long) for r in sub]
+        x0, x1 = min(r[0] for r in x_ranges), max(r[1] for r in x_ranges)
+        ends = np.concatenate([r.ends_m for r in sub])
+        lat = (ends[:, 0] - origin[1]) * frame[1, 1] + (ends[:, 1] - origin[2]) * frame[2, 1]
+        limits.append((x0 - origin[0] - pad, x1 - origin[0] + pad, float(lat.min()) - pad, float(lat.max()) + pad))
+        boxes.append((x0, x1, sub[0].ends_m[0], sub[-1].ends_m[1]))
+    n = len(subs)
+    factors = np.ones((n, n))
+    for i in range(n):
+        for j in range(i + 1, n):
+            dx = max(0.0, boxes[j][0] - boxes[i][1], boxes[i][0] - boxes[j][1])
+            dy, dz = boxes[j][2] - boxes[i][3]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            factors[i, j] = factors[j, i] = (max(0.0, d_sep - d) / (d_sep - d_comb)) ** 0.8
+    return np.array(limits), factors
+
+
 def plane_gap(geo: _SideGeometry, locus: ContactLocus, origin, frame, x_m, y_m, iterations: int = 10):
     """Undeformed distance along the plane normal at points (x, y) of the plane (origin, frame), m.
 
@@ -497,7 +559,8 @@ class WheelPatch:
     Attributes:
         geometry: :class:`ContactGeometry` at the contact reference point (undeformed distance exact).
         regions: the interpenetration regions joined in it.
-        combination: "single", "combined" (d <= D_COMB) or "blended" (D_COMB < d <= D_SEP, joined fully here).
+        combination: "single", "combined" (d <= D_COMB) or "blended" (D_COMB < d <= D_SEP: sub-patches
+            with reduced interaction, :func:`sub_patches`).
         deepest_point_m: main-frame point of the largest vertical interpenetration (on the rail), m.
         deepest_point_rail_m: (y, z) of it in rail-profile coordinates, m.
         min_vertical_gap_m: the largest vertical interpenetration (negative), m.
@@ -656,7 +719,11 @@ def wheel_patches(
             area = (float(xs[i0]), float(xs[i1]), float(ys[j0]), float(ys[j1]))
         else:
             area = None
-        undeformed = UndeformedDistance(x_m=xs, y_m=ys, distance_m=field, exact=gap_of, potential_area_m=area)
+        subs, factors = sub_patches(group, locus, a_long, origin, frame, opts)
+        undeformed = UndeformedDistance(
+            x_m=xs, y_m=ys, distance_m=field, exact=gap_of, potential_area_m=area, sub_patches_m=subs,
+            sub_patch_factors=factors,
+        )  # fmt: skip
         convex = a_rel > 0 and b_rel > 0
         if not convex or len(group) > 1:
             # the curvatures at one point do not describe a joined or conformal patch: the analytic rungs get the

@@ -6,7 +6,9 @@ the formed patch's reference point, its forces in the candidate's contact frame 
 The compiled 3-D search gives each side's candidates at the local minima of the normal gap, with the contact plane
 at the deepest point (at most two per side). The static case (equal to CONTACT) instead splits the vertical gap
 along the contact locus into interpenetration regions, joins close ones (D_COMB) and solves each patch in the plane
-of its weighted reference point and contact angle, with the undeformed distance evaluated exactly from the surfaces.
+of its weighted reference point and contact angle, with the undeformed distance evaluated exactly from the surfaces
+(regions D_COMB < d <= D_SEP apart are sub-patches whose normal interaction the ``bem`` rung reduces as CONTACT does:
+the formed patch's ``undeformed`` carries them, wheelset_patches.sub_patches, the same path as the static case).
 For a gap-solving model (callback.PatchCallback with patches "contact") the side's patches are formed so at the
 pose the candidate carries (once per side and pose) and
 

@@ -34,7 +34,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from rigid_dynamics.contact.bem.influence import InfluenceGrid
+from rigid_dynamics.contact.bem.influence import InfluenceGrid, SubPatchInfluence
 from rigid_dynamics.contact.bem.norm import METHODS as NORM_METHODS
 from rigid_dynamics.contact.bem.norm import solve_norm
 from rigid_dynamics.contact.bem.tang import rigid_slip, solve_tang, solve_tang_law
@@ -65,6 +65,8 @@ OPTIONS = declare(
     Option("difference_parameter", float, 0.0, "Kalker's K (dissimilar materials)", minimum=-0.5, maximum=0.5,
            exclusive_minimum=True, exclusive_maximum=True),
     Option("norm_method", str, "normcg", "NORM solver", choices=tuple(NORM_METHODS)),
+    Option("subpatch_interaction", str, "contact", "interaction of a patch's sub-patches (D_COMB < d <= D_SEP)",
+           choices=("contact", "full")),
     Option("extrapolate", bool, False, "Richardson extrapolation of the creep forces from a 2 x 2-merged grid"),
     Option("rolling_slip_point", str, "centre", "where the rolling slip is taken", choices=("centre", "midpoint")),
     Option("problem", str, "rolling", "tangential problem", choices=("rolling", "shift", "transient")),
@@ -107,6 +109,11 @@ DEFAULT_OPTIONS: dict = option_defaults(OPTIONS)
   limit;
 * ``difference_parameter``: Kalker's K (|K| < 0.5; 0 for quasi-identical bodies);
 * ``norm_method``: ``"normcg"`` (preconditioned) or ``"polonsky-keer"`` (:func:`~.norm.solve_norm`);
+* ``subpatch_interaction``: for a patch whose ``undeformed`` carries sub-patches (the wheelset case's regions
+  D_COMB < d <= D_SEP apart), ``"contact"`` (default) solves NORM as CONTACT does (IPLAN = 4): the normal
+  displacement between sub-patches i and j scaled by the factor f_ij, elements outside every sub-patch's rectangle
+  outside the potential contact area (:class:`~.influence.SubPatchInfluence`); ``"full"`` joins them fully (one
+  influence matrix over the whole potential area; before that option it was the only way);
 * ``extrapolate`` (bool): Richardson extrapolation of the creep forces and spin moment from this grid and the
   grid of 2 x 2 merged elements over the same potential area, F = 2 F_h - F_2h (the steady-rolling
   discretisation is first order: the leading edge of each row is quantised to element edges); the result
@@ -289,6 +296,20 @@ def _friction_places(geometry: ContactGeometry, law, xx: np.ndarray, yy: np.ndar
     if not math.isfinite(value):
         raise ValueError(f"friction varies_with = {law.varies_with!r}: the patch has no such place ({value!r})")
     return float(value)
+
+
+def _sub_patch_labels(geometry: ContactGeometry, xx: np.ndarray, yy: np.ndarray, opts):
+    """(labels, factors) of the patch's sub-patches on the element centres (xx, yy), or None (none, or option
+    ``subpatch_interaction = "full"``): label k + 1 where the centre lies in rectangle k (a later rectangle takes
+    the elements it shares with an earlier one), 0 in none (CONTACT's eldiv_cpatches).
+    """
+    und = geometry.undeformed
+    if und is None or und.sub_patches_m is None or opts["subpatch_interaction"] == "full":
+        return None
+    labels = np.zeros(xx.shape, np.int64)
+    for k, (x0, x1, y0, y1) in enumerate(np.asarray(und.sub_patches_m, float)):
+        labels[(xx >= x0) & (xx <= x1) & (yy >= y0) & (yy <= y1)] = k + 1
+    return labels, np.asarray(und.sub_patch_factors, float)
 
 
 def _options(options: Mapping | None) -> dict:
@@ -551,6 +572,10 @@ class BemModel:
             xx, yy = np.meshgrid(x, y)
             h = np.asarray(geometry.gap_m(xx, yy), float)
             influence = InfluenceGrid(nx, ny, dx, dy, g_mod, nu, k_diff)
+            subs = _sub_patch_labels(geometry, xx, yy, opts)
+            if subs is not None:
+                h = np.where(subs[0] > 0, h, np.inf)
+                influence = SubPatchInfluence(influence, *subs)
             guess = warm.guess(nx, ny, dx, dy) if warm is not None else None
             norm = solve_norm(
                 influence, h, normal_force_N=normal_force_N, tolerance=tol, max_iterations=max_it, method=norm_method,

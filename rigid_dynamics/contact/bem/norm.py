@@ -482,7 +482,7 @@ def _normcg(influence, h, p, allowed, start_set, force_control, normal_force, ar
         q = influence.normal(v, reuse=True)
         _alpha, rms_upd, rms_p, n_removed = _pcg_step(q, v, res, p, u, r_prv, active, removed)
         if n_removed:
-            if n_removed <= SPARSE_CORRECTION_LIMIT:
+            if n_removed <= SPARSE_CORRECTION_LIMIT and not getattr(influence, "reduced_interaction", False):
                 _subtract_sparse(u, removed, kernel)
             else:
                 u -= influence.normal(removed)
