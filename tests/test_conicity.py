@@ -187,3 +187,12 @@ def test_a_coarse_table_is_a_warning_in_every_output(capsys):
     assert record["discretisation_error_estimate"] > record["tolerance"] == 0.01
     assert main([*argv, "--tolerance", "nan"]) == 2
     assert "--tolerance" in capsys.readouterr().err
+
+
+def test_the_estimate_s_relative_change_has_no_division_by_zero():
+    """A table twice as coarse whose conicity is 0 or not finite gives an estimate (0, inf or nan), not an
+    exception; nan ends the refinement and makes the result a warning saying the error is not estimated."""
+    from rigid_dynamics.contact.conicity import _relative_change
+
+    assert _relative_change(0.0, 0.0) == 0.0 and _relative_change(0.1, 0.0) == math.inf
+    assert math.isnan(_relative_change(math.nan, 0.2)) and _relative_change(0.22, 0.2) == pytest.approx(0.1)

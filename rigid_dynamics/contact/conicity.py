@@ -185,6 +185,15 @@ def _conicities(shifts, delta, amplitude_m, e0_r0):
     return wavelength, conicity, float(b1 / (2.0 * amplitude_m))
 
 
+def _relative_change(coarse: float, fine: float) -> float:
+    """|coarse / fine - 1| (nan when either is not finite; 0 when both are 0, inf when only ``fine`` is)."""
+    if not (math.isfinite(coarse) and math.isfinite(fine)):
+        return math.nan
+    if fine == 0.0:
+        return 0.0 if coarse == 0.0 else math.inf
+    return abs(coarse / fine - 1.0)
+
+
 def _interleave(rows, middle):
     """rows[0], middle[0], rows[1], ... (length 2 n - 1 from n rows and n - 1 middles)."""
     out = np.empty(rows.size + middle.size, dtype=np.result_type(rows, middle))
@@ -255,8 +264,9 @@ def equivalent_conicity(
         wavelength, conicity, harmonic = _conicities(shifts[ok], delta[ok], amplitude_m, e0_r0)
         coarse = ok & (np.abs(np.arange(shifts.size) - centre) % 2 == 0)  # every second row, the centre kept
         _, conicity_2, harmonic_2 = _conicities(shifts[coarse], delta[coarse], amplitude_m, e0_r0)
-        estimate = max(abs(conicity_2 / conicity - 1.0), abs(harmonic_2 / harmonic - 1.0))
-        if not automatic or estimate <= tolerance or not np.all(ok) or refinement == MAX_TABLE_REFINEMENTS:
+        estimate = max(_relative_change(conicity_2, conicity), _relative_change(harmonic_2, harmonic))
+        stop = not automatic or estimate <= tolerance or not np.all(ok) or not math.isfinite(conicity)
+        if stop or refinement == MAX_TABLE_REFINEMENTS:
             break
         # halve the spacing: the new rows between the old ones, the old rows kept
         step *= 0.5
@@ -267,6 +277,9 @@ def equivalent_conicity(
         status, message = "not-converged", f"rigid contact failed at {int((~ok).sum())} shift(s); left out"
     if not math.isfinite(conicity):
         status, message = "no-oscillation", "Delta r(y) does not restore the wheelset: no kinematic oscillation"
+    elif status == "ok" and math.isnan(estimate):
+        status = "warning"
+        message += "; the table of every second shift gives no conicity: the table's error is not estimated"
     elif status == "ok" and not estimate <= tolerance:
         status = "warning"
         message += (
