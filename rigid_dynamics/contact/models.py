@@ -367,44 +367,34 @@ class FastsimModel(HertzianModel):
     def tangential(self, hertz, creepage, material, opts):
         from rigid_dynamics.contact.fastsim import fastsim_fields
 
-        (fx, fy, mz, slip_fraction), fields = fastsim_fields(
-            float(hertz.semi_axis_long_m),
-            float(hertz.semi_axis_lat_m),
-            float(hertz.normal_force_N),
-            creepage.longitudinal,
-            creepage.lateral,
-            creepage.spin_1_per_m,
-            shear_modulus_Pa=material.shear_modulus_Pa,
-            poisson_ratio=material.poisson_ratio,
-            friction_coefficient=material.friction if material.friction is not None else material.friction_coefficient,
-            rolling_speed_m_per_s=creepage.rolling_speed_m_per_s,
-            nx=opts["nx"],
-            ny=opts["ny"],
-            traction_bound=opts["traction_bound"],
-            flexibility=opts["flexibility"],
-        )
+        friction = material.friction if material.friction is not None else material.friction_coefficient
+
+        def run(nx, ny):  # the grid asked for and its companion of half the elements
+            return fastsim_fields(
+                float(hertz.semi_axis_long_m),
+                float(hertz.semi_axis_lat_m),
+                float(hertz.normal_force_N),
+                creepage.longitudinal,
+                creepage.lateral,
+                creepage.spin_1_per_m,
+                shear_modulus_Pa=material.shear_modulus_Pa,
+                poisson_ratio=material.poisson_ratio,
+                friction_coefficient=friction,
+                rolling_speed_m_per_s=creepage.rolling_speed_m_per_s,
+                nx=nx,
+                ny=ny,
+                traction_bound=opts["traction_bound"],
+                flexibility=opts["flexibility"],
+            )
+
+        (fx, fy, mz, slip_fraction), fields = run(opts["nx"], opts["ny"])
         forces = {
             "creep_force_long_N": fx,
             "creep_force_lat_N": fy,
             "spin_moment_Nm": mz,
             "fields": fields if opts["fields"] else None,
         }
-        (fx_half, fy_half, _, _), _ = fastsim_fields(
-            float(hertz.semi_axis_long_m),
-            float(hertz.semi_axis_lat_m),
-            float(hertz.normal_force_N),
-            creepage.longitudinal,
-            creepage.lateral,
-            creepage.spin_1_per_m,
-            shear_modulus_Pa=material.shear_modulus_Pa,
-            poisson_ratio=material.poisson_ratio,
-            friction_coefficient=material.friction if material.friction is not None else material.friction_coefficient,
-            rolling_speed_m_per_s=creepage.rolling_speed_m_per_s,
-            nx=max(1, opts["nx"] // 2),
-            ny=max(1, opts["ny"] // 2),
-            traction_bound=opts["traction_bound"],
-            flexibility=opts["flexibility"],
-        )
+        (fx_half, fy_half, _, _), _ = run(max(1, opts["nx"] // 2), max(1, opts["ny"] // 2))
         size = math.hypot(fx, fy)
         estimate = math.hypot(fx - fx_half, fy - fy_half) / size if size > 0 else 0.0
         extra = {
