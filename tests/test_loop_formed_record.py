@@ -245,16 +245,18 @@ def test_auto_records_its_served_bem_patches_in_the_formed_plane(auto_run, at_st
 
 def test_auto_measures_its_reuse_error_in_the_formed_plane(auto_run):
     """The reuse's own error (the corrected value the old anchor would have served against each fresh BEM solve,
-    auto_reuse._correction_errors) is judged in the formed patch's plane: on this run its largest creep-force error
-    is 11.8 % (at t = 0, from the static start's anchors) and 1 of 9 measured corrections is above the 5 %
-    tolerance (the run says so: ``warning``). In the candidate's plane, 0.26 rad off, the same corrections read
+    auto_reuse._correction_errors) is judged in the formed patch's plane. Since auto decides on the sampled gap's
+    geometry, both wheels' patches of this run go up the ladder (the flange root's ellipticity residual 1.5-2.5, the
+    right tread's 0.24-0.45) and are served by the reuse: 14 corrections measured, the largest creep-force error
+    4.6 % (normal force 1.7 %), none above the 5 % tolerance, so the run ends ``ok``. (Before, with the right tread on
+    the ellipse: 11.8 %, 1 of 9 above, ``warning``; in the candidate's plane, 0.26 rad off, the same corrections read
     110 % and 4 of 10: there the creep force is mostly a component of the normal force, a few per cent of the
-    patch's own. (On curve-flange's first 20 ms from the root: 45 BEM solves and 182 served, against 66 and 161.)
+    patch's own.) The warning path itself: tests/test_dynamics_regression.py.
     """
     stats = auto_run.summary()["callback"]["auto_reuse"]
-    assert auto_run.status == "warning" and "auto's reused BEM patches" in auto_run.message
-    assert 0.08 < stats["max_creep_force_error"] < 0.2
-    assert stats["errors_above_tolerance"] <= 2
+    assert stats["errors_measured"] >= 10
+    assert 0.01 < stats["max_creep_force_error"] < 0.05 and stats["errors_above_tolerance"] == 0
+    assert auto_run.status == "ok", auto_run.message
 
 
 def test_reuse_errors_are_judged_in_the_plane_solved_in():

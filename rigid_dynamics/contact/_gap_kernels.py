@@ -704,6 +704,92 @@ def ellipticity_residual(xs, ys, gap, quadric, q):
 
 
 @njit(cache=True, _nrt=False)
+def curvature_change(xs, ys, gap, big_a, big_b):
+    """auto._local_curvature_change on a sampled grid: (max - min) of d2g/dx2 / 2 over the overlap (g < 0, the
+    centre point of the difference inside it), / A; the same along y, / B; the larger (0 where fewer than two
+    differences are defined or A, B <= 0).
+    """
+    out = 0.0
+    nx, ny = xs.shape[0], ys.shape[0]
+    for axis in range(2):
+        n = nx if axis == 0 else ny
+        ref = big_a if axis == 0 else big_b
+        if n < 3 or not ref > 0.0:
+            continue
+        d = (xs[1] - xs[0]) if axis == 0 else (ys[1] - ys[0])
+        lo, hi, count = math.inf, -math.inf, 0
+        for j in range(ny):
+            for i in range(nx):
+                g = gap[j, i]
+                if not (math.isfinite(g) and g < 0.0):
+                    continue
+                if axis == 0:
+                    if i == 0 or i == nx - 1:
+                        continue
+                    second = (gap[j, i + 1] - 2.0 * g + gap[j, i - 1]) / (2.0 * d * d)
+                else:
+                    if j == 0 or j == ny - 1:
+                        continue
+                    second = (gap[j + 1, i] - 2.0 * g + gap[j - 1, i]) / (2.0 * d * d)
+                if math.isfinite(second):
+                    lo, hi, count = min(lo, second), max(hi, second), count + 1
+        if count >= 2:
+            out = max(out, (hi - lo) / ref)
+    return out
+
+
+@njit(cache=True, _nrt=False)
+def _overlap_row(gap, j):
+    """Whether row j of a sampled grid has a point in overlap (finite g < 0)."""
+    for i in range(gap.shape[1]):
+        if math.isfinite(gap[j, i]) and gap[j, i] < 0.0:
+            return True
+    return False
+
+
+@njit(cache=True, _nrt=False)
+def second_patch_nearness(ys, gap):
+    """auto._second_patch_nearness on a sampled grid: the lateral extent of the widest run of overlap rows over its
+    clearance to the nearest other run (at least one spacing); 0 with one run.
+    """
+    ny = ys.shape[0]
+    if ny < 2:
+        return 0.0
+    # pass 1: the widest run (the first of equal widths) and the number of runs
+    runs, main_start, main_stop, widest = 0, -1, -1, -1
+    j = 0
+    while j < ny:
+        if not _overlap_row(gap, j):
+            j += 1
+            continue
+        start = j
+        while j + 1 < ny and _overlap_row(gap, j + 1):
+            j += 1
+        runs += 1
+        if j - start > widest:
+            widest, main_start, main_stop = j - start, start, j
+        j += 1
+    if runs < 2:
+        return 0.0
+    # pass 2: the clearance to the nearest other run
+    dy = ys[1] - ys[0]
+    clearance = math.inf
+    j = 0
+    while j < ny:
+        if not _overlap_row(gap, j):
+            j += 1
+            continue
+        start = j
+        while j + 1 < ny and _overlap_row(gap, j + 1):
+            j += 1
+        if start != main_start:
+            rows = start - main_stop - 1 if start > main_stop else main_start - j - 1
+            clearance = min(clearance, rows * dy)
+        j += 1
+    return (widest + 1) * dy / max(clearance, dy)
+
+
+@njit(cache=True, _nrt=False)
 def quadric_grid(quadric, q, box, xs, ys, gap):
     """The quadric gap A x'^2 + B y'^2 - q (quadric = (A, B, angle)) on the grid of box into xs, ys, gap."""
     big_a, big_b, angle = quadric

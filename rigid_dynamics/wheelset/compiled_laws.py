@@ -24,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from rigid_dynamics.contact.auto import GEOMETRY_FLOOR
 from rigid_dynamics.contact.creep_table import CreepTable, empty_table, table_creep_law, uniform_cell
 from rigid_dynamics.contact.fastsim import (
     FastsimGrid,
@@ -314,16 +315,19 @@ def _auto_choice(par, feats):
 
 
 @njit(cache=True, _nrt=False)
-def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
+def _law(par, tables, dummy, geometry, creep, where, rec, c, record, shape=(0.0, 0.0, 0.0)):
     """The compiled contact law of one patch: (N, a, b, T_x, T_y, M_z, to_callback); to_callback: the patch is for
     the callback (``auto`` chose BEM, or its FASTSIM broke the friction bound as auto's does in contact.models).
     geometry = (q, A, B); creep = (xi, eta, phi); where = (place, rolling speed) of the friction law
-    (:func:`patch_friction`; tables.friction).
+    (:func:`patch_friction`; tables.friction); shape = auto's geometric features of the patch's sampled gap
+    (ellipticity residual, curvature change, second-patch nearness: compiled_patch.sample_candidates; zeros for a
+    quadric: nothing sampled).
 
-    ``auto`` (par.model_code layout.LAW_AUTO): the features of contact.auto.patch_features that a quadric patch has
-    (saturation w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N); the geometric features
-    are 0: the compiled geometry is a quadric), the rung by :func:`_auto_choice`, recorded (with ``record``) into
-    rec[c] as layout.AUTO_PATCH_FIELDS; par.auto_fastsim_table 1: the FASTSIM rung served by the creep-force table.
+    ``auto`` (par.model_code layout.LAW_AUTO): the features of contact.auto.patch_features (saturation
+    w' = T_lin / (3 mu N), spin share G (ab)^1.5 C23 |phi| / max(T_lin, mu N) on Hertz's ellipse, and ``shape``,
+    each below contact.auto.GEOMETRY_FLOOR taken as 0 as there), the rung by :func:`_auto_choice`, recorded (with
+    ``record``) into rec[c] as layout.AUTO_PATCH_FIELDS; par.auto_fastsim_table 1: the FASTSIM rung served by the
+    creep-force table. A rung served on the ellipse is one whose measured box holds the sampled gap's features too.
     """
     q, ca, cb = geometry
     xi, eta, spin = creep
@@ -342,12 +346,13 @@ def _law(par, tables, dummy, geometry, creep, where, rec, c, record):
     gab15 = gab * math.sqrt(ab)
     t_lin = math.hypot(-gab * c11 * xi, -gab * c22 * eta - gab15 * c23 * spin)
     mu_n = friction.coefficient * normal
+    residual, change, nearness = shape
     feats = (
         t_lin / (3.0 * mu_n) if mu_n > 0 else np.inf,
         gab15 * c23 * abs(spin) / max(t_lin, mu_n) if max(t_lin, mu_n) > 0 else 0.0,
-        0.0,
-        0.0,
-        0.0,
+        residual if residual >= GEOMETRY_FLOOR else 0.0,
+        change if change >= GEOMETRY_FLOOR else 0.0,
+        nearness,
     )
     rung, deciding, threshold = _auto_choice(par, feats)
     to_callback = False

@@ -34,8 +34,10 @@ from rigid_dynamics.contact._gap_kernels import (
     GapPatch,
     GapSurfaces,
     GridFit,
+    curvature_change,
     ellipticity_residual,
     fitted_grid,
+    second_patch_nearness,
     warm_grid,
 )
 from rigid_dynamics.wheelset.compiled_search import (
@@ -67,16 +69,20 @@ FAR_GAP_M = 1.0  # a grid point whose normal misses a surface: far from contact 
 
 class PatchScratch(NamedTuple):
     """The sampled patches of a right-hand side and the gap law's scratch: per candidate the gap (ncand, ny, nx), m,
-    its grid xs (ncand, nx), ys (ncand, ny), m, the ellipticity residual (ncand,) and whether it was sampled
-    (ncand,: 1 sampled, 0 the quadric); the law's fields (ny, nx): pressure, in_contact, tractions t_x, t_y, in_slip;
-    the rows' first and last element in contact (ny,); per candidate the last sampled box (ncand, 4: x_lo, x_hi,
-    y_lo, y_hi, m; NaN: none); the sampler's column scratch (nx, COLUMN_SCRATCH: _gap_kernels.sample_grid).
+    its grid xs (ncand, nx), ys (ncand, ny), m, the ellipticity residual (ncand,), auto's other two geometric
+    features (ncand,: contact.auto's curvature change and second-patch nearness, _gap_kernels.curvature_change and
+    second_patch_nearness) and whether it was sampled (ncand,: 1 sampled, 0 the quadric); the law's fields
+    (ny, nx): pressure, in_contact, tractions t_x, t_y, in_slip; the rows' first and last element in contact (ny,);
+    per candidate the last sampled box (ncand, 4: x_lo, x_hi, y_lo, y_hi, m; NaN: none); the sampler's column
+    scratch (nx, COLUMN_SCRATCH: _gap_kernels.sample_grid).
     """
 
     gap: np.ndarray
     xs: np.ndarray
     ys: np.ndarray
     residual: np.ndarray
+    curvature_change: np.ndarray
+    nearness: np.ndarray
     sampled: np.ndarray
     pressure: np.ndarray
     contact: np.ndarray
@@ -97,9 +103,9 @@ def patch_scratch(par, ncand):
     nx, ny = max(int(par.kpec_nx), 2), max(int(par.kpec_ny), 2)
     return PatchScratch(
         np.zeros((ncand, ny, nx)), np.zeros((ncand, nx)), np.zeros((ncand, ny)), np.full(ncand, np.nan),
-        np.zeros(ncand), np.zeros((ny, nx)), np.zeros((ny, nx), np.bool_), np.zeros((ny, nx)), np.zeros((ny, nx)),
-        np.zeros((ny, nx), np.bool_), np.zeros(ny, np.int64), np.zeros(ny, np.int64), np.full((ncand, 4), np.nan),
-        np.zeros((nx, COLUMN_SCRATCH)),
+        np.zeros(ncand), np.zeros(ncand), np.zeros(ncand), np.zeros((ny, nx)), np.zeros((ny, nx), np.bool_),
+        np.zeros((ny, nx)), np.zeros((ny, nx)), np.zeros((ny, nx), np.bool_), np.zeros(ny, np.int64),
+        np.zeros(ny, np.int64), np.full((ncand, 4), np.nan), np.zeros((nx, COLUMN_SCRATCH)),
     )  # fmt: skip
 
 
@@ -116,7 +122,8 @@ def _side_centre(y, par, side, centre):
 
 @njit(cache=True, _nrt=False)
 def sample_candidates(y, run, cg, field, centre):
-    """The sampled gap and its ellipticity residual of every candidate in contact (q > 0) into ``field``
+    """The sampled gap, its ellipticity residual and auto's other geometric features of every candidate in contact
+    (q > 0) into ``field``
     (:class:`PatchScratch`) at the state y, from the search's surfaces (run.search: its tables, irregularity rows
     and the rotation of this evaluation); centre: a scratch 3-vector. Returns the number of grid samplings.
     """
@@ -128,6 +135,7 @@ def sample_candidates(y, run, cg, field, centre):
         q = g[G_APPROACH]
         field.sampled[c] = 0.0
         field.residual[c] = np.nan
+        field.curvature_change[c] = field.nearness[c] = 0.0
         if not q > 0.0:
             field.box[c, :] = np.nan
             continue
@@ -169,6 +177,8 @@ def sample_candidates(y, run, cg, field, centre):
         if not math.isfinite(angle):
             angle = 0.0
         field.residual[c] = ellipticity_residual(xs, ys, gap, (ca, cb, angle), q)
+        field.curvature_change[c] = curvature_change(xs, ys, gap, ca, cb)
+        field.nearness[c] = second_patch_nearness(ys, gap)
         for j in range(gap.shape[0]):
             for i in range(gap.shape[1]):
                 if not math.isfinite(gap[j, i]):

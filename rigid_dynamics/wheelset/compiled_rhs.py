@@ -299,8 +299,8 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
     """d/dt of the full state into ``out`` from the candidate geometry cg (ncand, layout.N_GEO) (a candidate with
     q = NaN is absent: recorded as NaN); fills the patch record rec (ncand + 2, layout.N_FIELDS) and the side
     forces when ``record``; sc: the scratch rows (layout.SCRATCH_ROWS, 3); dummy: FASTSIM's empty field array;
-    field: the sampled patches (compiled_patch.PatchScratch) of LAW_KPEC, and of LAW_AUTO when ``record`` (the
-    ellipticity residual recorded beside the ellipse auto's compiled rungs served).
+    field: the sampled patches (compiled_patch.PatchScratch) of LAW_KPEC and LAW_AUTO (auto's geometric features;
+    the ellipticity residual recorded beside the ellipse auto's compiled rungs served).
     Returns the status (layout.STATUS). (The run's and the workspace's arrays are passed apart, not as their
     records: a record argument is passed field by field, and this runs for every right-hand side.)
     """
@@ -374,8 +374,11 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
             resid = field.residual[c] if sampled else math.nan
             law = LAW_KPEC
         else:
+            shape = (0.0, 0.0, 0.0)  # auto's geometric features: those of the sampled gap, else the quadric's
+            if field.sampled[c] > 0.0:
+                shape = (field.residual[c], field.curvature_change[c], field.nearness[c])
             normal, sa, sb, tx, ty, mz, to_callback = _law(
-                par, tables, dummy, (q, ca, cb), (xi, eta, spin), where, rec, c, record
+                par, tables, dummy, (q, ca, cb), (xi, eta, spin), where, rec, c, record, shape
             )
             # a compiled law sees the quadric: Hertz's ellipse, its area and max pressure
             area = math.pi * sa * sb
@@ -446,10 +449,10 @@ def _rhs(t, y, run, ws, record, full, out):
     (benchmarks/results/compile_and_speed_issue25.md).
     """
     _geometry(y, run, ws, full)
-    # KPEC solves the sampled gap; auto (which decides on Hertz's ellipse) has it sampled on its recorded
-    # evaluations, so that the run states how far its patches depart from the ellipse (_forces)
+    # KPEC solves the sampled gap; auto decides on its geometric features (ellipticity residual, curvature change,
+    # second-patch nearness: a patch whose real gap is beyond a rung's measured box goes further up the ladder)
     code = run.par.model_code
-    if code == LAW_KPEC or (code == LAW_AUTO and record):
+    if code == LAW_KPEC or code == LAW_AUTO:
         if run.mode == GEOMETRY_SEARCH and run.par.patch_sampled > 0:
             sample_candidates(y, run, ws.cg, ws.patch, ws.scratch[S_SEARCH_CENTRE])
         else:

@@ -201,10 +201,12 @@ def auto_reuse_check(status: str, message: str, callback_stats) -> tuple[str, st
 
 
 def auto_geometry(result, fastsim_grid) -> dict | None:
-    """How far ``auto``'s patches served on Hertz's ellipse depart from it: None for other models. Auto decides in
-    the compiled loop on the ellipse's features (its geometric features are 0 there); with the 3-D search and
-    ``patch_geometry = "sampled"`` its recorded evaluations also sample the gap (compiled_patch.sample_candidates)
-    and record its ellipticity residual. A recorded patch served by linear theory, Vermeulen-Johnson or FASTSIM whose
+    """How far ``auto``'s patches served on Hertz's ellipse depart from it: None for other models. With the 3-D
+    search and ``patch_geometry = "sampled"`` the compiled loop samples each patch's gap (compiled_patch.
+    sample_candidates) and auto decides on its geometric features too, so this check finds no patch outside its
+    rung's box unless the decision and the thresholds disagree (it stays as the run's guard); on the tables or with
+    ``patch_geometry = "ellipse"`` the geometric features are 0 and nothing is seen. A recorded patch served by
+    linear theory, Vermeulen-Johnson or FASTSIM whose
     residual exceeds that rung's measured box at the run's level (contact/data/auto_thresholds.json; the boxes come
     from the bench's cases, and a box of 0 means no measured case beyond the ellipse) is outside what the thresholds
     were measured on: its error against the BEM on the sampled gap is not known. Returns the counts, the largest
