@@ -339,7 +339,7 @@ A22_NOTES = {
 }
 """Per A-2.2 case: how our BEM compares with CONTACT at the same element size (SOURCE.md)."""
 
-A22_DECK_INPUTS = {11: (-0.0003554, -4.3353637)}
+A22_DECK_INPUTS = {6: (-0.0001457, -4.3455627), 11: (-0.0003554, -4.3353637), 17: (-0.008606, -4.2534857)}
 """Per A-2.2 case whose case.toml takes the deck's inputs: (roll angle, pitch rate) of mbench_a22_right.inp."""
 
 
