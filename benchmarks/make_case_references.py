@@ -332,14 +332,28 @@ A22_NOTES = {
     "mu N; before the inputs were the deck's, the bench's BEM measured max pressure -3.3 % and area +1.6 % here, "
     "which an earlier note here took for a difference of models (CONTACT's sub-patch interaction and these inputs "
     "together).\n",
-    17: "\nOn the same deck with square elements of CONTACT's size our BEM agrees with CONTACT within 0.15 % in max "
-    "pressure and area at every size from 0.2 to 0.025 mm (benchmarks/results/contact_grid.md).\n",
-    6: "\nOn the same deck with square elements of CONTACT's size our BEM agrees with CONTACT within 0.26 % in max "
-    "pressure and area at 0.2, 0.1 and 0.05 mm (benchmarks/results/contact_grid.md).\n",
+    17: "\nThe case's inputs are the deck's: its profiles interpolated (SMOOTH = 0: `profile_smoothing_m = 0`) and "
+    "its prescribed roll angle and pitch rate of case 17 (added 2026-11-29, as for a22-flange-root; before, the 2 mm "
+    "default smoothing and a free roll). On the same deck with square elements of CONTACT's size our BEM agrees with "
+    "CONTACT within 0.16 % in max pressure and area at every size from 0.2 to 0.025 mm "
+    "(benchmarks/results/contact_grid.md). At its default grid (refined to 80 x 80) our BEM gives N 12726.3 N, Fx "
+    "2073.5 N, Fy -3193.6 N, max pressure 2594.2 MPa, area 7.443 mm^2 on the wheel: max pressure -0.11 %, area "
+    "+0.20 %, forces within 0.01 % of mu N of this reference (before: -0.11 %, +0.19 %, Fx -0.04 % of mu N). "
+    "Vermeulen-Johnson is 11.3 % off here (Fx -10.4 % of mu N), FASTSIM 20 x 20 1.2 %; with the free roll VJ was "
+    "4.1 % off at a longitudinal creepage 19 % above CONTACT's (0.0253 against its CKSI 0.02127; now 0.02127): the "
+    "wrong creepage offset part of its error.\n",
+    6: "\nThe case's inputs are the deck's: its profiles interpolated (SMOOTH = 0: `profile_smoothing_m = 0`) and "
+    "its prescribed roll angle and pitch rate of case 6 (added 2026-11-29, as for a22-flange-root; before, the 2 mm "
+    "default smoothing and a free roll). On the same deck with square elements of CONTACT's size our BEM agrees with "
+    "CONTACT within 0.01 % in max pressure and area at 0.2, 0.1 and 0.05 mm (benchmarks/results/contact_grid.md). "
+    "At its default grid (refined to 80 x 80, stated grid error 1.7 %) our BEM gives N 9786.7 N, Fx 456.5 N, Fy "
+    "-2900.1 N, max pressure 730.5 MPa, area 20.34 mm^2 on the wheel: max pressure -0.01 %, area +0.52 % (the "
+    "reference's own 0.47 %), forces within 0.01 % of mu N (before: +0.22 %, +0.18 %, 0.00 % of mu N). "
+    "Vermeulen-Johnson and FASTSIM 20 x 20 are within 0.7 % here (VJ 1.1 % with the free roll).\n",
 }
 """Per A-2.2 case: how our BEM compares with CONTACT at the same element size (SOURCE.md)."""
 
-A22_DECK_INPUTS = {11: (-0.0003554, -4.3353637)}
+A22_DECK_INPUTS = {6: (-0.0001457, -4.3455627), 11: (-0.0003554, -4.3353637), 17: (-0.008606, -4.2534857)}
 """Per A-2.2 case whose case.toml takes the deck's inputs: (roll angle, pitch rate) of mbench_a22_right.inp."""
 
 
