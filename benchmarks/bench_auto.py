@@ -140,15 +140,16 @@ def same_state_departure(scene, result) -> dict:
     for k in range(len(result.t)):
         track = result.track_full_states[k] if result.track_full_states is not None else None
         cs = model.contact(result.states[k], record=True, track=track, keep_search_memory=True)
+        rec = cs.record  # as a run records them: a formed patch's own values (its plane), not its candidate's
         for i, (side, slot) in enumerate(zip(cs.side, cs.slot, strict=True)):
-            nb = float(np.nan_to_num(cs.values["normal_force_N"][i]))
+            nb = float(np.nan_to_num(rec["normal_force_N"][i]))
             na = float(np.nan_to_num(p["normal_force_N"][k, side, slot]))
             if not (na > 0 and nb > 0):
                 continue
-            fb = np.hypot(cs.values["creep_force_long_N"][i], cs.values["creep_force_lat_N"][i])
+            fb = np.hypot(rec["creep_force_long_N"][i], rec["creep_force_lat_N"][i])
             df = np.hypot(
-                p["creep_force_long_N"][k, side, slot] - cs.values["creep_force_long_N"][i],
-                p["creep_force_lat_N"][k, side, slot] - cs.values["creep_force_lat_N"][i],
+                p["creep_force_long_N"][k, side, slot] - rec["creep_force_long_N"][i],
+                p["creep_force_lat_N"][k, side, slot] - rec["creep_force_lat_N"][i],
             )
             creep = float(df / max(fb, 0.01 * mu * nb))
             rung = AUTO_RUNGS[int(p["auto_rung"][k, side, slot])]
