@@ -74,6 +74,11 @@ VARIANTS = {
     "BEM sampled": ("bem", "sampled"),
 }
 """Variant -> (contact model, patch geometry)."""
+SKIPPED = {
+    ("wheel-flat", "BEM ellipse"): "not run: the BEM on a quadric refines its grid to its 2 % tolerance on every solve "
+    "(the sampled path keeps the loop's element-size ladder); through the impact this ran over 30 min and was stopped"
+}
+"""(scene, variant) -> why it is not run (nor evaluated at the reference's states)."""
 REFERENCE = "BEM sampled"
 CHECK = "BEM sampled, 80 x 80"
 """The reference's grid check: the BEM on the sampled gap on a named 80 x 80 grid over the potential area (finer than
@@ -128,7 +133,7 @@ def run_one(name: str, variant: str, npz: Path) -> dict:
     }
     if variant == REFERENCE:
         ref = (result.t, result.states, result.track_full_states, result.patches)
-        out["same_state"] = {v: same_state(name, ref, v) for v in MODELS if v != REFERENCE}
+        out["same_state"] = {v: same_state(name, ref, v) for v in MODELS if v != REFERENCE and (name, v) not in SKIPPED}
     return out
 
 
@@ -312,7 +317,7 @@ def report(rows: list, machine: str, commit: str) -> list:
             peaks = run.get("peaks")
             if not peaks or peaks["left"]["normal_N"] is None:
                 lines.append(
-                    f"| {row['scene']} | {variant} | {run.get('status')}: {run.get('message', '')[:80]} | - | - | - "
+                    f"| {row['scene']} | {variant} | {run.get('status')}: {run.get('message', '')[:200]} | - | - | - "
                     "| - | - | - | - | - |"
                 )
                 continue
@@ -366,7 +371,14 @@ def main() -> int:
         kept = {}
         for variant in VARIANTS:
             stem = scratch / f"{name}-{variant.replace(' ', '_')}"
-            if name in names and not report_only and (not only or variant in only):
+            if (name, variant) in SKIPPED:
+                kept[variant] = {
+                    "scene": name,
+                    "variant": variant,
+                    "status": "not-run",
+                    "message": SKIPPED[name, variant],
+                }
+            elif name in names and not report_only and (not only or variant in only):
                 kept[variant] = run_variant(name, variant, scratch)
             elif stem.with_suffix(".json").exists():
                 kept[variant] = json.loads(stem.with_suffix(".json").read_text())
