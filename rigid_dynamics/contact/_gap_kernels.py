@@ -748,6 +748,15 @@ def _overlap_row(gap, j):
 
 
 @njit(cache=True, _nrt=False)
+def _run_stop(gap, start):
+    """The last row of the run of consecutive overlap rows that starts at row ``start``."""
+    j = start
+    while j + 1 < gap.shape[0] and _overlap_row(gap, j + 1):
+        j += 1
+    return j
+
+
+@njit(cache=True, _nrt=False)
 def second_patch_nearness(ys, gap):
     """auto._second_patch_nearness on a sampled grid: the lateral extent of the widest run of overlap rows over its
     clearance to the nearest other run (at least one spacing); 0 with one run.
@@ -756,18 +765,15 @@ def second_patch_nearness(ys, gap):
     if ny < 2:
         return 0.0
     # pass 1: the widest run (the first of equal widths) and the number of runs
-    runs, main_start, main_stop, widest = 0, -1, -1, -1
+    runs, main_start, main_stop = 0, -1, -2
     j = 0
     while j < ny:
-        if not _overlap_row(gap, j):
-            j += 1
-            continue
-        start = j
-        while j + 1 < ny and _overlap_row(gap, j + 1):
-            j += 1
-        runs += 1
-        if j - start > widest:
-            widest, main_start, main_stop = j - start, start, j
+        if _overlap_row(gap, j):
+            stop = _run_stop(gap, j)
+            runs += 1
+            if stop - j > main_stop - main_start:
+                main_start, main_stop = j, stop
+            j = stop
         j += 1
     if runs < 2:
         return 0.0
@@ -776,17 +782,14 @@ def second_patch_nearness(ys, gap):
     clearance = math.inf
     j = 0
     while j < ny:
-        if not _overlap_row(gap, j):
-            j += 1
-            continue
-        start = j
-        while j + 1 < ny and _overlap_row(gap, j + 1):
-            j += 1
-        if start != main_start:
-            rows = start - main_stop - 1 if start > main_stop else main_start - j - 1
-            clearance = min(clearance, rows * dy)
+        if _overlap_row(gap, j):
+            stop = _run_stop(gap, j)
+            if j != main_start:
+                rows = j - main_stop - 1 if j > main_stop else main_start - stop - 1
+                clearance = min(clearance, rows * dy)
+            j = stop
         j += 1
-    return (widest + 1) * dy / max(clearance, dy)
+    return (main_stop - main_start + 1) * dy / max(clearance, dy)
 
 
 @njit(cache=True, _nrt=False)
