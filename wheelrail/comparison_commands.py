@@ -30,7 +30,7 @@ DEMO_PATCH_GEOMETRY = "ellipse"
 (multi-Hertzian), the geometry auto's thresholds were measured on. With ``--patch-geometry sampled`` (the scenes'
 default) auto decides on each patch's sampled gap too: polygonal-wheel's S1002/UIC60 treads (ellipticity residual
 1-20 in the loop) lie beyond every ellipse rung's measured box (0.55 at 10 %), so every patch goes to the BEM or its
-reuse and the 2 s run takes hours (auto at 5 %: 0.0011x real time in process over 0.04 s,
+reuse and the 2 s run takes about 5 minutes in process (auto at 5 %: 0.0061x real time over the whole 2 s,
 benchmarks/results/auto_vs_bem.md)."""
 
 DEMO_FEA_OPTIONS = {"domain_factor": 40.0}
@@ -417,6 +417,6 @@ def register(sub) -> None:
         "--patch-geometry", choices=PATCH_GEOMETRIES, default=DEMO_PATCH_GEOMETRY,
         help=f"what the run's contact models see per patch (default {DEMO_PATCH_GEOMETRY}: Hertz's ellipse, where "
         "auto's thresholds were measured; sampled: the real gap, on which auto then decides: on the S1002/UIC60 "
-        "treads every patch goes to the BEM, hours)",
+        "treads every patch goes to the BEM or its reuse: minutes)",
     )  # fmt: skip
     demo.set_defaults(func=cmd_demo)
