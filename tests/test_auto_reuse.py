@@ -16,6 +16,7 @@ RADII = (0.46, 0.3)
 LOAD_N = 1.0e5
 ANCHOR_CREEP = (2.0e-3, -1.0e-3, 0.8)  # |F| ~0.65 mu N with spin: auto gives such a patch to BEM at 5 %
 NOT_FORMED = ((math.nan,) * 12, (math.nan,) * 12, 0.0)  # reuse_anchor's ``formed`` of a patch solved on its own plane
+NO_GAP = (math.nan, math.nan, math.nan)  # the sampled-gap descriptor of a patch on the quadric (auto_reuse.NO_GAP)
 
 
 def _setup():
@@ -73,18 +74,18 @@ def test_the_correction_against_fresh_bem_solves():
     par, hk, g = _setup()
     where, dummy = (0.0, 20.0), np.zeros((1, 1))
     anchor = _bem(ANCHOR_CREEP)
-    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, _solved(anchor), NOT_FORMED)
-    same = reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0)
+    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, _solved(anchor), NOT_FORMED, NO_GAP)
+    same = reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, NO_GAP)
     assert same[0]
     assert same[1:5] == pytest.approx(_solved(anchor)[:4], rel=1e-9, abs=1e-9)
     assert hk.reuse[0, R_RADIUS] == pytest.approx(0.1)
     moved = tuple(c * f for c, f in zip(ANCHOR_CREEP, (1.06, 0.95, 1.05), strict=True))
-    served = reuse_serve(par, hk, dummy, g, moved, where, 0)
+    served = reuse_serve(par, hk, dummy, g, moved, where, 0, NO_GAP)
     assert served[0]
     fresh = _bem(moved)
     err = _bench_error(served, fresh)
     par["auto_reuse"] = 0.0
-    assert not reuse_serve(par, hk, dummy, g, moved, where, 0)[0]  # switched off: never served
+    assert not reuse_serve(par, hk, dummy, g, moved, where, 0, NO_GAP)[0]  # switched off: never served
     par["auto_reuse"] = 1.0
     # FASTSIM alone (the anchor's correction set to zero) is beyond the tolerance
     from rigid_dynamics.wheelset.auto_reuse import R_DFX, R_DFY, R_NORMAL_RATIO
@@ -92,13 +93,13 @@ def test_the_correction_against_fresh_bem_solves():
     saved = hk.reuse[0].copy()
     hk.reuse[0, R_DFX] = hk.reuse[0, R_DFY] = 0.0
     hk.reuse[0, R_NORMAL_RATIO] = 1.0
-    plain = _bench_error(reuse_serve(par, hk, dummy, g, moved, where, 0), fresh)
+    plain = _bench_error(reuse_serve(par, hk, dummy, g, moved, where, 0, NO_GAP), fresh)
     hk.reuse[0] = saved
     assert plain > 0.05, plain
     assert err < 0.012, err
     assert abs(served[1] - fresh.normal_force_N) / fresh.normal_force_N < 0.005
     far = tuple(2.0 * c for c in ANCHOR_CREEP)
-    assert not reuse_serve(par, hk, dummy, g, far, where, 0)[0]
+    assert not reuse_serve(par, hk, dummy, g, far, where, 0, NO_GAP)[0]
 
 
 def test_the_radius_follows_the_measured_error():
@@ -111,19 +112,70 @@ def test_the_radius_follows_the_measured_error():
     par, hk, g = _setup()
     where, dummy = (0.0, 20.0), np.zeros((1, 1))
     anchor = _solved(_bem(ANCHOR_CREEP))
-    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, anchor, NOT_FORMED)
+    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, anchor, NOT_FORMED, NO_GAP)
     near = tuple(c * 1.15 for c in ANCHOR_CREEP)  # beyond the radius 0.1, within twice it
-    assert not reuse_serve(par, hk, dummy, g, near, where, 0)[0]
+    assert not reuse_serve(par, hk, dummy, g, near, where, 0, NO_GAP)[0]
     wrong = list(anchor)
     wrong[1] *= 1.5  # a "BEM" solution 50 % off the anchor's correction: the radius halves
-    reuse_anchor(par, hk, dummy, g, near, where, 0, 1.0, tuple(wrong), NOT_FORMED)
+    reuse_anchor(par, hk, dummy, g, near, where, 0, 1.0, tuple(wrong), NOT_FORMED, NO_GAP)
     assert hk.reuse[-1, T_CHECKED] == 1 and hk.reuse[0, R_RADIUS] == pytest.approx(0.05)
     reuse_anchor(
-        par, hk, dummy, g, near, where, 0, 2.0, tuple(wrong), NOT_FORMED
+        par, hk, dummy, g, near, where, 0, 2.0, tuple(wrong), NOT_FORMED, NO_GAP
     )  # the same solution again: error 0, grows
     assert hk.reuse[0, R_RADIUS] == pytest.approx(0.075)
-    assert reuse_serve(par, hk, dummy, g, near, where, 0)[0]
+    assert reuse_serve(par, hk, dummy, g, near, where, 0, NO_GAP)[0]
     assert hk.reuse[-1, T_SERVED] == 1 and hk.reuse[-1, T_SOLVED] == 3
+
+
+def _paraboloid_gap(ca, cb, q, shift_m=0.0, n=121):
+    """The gap ca (x - shift)^2 + cb y^2 - q sampled on an n x n grid over twice the quadric's overlap."""
+    a, b = math.sqrt(q / ca), math.sqrt(q / cb)
+    xs, ys = np.linspace(-2.0 * a, 2.0 * a, n), np.linspace(-2.0 * b, 2.0 * b, n)
+    return xs, ys, ca * (xs[None, :] - shift_m) ** 2 + cb * ys[:, None] ** 2 - q
+
+
+def test_gap_descriptor_against_the_paraboloid_closed_form():
+    """Physics (closed form): the overlap of the gap A x^2 + B y^2 - q has the volume pi q^2 / (2 sqrt(AB)) and its
+    centroid at the origin. The descriptor (ln V/V_q, x_c/a_q, y_c/b_q) of the quadric's own gap is (0, 0, 0) to the
+    grid's error; doubling the longitudinal curvature at the same quadric (a polygon's facet the ellipse does not see)
+    gives ln(1/sqrt 2) = -0.347; shifting the overlap by half its semi-axis (a flat moving the deepest point) gives
+    x_c/a_q = 0.5. No overlap or no quadric: NaN (auto_reuse.NO_GAP).
+    """
+    from rigid_dynamics.wheelset.auto_reuse import gap_descriptor
+
+    ca, cb, q = 1.1, 1.7, 5.0e-5
+    a = math.sqrt(q / ca)
+    own = gap_descriptor(*_paraboloid_gap(ca, cb, q), q, ca, cb)
+    assert own == pytest.approx((0.0, 0.0, 0.0), abs=2e-3)
+    steeper = gap_descriptor(*_paraboloid_gap(2.0 * ca, cb, q), q, ca, cb)
+    assert steeper[0] == pytest.approx(-0.5 * math.log(2.0), abs=3e-3) and abs(steeper[1]) < 1e-9
+    shifted = gap_descriptor(*_paraboloid_gap(ca, cb, q, shift_m=0.5 * a), q, ca, cb)
+    assert shifted == pytest.approx((0.0, 0.5, 0.0), abs=3e-3)
+    xs, ys, gap = _paraboloid_gap(ca, cb, q)
+    assert all(math.isnan(v) for v in gap_descriptor(xs, ys, gap + 2.0 * q, q, ca, cb))
+    assert all(math.isnan(v) for v in gap_descriptor(xs, ys, gap, q, 0.0, cb))
+
+
+def test_the_trust_region_sees_the_sampled_gap():
+    """Regression (the distance): an anchor made on a sampled gap is served at the same inputs and the same gap; a
+    gap whose overlap volume (against the quadric's) changed by more than the radius, or whose centroid moved by
+    more than the radius in semi-axes, leaves the region at unchanged creepages, approach and curvatures (the
+    quadric, and with it FASTSIM's ellipse, cannot see it); so does a patch whose geometry switched between the
+    quadric and the sampled gap.
+    """
+    from rigid_dynamics.wheelset.auto_reuse import R_RADIUS, reuse_anchor, reuse_serve
+
+    par, hk, g = _setup()
+    where, dummy = (0.0, 20.0), np.zeros((1, 1))
+    anchor = _solved(_bem(ANCHOR_CREEP))
+    shape = (0.05, 0.02, -0.01)
+    reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, anchor, NOT_FORMED, shape)
+    radius = hk.reuse[0, R_RADIUS]
+    assert reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, shape)[0]
+    assert reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, (0.05 + 0.5 * radius, 0.02, -0.01))[0]
+    assert not reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, (0.05 + 1.5 * radius, 0.02, -0.01))[0]
+    assert not reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, (0.05, 0.02 + 1.5 * radius, -0.01))[0]
+    assert not reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, NO_GAP)[0]
 
 
 def test_a_run_records_the_reused_rung_and_its_error():

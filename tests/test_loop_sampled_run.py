@@ -186,3 +186,35 @@ def test_bem_runs_state_their_grid_error(runs):
         coarse = grid["estimate"] > grid["grid_tolerance"]
         assert result.status == ("warning" if coarse else "ok"), result.message
         assert ("exceeds the BEM's grid_tolerance = 0.02" in result.message) == coarse
+
+
+def test_the_loop_bem_element_size_stays_within_one_ladder_step():
+    """Regression (the loop BEM's grid choice, callback.PatchCallback._solve): a sampled patch whose box grows from
+    4 to 16 mm and shrinks back is solved on ladder sizes at most one step (2^(1/4)) from the size its box asks
+    for, so two runs passing the same box by different paths solve it on elements at most one step apart (the
+    window was a factor 2 each way: up to twice as large, and 9.9 % apart in the wheel flat's creep forces).
+    """
+    from types import SimpleNamespace
+
+    from rigid_dynamics.wheelset.callback import LADDER_STEP, PatchCallback, ladder_element_size
+
+    used = []
+
+    class Recorder:
+        name = "bem"
+
+        def solve(self, geometry, creepage, material, options=None, warm_start=None):
+            used.append(options["element_size_m"])
+
+    callback = PatchCallback(Recorder(), None, None)
+    patch = SimpleNamespace(side=0, candidate=0)
+    extents = np.concatenate([np.geomspace(4e-3, 16e-3, 60), np.geomspace(16e-3, 4e-3, 60)])
+    wanted = []
+    for extent in extents:
+        undeformed = SimpleNamespace(x_m=np.linspace(0.0, extent, 5), y_m=np.linspace(0.0, extent, 5))
+        callback._solve(patch, SimpleNamespace(undeformed=undeformed), None)
+        wanted.append(ladder_element_size(undeformed))
+    steps = np.log(np.asarray(used) / np.asarray(wanted)) / np.log(LADDER_STEP)
+    assert np.all(np.abs(steps) <= 1.0 + 1e-9)
+    # the size follows the box: a factor 4 is 8 steps, taken two at a time (kept while one step off)
+    assert len(set(np.round(np.log2(used) * 4))) >= 5

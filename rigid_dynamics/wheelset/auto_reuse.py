@@ -12,7 +12,11 @@ anchor's trust region are served by FASTSIM on the ellipse corrected by the stor
 The inputs and their distance from the anchor (the largest of): the normalised creepages c* = (xi*, eta*, phi^)
 (creep_table.normalised_creepages), |c* - c*_0| / (|c*_0| + ``creep_floor``); ln(a/b) and ln q (approach), each
 as |change| (times a weight, :data:`DEFAULTS`); the contact point's lateral place on the wheel profile over the
-anchor's lateral semi-axis |y_w - y_w0| / b_0 (a patch moving across the profile changes its sampled shape).
+anchor's lateral semi-axis |y_w - y_w0| / b_0 (a patch moving across the profile changes its sampled shape); and
+when the patch's gap is sampled (patch_geometry "sampled"), what the quadric does not see of it: the change of the
+overlap's volume relative to the quadric's, |change of ln(V / V_q)|, and the move of the overlap's centroid in the
+quadric's semi-axes (:func:`gap_descriptor`), so that a flat or a polygon's facet passing under the patch leaves
+the region although the curvatures at the contact point, and with them the ellipse, stay the same.
 Leaving the region (distance above the candidate's radius), the patch is solved by the callback again and becomes
 the new anchor.
 
@@ -67,6 +71,7 @@ ANCHOR = (
     "formed_creepage_long_rigid", "formed_creepage_lat_rigid", "formed_spin_departure_1_per_m",
     "formed_approach_departure_m", "formed_point_y_departure_m", "formed_wheel_lateral_departure_m",
     "formed_rolling_radius_departure_m", "formed_contact_angle_departure_rad",
+    "gap_log_volume_ratio", "gap_centroid_long", "gap_centroid_lat",
 )  # fmt: skip
 """Columns of a candidate's row: its anchor (valid 1/0), the anchor's inputs, the trust radius, the corrections,
 the anchor's patch geometry code and ellipticity residual, and for an anchor that was a formed patch (``formed``
@@ -88,6 +93,10 @@ F_XI, F_ETA, F_SPIN, F_APPROACH, F_POINT_Y, F_LATERAL, F_RADIUS, F_ANGLE = range
 """Columns of the formed patch's departures from the candidate's: the transported creepages' rigid-motion parts
 (k_x, k_y) and the spin's departure, then the approach, reference point y, wheel lateral coordinate, rolling radius
 and contact angle."""
+R_GAP = F_ANGLE + 1
+"""The first of the sampled-gap descriptor's three columns (:func:`gap_descriptor`)."""
+NO_GAP = (math.nan, math.nan, math.nan)
+"""The descriptor of a patch whose geometry is the quadric's (no sampled gap)."""
 STATS = (
     "served",
     "solved",
@@ -105,11 +114,12 @@ definition; normal force, relative) and the time of the largest, radius changes,
 level."""
 T_SERVED, T_SOLVED, T_CHECKED, T_MAX_FORCE, T_MAX_NORMAL, T_MAX_T, T_SHRUNK, T_GROWN, T_ABOVE = range(len(STATS))
 SETTINGS = ("radius_start", "radius_min", "radius_max", "creep_floor", "approach_weight", "shape_weight",
-            "place_weight")  # fmt: skip
+            "place_weight", "gap_weight")  # fmt: skip
 """The trust region's settings, kept in the statistics row after :data:`STATS` (set by :func:`reuse_store` from
 :data:`DEFAULTS`, so that a study can change them without recompiling): the radii, the creepage distance's floor and
-the weights of |change of ln q|, |change of ln(a/b)| and of the lateral place in the distance."""
-C_RADIUS_START, C_RADIUS_MIN, C_RADIUS_MAX, C_CREEP_FLOOR, C_APPROACH, C_SHAPE, C_PLACE = range(
+the weights of |change of ln q|, |change of ln(a/b)|, of the lateral place and of the sampled gap's descriptor in
+the distance."""
+C_RADIUS_START, C_RADIUS_MIN, C_RADIUS_MAX, C_CREEP_FLOOR, C_APPROACH, C_SHAPE, C_PLACE, C_GAP = range(
     len(STATS), len(STATS) + len(SETTINGS)
 )
 N_REUSE = max(len(ANCHOR), len(STATS) + len(SETTINGS))
@@ -122,10 +132,16 @@ DEFAULTS = {
     "approach_weight": 1.0,
     "shape_weight": 1.0,
     "place_weight": 1.0,
+    "gap_weight": 4.0,
 }
 """The settings (:data:`SETTINGS`): a new anchor's radius, its bounds; the creep floor added to |c*_0| in the
 creepage distance (near zero creepage the force is linear in c* and small; 0.1 is a tenth of the saturation
-scale); the weights of the other distances."""
+scale); the weights of the other distances. The sampled gap's weight was measured on wheel-flat's first impact
+(0.0135 s, contact_tolerance 0.05; same-state departure from the loop's BEM at auto's output samples, bench
+definition): weights 1 / 4 / 8 gave 390 / 676 / 986 BEM solves (always-BEM: 17904), a largest creep-force
+departure of 52 / 14 / 10 % and 58 of 306 / 32 of 578 / 20 of 823 measured corrections above 5 %; the remaining
+departures are at creep forces of 0.01-0.02 mu N, where two BEM runs through the same states differed by 9.9 %
+before the loop's element-size window was narrowed (callback.LADDER_STEP)."""
 
 
 def reuse_store(candidates: int, settings: dict | None = None) -> np.ndarray:
@@ -191,14 +207,62 @@ def _cheap(par, tables, dummy, g, creep, where):
 
 
 @njit(cache=True, _nrt=False)
-def _distance(row, star, log_ab, g, st):
-    """The distance of the inputs from the anchor in ``row`` (module docstring; st the statistics row: settings)."""
+def gap_descriptor(xs, ys, gap, q, ca, cb):
+    """What the trust region sees of a sampled gap (gap[j, i] = h(xs[i], ys[j]) - q, negative in the overlap, on a
+    uniform grid; q the approach, ca, cb the quadric's coefficients of the same patch, 1/m): (ln(V / V_q), x_c / a_q,
+    y_c / b_q) with V the overlap's volume (the integral of -gap where negative), V_q = pi q^2 / (2 sqrt(ca cb)) the
+    quadric's, (x_c, y_c) the centroid of -gap over the overlap and a_q = sqrt(q / ca), b_q = sqrt(q / cb) the
+    quadric's overlap semi-axes. A flat or a polygon's facet passing under the patch moves the centroid and changes
+    the volume at an unchanged quadric; on a round wheel and rail the descriptor stays put. :data:`NO_GAP` when the
+    grid, the approach or the quadric cannot define it or the sampled gap has no overlap.
+    """
+    if xs.shape[0] < 2 or ys.shape[0] < 2 or not (q > 0.0 and ca > 0.0 and cb > 0.0):
+        return NO_GAP
+    volume, moment_x, moment_y = 0.0, 0.0, 0.0
+    for j in range(ys.shape[0]):
+        for i in range(xs.shape[0]):
+            depth = -gap[j, i]
+            if depth > 0.0:
+                volume += depth
+                moment_x += depth * xs[i]
+                moment_y += depth * ys[j]
+    if not volume > 0.0:
+        return NO_GAP
+    cell = (xs[1] - xs[0]) * (ys[1] - ys[0])
+    volume_q = math.pi * q * q / (2.0 * math.sqrt(ca * cb))
+    return (
+        math.log(volume * cell / volume_q),
+        moment_x / volume / math.sqrt(q / ca),
+        moment_y / volume / math.sqrt(q / cb),
+    )
+
+
+@njit(cache=True, _nrt=False)
+def _gap_distance(row, shape):
+    """The sampled gap's distance from the anchor's: the larger of |change of ln(V / V_q)| and the centroid's move
+    (:func:`gap_descriptor`); 0 when neither was sampled, inf when one was and the other not.
+    """
+    here, there = math.isfinite(shape[0]), math.isfinite(row[R_GAP])
+    if not here and not there:
+        return 0.0
+    if here != there:
+        return math.inf
+    moved = math.hypot(shape[1] - row[R_GAP + 1], shape[2] - row[R_GAP + 2])
+    return max(abs(shape[0] - row[R_GAP]), moved)
+
+
+@njit(cache=True, _nrt=False)
+def _distance(row, star, log_ab, g, st, shape):
+    """The distance of the inputs from the anchor in ``row`` (module docstring; st the statistics row: settings;
+    shape the sampled gap's descriptor, :func:`gap_descriptor`).
+    """
     xs, ys, ps = star
     ds = math.sqrt((xs - row[R_XS]) ** 2 + (ys - row[R_YS]) ** 2 + (ps - row[R_PS]) ** 2)
     s0 = math.sqrt(row[R_XS] ** 2 + row[R_YS] ** 2 + row[R_PS] ** 2)
     d = ds / (s0 + st[C_CREEP_FLOOR])
     d = max(d, st[C_SHAPE] * abs(log_ab - row[R_LOG_AB]))
     d = max(d, st[C_APPROACH] * abs(math.log(g[G_APPROACH]) - row[R_LOG_Q]))
+    d = max(d, st[C_GAP] * _gap_distance(row, shape))
     return max(d, st[C_PLACE] * abs(g[G_WHEEL_LATERAL] - row[R_WHEEL_Y]) / row[R_HALF_WIDTH])
 
 
@@ -224,9 +288,10 @@ def _corrected(row, hertz, forces):
 
 
 @njit(cache=True, _nrt=False)
-def reuse_serve(par, tables, dummy, g, creep, where, c):
+def reuse_serve(par, tables, dummy, g, creep, where, c, shape):
     """Candidate c by its anchor's correction when the inputs are within its trust region: (served, N, T_x, T_y,
     M_z, a, b, area, max pressure, patch geometry code, ellipticity residual); served False: solve it (callback).
+    shape: the sampled gap's descriptor (:func:`gap_descriptor`; :data:`NO_GAP` on the quadric).
     """
     store = tables.reuse
     if not _enabled(par, store, c) or store[c, R_VALID] <= 0.0 or not g[G_APPROACH] > 0.0:
@@ -234,7 +299,7 @@ def reuse_serve(par, tables, dummy, g, creep, where, c):
     row = store[c]
     hertz, forces, star, log_ab = _cheap(par, tables, dummy, g, creep, where)
     mu_n = hertz[-1]
-    if not mu_n > 0.0 or _distance(row, star, log_ab, g, store[-1]) > row[R_RADIUS]:
+    if not mu_n > 0.0 or _distance(row, star, log_ab, g, store[-1], shape) > row[R_RADIUS]:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, math.nan
     n, tx, ty, mz, sa, sb, area, pmax = _corrected(row, hertz, forces)
     store[-1, T_SERVED] += 1.0
@@ -348,11 +413,12 @@ def _correction_errors(served, fresh, mu_n, fmap):
 
 
 @njit(cache=True, _nrt=False)
-def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed):
+def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed, shape):
     """Candidate c solved by the callback at this input (solved = (N, T_x, T_y, M_z, a, b, area, max pressure,
     patch geometry code, ellipticity residual); formed = (the formed patch's own quantities, NaN if none; the frame
-    map; the candidate's point y): :func:`_keep_formed`): measure the old anchor's correction against it when the
-    input is within twice the old radius (adapting the radius), then make it the anchor (module docstring).
+    map; the candidate's point y): :func:`_keep_formed`; shape: the sampled gap's descriptor, :func:`gap_descriptor`):
+    measure the old anchor's correction against it when the input is within twice the old radius (adapting the
+    radius), then make it the anchor (module docstring).
     """
     store = tables.reuse
     if not _enabled(par, store, c):
@@ -369,7 +435,7 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed):
         row[R_VALID] = 0.0
         return
     radius = row[R_RADIUS]
-    if row[R_VALID] > 0.0 and _distance(row, star, log_ab, g, store[-1]) <= 2.0 * radius:
+    if row[R_VALID] > 0.0 and _distance(row, star, log_ab, g, store[-1], shape) <= 2.0 * radius:
         n, tx, ty, _, _, _, _, _ = _corrected(row, hertz, forces)
         errors = _correction_errors((n, tx, ty), (n_b, tx_b, ty_b), mu_n * n_b / normal_h, formed[1])
         radius = _measure(store[-1], radius, errors, par.auto_level, t)
@@ -391,4 +457,5 @@ def reuse_anchor(par, tables, dummy, g, creep, where, c, t, solved, formed):
     pmax_h = 1.5 * normal_h / area_h
     row[R_PMAX_RATIO] = pmax_b / pmax_h if math.isfinite(pmax_b) else 1.0
     row[R_GEOMETRY], row[R_RESIDUAL] = geom, resid
+    row[R_GAP], row[R_GAP + 1], row[R_GAP + 2] = shape
     _keep_formed(row, creep, g, formed)

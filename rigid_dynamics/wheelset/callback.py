@@ -49,8 +49,8 @@ class PatchCallback:
     BEM in the loop (``warm_start``, default True): each candidate (side, slot) keeps a bem.BemWarmStart, the
     last solve on each grid starting the next one on the same grid; a sampled patch is solved on square elements
     of a size chosen from a ladder (powers of 2^(1/4)) to give about ``BEM_ELEMENTS``^2 elements over the
-    patch's potential area, kept while the box changes by less than a factor 2, so the grid and its influence
-    numbers repeat from step to step.
+    patch's potential area, kept while the size the box asks for stays within one step of it (:data:`LADDER_STEP`),
+    so the grid and its influence numbers repeat from step to step.
     ``calls`` and ``seconds`` count the solves; ``message`` holds the last failure.
     """
 
@@ -289,7 +289,7 @@ class PatchCallback:
         if geometry.undeformed is not None and not named:
             size = self.sizes.get(key)
             wanted = ladder_element_size(geometry.undeformed)
-            if size is None or not (0.5 * wanted <= size <= 2.0 * wanted):
+            if size is None or abs(math.log(size / wanted, LADDER_STEP)) > 1.0 + 1e-6:
                 size = wanted
                 self.sizes[key] = size
             options = dict(options or {}, element_size_m=size)
@@ -303,6 +303,13 @@ def ladder_element_size(undeformed) -> float:
     extent = math.sqrt(float(np.ptp(undeformed.x_m)) * float(np.ptp(undeformed.y_m)))
     return 0.5 * 2.0 ** (round(4.0 * math.log2(extent / BEM_ELEMENTS)) / 4.0)
 
+
+LADDER_STEP = 2.0**0.25
+"""The ladder's ratio between neighbouring element sizes. A patch keeps its element size while the size its box
+asks for is at most one step away (the kept size at most one step coarser or finer than asked: no flapping between
+two sizes at a rung's boundary). The window was a factor 2 each way until session 23: two runs through the same
+states then solved a patch on elements up to twice as large or small, depending on the path, and differed by up to
+9.9 % in the creep force (bench definition) on the wheel flat (benchmarks/results/auto_vs_bem.md)."""
 
 BEM_ELEMENTS = 40
 """Elements of the ladder's size across the sampled box (geometric mean of its sides), before the halving: the box

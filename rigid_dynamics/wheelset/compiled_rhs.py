@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit, objmode
 
 from rigid_dynamics.contact.friction import VARIES_ALONG_TRACK, VARIES_WITH_INCLINATION
-from rigid_dynamics.wheelset.auto_reuse import reuse_anchor, reuse_own, reuse_serve
+from rigid_dynamics.wheelset.auto_reuse import NO_GAP, gap_descriptor, reuse_anchor, reuse_own, reuse_serve
 from rigid_dynamics.wheelset.compiled_laws import (
     LAW_AUTO,
     LAW_BEM_CORRECTED,
@@ -237,11 +237,12 @@ def _external(t, y, c, side, g, creep, frame):
 
 
 @njit(cache=True, _nrt=False)
-def _auto_bem(t, y, c, side, g, creep, frame, laws):
+def _auto_bem(t, y, c, side, g, creep, frame, laws, shape):
     """A patch ``auto`` gave to BEM: served by its stored BEM anchor's correction of FASTSIM within the trust
     region (auto_reuse.reuse_serve; recorded as rung layout.AUTO_BEM_CORRECTED, law compiled_laws.LAW_BEM_CORRECTED),
     else solved by the callback (:func:`_external`) and made the candidate's anchor (auto_reuse.reuse_anchor).
-    Arguments as :func:`_external`'s; laws = (par, tables, dummy, where, rec, record). Returns _external's values
+    Arguments as :func:`_external`'s; laws = (par, tables, dummy, where, rec, record); shape: the sampled gap's
+    descriptor (auto_reuse.gap_descriptor; auto_reuse.NO_GAP on the quadric). Returns _external's values
     (without the frame map) and the law code; a served patch whose anchor was a formed patch gives the formed
     patch's own quantities at the served forces (auto_reuse.reuse_own; when ``record``), else layout.NOT_FORMED.
     """
@@ -249,7 +250,7 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     _, xi, eta, spin = creep
     point_y = y[Y] + g[G_LEVER + 1]
     served, normal, tx, ty, mz, sa, sb, area, pmax, geom, resid = reuse_serve(
-        par, tables, dummy, g, (xi, eta, spin), where, c
+        par, tables, dummy, g, (xi, eta, spin), where, c, shape
     )
     if served:
         own = NOT_FORMED
@@ -260,7 +261,7 @@ def _auto_bem(t, y, c, side, g, creep, frame, laws):
     normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, fmap = _external(t, y, c, side, g, creep, frame)
     if st == 0:
         solved = (normal, tx, ty, mz, sa, sb, area, pmax, geom, resid)
-        reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved, (own, fmap, point_y))
+        reuse_anchor(par, tables, dummy, g, (xi, eta, spin), where, c, t, solved, (own, fmap, point_y), shape)
     return normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, LAW_CALLBACK
 
 
@@ -388,8 +389,19 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
                 resid = field.residual[c]
             law = _served_law(par, rec, c, record)
             if to_callback:  # auto chose BEM (or FASTSIM broke the friction bound): its anchor or the callback
+                gap_shape = NO_GAP
+                if field.sampled[c] > 0.0:
+                    gap_shape = gap_descriptor(field.xs[c], field.ys[c], field.gap[c], q, ca, cb)
                 normal, tx, ty, mz, sa, sb, area, pmax, geom, resid, st, own, law = _auto_bem(
-                    t, y, c, side, g, (speed, xi, eta, spin), (ex, ey), (par, tables, dummy, where, rec, record)
+                    t,
+                    y,
+                    c,
+                    side,
+                    g,
+                    (speed, xi, eta, spin),
+                    (ex, ey),
+                    (par, tables, dummy, where, rec, record),
+                    gap_shape,
                 )
                 if st != 0:
                     return CALLBACK_FAILED
