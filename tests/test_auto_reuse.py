@@ -163,14 +163,14 @@ def test_the_trust_region_sees_the_sampled_gap():
     quadric, and with it FASTSIM's ellipse, cannot see it); so does a patch whose geometry switched between the
     quadric and the sampled gap.
     """
-    from rigid_dynamics.wheelset.auto_reuse import R_RADIUS, reuse_anchor, reuse_serve
+    from rigid_dynamics.wheelset.auto_reuse import DEFAULTS, R_RADIUS, reuse_anchor, reuse_serve
 
     par, hk, g = _setup()
     where, dummy = (0.0, 20.0), np.zeros((1, 1))
     anchor = _solved(_bem(ANCHOR_CREEP))
     shape = (0.05, 0.02, -0.01)
     reuse_anchor(par, hk, dummy, g, ANCHOR_CREEP, where, 0, 0.0, anchor, NOT_FORMED, shape)
-    radius = hk.reuse[0, R_RADIUS]
+    radius = hk.reuse[0, R_RADIUS] / DEFAULTS["gap_weight"]  # the gap's own reach
     assert reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, shape)[0]
     assert reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, (0.05 + 0.5 * radius, 0.02, -0.01))[0]
     assert not reuse_serve(par, hk, dummy, g, ANCHOR_CREEP, where, 0, (0.05 + 1.5 * radius, 0.02, -0.01))[0]

@@ -197,7 +197,8 @@ def test_run_wheel_forces_are_the_records_and_the_former_ones(run):
 @pytest.fixture(scope="module")
 def auto_run():
     """``auto`` (5 %, its BEM patches reused: auto_reuse.py) on the sampled gap from curve-flange's flange root, 6 ms:
-    the flange patch goes to BEM, and every recorded sample of it is served by its anchor's correction."""
+    the flange patch goes to BEM, and most recorded samples of it are served by its anchor's correction (5 of 7;
+    the other two were re-solved by the callback there: the sampled gap had moved beyond the trust region)."""
     return _root_run("auto", 0.006)
 
 
@@ -213,14 +214,15 @@ def test_auto_records_its_served_bem_patches_in_the_formed_plane(auto_run, at_st
     force to 3.3e-6 relative (the candidate's frame moves within the trust region; exact for the solved patches).
     """
     from rigid_dynamics.contact.search import WheelsetPose
-    from rigid_dynamics.wheelset.compiled_laws import LAW_BEM_CORRECTED
+    from rigid_dynamics.wheelset.compiled_laws import LAW_BEM_CORRECTED, LAW_CALLBACK
     from rigid_dynamics.wheelset.formed_patches import PatchFormer
     from rigid_dynamics.wheelset.simulate import build_provider
 
     run = auto_run
     model = at_state[0]
     p = run.patches
-    assert np.all(p["contact_law_code"][:, 0, 0] == LAW_BEM_CORRECTED), p["contact_law_code"][:, 0, 0]
+    laws = p["contact_law_code"][:, 0, 0]
+    assert np.all((laws == LAW_BEM_CORRECTED) | (laws == LAW_CALLBACK)) and np.sum(laws == LAW_BEM_CORRECTED) >= 4, laws
     former = PatchFormer(build_provider(run.scene).surfaces)
     for i in range(len(run.t)):
         (formed,) = former.patches("left", WheelsetPose(*(float(v) for v in run.states[i, :6])))
@@ -247,16 +249,19 @@ def test_auto_measures_its_reuse_error_in_the_formed_plane(auto_run):
     """The reuse's own error (the corrected value the old anchor would have served against each fresh BEM solve,
     auto_reuse._correction_errors) is judged in the formed patch's plane. Since auto decides on the sampled gap's
     geometry, both wheels' patches of this run go up the ladder (the flange root's ellipticity residual 1.5-2.5, the
-    right tread's 0.24-0.45) and are served by the reuse: 14 corrections measured, the largest creep-force error
-    4.6 % (normal force 1.7 %), none above the 5 % tolerance, so the run ends ``ok``. (Before, with the right tread on
-    the ellipse: 11.8 %, 1 of 9 above, ``warning``; in the candidate's plane, 0.26 rad off, the same corrections read
-    110 % and 4 of 10: there the creep force is mostly a component of the normal force, a few per cent of the
-    patch's own.) The warning path itself: tests/test_dynamics_regression.py.
+    right tread's 0.24-0.45) and are served by the reuse. Since the trust region also sees the sampled gap
+    (auto_reuse.gap_descriptor), 19 corrections are measured (46 re-solves), the largest creep-force error 5.3 %
+    (normal force 2.2 %), one above the 5 % tolerance, so the run ends ``warning`` and says so. (Before the gap
+    entered the region: 14 measured, largest 4.6 %, ``ok``: the gap's moves were served without being measured.
+    With the right tread on the ellipse: 11.8 %, 1 of 9 above; in the candidate's plane, 0.26 rad off, the same
+    corrections read 110 % and 4 of 10: there the creep force is mostly a component of the normal force, a few per
+    cent of the patch's own.)
     """
     stats = auto_run.summary()["callback"]["auto_reuse"]
-    assert stats["errors_measured"] >= 10
-    assert 0.01 < stats["max_creep_force_error"] < 0.05 and stats["errors_above_tolerance"] == 0
-    assert auto_run.status == "ok", auto_run.message
+    assert stats["errors_measured"] >= 15
+    assert 0.01 < stats["max_creep_force_error"] < 0.06 and stats["max_normal_force_error"] < 0.03
+    assert stats["errors_above_tolerance"] == 1
+    assert auto_run.status == "warning" and "1 of 19 measured corrections" in auto_run.message, auto_run.message
 
 
 def test_reuse_errors_are_judged_in_the_plane_solved_in():
