@@ -140,8 +140,8 @@ scale); the weights of the other distances. The sampled gap's weight was measure
 (0.0135 s, contact_tolerance 0.05; same-state departure from the loop's BEM at auto's output samples, bench
 definition): weights 1 / 4 / 8 gave 390 / 676 / 986 BEM solves (always-BEM: 17904), a largest creep-force
 departure of 52 / 14 / 10 % and 58 of 306 / 32 of 578 / 20 of 823 measured corrections above 5 %; the remaining
-departures are at creep forces of 0.01-0.02 mu N, where two BEM runs through the same states differed by 9.9 %
-before the loop's element-size window was narrowed (callback.LADDER_STEP)."""
+departures are at creep forces of 0.01-0.02 mu N, where two BEM runs through the same states differ by 9.5 %
+(callback.LADDER_STEP) and the BEM's own grid-error estimate reaches 0.49 of the bench's creep-force scale."""
 
 
 def reuse_store(candidates: int, settings: dict | None = None) -> np.ndarray:

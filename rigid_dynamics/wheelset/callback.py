@@ -307,9 +307,12 @@ def ladder_element_size(undeformed) -> float:
 LADDER_STEP = 2.0**0.25
 """The ladder's ratio between neighbouring element sizes. A patch keeps its element size while the size its box
 asks for is at most one step away (the kept size at most one step coarser or finer than asked: no flapping between
-two sizes at a rung's boundary). The window was a factor 2 each way until session 23: two runs through the same
-states then solved a patch on elements up to twice as large or small, depending on the path, and differed by up to
-9.9 % in the creep force (bench definition) on the wheel flat (benchmarks/results/auto_vs_bem.md)."""
+two sizes at a rung's boundary). The window was a factor 2 each way until session 23, so that two runs through the
+same states could solve a patch on elements up to twice as large or small, depending on the path. Measured on the
+wheel flat's impact (benchmarks/results/auto_vs_bem.md, auto without reuse against always-BEM at the same states):
+9.9 % apart in the creep force (bench definition) with the factor-2 window, 9.5 % with one step. What remains is
+the grid's own error at these patches (creep forces near 0.01 mu N; the BEM's estimate there is up to 0.49 of
+that scale): one step apart moves it that much."""
 
 BEM_ELEMENTS = 40
 """Elements of the ladder's size across the sampled box (geometric mean of its sides), before the halving: the box
