@@ -53,6 +53,17 @@ def held():
 
 
 def test_regression_loop_kpec_equals_static_kpec_on_the_sampled_gap(held):
+    """At the held flange-contact pose: the patches of one compiled right-hand side (compiled_rhs.contact_once, the
+    loop's own evaluation, kernels compiled at setup) against the static KpecModel on the gap the loop's sampler
+    (compiled_patch.sample_candidates, which _rhs calls for KPEC) gives for that evaluation's candidate geometry,
+    state and rotation: forces, area and max pressure to 1e-9 (forces 1e-6 mu N) on >= 2 sampled patches, one on the
+    flange (contact angle > 0.5 rad). Were the loop's law served another gap than the sampler's, they would differ.
+    Until 2026-11-30 the gap came from compiled_rhs.patches_once (the workspace's copy), a test-only entry point that
+    compiled the whole right-hand side again in every clean clone (24-55 s; tests/test_kpec_loop.py was then the
+    only caller): the same claim, now checked in about 3 s.
+    """
+    from rigid_dynamics.wheelset.compiled_patch import sample_candidates
+
     scene, run, _ = held
     from rigid_dynamics.wheelset.equilibrium import initial_state
     from rigid_dynamics.wheelset.state import n_states
@@ -65,7 +76,8 @@ def test_regression_loop_kpec_equals_static_kpec_on_the_sampled_gap(held):
     cg = np.zeros((ncand, lay.N_GEO))
     field = patch_scratch(run.par, ncand)
     out = np.zeros_like(y)
-    assert compiled_rhs.patches_once(0.0, y, run, out, rec, cg, field) == lay.OK
+    assert compiled_rhs.contact_once(0.0, y, run, out, rec, cg) == lay.OK
+    sample_candidates(y, run, cg, field, np.zeros(3))  # the sampled gaps of this evaluation (3-vector: scratch)
     material = scene.material
     checked = 0
     for c in range(ncand):

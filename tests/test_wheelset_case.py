@@ -8,7 +8,6 @@ example input ``examples/mbench_a22_right.inp`` (repository eve70a/CONTACT): the
 difference is expected.
 """
 
-import dataclasses
 import math
 
 import numpy as np
@@ -265,26 +264,5 @@ def test_case_file_rail_smoothing_key(tmp_path):
         load_case(tmp_path / "bad.toml")
 
 
-def test_default_bem_rebalances_on_the_grids_that_meet_its_tolerance():
-    """README's `wheelrail contact manchester-a22 --method bem`: at the defaults the final patches are refined until
-    the BEM's estimate meets grid_tolerance (the right wheel's joined tread-flange patch 40 x 40 -> 320 x 320, its
-    max pressure estimate 20 % -> 1.2 %) and the equilibrium is rebalanced on those grids (the load is carried by
-    the refined patches' forces, not the default grid's). A grid the caller names is solved as named."""
-    import wheelrail as wr
-
-    solution = wr.solve_case("manchester-a22", "bem")
-    assert solution.success, solution.message
-    assert "rebalanced on the grids its patches were refined to" in solution.message
-    grids = {side: (result.extra["nx"], result.extra["ny"]) for side, _, _, result in solution.patches}
-    assert grids["right"][0] >= 160 and grids["left"][0] >= 80
-    for side, _, _, result in solution.patches:
-        assert result.status == "ok", (side, result.message)
-        assert result.extra["grid_error_estimate"] <= 0.02
-    loads = solution.extra["wheel_vertical_load_N"]
-    assert all(load == pytest.approx(1.0e4, rel=1e-5) for load in loads.values())
-    case = wr.load_case("manchester-a22")
-    named = wr.solve_case(dataclasses.replace(case, solver_options={"model": {"nx": 40, "ny": 40}}), "bem")
-    assert named.success and "rebalanced" not in named.message
-    assert {result.extra["nx"] for _, _, _, result in named.patches} == {40}
-    right = next(result for side, _, _, result in named.patches if side == "right")
-    assert right.status == "warning" and right.extra["grid_error_estimate"] > 0.1  # 40 x 40 states its 20 %
+# test_default_bem_rebalances_on_the_grids_that_meet_its_tolerance is in tests/test_docs.py: it checks the solution
+# of the README's Python block (the same `wr.solve_case("manchester-a22", "bem")`), so the case is solved once.
