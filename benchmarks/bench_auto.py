@@ -276,8 +276,8 @@ NO_WHOLE = [
     "",
     "Not run (``--whole`` runs them): since auto decides on the sampled gap's geometry (commit 7aa8be7), the "
     "S1002/UIC60 treads of polygonal-wheel and curve-flange lie beyond every ellipse rung's measured box and go to the "
-    "BEM or its reuse; measured once (--whole, 2026-11-29): polygonal-wheel 0.0061x, curve-flange 0.0093x in process "
-    "(before the trust region saw the sampled gap, commit ff9f46e; not rerun since).",
+    "BEM or its reuse; last measured with --whole on 2026-11-30 (the trust region seeing the sampled gap): "
+    "polygonal-wheel 0.0058x, curve-flange 0.030x in process.",
     "",
 ]
 """The report's closing section when the whole-scene runs were not made."""

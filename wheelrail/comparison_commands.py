@@ -30,7 +30,7 @@ DEMO_PATCH_GEOMETRY = "ellipse"
 (multi-Hertzian), the geometry auto's thresholds were measured on. With ``--patch-geometry sampled`` (the scenes'
 default) auto decides on each patch's sampled gap too: polygonal-wheel's S1002/UIC60 treads (ellipticity residual
 1-20 in the loop) lie beyond every ellipse rung's measured box (0.55 at 10 %), so every patch goes to the BEM or its
-reuse and the 2 s run takes about 5 minutes in process (auto at 5 %: 0.0061x real time over the whole 2 s,
+reuse and the 2 s run takes about 6 minutes in process (auto at 5 %: 0.0058x real time over the whole 2 s,
 benchmarks/results/auto_vs_bem.md)."""
 
 DEMO_FEA_OPTIONS = {"domain_factor": 40.0}
