@@ -59,8 +59,8 @@ def test_regression_loop_kpec_equals_static_kpec_on_the_sampled_gap(held):
     state and rotation: forces, area and max pressure to 1e-9 (forces 1e-6 mu N) on >= 2 sampled patches, one on the
     flange (contact angle > 0.5 rad). Were the loop's law served another gap than the sampler's, they would differ.
     Until 2026-11-30 the gap came from compiled_rhs.patches_once (the workspace's copy), a test-only entry point that
-    compiled the whole right-hand side again in every clean clone (24-55 s; tests/test_kpec_loop.py was then the
-    only caller): the same claim, now checked in about 3 s.
+    compiled the whole right-hand side again in every clean clone (24-55 s; this test was its only caller, and it was
+    removed): the same claim, now checked in about 3 s.
     """
     from rigid_dynamics.wheelset.compiled_patch import sample_candidates
 

@@ -572,19 +572,3 @@ def force_difference(f4, f3):
             if d > worst:
                 worst = d
     return worst
-
-
-@njit(cache=True)
-def patches_once(t, y, run, out, rec, cg, field):
-    """:func:`contact_once` (search or tables mode) that also copies the sampled patches (compiled_patch.PatchScratch
-    of the run's grid, from compiled_patch.patch_scratch) into ``field``: for tests and the benchmark's inspection.
-    """
-    ws = workspace(run, rec)
-    st = _rhs(t, y, run, ws, True, True, out)
-    cg[:, :] = ws.cg
-    field.gap[:] = ws.patch.gap
-    field.xs[:] = ws.patch.xs
-    field.ys[:] = ws.patch.ys
-    field.residual[:] = ws.patch.residual
-    field.sampled[:] = ws.patch.sampled
-    return st
