@@ -321,6 +321,36 @@ def _same_state_text(ss) -> str:
     return f"{_pct(ss['normal_relative'])}, {_pct(ss['creep_bench'])}; {rungs}"
 
 
+def verdict(departure: float, spread: float, tolerance: float) -> str:
+    """auto's same-state departure from always-BEM judged against the tolerance with the reference's own spread
+    (two always-BEM evaluations of the same states: auto-no-reuse's same-state departure): "within" when
+    departure + spread <= tolerance, "beyond" when departure - spread > tolerance, else "undecided".
+    """
+    if departure + spread <= tolerance:
+        return "within"
+    if departure - spread > tolerance:
+        return "beyond"
+    return "undecided"
+
+
+def verdict_lines(rows: list) -> list:
+    """One line per scene: auto's same-state normal and creep-force departures judged by :func:`verdict`."""
+    out = []
+    for r in rows:
+        auto = r["runs"].get("auto", {}).get("same_state")
+        spread = r["runs"].get("auto-no-reuse", {}).get("same_state")
+        if not auto or not spread:
+            continue
+        tol = r["runs"]["auto"]["tolerance"]
+        parts = [
+            f"{label} {_pct(auto[key])} against the reference's spread {_pct(spread[key])}: "
+            f"{verdict(auto[key], spread[key], tol)}"
+            for label, key in (("normal force", "normal_relative"), ("creep force", "creep_bench"))
+        ]
+        out.append(f"- {r['scene']}: " + "; ".join(parts) + f" (tolerance {_pct(tol)}).")
+    return out
+
+
 def _pct(v, digits=2):
     return "-" if v is None else f"{100 * v:.{digits}g} %"
 
@@ -393,6 +423,12 @@ def report(rows: list) -> list:
         "per patch in contact in both; per rung the largest and the number of patches. A run that stopped "
         "(budget-exceeded: the integrator's wall-time budget, 600 s before this bench raised it) is compared over "
         "the samples it reached, its RTF over the simulated time it reached.",
+        "",
+        "Verdicts (same state; the reference's spread: auto-no-reuse, i.e. always-BEM evaluated along another path, "
+        "against always-BEM at the same states: its element sizes and warm starts differ by path; within when "
+        "departure + spread <= tolerance, beyond when departure - spread > tolerance, else undecided):",
+        "",
+        *verdict_lines(rows),
         "",
     ]
     return lines
