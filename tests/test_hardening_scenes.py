@@ -59,6 +59,11 @@ def scene_text(name: str, *replacements: tuple[str, str]) -> str:
             [("lateral_displacement_m = 0.003", "lateral_displacement_m = 1e30")],
             ["'initial.lateral_displacement_m' = 1e+30", "flangeway"],
         ),
+        (
+            "curve-flange",
+            [("[suspension]\n", "[suspension]\nframe_yaw_rad = 0.2\n")],
+            ["frame_yaw_rad = 0.2", "|value| <= 0.1"],
+        ),
     ],
 )
 def test_bad_scene_refused_before_work(capsys, tmp_path, scene, replacements, fragments):

@@ -205,3 +205,85 @@ def test_cli_curve_flange_kpec_records_sampled_flange_patches(tmp_path):
     )
     print(message)
     assert abs(a_s / a_e - 1) > 0.01 or abs(p_s / p_e - 1) > 0.01, message
+
+
+def _no_pressure_gap():
+    """A gap the loop sampled on curve-flange with the frame held at -12.5 mrad (suspension.frame_yaw_rad, kx 3e7 N/m,
+    kpec, 0.1 ms), t = 0.141 s, left wheel: a deep narrow overlap (-24.8 um) on the row next to grid rows whose normal
+    misses a profile (FAR_GAP, 1e6 m) and a shallow wide one below it. KPEC's equivalent ellipse then puts the deepest
+    row outside itself (eps = 0): the deepest element alone is flagged, on a strip of zero length.
+    """
+    data = np.load(ROOT / "tests" / "data" / "kpec_no_pressure_gap.npz")
+    return data["x_m"], data["y_m"], data["gap_m"]
+
+
+def test_kpec_puts_no_contact_flag_without_pressure_and_fails_on_an_overlapping_gap():
+    """Before 2026-11-30 the element on the zero-length strip was flagged in contact with zero pressure: the law
+    went on with F_N = 0 into the flexibilities and the compiled loop died of a ZeroDivisionError (the run ended
+    'solver-failed: ZeroDivisionError'). Now an element is in the contact area only where it carries pressure, the
+    static rung ends 'no-pressure' (success False, no number) and the loop's law returns NaN, which
+    compiled_rhs turns into layout.GAP_LAW_FAILED ('contact-failed', named)."""
+    from rigid_dynamics.contact.kpec import kpec_pressure
+
+    xs, ys, gap = _no_pressure_gap()
+    assert gap.min() < -2e-5
+    p, c = np.zeros(gap.shape), np.zeros(gap.shape, np.bool_)
+    force = kpec_pressure(gap, xs, ys, 82e9, 0.28, p, c)[0]
+    assert force == 0.0 and not c.any() and not p.any()
+    # the static rung fits its own grid to the overlap (where this gap gives pressure); its branch for the same
+    # outcome, a kernel that flags nothing on an overlapping gap, ends 'no-pressure' with no number
+    material = load_scene("curve-flange").material
+
+    class Degenerate(KpecModel):
+        def _normal(self, h, x, y, g_mod, nu, p, contact):
+            out = super()._normal(h, x, y, g_mod, nu, p, contact)
+            p[...], contact[...] = 0.0, False
+            return out
+
+    geometry = ContactGeometry.quadric(0.46, 0.3, approach_m=5e-5)
+    res = Degenerate().solve(geometry, Creepage(1e-3, -2e-3, 0.5, 10.0), material)
+    assert not res.success and res.status == "no-pressure" and "put pressure on no element" in res.message
+    assert math.isnan(res.normal_force_N)
+    # the loop's law
+    par = new_parameters()
+    g, nu = material.shear_modulus_Pa, material.poisson_ratio
+    par["shear_modulus_Pa"], par["contact_modulus_Pa"] = g, g / (1 - nu)
+    par["friction_coefficient"] = material.friction_coefficient
+    par["kpec_nx"], par["kpec_ny"] = xs.size, ys.size
+    field = patch_scratch(par, 1)
+    field.xs[0], field.ys[0], field.gap[0], field.sampled[0] = xs, ys, gap, 1.0
+    out = _kpec_law(
+        par, hertz_kalker_tables(tables_for(g, nu)), field, 0, (-float(gap.min()), 1.0, 1.0, 0.0), (1e-3, -2e-3, 0.5),
+        material.friction_coefficient,
+    )  # fmt: skip
+    assert math.isnan(out[0])
+    assert lay.STATUS[lay.GAP_LAW_FAILED][0] == "contact-failed"
+
+
+def test_kpec_contact_flags_are_the_elements_with_pressure(held):
+    """On the loop's sampled gaps at the held flange pose the contact area (flags) is where the pressure is > 0."""
+    from rigid_dynamics.contact.kpec import kpec_pressure
+    from rigid_dynamics.wheelset.compiled_patch import sample_candidates
+    from rigid_dynamics.wheelset.equilibrium import initial_state
+    from rigid_dynamics.wheelset.state import n_states
+
+    scene, run, _ = held
+    y = np.zeros(n_states(int(run.par["track_positions"])))
+    y[:12] = initial_state(scene)
+    y[:6] = POSE
+    ncand = run.sides.shape[0]
+    rec, cg = np.zeros((ncand + 2, lay.N_FIELDS)), np.zeros((ncand, lay.N_GEO))
+    field = patch_scratch(run.par, ncand)
+    assert compiled_rhs.contact_once(0.0, y, run, np.zeros_like(y), rec, cg) == lay.OK
+    sample_candidates(y, run, cg, field, np.zeros(3))
+    checked = 0
+    for c in range(ncand):
+        if field.sampled[c] > 0:
+            gap = field.gap[c]
+            p, flags = np.zeros(gap.shape), np.zeros(gap.shape, np.bool_)
+            kpec_pressure(
+                gap, field.xs[c], field.ys[c], scene.material.shear_modulus_Pa, scene.material.poisson_ratio, p, flags
+            )
+            assert flags.any() and np.array_equal(flags, p > 0)
+            checked += 1
+    assert checked >= 2

@@ -257,6 +257,10 @@ def kpec_pressure_into(h, x, y, material, fields, rows):
             total += pressure[j, i]
             if not in_contact[j, i]:
                 pressure[j, i] = 0.0
+            elif not pressure[j, i] > 0.0:
+                # an element at its strip's end (the strip of zero length when the deepest element sits on its row's
+                # threshold, eps = 0): no pressure, so not in the contact area either
+                in_contact[j, i] = False
     return total * dx * dy, p_max, curv_a, curv_b, y_mid, a, b, -h_min
 
 

@@ -214,6 +214,17 @@ class KpecModel:
                 x, y, h, p, contact, out = solve_at(pen)
         force = _force(p, x, y)
         if not contact.any():
+            if float(h.min()) < 0.0:  # the gap overlaps, yet no element carries pressure: a failure, not "no contact"
+                return ContactResult(
+                    method=self.name,
+                    success=False,
+                    status="no-pressure",
+                    message=f"{self.name.upper()} put pressure on no element of a gap that overlaps by "
+                    f"{-float(h.min()):.3g} m (its equivalent ellipse misses the deepest row)",
+                    normal_force_N=math.nan,
+                    creepage=creepage,
+                    wall_time_s=time.perf_counter() - start,
+                )
             return _no_contact(self.name, geometry, creepage, start, "KPEC found no element in contact")
         converged = normal_force_N is None or abs(force / normal_force_N - 1.0) < 1e-8
         message = f"{self.name.upper()} + {'FaStrip' if opts['tangential'] == 'fastrip' else 'FASTSIM'} per strip"

@@ -416,7 +416,8 @@ def _kpec_law(par, tables, field, c, geometry, creep, mu):
     patch's coefficient (compiled_rhs: the law at the patch's place and mean slip velocity, as the analytic laws).
     Kalker's C_ij of the flexibilities from the run's tables (relative error < 1e-7). Returns (N, a, b, T_x, T_y,
     M_z, area m^2, max pressure Pa); (a, b): the flexibilities' ellipse of the contact area; M_z about the contact
-    point.
+    point. N is NaN when the gap overlaps but KPEC puts pressure on no element (its equivalent ellipse misses the
+    deepest row: seen where the overlap runs into grid rows whose normal misses a profile).
     """
     if field.sampled[c] == 0.0:
         _quadric_field(par, field, c, geometry)
@@ -435,6 +436,14 @@ def _kpec_law(par, tables, field, c, geometry, creep, mu):
             if contact[j, i]:
                 count += 1
     if count == 0:
+        # no element carries pressure: no contact when the gap has no overlap, else KPEC failed on this gap (NaN:
+        # compiled_rhs ends the run with layout.GAP_LAW_FAILED; a zero force would be a wrong number)
+        overlap = 0.0
+        for j in range(gap.shape[0]):
+            for i in range(gap.shape[1]):
+                overlap = min(overlap, gap[j, i])
+        if overlap < 0.0:
+            return math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     a, b = flexibility_ellipse(contact, dx, dy)
     xi, eta, phi = creep

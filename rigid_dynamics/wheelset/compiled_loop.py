@@ -62,6 +62,7 @@ from rigid_dynamics.wheelset.layout import (
     CALLBACK_FAILED,
     DERAILED,
     FORCE_ANOMALY,
+    GAP_LAW_FAILED,
     N_FIELDS,
     NORMAL_FORCE,
     OK,
@@ -384,7 +385,7 @@ def _advance(y, span, tableau, control, run, outputs, carried, events, work):
             for i in range(nst):
                 kst[s, i] = stage[i]
             evals += 1
-            if st == CALLBACK_FAILED or (st != 0 and fixed):
+            if st == CALLBACK_FAILED or st == GAP_LAW_FAILED or (st != 0 and fixed):
                 # the contact model behind the callback failed (not a matter of the step), or a fixed step's stage
                 return _ended(st, t, h, accepted, rejected, k_out, evals, located, st)
             if st != 0:

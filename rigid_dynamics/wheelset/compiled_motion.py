@@ -196,14 +196,18 @@ def _assemble(t, y, par, force, moment, p_con, rail_force, om, rzx, out):
     p_ext = par.axle_load_N * vz
     ax0, ax1, ax2 = -sps * cth, cps * cth, sth
     x_frame = par.frame_x0_m + par.speed_m_per_s * t
+    # the frame's points, yawed by the held frame_yaw_rad (a bogie frame's angle to the track at this axle)
+    frame_cos, frame_sin = math.cos(par.frame_yaw_rad), math.sin(par.frame_yaw_rad)
     for s in (-1.0, 1.0):
         sb_ = s * par.suspension_half_spacing_m
         a0, a1, a2 = ax0 * sb_, ax1 * sb_, ax2 * sb_
         v0 = vx + om[1] * a2 - om[2] * a1
         v1 = vy + om[2] * a0 - om[0] * a2
         v2 = vz + om[0] * a1 - om[1] * a0
-        f0 = -par.suspension_kx_N_per_m * (xc + a0 - x_frame) - par.suspension_cx_N_s_per_m * (v0 - par.speed_m_per_s)
-        f1 = -par.suspension_ky_N_per_m * (yc + a1 - sb_) - par.suspension_cy_N_s_per_m * (v1 - 0.0)
+        f0 = -par.suspension_kx_N_per_m * (xc + a0 - x_frame + frame_sin * sb_) - par.suspension_cx_N_s_per_m * (
+            v0 - par.speed_m_per_s
+        )
+        f1 = -par.suspension_ky_N_per_m * (yc + a1 - frame_cos * sb_) - par.suspension_cy_N_s_per_m * (v1 - 0.0)
         f2 = -par.suspension_kz_N_per_m * (zc + a2 - par.frame_z_m) - par.suspension_cz_N_s_per_m * (v2 - 0.0)
         fe0 += f0
         fe1 += f1
@@ -212,7 +216,7 @@ def _assemble(t, y, par, force, moment, p_con, rail_force, om, rzx, out):
         me1 += a2 * f0 - a0 * f2
         me2 += a0 * f1 - a1 * f0
         p_ext += f0 * v0 + f1 * v1 + f2 * v2
-    myaw = -2.0 * (par.yaw_stiffness_N_m_per_rad * yaw + par.yaw_damping_N_m_s_per_rad * yr)
+    myaw = -2.0 * (par.yaw_stiffness_N_m_per_rad * (yaw - par.frame_yaw_rad) + par.yaw_damping_N_m_s_per_rad * yr)
     me2 += myaw
     p_ext += myaw * om[2]
     if par.torque_N_m != 0.0:

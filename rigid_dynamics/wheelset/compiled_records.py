@@ -97,6 +97,7 @@ def model_parameters(model_wheelset):
     par["suspension_kx_N_per_m"], par["suspension_ky_N_per_m"], par["suspension_kz_N_per_m"] = m.k
     par["suspension_cx_N_s_per_m"], par["suspension_cy_N_s_per_m"], par["suspension_cz_N_s_per_m"] = m.c
     par["yaw_stiffness_N_m_per_rad"], par["yaw_damping_N_m_s_per_rad"] = m.k_yaw, m.c_yaw
+    par["frame_yaw_rad"] = m.frame_yaw
     par["suspension_half_spacing_m"], par["frame_z_m"], par["frame_x0_m"], par["speed_m_per_s"] = (
         m.half_spacing,
         m.z_frame,

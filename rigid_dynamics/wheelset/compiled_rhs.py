@@ -76,6 +76,7 @@ from rigid_dynamics.wheelset.layout import (
     G_NORMAL,
     G_ROLLING_RADIUS,
     G_WHEEL_LATERAL,
+    GAP_LAW_FAILED,
     GEOMETRY_SEARCH,
     GEOMETRY_TABLES,
     MAX_PRESSURE,
@@ -370,6 +371,8 @@ def _forces(t, y, par, tables, sides, cg, rec, sc, dummy, field, record, out):
             normal, sa, sb, tx, ty, mz, area, pmax = _kpec_law(
                 par, tables, field, c, (q, ca, cb, angle), (xi, eta, spin), mu
             )
+            if normal != normal:
+                return GAP_LAW_FAILED
             sampled = field.sampled[c] > 0.0
             geom = PATCH_SAMPLED if sampled else PATCH_ELLIPSE
             resid = field.residual[c] if sampled else math.nan

@@ -19,9 +19,11 @@ from rigid_dynamics.wheelset.layout import (
     CALLBACK_FAILED,
     CREEP_FORCE_LONG,
     CREEPAGE_LONG,
+    GAP_LAW_FAILED,
     MAX_SLOTS,
     N_FIELDS,
     NORMAL_FORCE,
+    STATUS,
     UNDERFLOW,
     record_columns,
     status_name,
@@ -394,6 +396,8 @@ def _stop_from_status(model, status, t_end, y_end, method, steps, why=""):
     name = status_name(status)
     if status == CALLBACK_FAILED and model.callback is not None:
         why = f": {model.callback.message}"
+    elif status == GAP_LAW_FAILED:
+        why = f": {STATUS[GAP_LAW_FAILED][1]}"
     message = f"compiled {method} stopped ({name}) at t = {t_end:.6g} s{why}"
     stop = Stop(name, message, float(t_end), np.array(y_end[:12]))
     stop.steps = steps

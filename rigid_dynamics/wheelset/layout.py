@@ -237,7 +237,7 @@ GEOMETRY_TABLES, GEOMETRY_SEARCH, GEOMETRY_GIVEN = range(3)
 """Where the right-hand side's candidate geometry comes from: the compiled tables (with the running-direction
 irregularities), the compiled 3-D search, or given by the caller (a provider the compiled code does not evaluate)."""
 
-OK, BLOW_UP, FORCE_ANOMALY, DERAILED, CREEPAGES_UNDEFINED, CALLBACK_FAILED, UNDERFLOW = range(7)
+OK, BLOW_UP, FORCE_ANOMALY, DERAILED, CREEPAGES_UNDEFINED, CALLBACK_FAILED, UNDERFLOW, GAP_LAW_FAILED = range(8)
 STATUS = {
     OK: ("ok", "ok"),
     BLOW_UP: ("blow-up", "a state is not finite"),
@@ -246,6 +246,11 @@ STATUS = {
     CREEPAGES_UNDEFINED: ("contact-failed", "the creepages are undefined (no rolling speed at a patch)"),
     CALLBACK_FAILED: ("contact-failed", "the contact model behind the callback failed"),
     UNDERFLOW: ("step-size-underflow", "the error-controlled step fell below its smallest size"),
+    GAP_LAW_FAILED: (
+        "contact-failed",
+        "KPEC put pressure on no element of a sampled gap that overlaps (its equivalent ellipse misses the deepest "
+        "row)",
+    ),
 }
 """The one status table of the compiled right-hand side and loops: code -> (run status, what happened)."""
 
@@ -272,6 +277,7 @@ PARAMETER_FIELDS = (
     ("suspension_half_spacing_m", "lateral half spacing of the springs"),
     ("frame_z_m", "frame height (spring attachment)"),
     ("frame_x0_m", "frame x at t = 0 (moves at speed_m_per_s)"),
+    ("frame_yaw_rad", "the frame's held yaw (its points at (x_frame - s b sin, s b cos))"),
     ("speed_m_per_s", "running speed"),
     ("axle_load_N", "axle load, z down"),
     ("torque_N_m", "driving/braking torque about the axle"),

@@ -161,7 +161,8 @@ def linear_model_for_scene(
 
     The conicity is the effective one of the analytic conical provider,
     lambda / (1 - lambda R_r / e0) (providers/conical.py), and W = m g + axle load. ``classic`` drops the
-    roll coupling (kappa = 0).
+    roll coupling (kappa = 0). The suspension's ``frame_yaw_rad`` is a constant forcing: it moves the equilibrium,
+    not the eigenvalues of this linear model, so it does not enter it.
     """
     ws, susp, track = scene.wheelset, scene.suspension, scene.track
     lam, e0 = track.conicity, ws.contact_half_distance_m

@@ -61,6 +61,11 @@ class WheelsetParameters:
         check_finite(self, positive=[f.name for f in fields(self)])
 
 
+MAX_FRAME_YAW_RAD = 0.1
+"""SuspensionParameters.frame_yaw_rad's bound: a bogie's angle of attack is tens of mrad (a/R: 2.5 m wheelbase, 25 m
+radius: 50 mrad)."""
+
+
 @dataclass(frozen=True)
 class SuspensionParameters:
     """Primary suspension between the axle and a frame moving at constant speed along the track.
@@ -76,6 +81,12 @@ class SuspensionParameters:
         longitudinal_damping_N_s_per_m, lateral_damping_N_s_per_m, vertical_damping_N_s_per_m: c per side, N s/m.
         yaw_stiffness_N_m_per_rad: torsional yaw stiffness per side, N m/rad.
         yaw_damping_N_m_s_per_rad: torsional yaw damping per side, N m s/rad.
+        frame_yaw_rad: the frame's yaw about z against the track (in a curve against the radial direction through
+            the frame), held through the run, rad: the frame points of side s sit at (x_frame - s b sin, s b cos)
+            and the torsional springs act on the wheelset's yaw less it. A bogie frame's angle at one of its axles:
+            the leading axle of a bogie of semi-wheelbase a, the frame tangent to a curve of radius R, is held
+            about a/R under-radial (negative in a right-hand curve, positive in a left-hand one: the angle of
+            attack of flange climbing). 0: the frame follows the track (or the curve's radial).
     """
 
     longitudinal_stiffness_N_per_m: float = 0.0
@@ -86,9 +97,15 @@ class SuspensionParameters:
     vertical_damping_N_s_per_m: float = 0.0
     yaw_stiffness_N_m_per_rad: float = 0.0
     yaw_damping_N_m_s_per_rad: float = 0.0
+    frame_yaw_rad: float = 0.0
 
     def __post_init__(self) -> None:
-        check_finite(self, nonnegative=[f.name for f in fields(self)])
+        check_finite(self, nonnegative=[f.name for f in fields(self) if f.name != "frame_yaw_rad"])
+        if not abs(self.frame_yaw_rad) <= MAX_FRAME_YAW_RAD:
+            raise ValueError(
+                f"frame_yaw_rad = {self.frame_yaw_rad!r}: expected |value| <= {MAX_FRAME_YAW_RAD} (a bogie's angle of "
+                "attack: tens of mrad)"
+            )
 
     @property
     def is_damped(self) -> bool:

@@ -77,6 +77,7 @@ from rigid_dynamics.wheelset.layout import (
     G_NORMAL,
     G_ROLLING_RADIUS,
     G_WHEEL_LATERAL,
+    GAP_LAW_FAILED,
     GEOMETRY_GIVEN,
     GEOMETRY_SEARCH,
     MAX_SLOTS,
@@ -84,6 +85,7 @@ from rigid_dynamics.wheelset.layout import (
     N_GEO,
     NORMAL_FORCE,
     SPIN_MOMENT,
+    STATUS,
     record_columns,
     status_name,
 )
@@ -217,6 +219,7 @@ class WheelsetModel:
         )
         self.k_yaw = susp.yaw_stiffness_N_m_per_rad
         self.c_yaw = susp.yaw_damping_N_m_s_per_rad
+        self.frame_yaw = susp.frame_yaw_rad
         self.has_suspension = bool(np.any(self.k > 0) or np.any(self.c > 0) or self.k_yaw > 0 or self.c_yaw > 0)
         self.half_spacing = ws.suspension_half_spacing_m
         self.z_frame = -ws.nominal_radius_m
@@ -401,6 +404,8 @@ class WheelsetModel:
     def _failure(self, status: int, t: float) -> ContactFailure:
         if status == CALLBACK_FAILED and self.callback is not None:
             return ContactFailure(self.callback.message)
+        if status == GAP_LAW_FAILED:
+            return ContactFailure(f"{STATUS[GAP_LAW_FAILED][1]} (t = {t:.6g} s)")
         if status == CREEPAGES_UNDEFINED:
             return ContactFailure(f"rolling speed not > 0 at a contact (t = {t:.6g} s): creepages undefined")
         return ContactFailure(f"compiled right-hand side: status {status} ({status_name(status)})")
