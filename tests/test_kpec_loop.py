@@ -287,3 +287,25 @@ def test_kpec_contact_flags_are_the_elements_with_pressure(held):
             assert flags.any() and np.array_equal(flags, p > 0)
             checked += 1
     assert checked >= 2
+
+
+def test_a_kpec_run_that_meets_such_a_gap_ends_contact_failed_in_print_json_and_exit_code(tmp_path, capsys):
+    """The run the gap above came from (curve-flange, the frame held at -12.5 mrad, kx 3e7 N/m, 0.1 ms): it stops with
+    the named status (at 0.13 s here, within 0.3 s); printed status, summary.json's status and the exit code agree."""
+    import json
+
+    from wheelrail.cli import main
+
+    out = tmp_path / "run"
+    code = main(
+        [
+            "run", "curve-flange", "--set", 'contact_model="kpec"', "--set", "suspension.frame_yaw_rad=-0.0125",
+            "--set", "suspension.longitudinal_stiffness_N_per_m=3e7", "--set", "integrator.fixed_step_s=1e-4",
+            "--set", "duration_s=0.3", "--out", str(out),
+        ]
+    )  # fmt: skip
+    printed = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "contact-failed" and "KPEC put pressure on no element" in summary["message"]
+    assert printed.startswith("curve-flange: contact-failed - ") and code == 1
+    assert 0.05 < summary["simulated_time_s"] < 0.3
