@@ -45,6 +45,22 @@ def _static_kpec(xs, ys, gap, creepage, material):
     return KpecModel().solve(geometry, creepage, material, options={"nx": xs.size, "ny": ys.size})
 
 
+def _loop_law_on(sampled, material, approach_m, creep):
+    """The loop's compiled KPEC law (compiled_laws._kpec_law) on a given sampled gap: sampled = (xs, ys, gap) (element
+    centres, m; gap (ny, nx), m), the approach and creep = (xi, eta, phi); its (N, a, b, T_x, T_y, M_z, area, p_max).
+    """
+    xs, ys, gap = sampled
+    par = new_parameters()
+    g, nu = material.shear_modulus_Pa, material.poisson_ratio
+    par["shear_modulus_Pa"], par["contact_modulus_Pa"] = g, g / (1 - nu)
+    par["friction_coefficient"] = material.friction_coefficient
+    par["kpec_nx"], par["kpec_ny"] = xs.size, ys.size
+    field = patch_scratch(par, 1)
+    field.xs[0], field.ys[0], field.gap[0], field.sampled[0] = xs, ys, gap, 1.0
+    tables = hertz_kalker_tables(tables_for(g, nu))
+    return _kpec_law(par, tables, field, 0, (approach_m, 1.0, 1.0, 0.0), creep, material.friction_coefficient)
+
+
 @pytest.fixture(scope="module")
 def held():
     scene = replace(load_scene("curve-flange"), contact_model="kpec", contact_provider="search")
@@ -132,18 +148,10 @@ def test_loop_kpec_law_equals_contacts_kpec(contact_cases, case):
     xs, ys = np.asarray(res.fields.x_m, float), np.asarray(res.fields.y_m, float)
     gap = np.asarray(geo.gap_m(*np.meshgrid(xs, ys)), float)
     gap = np.where(np.isfinite(gap), gap, 1.0)
-    par = new_parameters()
-    g, nu = material.shear_modulus_Pa, material.poisson_ratio
-    par["shear_modulus_Pa"], par["contact_modulus_Pa"] = g, g / (1 - nu)
-    par["friction_coefficient"] = material.friction_coefficient
-    par["kpec_nx"], par["kpec_ny"] = xs.size, ys.size
-    field = patch_scratch(par, 1)
-    field.xs[0], field.ys[0], field.gap[0], field.sampled[0] = xs, ys, gap, 1.0
     cr = patch.creepage
-    fn, _, _, fx, fy, _, area, pmax = _kpec_law(
-        par, hertz_kalker_tables(tables_for(g, nu)), field, 0, (geo.approach_m, 1.0, 1.0, 0.0),
-        (cr.longitudinal, cr.lateral, cr.spin_1_per_m), material.friction_coefficient,
-    )  # fmt: skip
+    fn, _, _, fx, fy, _, area, pmax = _loop_law_on(
+        (xs, ys, gap), material, geo.approach_m, (cr.longitudinal, cr.lateral, cr.spin_1_per_m)
+    )
     mu_fn = material.friction_coefficient * ref["fn_N"]
     diffs = {
         "fn": fn / ref["fn_N"] - 1,
@@ -245,17 +253,7 @@ def test_kpec_puts_no_contact_flag_without_pressure_and_fails_on_an_overlapping_
     assert not res.success and res.status == "no-pressure" and "put pressure on no element" in res.message
     assert math.isnan(res.normal_force_N)
     # the loop's law
-    par = new_parameters()
-    g, nu = material.shear_modulus_Pa, material.poisson_ratio
-    par["shear_modulus_Pa"], par["contact_modulus_Pa"] = g, g / (1 - nu)
-    par["friction_coefficient"] = material.friction_coefficient
-    par["kpec_nx"], par["kpec_ny"] = xs.size, ys.size
-    field = patch_scratch(par, 1)
-    field.xs[0], field.ys[0], field.gap[0], field.sampled[0] = xs, ys, gap, 1.0
-    out = _kpec_law(
-        par, hertz_kalker_tables(tables_for(g, nu)), field, 0, (-float(gap.min()), 1.0, 1.0, 0.0), (1e-3, -2e-3, 0.5),
-        material.friction_coefficient,
-    )  # fmt: skip
+    out = _loop_law_on((xs, ys, gap), material, -float(gap.min()), (1e-3, -2e-3, 0.5))
     assert math.isnan(out[0])
     assert lay.STATUS[lay.GAP_LAW_FAILED][0] == "contact-failed"
 
