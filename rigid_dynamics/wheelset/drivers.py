@@ -19,7 +19,6 @@ from rigid_dynamics.wheelset.layout import (
     CALLBACK_FAILED,
     CREEP_FORCE_LONG,
     CREEPAGE_LONG,
-    GAP_LAW_FAILED,
     MAX_SLOTS,
     N_FIELDS,
     NORMAL_FORCE,
@@ -396,8 +395,8 @@ def _stop_from_status(model, status, t_end, y_end, method, steps, why=""):
     name = status_name(status)
     if status == CALLBACK_FAILED and model.callback is not None:
         why = f": {model.callback.message}"
-    elif status == GAP_LAW_FAILED:
-        why = f": {STATUS[GAP_LAW_FAILED][1]}"
+    elif not why:
+        why = f": {STATUS[status][1]}"  # what happened, from the one status table
     message = f"compiled {method} stopped ({name}) at t = {t_end:.6g} s{why}"
     stop = Stop(name, message, float(t_end), np.array(y_end[:12]))
     stop.steps = steps

@@ -77,7 +77,6 @@ from rigid_dynamics.wheelset.layout import (
     G_NORMAL,
     G_ROLLING_RADIUS,
     G_WHEEL_LATERAL,
-    GAP_LAW_FAILED,
     GEOMETRY_GIVEN,
     GEOMETRY_SEARCH,
     MAX_SLOTS,
@@ -404,11 +403,11 @@ class WheelsetModel:
     def _failure(self, status: int, t: float) -> ContactFailure:
         if status == CALLBACK_FAILED and self.callback is not None:
             return ContactFailure(self.callback.message)
-        if status == GAP_LAW_FAILED:
-            return ContactFailure(f"{STATUS[GAP_LAW_FAILED][1]} (t = {t:.6g} s)")
         if status == CREEPAGES_UNDEFINED:
             return ContactFailure(f"rolling speed not > 0 at a contact (t = {t:.6g} s): creepages undefined")
-        return ContactFailure(f"compiled right-hand side: status {status} ({status_name(status)})")
+        return ContactFailure(
+            f"compiled right-hand side: status {status} ({status_name(status)}, t = {t:.6g} s): {STATUS[status][1]}"
+        )
 
     def contact(
         self, state: np.ndarray, record: bool = False, track: np.ndarray | None = None, keep_search_memory=False
