@@ -214,13 +214,13 @@ class KpecModel:
                 x, y, h, p, contact, out = solve_at(pen)
         force = _force(p, x, y)
         if not contact.any():
-            if float(h.min()) < 0.0:  # the gap overlaps, yet no element carries pressure: a failure, not "no contact"
+            if out[7] > 0.0:  # the gap overlaps (the kernel's penetration), yet no element carries pressure: a failure
                 return ContactResult(
                     method=self.name,
                     success=False,
                     status="no-pressure",
                     message=f"{self.name.upper()} put pressure on no element of a gap that overlaps by "
-                    f"{-float(h.min()):.3g} m (its equivalent ellipse misses the deepest row)",
+                    f"{float(out[7]):.3g} m (its equivalent ellipse misses the deepest row)",
                     normal_force_N=math.nan,
                     creepage=creepage,
                     wall_time_s=time.perf_counter() - start,

@@ -426,7 +426,8 @@ def _kpec_law(par, tables, field, c, geometry, creep, mu):
     nu = 1.0 - g_mod / par.contact_modulus_Pa
     pressure, contact = field.pressure, field.contact
     # fn_kpec: CONTACT's F_N of the flexibilities, the pressure before the in-row gaps are cleared
-    fn_kpec = kpec_pressure_into(gap, xs, ys, (g_mod, nu), (pressure, contact), (field.first, field.last))[0]
+    normal = kpec_pressure_into(gap, xs, ys, (g_mod, nu), (pressure, contact), (field.first, field.last))
+    fn_kpec, penetration = normal[0], normal[7]
     dx, dy = xs[1] - xs[0], ys[1] - ys[0]
     total, count, pmax = 0.0, 0, 0.0
     for j in range(gap.shape[0]):
@@ -438,11 +439,7 @@ def _kpec_law(par, tables, field, c, geometry, creep, mu):
     if count == 0:
         # no element carries pressure: no contact when the gap has no overlap, else KPEC failed on this gap (NaN:
         # compiled_rhs ends the run with layout.GAP_LAW_FAILED; a zero force would be a wrong number)
-        overlap = 0.0
-        for j in range(gap.shape[0]):
-            for i in range(gap.shape[1]):
-                overlap = min(overlap, gap[j, i])
-        if overlap < 0.0:
+        if penetration > 0.0:
             return math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     a, b = flexibility_ellipse(contact, dx, dy)
