@@ -289,7 +289,9 @@ def test_kpec_contact_flags_are_the_elements_with_pressure(held):
 
 def test_a_kpec_run_that_meets_such_a_gap_ends_contact_failed_in_print_json_and_exit_code(tmp_path, capsys):
     """The run the gap above came from (curve-flange, the frame held at -12.5 mrad, kx 3e7 N/m, 0.1 ms): it stops with
-    the named status (at 0.13 s here, within 0.3 s); printed status, summary.json's status and the exit code agree."""
+    the named status (at about 0.10 s here, within 0.3 s); printed status, summary.json's status and the exit code
+    agree.
+    """
     import json
 
     from wheelrail.cli import main
