@@ -426,8 +426,9 @@ def _kpec_law(par, tables, field, c, geometry, creep, mu):
     nu = 1.0 - g_mod / par.contact_modulus_Pa
     pressure, contact = field.pressure, field.contact
     # fn_kpec: CONTACT's F_N of the flexibilities, the pressure before the in-row gaps are cleared
-    normal = kpec_pressure_into(gap, xs, ys, (g_mod, nu), (pressure, contact), (field.first, field.last))
-    fn_kpec, penetration = normal[0], normal[7]
+    fn_kpec, _, _, _, _, _, _, penetration = kpec_pressure_into(
+        gap, xs, ys, (g_mod, nu), (pressure, contact), (field.first, field.last)
+    )
     dx, dy = xs[1] - xs[0], ys[1] - ys[0]
     total, count, pmax = 0.0, 0, 0.0
     for j in range(gap.shape[0]):
