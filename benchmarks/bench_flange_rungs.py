@@ -152,7 +152,8 @@ def write(data: dict) -> None:
     from rigid_dynamics.files import write_text
 
     lines = [
-        "# The flange-climbing case's contact by three patch models at the same states (benchmarks/bench_flange_rungs.py)",
+        "# The flange-climbing case's contact by three patch models at the same states "
+        "(benchmarks/bench_flange_rungs.py)",
         "",
         (__doc__ or "").split("\n\nRun:")[0],
         "",
@@ -167,7 +168,8 @@ def write(data: dict) -> None:
             rows = model["rows"]
             ok = sum(r["status"] == "ok" for r in rows)
             yq, q, y = _stats(rows, "y_over_q"), _stats(rows, "q_N"), _stats(rows, "y_N")
-            ang, area, pmax = (_stats(rows, k) for k in ("flange_angle_rad", "flange_area_mm2", "flange_max_pressure_MPa"))
+            keys = ("flange_angle_rad", "flange_area_mm2", "flange_max_pressure_MPa")
+            ang, area, pmax = (_stats(rows, k) for k in keys)
             grid = _stats(rows, "grid_error_force")[2], _stats(rows, "grid_error_all")[2]
             stated = f"{grid[0]:.1%} / {grid[1]:.1%}" if math.isfinite(grid[0]) else "not stated"
             lines.append(
@@ -176,7 +178,8 @@ def write(data: dict) -> None:
                 f"{area[0]:.1f} ({area[1]:.1f}-{area[2]:.1f}) | {pmax[0]:.0f} ({pmax[1]:.0f}-{pmax[2]:.0f}) | "
                 f"{stated} | {model['cpu_s']:.1f} |"
             )
-    lines += ["", "Largest difference to the BEM on the sampled patch at the same state (relative to the BEM's value):", "",
+    lines += ["", "Largest difference to the BEM on the sampled patch at the same state (relative to the BEM's value):",
+              "",
               "| held frame yaw | model | Q | Y | Y/Q | flange area | flange p max | states compared |",
               "|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for entry in data["angles"]:
