@@ -1,5 +1,7 @@
 """The flange-climbing case's contact by three patch models at the same states: the ellipse at the deepest point
-(FASTSIM, multi-Hertzian), KPEC on the sampled gap (semi-Hertzian) and the BEM on the sampled, formed patch.
+(FASTSIM, multi-Hertzian), KPEC on the sampled gap (semi-Hertzian: compiled, on the candidate's own plane at its
+deepest point, and through the callback on the formed patch, ``patch_geometry = "formed"``) and the BEM on the
+sampled, formed patch.
 
 The states: ``curve-flange`` (S1002/UIC60 1:40, R = 100 m, cant 0.15 m, 50 km/h) with the primary suspension's
 frame held at a yaw (``suspension.frame_yaw_rad``, the leading axle of a bogie; bench_flange_aoa.py) and stiff
@@ -37,18 +39,20 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 OUT = ROOT / "benchmarks" / "results"
 ANGLES_RAD = (0.0, -0.00455, -0.008, -0.0125)
-MODELS = ("fastsim", "kpec", "bem")
+MODELS = ("fastsim", "kpec", "kpec-formed", "bem")
+"""The patch models compared; ``kpec-formed``: kpec with ``patch_geometry = "formed"`` (the static KPEC on the formed
+patch through the callback, as CONTACT applies KPEC)."""
 SAMPLES = 24
 DURATION_S, WINDOW_S, STEP_S = 0.6, 0.3, 1.0e-4
 
 
-def scene_at(frame_yaw: float, model: str):
+def scene_at(frame_yaw: float, model: str, geometry: str = "sampled"):
     from wheelrail.config import read_toml
     from wheelrail.scenes import parse_scene, resolve_scene_path
 
     path = resolve_scene_path("curve-flange")
     doc = read_toml(path, "scene file")
-    doc.update(duration_s=DURATION_S, contact_model=model)
+    doc.update(duration_s=DURATION_S, contact_model=model, patch_geometry=geometry)
     doc["suspension"].update(frame_yaw_rad=frame_yaw, longitudinal_stiffness_N_per_m=3.0e7)
     doc["integrator"].update(fixed_step_s=STEP_S, output_step_s=1.0e-4)
     return parse_scene(doc, base_dir=path.parent)
@@ -75,7 +79,8 @@ def model_for(frame_yaw: float, name: str):
     from rigid_dynamics.wheelset.simulate import build_provider, model_options
     from rigid_dynamics.wheelset.wheelset_model import WheelsetModel
 
-    scene = scene_at(frame_yaw, name)
+    name, _, formed = name.partition("-")
+    scene = scene_at(frame_yaw, name, "formed" if formed else "sampled")
     return WheelsetModel(scene, build_provider(scene), get_model(name), model_options(name, scene))
 
 
@@ -184,7 +189,7 @@ def write(data: dict) -> None:
               "|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for entry in data["angles"]:
         bem = entry["models"]["bem"]["rows"]
-        for name in ("fastsim", "kpec"):
+        for name in ("fastsim", "kpec", "kpec-formed"):
             rows = entry["models"][name]["rows"]
             cells = []
             count = 0

@@ -458,10 +458,11 @@ def patch_summary_lines(summary: dict) -> list[str]:
             f"iterations; patch sampling {callback['sampling_seconds']:.3g} s of {callback['seconds']:.3g} s"
         )
     grid = (summary.get("discretisation_errors") or {}).get("contact_grid") or {}
-    grid = grid if "largest_all_quantities" in grid else grid.get("bem") or {}  # the BEM's own estimate, if any
+    grid = grid if "largest_all_quantities" in grid else grid.get("bem") or {}  # the model's own estimate, if any
     if grid.get("estimate") is not None:
+        name = "bem" if bem else callback.get("model", "contact")
         lines.append(
-            f"bem grid error: largest estimate {100 * grid['estimate']:.2f} % of the patch forces (all quantities "
+            f"{name} grid error: largest estimate {100 * grid['estimate']:.2f} % of the patch forces (all quantities "
             f"{100 * grid['largest_all_quantities']:.2f} %), {grid['solves_above_grid_tolerance']} of "
             f"{grid['solves_estimated']} solves above grid_tolerance {grid['grid_tolerance']:g}"
         )

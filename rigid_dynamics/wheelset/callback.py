@@ -97,6 +97,8 @@ class PatchCallback:
             "sampling_seconds": float(self.sampling_seconds),
             "bem_warm_start": bool(self.bem and self.warm_start),
             **({"bem": self.warm_counts(), "bem_grid_error": dict(self.grid_error)} if self.bem else {}),
+            # another callback model that states its grid error per solve (kpec through "formed" patches)
+            **({"grid_error": dict(self.grid_error)} if not self.bem and self.grid_error["estimated"] else {}),
             **({"auto_reuse": self.reuse_stats()} if self.reuse is not None else {}),
         }
 
@@ -110,9 +112,10 @@ class PatchCallback:
         return {"enabled": bool(enabled), **reuse_stats(store, tolerance)}
 
     def _record_grid_error(self, result, t_s: float) -> None:
-        """Keep the run's largest BEM grid-error estimate (bem.model.grid_error_estimate, every solve's own) of the
-        forces (normal and creep force, relative as the BEM states them) and of all its quantities, and count the
-        solves above their ``grid_tolerance`` and those not estimated (summary.json ``discretisation_errors``).
+        """Keep the run's largest grid-error estimate of a model that states one per solve (``extra["grid_error"]``:
+        the BEM's bem.model.grid_error_estimate, KPEC's the same on its own companion grids) of the forces (normal
+        and creep force, relative as the model states them) and of all its quantities, and count the solves above
+        their ``grid_tolerance`` and those not estimated (summary.json ``discretisation_errors``).
         """
         grid = (result.extra or {}).get("grid_error")
         if grid is None or result.status == "no-contact":
@@ -184,8 +187,7 @@ class PatchCallback:
             return _FAILED
         finally:
             self.seconds += time.perf_counter() - start
-        if self.bem:
-            self._record_grid_error(result, t)
+        self._record_grid_error(result, t)
         if not result.success and result.status != "no-contact":
             self.message = f"contact model {result.method!r} failed at t = {t:.6g} s: {result.status}: {result.message}"
             return _FAILED

@@ -68,11 +68,18 @@ def geometry_mode(provider) -> int:
     return int(answer()) if callable(answer) else GEOMETRY_GIVEN
 
 
-def law_code(model) -> int:
+def law_code(model, patch_geometry: str = "sampled") -> int:
     """The compiled law of a contact model instance (compiled_laws.LAW_CODES of its ``compiled_law``; None or absent:
-    LAW_CALLBACK, every patch through the callback).
+    LAW_CALLBACK, every patch through the callback). With ``patch_geometry`` "formed" (DynamicsScene.patch_geometry)
+    a model that solves a gap (callback._solves_gap: kpec) goes through the callback too, on the formed patches.
     """
-    return LAW_CODES.get(getattr(model, "compiled_law", None), LAW_CALLBACK)
+    code = LAW_CODES.get(getattr(model, "compiled_law", None), LAW_CALLBACK)
+    if patch_geometry == "formed" and code not in (LAW_CALLBACK, LAW_AUTO):
+        from rigid_dynamics.wheelset.callback import _solves_gap
+
+        if _solves_gap(model):
+            return LAW_CALLBACK
+    return code
 
 
 def supported(scene, provider) -> bool:
@@ -164,7 +171,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     par["contact_modulus_Pa"] = tables.e_star
     law = friction_law_of(scene.material)
     par["friction_coefficient"] = law.max_static  # the coefficient of Coulomb's uniform law; else mu_s at most
-    code = law_code(model)
+    code = law_code(model, scene.patch_geometry)
     par["model_code"] = code
     par["z_ref_m"] = provider.z_ref if mode == GEOMETRY_TABLES else 0.0
     opts = {"nx": 20, "ny": 20, "traction_bound": "elliptic", "flexibility": "three"}
@@ -174,7 +181,7 @@ def pack(model_wheelset, provider, tables, model, options=None, tolerance=0.05, 
     par["flexibility_code"] = FLEXIBILITY_CODES[opts["flexibility"]]
     par["kpec_nx"] = par["kpec_ny"] = scene.kpec_points
     par["kpec_margin"] = SEARCH_OPTIONS["field_margin"]
-    par["patch_sampled"] = 1.0 if scene.patch_geometry == "sampled" else 0.0
+    par["patch_sampled"] = 1.0 if scene.patch_geometry in ("sampled", "formed") else 0.0
     if code == LAW_AUTO:
         auto_parameters(par, tolerance, (opts["nx"], opts["ny"]))
         par["auto_fastsim_table"] = 1.0 if getattr(scene, "creep_table", False) else 0.0

@@ -166,7 +166,8 @@ def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, 
     ``grid_tolerance`` asks (the largest force estimate of a solve above it) ends "warning", naming the estimate; a
     run already warned names it too.
     """
-    grid = (callback_stats or {}).get("bem_grid_error")
+    stats = callback_stats or {}
+    grid = stats.get("bem_grid_error") or stats.get("grid_error")
     if (
         status not in ("ok", "warning")
         or not grid
@@ -174,6 +175,11 @@ def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, 
         or grid["largest_force"] <= grid["tolerance"]
     ):
         return status, message
+    if not stats.get("bem_grid_error"):
+        return "warning", (
+            f"{message}; {stats.get('model', 'the contact model')}'s grid-error estimate of the patch forces "
+            f"{grid['largest_force']:.3g} (t = {grid['t_s']:.6g} s) exceeds its grid_tolerance = {grid['tolerance']:g}"
+        )
     return "warning", (
         f"{message}; BEM grid-error estimate of the patch forces {grid['largest_force']:.3g} (t = {grid['t_s']:.6g} s) "
         f"exceeds the BEM's grid_tolerance = {grid['tolerance']:g} (the loop solves a sampled patch on about "
@@ -266,15 +272,20 @@ def _contact_grid_error(result) -> dict:
     """The contact grid's statement: the BEM's own estimate of every solve in the loop (callback.PatchCallback
     keeps the largest), or "not estimated" for the other models.
     """
-    grid = (result.callback_stats or {}).get("bem_grid_error")
+    stats = result.callback_stats or {}
+    grid = stats.get("bem_grid_error") or stats.get("grid_error")
     if not grid or not grid["estimated"]:
         return {"estimate": None, "method": f"not estimated ({result.contact_model})"}
+    name = "BEM" if stats.get("bem_grid_error") else stats.get("model", result.contact_model)
     return {
         "estimate": grid["largest_force"],
-        "relative_to": "each BEM patch's own normal and creep force (the creep force at least 0.01 mu F_N)",
+        "relative_to": f"each {name} patch's own normal and creep force (the creep force at least 0.01 mu F_N)",
         "method": (
             "the BEM's companion grids with elements 2x and 4x as large on every solve (rigid_dynamics.contact.bem."
             "model.grid_error_estimate), the largest over the run"
+            if name == "BEM"
+            else f"{name}'s own estimate of every solve (its result's grid_error: companion grids with elements 2x "
+            "and 4x as large), the largest over the run"
         ),
         "largest_all_quantities": grid["largest"],
         "at_t_s": grid["t_s"],

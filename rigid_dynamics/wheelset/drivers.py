@@ -287,7 +287,9 @@ def sensitivity_velocity_columns(model) -> Callable | None:
     from rigid_dynamics.wheelset.compiled_laws import LAW_CALLBACK
     from rigid_dynamics.wheelset.compiled_records import law_code
 
-    if model is None or law_code(model.model) != LAW_CALLBACK or model.elastic or model.par["track_frame"] > 0:
+    if model is None or model.elastic or model.par["track_frame"] > 0:
+        return None
+    if law_code(model.model, model.scene.patch_geometry) != LAW_CALLBACK:
         return None
     from rigid_dynamics.wheelset.creep_jacobian import creep_velocity_columns
 

@@ -21,7 +21,7 @@ from rigid_dynamics.wheelset.traction import TractionControl
 CONTACT_PROVIDERS = ("auto", "conical", "tables", "search")
 """Names of the contact-geometry providers (see :mod:`rigid_dynamics.wheelset.providers`)."""
 
-PATCH_GEOMETRIES = ("sampled", "ellipse")
+PATCH_GEOMETRIES = ("sampled", "ellipse", "formed")
 """What a gap-solving contact model sees per patch in dynamics (DynamicsScene.patch_geometry)."""
 
 INTEGRATORS = ("RK45", "DOP853", "Radau", "BDF", "LSODA", "RK4", "DP54", "BS32")
@@ -530,8 +530,15 @@ class DynamicsScene:
         patch_geometry: what a contact model that solves a gap sees per patch (:data:`PATCH_GEOMETRIES`):
             "sampled" (default) the undeformed distance sampled from the real surfaces around the patch (the
             flange's, a flat edge's or a worn pair's non-elliptic patch), "ellipse" the quadric of the relative
-            curvatures at the contact point (multi-Hertzian). The Hertzian laws (hertz, linear,
-            vermeulen-johnson, fastsim) see the quadric either way.
+            curvatures at the contact point (multi-Hertzian), "formed" every gap-solving model through the callback
+            on the patches formed as the static wheelset case forms them (CONTACT's module 1: regions joined or
+            split, each solved in the plane of its weighted contact angle; wheelset/formed_patches.py). For the
+            ``bem`` "sampled" already forms them; for ``kpec``, whose compiled law with "sampled" samples each
+            candidate on its own plane at its deepest point, "formed" solves the static KPEC on the formed patch
+            instead (a conformal region from the flange root to the flank is then one patch at its weighted angle,
+            not at the deepest point's: benchmarks/results/flange_rungs.md), at Python's cost per patch; ``auto``
+            treats it as "sampled". The Hertzian laws (hertz, linear, vermeulen-johnson, fastsim) see the quadric
+            either way.
         settling_distance_m: distance travelled from the start after which the summary's peaks are taken (the
             start-up from the initial offset is not a result), m; the full-run peaks are reported beside them.
             The default 10 m covers the start-up of the embedded polygonal-wheel scene from its 1 mm offset (two-point

@@ -233,7 +233,7 @@ class WheelsetModel:
         self.track_rest = np.zeros(self.n_state - 14)  # the track's states used with a 12-state (static equilibrium)
         self.rhs_evaluations = 0
         self.par = model_parameters(self)  # replaced by the packed record below (same fields, contact fields set)
-        code = law_code(contact_model)
+        code = law_code(contact_model, scene.patch_geometry)
         opts = dict(model_options or {})
         fastsim = (
             opts if code in (LAW_FASTSIM, LAW_TABLE) else dict((opts.get("model_options") or {}).get("fastsim") or {})
@@ -244,7 +244,7 @@ class WheelsetModel:
         self.par = self.packed.par
         self.mode = self.packed.mode
         self.callback = None
-        surfaces = _patch_surfaces(scene, provider) if scene.patch_geometry == "sampled" else None
+        surfaces = _patch_surfaces(scene, provider) if scene.patch_geometry in ("sampled", "formed") else None
         if code == LAW_CALLBACK:
             self.callback = PatchCallback(contact_model, model_options, scene.material, surfaces, self.elastic)
         elif code == LAW_AUTO:
