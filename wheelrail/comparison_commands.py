@@ -39,7 +39,7 @@ truncation enters the max pressure at second order, stated as 0.5 % (20 / D)^2 (
 LOAD_CONTROL_BLOCK_ERROR): 0.125 % at 40 for about 2 % more unknowns (4878 against 4785 on the demo's coarse
 locating solve)."""
 
-PATCH_GEOMETRIES = ("sampled", "ellipse")
+PATCH_GEOMETRIES = ("sampled", "ellipse", "formed")
 """The values of ``--patch-geometry`` (rigid_dynamics.wheelset.parameters.PATCH_GEOMETRIES, not imported here: the
 parser is built before the dynamics are)."""
 
