@@ -225,8 +225,9 @@ def structured_rows() -> list[dict]:
             for xi, eta in STRUCTURED_CREEPAGES if fit else STRUCTURED_CREEPAGES[:2]:
                 t1 = time.process_time()
                 sol = solve_rolling(
-                    domain, normal, e_block, NU, MU, (xi, eta, 0.0), step_m=spec.contact_size_m / 2, length_scale_m=a
-                )
+                    domain, normal, e_block, NU, MU, (xi, eta, 0.0), step_m=spec.contact_size_m / 2,
+                    length_scale_m=a, row_transport=True,
+                )  # fmt: skip
                 cpu = time.process_time() - t1
                 (ref_x, ref_y), ref_error = refs[(xi, eta)]
                 k = 0 if eta == 0.0 else 1

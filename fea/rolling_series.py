@@ -15,6 +15,14 @@ error (measured on the Hertz circle: p = 1.6 to 1.9, the first-order estimate ab
 benchmarks/results/fea_friction.md); the extrapolation with the observed order, F_3 + (F_3 - F_2)/(r^p - 1), is
 returned beside it. The series is "irregular" (no error stated, a status, never a number) when the differences
 change sign or p falls outside [0.5, 4].
+
+Resolution: the series states an error only when every level resolves the slip zone (at least as many slip nodes
+as face rows in contact). At small creepage the slip zone at the trailing edge is narrower than a cell (Carter:
+2 (a - c) = 2 a xi R/(mu a), 0.04 a at the circle's xi = 5e-5), every row sticks to its last node, and the force is
+the no-slip discretisation's, whose traction is singular at the trailing edge: measured on the circle at xi = 5e-5,
++21.2/+10.8/+6.6/+3.0 % at n = 4/6/9/13.5, observed order 2.2 from 4/6/9 but 0.43 from 6/9/13.5 (a first-order
+estimate from 6 and 9 would state 8.5 % on n = 9, and was right only by the luck of the coarse meshes). Such a
+series is "unresolved", a status. A fully sliding patch (no stick node) has F = mu P on every mesh.
 """
 
 from __future__ import annotations
@@ -95,7 +103,9 @@ class RollingSeries:
     """Creep force of steady rolling with its stated error from a mesh series (:func:`solve_rolling_series`).
 
     Attributes:
-        status: "ok", "irregular" (the series does not state an error) or "not-converged" (a level failed).
+        status: "ok", "irregular" (the series does not state an error), "unresolved" (the slip zone is narrower
+            than a cell on some level: fewer slip nodes than face rows in contact; no error stated) or
+            "not-converged" (a level failed).
         message: explanation.
         creep_force_N: (F_x, F_y) on the wheel, the finest mesh's, N.
         stated_error_N: (e_x, e_y), stated error of each component, N (nan unless "ok").
@@ -128,7 +138,7 @@ def solve_rolling_series(
     elements: tuple[float, float, float] = (4.0, 6.0, 9.0),
     initial_approach_m: float | None = None,
     domain_factor: float = 10.0,
-    insignificant_fraction: float = 1e-3,
+    insignificant_fraction: float = 5e-3,
 ) -> RollingSeries:
     """Steady rolling on three rolling blocks (n, r n, r^2 n elements per semi-axis) and the force's stated error.
 
@@ -148,12 +158,14 @@ def solve_rolling_series(
         domain_factor: block half-width in units of max(a, b).
         insignificant_fraction: a component whose three forces all stay below this fraction of the largest force
             magnitude of the series is reported without an order, its error stated as its largest magnitude (e.g.
-            F_y of a pure longitudinal creepage: zero by the mesh's symmetry up to the solver's tolerances).
+            F_y of a pure longitudinal creepage: zero by the box's symmetry, up to 8e-4 of F_x measured, the
+            unstructured rest of the block not being symmetric).
 
     Returns:
         :class:`RollingSeries`; a failed level or an irregular series is a status. Serial only.
     """
     import dolfinx_solver  # noqa: F401
+    import numpy as np
 
     from fea.domain import rolling_block_domain
     from fea.friction import solve_rolling
@@ -178,7 +190,7 @@ def solve_rolling_series(
             )  # fmt: skip
         sol = solve_rolling(
             domain, normal, young_modulus_Pa, poisson_ratio, friction_coefficient, creepage,
-            step_m=spec.contact_size_m / 2, length_scale_m=short,
+            step_m=spec.contact_size_m / 2, length_scale_m=short, row_transport=True,
         )  # fmt: skip
         levels.append(
             {
@@ -186,6 +198,8 @@ def solve_rolling_series(
                 "dofs": sol.dofs,
                 "contact_nodes": len(sol.node_xy_m),
                 "creep_force_N": tuple(sol.creep_force_N),
+                "slip_nodes": int(np.count_nonzero(~sol.stick)),
+                "rows": len(np.unique(np.round(sol.node_xy_m[:, 1] / spec.contact_size_m))),
                 "status": sol.status,
                 "cpu_s": time.process_time() - t0,
             }
@@ -194,6 +208,21 @@ def solve_rolling_series(
             return RollingSeries(
                 "not-converged", f"n = {n:g}: rolling {sol.status}: {sol.message}", nan2, nan2, nan2, nan2, (), levels
             )
+    unresolved = [lv["n"] for lv in levels if 0 < lv["slip_nodes"] < lv["rows"]]
+    if unresolved:
+        return RollingSeries(
+            "unresolved",
+            f"n = {', '.join(f'{n:g}' for n in unresolved)}: fewer slip nodes than rows (the slip zone narrower than "
+            "a cell: the no-slip regime, whose singular trailing edge converges at an order below 1)",
+            nan2, nan2, nan2, nan2, (), levels,
+        )  # fmt: skip
+    if all(lv["slip_nodes"] == lv["contact_nodes"] for lv in levels):
+        final = levels[-1]["creep_force_N"]
+        spread = tuple(max(abs(lv["creep_force_N"][k] - final[k]) for lv in levels) for k in (0, 1))
+        return RollingSeries(
+            "ok", "the whole patch slides on every mesh: F = mu P along the slip (error: the levels' spread)",
+            tuple(final), spread, tuple(final), nan2, (), levels,
+        )  # fmt: skip
     estimates = []
     magnitude = max(math.hypot(*lv["creep_force_N"]) for lv in levels)
     for k in (0, 1):

@@ -18,8 +18,8 @@ along a row, and every mesh of a series n, r n, r^2 n is the same grid scaled by
 (Carter's) situation, where the error falls at first order.
 
 The box half-sizes are whole numbers of cells: X = ceil(rho_0 a/h) h, Y = ceil(rho_0 b/h) h,
-Z = ceil(rho_z min(a, b)/h) h (rho_0 = ``box_radius``, rho_z = ``box_depth``), so the box covers the patch and the transport's reach (a + dq) and
-keeps its shape to within one cell along a series.
+Z = ceil(rho_z min(a, b)/h) h (rho_0 = ``box_radius``, rho_z = ``box_depth``), so the box covers the patch and the
+transport's reach (a + dq) and keeps its shape to within one cell along a series.
 
 Edge-fitted rows (``fit_edge``, :func:`fit_rows_to_edge`): the grid alone leaves one irregular term. The patch edge
 x_e(y_j) = a sqrt(1 - y_j^2/b^2) of row j falls at a fraction of a cell that changes from row to row and from mesh to
