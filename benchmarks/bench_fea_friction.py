@@ -242,6 +242,7 @@ def structured_rows() -> list[dict]:
                         "dofs": sol.dofs,
                         "contact_nodes": len(sol.node_xy_m),
                         "stick_nodes": int(sol.stick.sum()),
+                        "rows": len({round(float(y) / spec.contact_size_m) for y in sol.node_xy_m[:, 1]}),
                         "mesh_normal_cpu_s": mesh_cpu,
                         "cpu_s": cpu,
                         "creep_force_N": force,
@@ -274,11 +275,13 @@ def structured_estimates(rows: list[dict]) -> list[dict]:
                 else math.nan
             )
             band = three[-1]["reference_relative_error"] * abs(ref)
+            # fea.rolling_series's rule: no error stated unless every level resolves the slip zone
+            resolved = all(v["contact_nodes"] - v["stick_nodes"] >= v["rows"] for v in three)
             out.append(
                 {
                     "series": series,
                     "meshes": [v["n"] for v in three],
-                    "status": est.status,
+                    "status": est.status if resolved else "unresolved",
                     "observed_order": est.observed_order,
                     "error_N": true_error,
                     "reference_band_N": band,
@@ -375,6 +378,9 @@ def markdown(data: dict) -> str:
             "Richardson from three consecutive meshes (ratio 1.5; 13.5 = 1.5 x 9): observed order p, the error of the",
             "finest mesh against the BEM, the estimates |F_3 - F_2|/(r^q - 1) with q = 1 (Carter's first order; the",
             "stated error of fea.rolling_series) and q = p, and whether each brackets the error within the BEM's band.",
+            "Status as fea.rolling_series gives it: 'unresolved' when a level has fewer slip nodes than face rows in",
+            "contact (the slip zone narrower than a cell), 'irregular' when the differences change sign or p is",
+            "outside [0.5, 4]; only 'ok' rows state an error.",
             "",
             "| series | meshes | status | p | error [N] (BEM band) | estimate q = 1 [N] | estimate q = p [N] | "
             "extrapolated (p) error | q = 1 brackets | q = p brackets |",

@@ -114,7 +114,7 @@ def rolling_block_domain(spec, comm=None, limits: QualityLimits | None = None) -
     msh = data.mesh
     if spec.fit_edge:
         x = msh.geometry.x
-        cells = msh.geometry.dofmap
+        cells = np.asarray(msh.geometry.dofmaps[0])
         before = _tet_volumes(x, cells)
         x[:] = fit_rows_to_edge(spec, x)
         ratio = float(np.min(_tet_volumes(x, cells) / before, initial=np.inf))

@@ -208,7 +208,23 @@ def solve_rolling_series(
             return RollingSeries(
                 "not-converged", f"n = {n:g}: rolling {sol.status}: {sol.message}", nan2, nan2, nan2, nan2, (), levels
             )
-    unresolved = [lv["n"] for lv in levels if 0 < lv["slip_nodes"] < lv["rows"]]
+    return series_from_levels(levels, elements, insignificant_fraction=insignificant_fraction)
+
+
+def series_from_levels(levels: list, elements, *, insignificant_fraction: float = 5e-3) -> RollingSeries:
+    """The decision of :func:`solve_rolling_series` from its three levels (module docstring: statuses and rules).
+
+    Args:
+        levels: per mesh, coarse to fine: {"n", "creep_force_N": (F_x, F_y), "contact_nodes", "slip_nodes",
+            "rows" (face rows holding contact nodes), ...}.
+        elements: (n_1, n_2, n_3).
+        insignificant_fraction: see :func:`solve_rolling_series`.
+    """
+    nan2 = (math.nan, math.nan)
+    if all(lv["creep_force_N"] == (0.0, 0.0) for lv in levels):
+        zero = (0.0, 0.0)
+        return RollingSeries("ok", "no creepage: F = 0 on every mesh", zero, zero, zero, nan2, (), levels)
+    unresolved = [lv["n"] for lv in levels if lv["slip_nodes"] < lv["rows"]]
     if unresolved:
         return RollingSeries(
             "unresolved",

@@ -24,11 +24,11 @@ transport's reach (a + dq) and keeps its shape to within one cell along a series
 Edge-fitted rows (``fit_edge``, :func:`fit_rows_to_edge`): the grid alone leaves one irregular term. The patch edge
 x_e(y_j) = a sqrt(1 - y_j^2/b^2) of row j falls at a fraction of a cell that changes from row to row and from mesh to
 mesh (the lattice points of an ellipse; near y = 0 the edge is stationary, so neighbouring rows share the fraction
-and their edge errors add up instead of averaging out). Measured at 4/6/8/9 elements per semi-axis on the grid
-without the fit: +10.8/+8.1/+5.2/+3.7 % at xi = 5e-4 and +12.6/+10.7/+6.4/+5.7 % at xi = 5e-5 against the BEM, not a
-regular series (the differences grow from 4-6 to 6-9). With the rows' nodes moved along x so that each row's m-th
-node lies on x_e (m = round(x_e/h)), the series is monotone with an observed order of about 1.6-1.9
-(benchmarks/results/fea_friction.md).
+and their edge errors add up instead of averaging out). Measured on the Hertz circle against the BEM at 4/6/9
+elements per semi-axis on the grid without the fit: +12.1/+8.7/+3.9 % at xi = 5e-4 and +14.6/+11.3/+6.6 % at
+xi = 5e-5, not a regular series (the differences grow from 4-6 to 6-9). With the rows' nodes moved along x so that
+each row's m-th node lies on x_e (m = round(x_e/h)): +11.3/+5.8/+2.7/+1.1 % at 4/6/9/13.5 (xi = 5e-4), observed
+order 1.45 (4/6/9) and 1.56 (6/9/13.5) (benchmarks/results/fea_friction.md).
 
 Physical groups (named): ``body`` (3-D, both volumes), ``contact`` (the face z = 0, both parts), ``base`` (z = -L).
 """
