@@ -362,6 +362,8 @@ def markdown(data: dict) -> str:
             "component along the creepage on the wheel; cross = the other component (zero by symmetry). CPU s: the",
             "rolling solve (mesh and normal solve beside it).",
             "",
+            f"Measured on: {data.get('structured_machine', data['machine'])}.",
+            "",
             "| case | status | DOFs | contact (stick) nodes | CPU s (mesh+normal) | force [N] | cross [N] | "
             "BEM [N] | error |",
             "| --- | --- | ---: | ---: | ---: | ---: | ---: | --- | ---: |",
@@ -376,8 +378,9 @@ def markdown(data: dict) -> str:
         lines += [
             "",
             "Richardson from three consecutive meshes (ratio 1.5; 13.5 = 1.5 x 9): observed order p, the error of the",
-            "finest mesh against the BEM, the estimates |F_3 - F_2|/(r^q - 1) with q = 1 (Carter's first order; the",
-            "stated error of fea.rolling_series) and q = p, and whether each brackets the error within the BEM's band.",
+            "finest mesh against the BEM, the estimates |F_3 - F_2|/(r^q - 1) with q = 1 (Carter's first order;",
+            "fea.rolling_series states q = min(p, 1)) and q = p, and whether each brackets the error within the BEM's",
+            "band.",
             "Status as fea.rolling_series gives it: 'unresolved' when a level has fewer slip nodes than face rows in",
             "contact (the slip zone narrower than a cell), 'irregular' when the differences change sign or p is",
             "outside [0.5, 4]; only 'ok' rows state an error.",
