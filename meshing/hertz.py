@@ -39,6 +39,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from meshing.session import gmsh_number, set_size_field
+
 SYMMETRIES = ("quarter", "full")
 
 
@@ -212,10 +214,6 @@ def build_hertz_pair(model, spec: HertzBlockSpec) -> dict[str, tuple[int, int]]:
 
 def _size_field(model, spec: HertzBlockSpec) -> None:
     """MathEval size field of the module docstring (refined box around the expected patch, bounded grading)."""
-
-    def num(value):
-        return f"{float(value):.17g}"
-
     r0 = spec.refine_radius
     h_max = spec.half_width_m / 3.0
     boxes = spec.refine_boxes_m or ((*spec.center_m, spec.semi_axis_long_m, spec.semi_axis_lat_m),)
@@ -224,13 +222,11 @@ def _size_field(model, spec: HertzBlockSpec) -> None:
     sized = [(xc, yc, r0 * a, r0 * b, spec.contact_size_m) for xc, yc, a, b in boxes] + list(spec.peak_boxes_m)
     terms = []
     for xc, yc, a, b, size in sized:
-        dx = f"max(abs(x-({num(xc)}))-{num(a)},0)"
-        dy = f"max(abs(y-({num(yc)}))-{num(b)},0)"
-        dz = f"max(abs(z)-{num(min(a, b))},0)"
-        terms.append(f"{num(size)}+{num(spec.grading)}*sqrt({dx}^2+{dy}^2+{dz}^2)")
-    expression = num(h_max)
+        dx = f"max(abs(x-({gmsh_number(xc)}))-{gmsh_number(a)},0)"
+        dy = f"max(abs(y-({gmsh_number(yc)}))-{gmsh_number(b)},0)"
+        dz = f"max(abs(z)-{gmsh_number(min(a, b))},0)"
+        terms.append(f"{gmsh_number(size)}+{gmsh_number(spec.grading)}*sqrt({dx}^2+{dy}^2+{dz}^2)")
+    expression = gmsh_number(h_max)
     for term in terms:  # gmsh's MathEval min takes two arguments
         expression = f"min({expression},{term})"
-    field = model.mesh.field.add("MathEval")
-    model.mesh.field.setString(field, "F", expression)
-    model.mesh.field.setAsBackgroundMesh(field)
+    set_size_field(model, expression)

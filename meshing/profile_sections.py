@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshing.session import gmsh_number, set_size_field
+
 SECTION_KINDS = ("rail", "wheel")
 
 
@@ -194,11 +196,6 @@ def build_profile_section(
     h_c = spec.contact_size_m
     h_max = max(d, spec.half_width_m, spec.half_length_m) / 4.0
 
-    def num(value):
-        return f"{float(value):.17g}"
-
-    rho2 = f"((x/{num(a)})^2+(y/{num(b)})^2+(z/{num(c)})^2)"
-    field = model.mesh.field.add("MathEval")
-    model.mesh.field.setString(field, "F", f"min({num(h_max)}, {num(h_c)}*sqrt(1+({rho2}/1.69)^2))")
-    model.mesh.field.setAsBackgroundMesh(field)
+    rho2 = f"((x/{gmsh_number(a)})^2+(y/{gmsh_number(b)})^2+(z/{gmsh_number(c)})^2)"
+    set_size_field(model, f"min({gmsh_number(h_max)}, {gmsh_number(h_c)}*sqrt(1+({rho2}/1.69)^2))")
     return groups

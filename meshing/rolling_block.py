@@ -38,6 +38,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from meshing.session import gmsh_number, set_size_field
+
 
 @dataclass(frozen=True)
 class RollingBlockSpec:
@@ -181,13 +183,10 @@ def build_rolling_block(model, spec: RollingBlockSpec) -> dict[str, tuple[int, i
     add(2, flat_at(0.0), "contact")
     add(2, flat_at(-half), "base")
 
-    def num(value):
-        return f"{float(value):.17g}"
-
-    d = f"sqrt(max(abs(x)-{num(bx)},0)^2+max(abs(y)-{num(by)},0)^2+max(abs(z+{num(bz / 2)})-{num(bz / 2)},0)^2)"
-    field = model.mesh.field.add("MathEval")
-    model.mesh.field.setString(field, "F", f"min({num(half / 3)},{num(h)}+{num(spec.grading)}*{d})")
-    model.mesh.field.setAsBackgroundMesh(field)
+    dx, dy = f"max(abs(x)-{gmsh_number(bx)},0)", f"max(abs(y)-{gmsh_number(by)},0)"
+    dz = f"max(abs(z+{gmsh_number(bz / 2)})-{gmsh_number(bz / 2)},0)"
+    d = f"sqrt({dx}^2+{dy}^2+{dz}^2)"
+    set_size_field(model, f"min({gmsh_number(half / 3)},{gmsh_number(h)}+{gmsh_number(spec.grading)}*{d})")
     return groups
 
 

@@ -60,3 +60,18 @@ def generate(model, dim: int = 3, optimize: bool = True) -> None:
     model.mesh.generate(dim)
     if optimize and dim == 3:
         model.mesh.optimize("")
+
+
+def gmsh_number(value) -> str:
+    """A number as gmsh's MathEval expressions read it back exactly (17 significant digits)."""
+    return f"{float(value):.17g}"
+
+
+def set_size_field(model, expression: str) -> int:
+    """A MathEval size field ``expression`` (of x, y, z; numbers written by :func:`gmsh_number`) set as the background
+    mesh size of ``model``; returns the field's tag.
+    """
+    field = model.mesh.field.add("MathEval")
+    model.mesh.field.setString(field, "F", expression)
+    model.mesh.field.setAsBackgroundMesh(field)
+    return field

@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from meshing.session import gmsh_number, set_size_field
+
 
 @dataclass(frozen=True)
 class SlabSpec:
@@ -80,12 +82,7 @@ def build_slab(model, spec: SlabSpec) -> dict[str, tuple[int, int]]:
     add(2, [sides[0]], "base")
     add(2, [surface, back], "symmetry_y")
 
-    def num(value):
-        return f"{float(value):.17g}"
-
     r0 = spec.refine_radius * spec.semi_axis_m
-    d = f"sqrt(max(abs(x)-{num(r0)},0)^2+max(abs(z)-{num(r0)},0)^2)"
-    field = model.mesh.field.add("MathEval")
-    model.mesh.field.setString(field, "F", f"min({num(half / 3)},{num(h_c)}+{num(spec.grading)}*{d})")
-    model.mesh.field.setAsBackgroundMesh(field)
+    d = f"sqrt(max(abs(x)-{gmsh_number(r0)},0)^2+max(abs(z)-{gmsh_number(r0)},0)^2)"
+    set_size_field(model, f"min({gmsh_number(half / 3)},{gmsh_number(h_c)}+{gmsh_number(spec.grading)}*{d})")
     return groups
