@@ -151,3 +151,16 @@ def test_kpec_grid_error_recorded_and_judged(model, probe):
     assert (
         contact_grid_check("ok", "reached t = 1 s", {**stats, "grid_error": {**grid, "largest_force": 0.01}})[0] == "ok"
     )
+
+
+def test_a_grid_error_in_another_form_counts_as_not_estimated(model):
+    """A user model's ``extra["grid_error"]`` without the BEM's form (estimated, relative forces, tolerance, largest)
+    is counted as not estimated, not read (no KeyError inside the run)."""
+    from types import SimpleNamespace
+
+    callback = model.callback
+    before = dict(callback.grid_error)
+    for grid in ({"estimated": True, "relative": "2 %"}, {"estimated": True, "relative": {"normal_force_N": 0.01}}):
+        callback._record_grid_error(SimpleNamespace(extra={"grid_error": grid}, status="ok"), 0.0)
+    assert callback.grid_error["not_estimated"] == before["not_estimated"] + 2
+    assert callback.grid_error["estimated"] == before["estimated"]

@@ -115,18 +115,20 @@ class PatchCallback:
         """Keep the run's largest grid-error estimate of a model that states one per solve (``extra["grid_error"]``:
         the BEM's bem.model.grid_error_estimate, KPEC's the same on its own companion grids) of the forces (normal
         and creep force, relative as the model states them) and of all its quantities, and count the solves above
-        their ``grid_tolerance`` and those not estimated (summary.json ``discretisation_errors``).
+        their ``grid_tolerance`` and those not estimated (summary.json ``discretisation_errors``). A user model's
+        ``grid_error`` in another form counts as not estimated.
         """
         grid = (result.extra or {}).get("grid_error")
-        if grid is None or result.status == "no-contact":
+        if not isinstance(grid, dict) or result.status == "no-contact":
             return
-        if not grid.get("estimated"):
+        rel = grid.get("relative")
+        stated = isinstance(rel, dict) and "normal_force_N" in rel and "creep_force_N" in rel
+        if not (grid.get("estimated") and stated and "tolerance" in grid and "largest_relative" in grid):
             self.grid_error["not_estimated"] += 1
             return
         record = self.grid_error
         record["estimated"] += 1
         record["tolerance"] = grid["tolerance"]
-        rel = grid["relative"]
         force = max(rel["normal_force_N"], rel["creep_force_N"])
         if force > record["largest_force"]:
             record["largest_force"], record["t_s"] = float(force), float(t_s)
