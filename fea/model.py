@@ -23,7 +23,8 @@ semi-axis, sized by Hertz's semi-axes at the normal force, each with its own fri
 the finest, on the wheel in the contact frame, with its first-order Richardson error; about 25 s CPU at 4/6/9 on the
 Hertz circle). Its stated error goes where every rung states its errors (``extra["discretisation_error"]
 ["relative_error"]["creep_force_long"]`` and ``["creep_force_lat"]``: |(e_x, e_y)| / max(|F|, 0.01 mu N), the BEM's
-scale), the series in ``extra["tangential"]``. Every other case, and a series whose status is not "ok"
+scale; a stated error above ``mesh_tolerance`` makes the status "mesh-tolerance-not-met", as the normal problem's),
+the series in ``extra["tangential"]``. Every other case, and a series whose status is not "ok"
 ("unresolved": the slip zone narrower than a cell, e.g. the linear range; "irregular"; "not-converged"), gives creep
 forces None, ``extra["tangential"]["status"]`` and ``["message"]`` saying why. Spin is not solved: the series was
 measured against the BEM at pure xi and eta only (docs/models.md, FEA with Coulomb friction). The normal problem's
@@ -987,9 +988,17 @@ def _with_rolling(result, geometry, creepage, material, normal_force_N, opts, co
     info["creep_force_method"] = method
     extra["discretisation_error"] = info
     message = f"{result.message}; creep forces from the rolling series, stated error {relative:.2%}"
+    status = result.status
+    if opts.mesh_tolerance is not None and relative > opts.mesh_tolerance:
+        # as the normal problem's series: a solution with a larger error than asked (the levels are fixed options)
+        message += (
+            f" above mesh_tolerance = {opts.mesh_tolerance:g} at rolling_elements = "
+            f"{'/'.join(f'{n:g}' for n in opts.rolling_elements)} (finer levels, e.g. 6/9/13.5, state less)"
+        )
+        status = "mesh-tolerance-not-met" if status == "ok" else status
     return dataclasses.replace(
-        result, creep_force_long_N=float(fx), creep_force_lat_N=float(fy), message=message, extra=extra,
-        wall_time_s=time.perf_counter() - t0,
+        result, creep_force_long_N=float(fx), creep_force_lat_N=float(fy), status=status, message=message,
+        extra=extra, wall_time_s=time.perf_counter() - t0,
     )  # fmt: skip
 
 

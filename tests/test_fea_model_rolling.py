@@ -126,3 +126,27 @@ def test_bad_rolling_options_are_one_line_errors(options, match):
     with pytest.raises(ValueError, match=match) as info:
         FeaModel.check_options(options)
     assert "\n" not in str(info.value)
+
+
+def test_a_stated_creep_error_above_mesh_tolerance_is_a_status(monkeypatch):
+    """A regular series (fabricated: F_x -1211.0/-1171.0/-1146.4 N, observed order 1.2, stated 4.3 %) whose stated error is above
+    ``mesh_tolerance``: creep forces given, status "mesh-tolerance-not-met" as the normal problem's series."""
+    import fea.rolling_series
+    from fea.model import _with_rolling
+    from fea.rolling_series import series_from_levels
+
+    levels = [
+        {"n": n, "creep_force_N": (f, 0.0), "slip_nodes": 20, "contact_nodes": 60, "rows": 7}
+        for n, f in ((4.0, -1211.0), (6.0, -1171.0), (9.0, -1146.4))
+    ]
+    monkeypatch.setattr(
+        fea.rolling_series, "solve_rolling_series", lambda *a, **k: series_from_levels(levels, (4.0, 6.0, 9.0))
+    )
+    creepage = Creepage(longitudinal=XI)
+    for tolerance, status in ((0.04, "mesh-tolerance-not-met"), (0.05, "ok")):
+        opts = FeaOptions.from_mapping({"mesh_tolerance": tolerance})
+        out = _with_rolling(_normal_result(), CIRCLE, creepage, STEEL, FORCE_N, opts, None, time.perf_counter())
+        assert out.creep_force_long_N == -1146.4 and out.creep_force_lat_N == 0.0
+        relative = out.extra["discretisation_error"]["relative_error"]["creep_force_long"]
+        assert relative == pytest.approx(24.6 / 0.5 / 1146.4)  # |F_3 - F_2| / (1.5 - 1) over |F|
+        assert out.status == status and out.extra["tangential"]["status"] == "ok"
