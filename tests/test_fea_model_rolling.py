@@ -129,8 +129,8 @@ def test_bad_rolling_options_are_one_line_errors(options, match):
 
 
 def test_a_stated_creep_error_above_mesh_tolerance_is_a_status(monkeypatch):
-    """A regular series (fabricated: F_x -1211.0/-1171.0/-1146.4 N, observed order 1.2, stated 4.3 %) whose stated error is above
-    ``mesh_tolerance``: creep forces given, status "mesh-tolerance-not-met" as the normal problem's series."""
+    """A regular series (fabricated: F_x -1211.0/-1171.0/-1146.4 N, observed order 1.2, stated 4.3 %) whose stated
+    error is above ``mesh_tolerance``: creep forces given, status "mesh-tolerance-not-met" as the normal problem's."""
     import fea.rolling_series
     from fea.model import _with_rolling
     from fea.rolling_series import series_from_levels
