@@ -6,20 +6,26 @@ repeated up to 5 times within 0.2 s and the shortest wall time kept) and compare
 
 * relative errors of the normal force, the max pressure and the contact area: |v / v_ref - 1|;
 * the creep-force error |F - F_ref| / max(|F_ref|, 0.01 mu N_ref) with F = (Fx, Fy) (None where the model gives
-  no creep forces: the FEA, whose 3-D rolling creep force has no stated error yet, see :data:`FEA_CREEP_STATUS`);
+  no creep forces: the FEA where its rolling series gives none, see :data:`FEA_CREEP_STATUS`; the FEA's creep
+  forces of a quadric patch with longitudinal or lateral creepage and no spin come from its rolling mesh series with
+  a stated error, fea.model "Creep forces", and are judged like every rung's);
 * the pressure-field error ||p - p_ref||_2 / ||p_ref||_2 on the reference's grid (model field bilinear, 0
   outside its grid) where both fields exist and the side has one patch;
 * ``error``: the largest of these (field excluded) over the quantities the reference has; None when the model
   cannot give one of them (then the run meets no tolerance);
 * ``normal_error``: the largest of the normal-force, max-pressure and area errors (the quantities every rung,
-  the FEA included, solves and states): the FEA's error on a creep case, where its creep forces are a status
-  (``creep_status``), shown in the tolerance table's FEA column and in the plots (hollow markers, off the front);
+  the FEA included, solves and states): the FEA's error on a creep case where its creep forces are a status
+  (``creep_status``: ``error-not-stated (<the series' status>)``, e.g. "unresolved" in the linear range or
+  "not-solved" with spin), shown in the tolerance table's FEA column and in the plots (hollow markers, off the
+  front);
 * ``result_status``: the status of the model's own result(s) on the side ("ok", or e.g. the FEA's
   "mesh-tolerance-not-met" when its stated error is above the run's mesh tolerance within its budget, the BEM's
   "warning" when its grid error is above its grid tolerance): the run's ``status`` says the solve succeeded and its
   numbers are used, this one whether the model met its own tolerance (both in the row);
 * ``stated_check``: for a model that states its error, whether the error against the reference is within the
-  stated error plus the reference's own, per quantity (an understated error is named, never hidden).
+  stated error plus the reference's own, per quantity, the creep force (as the vector error above, against the
+  creep-force error the model states) included (an understated error is named, never hidden); ``stated`` the
+  largest stated error over the quantities the reference has.
 
 A wheelset case is solved as a whole (search, equilibrium, both wheels; the time is the whole case's) and
 compared on the reference's side (:mod:`comparisons.named_cases` on patch sums). A run that raises or does not
@@ -70,14 +76,28 @@ REFERENCE_KEYS = {
 }
 """stated-error quantity -> the named case's reference / uncertainty key."""
 FEA_CREEP_STATUS = "error-not-stated"
-"""The status of the FEA's creep forces on a case with a creep-force reference. The FEA's steady rolling solver
-(fea.friction.solve_rolling) meets Carter's 2-D solution with a first-order error that falls with the mesh, but its
-3-D creep force against the BEM on the Hertz circle is +14.8 / +6.2 / +6.3 / +4.1 % at 4 / 6 / 8 / 12 elements per
-semi-axis at xi = 5e-5 (benchmarks/results/fea_friction.md): not monotone and not a constant-ratio series, so no
-refinement series states its error (a Richardson estimate from the last two meshes, 2 |F_12 - F_8| / |F_12|, is
-1.8 % at xi = 5e-4 where the error is 2.9 %: understated), and at 12 elements one solve costs 70-90 s CPU. The
-bench therefore gives no FEA creep-force number: the row says why, and the FEA's error is stated on N, p max and
-area only (``normal_error``)."""
+"""The status of the FEA's creep forces on a case with a creep-force reference where the FEA gives none, followed by
+the reason in parentheses, the status of its ``extra["tangential"]`` (:func:`fea_creep_status`). The FEA's creep
+forces come from its rolling mesh series (fea.rolling_series via fea.model "Creep forces": a quadric patch under load
+control with longitudinal or lateral creepage, no spin), with a stated first-order Richardson error; where that
+series gives none they are None: "unresolved" (the slip zone narrower than a cell on a level of the series, e.g. the
+linear range, creep-long-small), "irregular", "not-converged", or "not-solved" (spin: the series is measured against
+the BEM at pure xi and eta only; a sampled patch; a wheelset case under approach control). Such a run's error is
+stated on N, p max and area only (``normal_error``)."""
+CREEP_ERROR_NAMES = ("creep_force_long", "creep_force_lat")
+"""Stated-error quantities (comparisons.stated_errors) of the creep force; the bench's creep error is the vector's."""
+
+
+def fea_creep_status(results) -> str:
+    """``FEA_CREEP_STATUS`` with the reason the FEA's results give no creep forces (their ``extra["tangential"]``
+    statuses), e.g. "error-not-stated (unresolved)".
+    """
+    reasons = []
+    for result in results:
+        tangential = (result.extra or {}).get("tangential")
+        reason = tangential.get("status") if isinstance(tangential, dict) else None
+        reasons.append(reason or "not-solved")
+    return f"{FEA_CREEP_STATUS} ({', '.join(dict.fromkeys(reasons))})" if reasons else FEA_CREEP_STATUS
 
 
 @dataclass
@@ -212,6 +232,14 @@ def stated_check(named, errors: dict, stated: dict | None) -> dict | None:
             continue
         allowed = own + named.uncertainty.get(REFERENCE_KEYS[name], 0.0)
         out[name] = {"error": error, "allowed": allowed, "holds": error <= allowed * (1 + 1e-9) + 1e-12}
+    error = errors.get("err_creep_force")
+    own = [stated[n] for n in CREEP_ERROR_NAMES if n in stated]
+    if error is not None and own:
+        # the vector error |F - F_ref| / max(|F_ref|, 0.01 mu N) against the model's stated creep-force error (the
+        # BEM and the FEA state the vector's, on the same scale) plus the reference's own
+        reference = max(named.uncertainty.get(k, 0.0) for k in ("creep_force_long_N", "creep_force_lat_N"))
+        allowed = max(own) + reference
+        out["creep_force"] = {"error": error, "allowed": allowed, "holds": error <= allowed * (1 + 1e-9) + 1e-12}
     return out or None
 
 
@@ -280,11 +308,14 @@ def run_one(named, model: str, resolution: str, options: dict) -> BenchRun:
     run.values = side_values(patches, named.side)
     run.errors, run.error = case_errors(named, run.values)
     run.stated = side_stated_errors([p[3] for p in patches if p[0] == named.side])
-    run.stated_error = largest(run.stated)
+    creep_case = "err_creep_force" in run.errors
+    run.stated_error = largest(
+        run.stated, ("normal_force", "max_pressure", "contact_area", *(CREEP_ERROR_NAMES if creep_case else ()))
+    )
     normal = [run.errors[k] for k in NORMAL_ERROR_KEYS if k in run.errors]
     run.normal_error = None if not normal or None in normal else max(normal)
-    if "err_creep_force" in run.errors and run.errors["err_creep_force"] is None and model == "fea":
-        run.creep_status = FEA_CREEP_STATUS
+    if creep_case and run.errors["err_creep_force"] is None and model == "fea":
+        run.creep_status = fea_creep_status(side_results)
     run.stated_check = stated_check(named, run.errors, run.stated)
     run.errors["err_field"] = field_error(named, patches)
     estimates = [p[3].extra.get("grid_error_estimate") for p in patches if p[0] == named.side]
@@ -402,6 +433,10 @@ def _fea_cell(runs: list[BenchRun], case: str, row: dict | None) -> str:
     text += f", stated {_stated(best)}{_check_word(best)}" + ("" if met else ")")
     if best.creep_status:
         text += f"; creep forces: {best.creep_status}"
+    elif best.errors.get("err_creep_force") is not None:
+        creep = (best.stated_check or {}).get("creep_force")
+        stated = "not stated" if creep is None else f"stated {_pct(creep['allowed'])} with the reference's own"
+        text += f"; creep forces {_pct(best.errors['err_creep_force'])} ({stated})"
     return text
 
 
@@ -469,11 +504,14 @@ def markdown(runs: list[BenchRun], cases, quick: bool, wall_s: float, plots: dic
         "elements, its finest grid, the A-2.2 cases' published 0.2 mm numbers being grid-dependent; or the BEM "
         "Richardson limit: column `source`); a reference's own error estimate is stated under its case. `error` is "
         "the largest of the normal-force, creep-force, max-pressure and area "
-        "errors; `-` where a model gives no such number (Hertz has no creep forces: 100 %; the FEA's creep forces are "
-        f"`{FEA_CREEP_STATUS}`, its error on N, p max and area in the FEA column and as hollow markers in the plots). "
+        "errors; `-` where a model gives no such number (Hertz has no creep forces: 100 %; the FEA's creep forces, "
+        "from its rolling mesh series on a quadric patch with longitudinal or lateral creepage and no spin, are "
+        f"`{FEA_CREEP_STATUS} (reason)` where that series states no error, its error on N, p max and area then in the "
+        "FEA column and as hollow markers in the plots). "
         "Times are wall times of one case solve (a wheelset case includes the contact search and equilibrium). "
         "`stated`: the largest relative discretisation error the model states for its own normal force, max pressure "
-        "and area (the FEA's, from its refinement series, fea.refinement; `not stated` for a model that states none); "
+        "and area, and creep force on a creep case (the FEA's, from its refinement series, fea.refinement, and its "
+        "rolling series, fea.rolling_series; `not stated` for a model that states none); "
         "a run's `error` against the reference should be within its stated error plus the reference's own.",
         "",
         *(
@@ -483,9 +521,9 @@ def markdown(runs: list[BenchRun], cases, quick: bool, wall_s: float, plots: dic
         ),
         "## Tolerance table: the fastest run meeting each tolerance",
         "",
-        "Column FEA: the FEA on the quantities it solves and states (N, p max, area; its creep forces, where the "
-        f"case has them, are `{FEA_CREEP_STATUS}`: the 3-D rolling solver's error is not yet stated, see "
-        "comparisons/bench.py FEA_CREEP_STATUS): the smallest tolerance met by the fastest such run, its error, its "
+        "Column FEA: the FEA on the normal problem (N, p max, area; its creep forces, where the case has them, "
+        f"follow: their error and stated error, or `{FEA_CREEP_STATUS} (reason)`, see comparisons/bench.py "
+        "FEA_CREEP_STATUS): the smallest tolerance met by the fastest such run, its error, its "
         "stated error and whether the stated error holds against the reference (error <= stated + the reference's "
         "own).",
         "",

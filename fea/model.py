@@ -16,8 +16,19 @@ Formulations (option ``formulation``):
 * ``"profiles"``: local rail and wheel sections meshed from the real profiles around the patch's
   contact points (:mod:`meshing.profile_sections`), same two-body solver; yaw is neglected.
 
-Frictionless in all cases: creep forces are None (``extra["tangential"]`` says why: the rolling solver of
-:mod:`fea.friction` does not yet state its 3-D error).
+Creep forces (option ``rolling``, default ``"series"``): a quadric patch under load control with longitudinal and/or
+lateral creepage and no spin, rigid formulation, Coulomb friction, one MPI rank, gets the steady-rolling creep force
+of :func:`fea.rolling_series.solve_rolling_series` (three rolling blocks at ``rolling_elements`` elements per
+semi-axis, sized by Hertz's semi-axes at the normal force, each with its own frictionless normal solve; the force of
+the finest, on the wheel in the contact frame, with its first-order Richardson error; about 25 s CPU at 4/6/9 on the
+Hertz circle). Its stated error goes where every rung states its errors (``extra["discretisation_error"]
+["relative_error"]["creep_force_long"]`` and ``["creep_force_lat"]``: |(e_x, e_y)| / max(|F|, 0.01 mu N), the BEM's
+scale; a stated error above ``mesh_tolerance`` makes the status "mesh-tolerance-not-met", as the normal problem's),
+the series in ``extra["tangential"]``. Every other case, and a series whose status is not "ok"
+("unresolved": the slip zone narrower than a cell, e.g. the linear range; "irregular"; "not-converged"), gives creep
+forces None, ``extra["tangential"]["status"]`` and ``["message"]`` saying why. Spin is not solved: the series was
+measured against the BEM at pure xi and eta only (docs/models.md, FEA with Coulomb friction). The normal problem's
+results (N, p max, area, stresses, their stated errors) are the normal solve's, on its own meshes.
 
 Peak box (sampled patches, rigid formulation, solved to ``mesh_tolerance``). The pressure top of a sampled patch can
 be much narrower than the patch: at the demo's peak (polygonal-wheel, 98 kN) a ridge about 2 mm wide across a patch
@@ -70,6 +81,7 @@ from rigid_dynamics.contact.types import ContactFields, ContactGeometry, Contact
 from rigid_dynamics.materials import Material
 
 FORMULATIONS = ("rigid", "two-body", "profiles")
+ROLLING = ("series", "off")
 
 
 @dataclass(frozen=True)
@@ -124,6 +136,10 @@ class FeaOptions:
         peak_refinement: a sampled patch solved to ``mesh_tolerance`` (rigid formulation) is meshed ``peak_refinement``
             times finer in a box around its pressure peak, located by one coarse solve first (module docstring,
             "Peak box"); 1: no peak box.
+        rolling: "series": the creep forces of a quadric patch with creepage from the rolling mesh series with their
+            stated error (module docstring, "Creep forces"); "off": creep forces None.
+        rolling_elements: (n_1, n_2, n_3) elements per semi-axis of the rolling series, at a constant ratio > 1 (e.g.
+            (6, 9, 13.5): about four times the cost, half the stated error).
     """
 
     quick: bool = False
@@ -150,6 +166,8 @@ class FeaOptions:
     grading: float = 0.4
     load_balanced: bool = False
     peak_refinement: float = 3.0
+    rolling: str = "series"
+    rolling_elements: tuple = (4.0, 6.0, 9.0)
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.mesh_size_factor) and self.mesh_size_factor > 0):
@@ -188,6 +206,19 @@ class FeaOptions:
             raise ValueError(f"grading = {self.grading!r}: expected a finite number > 0")
         if not (math.isfinite(self.peak_refinement) and self.peak_refinement >= 1):
             raise ValueError(f"peak_refinement = {self.peak_refinement!r}: expected a finite number >= 1")
+        if self.rolling not in ROLLING:
+            raise ValueError(f"rolling = {self.rolling!r}: expected one of {ROLLING}")
+        levels = self.rolling_elements
+        if (
+            not isinstance(levels, (tuple, list))
+            or len(levels) != 3
+            or not all(isinstance(v, (int, float)) and math.isfinite(v) and v >= 2 for v in levels)
+            or not levels[0] < levels[1] < levels[2]
+            or abs(levels[2] / levels[1] - levels[1] / levels[0]) > 1e-6 * levels[1] / levels[0]
+        ):
+            raise ValueError(
+                f"rolling_elements = {levels!r}: expected three numbers >= 2 at a constant ratio n2/n1 = n3/n2 > 1"
+            )
         if self.stress_points_m is not None:
             pts = np.asarray(self.stress_points_m, dtype=float)
             if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)):
@@ -259,6 +290,11 @@ OPTIONS = declare_dataclass(
             "(1: no peak box)",
             "minimum": 1,
         },
+        "rolling": {
+            "help": "creep forces of a quadric patch with creepage: the rolling mesh series (stated error) or off",
+            "choices": ROLLING,
+        },
+        "rolling_elements": {"help": "elements per semi-axis of the rolling series' three meshes (constant ratio)"},
     },
 )
 """Options of :class:`FeaModel`: types and defaults from :class:`FeaOptions`, ranges here (``__post_init__``
@@ -266,10 +302,12 @@ adds the rules that join two options)."""
 
 
 class FeaModel:
-    """Finite-element normal contact (elastic block with combined modulus vs rigid indenter)."""
+    """Finite-element contact (elastic block with combined modulus vs rigid indenter; creep forces of quadric patches
+    from the rolling series).
+    """
 
     name = "fea"
-    description = "finite elements (FEniCSx): normal contact, subsurface stresses"
+    description = "finite elements (FEniCSx): normal contact, subsurface stresses, creep forces of quadric patches"
     OPTIONS = OPTIONS
 
     @staticmethod
@@ -306,11 +344,13 @@ class FeaModel:
         options: Mapping | None = None,
         comm=None,
     ) -> ContactResult:
-        """Solve the normal contact of one patch.
+        """Solve the normal contact of one patch and, where the patch has them, its creep forces (module docstring,
+        "Creep forces").
 
         Args:
             geometry: patch geometry (quadric if ``geometry.undeformed`` is None).
-            creepage: stored in the result; friction is not modelled (creep forces None).
+            creepage: (xi, eta) of a quadric patch under load control: the creep forces of the rolling series;
+                otherwise stored in the result (creep forces None, ``extra["tangential"]`` says why).
             material: elastic constants (E* = G/(1 - nu)).
             normal_force_N: P (load control), N; None = approach control with ``geometry.approach_m``.
             options: see :class:`FeaOptions`.
@@ -319,7 +359,8 @@ class FeaModel:
         Returns:
             ContactResult with method "fea": normal force (sum of the nodal contact forces), max
             pressure (filtered nodal field), semi-axes (elliptic fit; quadric patches only), contact
-            area, pressure on a regular grid; extra holds dofs, iterations, stress maxima and depths.
+            area, pressure on a regular grid, creep forces (or None); extra holds dofs, iterations, stress maxima and
+            depths, ``tangential`` (the rolling series or why there is none).
         """
         t0 = time.perf_counter()
         opts = FeaOptions.from_mapping(options)
@@ -337,7 +378,7 @@ class FeaModel:
             peak["box"] = memo.get("peak_box") if memo is not None else None
             reused = self._reuse_series(key, solve_level, t0)
             if reused is not None:
-                return reused
+                return _with_rolling(reused, geometry, creepage, material, normal_force_N, opts, comm, t0)
         use_peak_box = (
             geometry.undeformed is not None
             and opts.formulation == "rigid"
@@ -384,7 +425,7 @@ class FeaModel:
                 "mesh": mesh,
                 "peak_box": peak["box"],
             })  # fmt: skip
-        return result
+        return _with_rolling(result, geometry, creepage, material, normal_force_N, opts, comm, t0)
 
     def level_solver(self, patch: tuple, comm=None, t0: float | None = None):
         """(solve_level, peak) for one patch = (geometry, creepage, material, normal force or None): solve_level(level
@@ -673,11 +714,10 @@ class FeaModel:
                 if opts.surface_traction
                 else "none (frictionless)"
             ),
-            "tangential": (
-                "not available: creep forces None (fea.friction.solve_rolling meets Carter's 2-D solution, but its "
-                "3-D creep force is 3-6 % stiff at 12 elements per semi-axis and not regular enough to state its "
-                "error; docs/models.md, FEA with Coulomb friction)"
-            ),
+            "tangential": {
+                "status": "not-solved",
+                "message": "creep forces None: one normal solve (FeaModel.solve adds the rolling series)",
+            },
             "young_modulus_Pa": young_body,
             "element_size_m": spec.contact_size_m,
             "block_half_width_m": spec.half_width_m,
@@ -833,6 +873,133 @@ class FeaModel:
             wall_time_s=time.perf_counter() - t0,
             extra=extra or {},
         )
+
+
+def _rolling_precondition(geometry, creepage, material, normal_force_N, opts, comm, result) -> str | None:
+    """Why the rolling series is not run for this patch (a sentence), or None when it is (module docstring, "Creep
+    forces").
+    """
+    if opts.rolling == "off":
+        return "option rolling = 'off'"
+    if creepage.longitudinal == 0.0 and creepage.lateral == 0.0 and creepage.spin_1_per_m == 0.0:
+        return "no creepage"
+    if creepage.spin_1_per_m != 0.0:
+        return (
+            f"spin {creepage.spin_1_per_m:g} 1/m: the rolling series is measured against the BEM at pure "
+            "longitudinal and lateral creepage only (docs/models.md, FEA with Coulomb friction)"
+        )
+    if geometry.undeformed is not None:
+        return "a sampled patch: the rolling block is built for a quadric patch centred at the contact frame's origin"
+    if opts.formulation != "rigid":
+        return f"formulation {opts.formulation!r}: the rolling series uses the rigid formulation's equivalent block"
+    if opts.surface_traction:
+        return "the tractions are prescribed (surface_traction), not solved"
+    if normal_force_N is None:
+        return (
+            "approach control: the series runs under load control (one series per evaluation of a wheelset "
+            "equilibrium would cost three rolling solves each)"
+        )
+    if material.friction is not None:
+        return "a friction law is given: the FEA's rolling solver takes Coulomb's law with one coefficient"
+    if comm is not None and comm.size != 1:
+        return f"{comm.size} MPI ranks: the rolling solver runs on one rank"
+    if not result.success or result.status == "no-contact":
+        return f"the normal solve ended {result.status}"
+    return None
+
+
+def _with_rolling(result, geometry, creepage, material, normal_force_N, opts, comm, t0) -> ContactResult:
+    """``result`` (the normal solve) with the creep forces of the rolling series and their stated error where the
+    patch has them (module docstring, "Creep forces"), else creep forces None and ``extra["tangential"]`` saying why.
+    """
+    extra = dict(result.extra)
+    why = _rolling_precondition(geometry, creepage, material, normal_force_N, opts, comm, result)
+    if why is not None:
+        status = "off" if opts.rolling == "off" else "no-creepage" if why == "no creepage" else "not-solved"
+        extra["tangential"] = {"status": status, "message": f"creep forces None: {why}"}
+        return dataclasses.replace(result, extra=extra)
+    from fea.hertz_reference import hertz_elliptic
+    from fea.rolling_series import solve_rolling_series
+
+    mu = material.friction_coefficient
+    xi, eta = creepage.longitudinal, creepage.lateral
+    a_curv, b_curv = geometry.curvature_long_1_per_m, geometry.curvature_lat_1_per_m
+    nu = material.poisson_ratio
+    hertz = hertz_elliptic(a_curv, b_curv, normal_force_N, material.combined_modulus_Pa)
+    method = (
+        "steady rolling (fea.friction.solve_rolling) on rolling blocks (meshing.rolling_block, edge-fitted rows) at "
+        f"{'/'.join(f'{n:g}' for n in opts.rolling_elements)} elements per semi-axis of Hertz's patch "
+        f"({hertz.semi_axis_long_m * 1e3:.4g} x {hertz.semi_axis_lat_m * 1e3:.4g} mm), each with its own normal "
+        "solve; first-order Richardson error of the finest (fea.rolling_series)"
+    )
+    t_series = time.perf_counter()
+    if mu == 0.0:
+        fx = fy = 0.0
+        tangential = {"status": "ok", "message": "no friction: F = 0", "method": "mu = 0", "creep_force_N": [0.0, 0.0],
+                      "stated_error_N": [0.0, 0.0]}  # fmt: skip
+        error = (0.0, 0.0)
+    else:
+        try:
+            series = solve_rolling_series(
+                hertz.semi_axis_long_m, hertz.semi_axis_lat_m, lambda x, y: a_curv * x**2 + b_curv * y**2,
+                material.combined_modulus_Pa * (1.0 - nu**2), nu, mu, normal_force_N, (xi, eta, 0.0),
+                elements=tuple(float(n) for n in opts.rolling_elements), initial_approach_m=hertz.approach_m,
+            )  # fmt: skip
+        except (ValueError, RuntimeError, ArithmeticError) as exc:  # a failed series is a status, never a number
+            extra["tangential"] = {
+                "status": "failed",
+                "message": f"creep forces None: the rolling series raised {type(exc).__name__}: {exc}",
+                "method": method,
+                "wall_time_s": time.perf_counter() - t_series,
+            }
+            return dataclasses.replace(result, extra=extra, wall_time_s=time.perf_counter() - t0)
+        tangential = {
+            "status": series.status,
+            "message": series.message,
+            "method": method,
+            "elements": [float(n) for n in opts.rolling_elements],
+            "creep_force_N": list(series.creep_force_N),
+            "stated_error_N": list(series.stated_error_N),
+            "extrapolated_N": list(series.extrapolated_N),
+            "observed_order": list(series.observed_order),
+            "levels": [{k: (list(v) if isinstance(v, tuple) else v) for k, v in lv.items()} for lv in series.levels],
+        }
+        fx, fy = series.creep_force_N
+        error = series.stated_error_N
+        ok = series.status == "ok" and all(math.isfinite(v) for v in (fx, fy, *error))
+        if not ok:
+            tangential["message"] = f"creep forces None: series {series.status}: {series.message}"
+            tangential["creep_force_N"] = tangential["stated_error_N"] = None  # a status, never a number
+            tangential["finest_level_force_N"] = list(series.creep_force_N)  # diagnostic, not a result
+            tangential["wall_time_s"] = time.perf_counter() - t_series
+            extra["tangential"] = tangential
+            return dataclasses.replace(result, extra=extra, wall_time_s=time.perf_counter() - t0)
+    scale = max(math.hypot(fx, fy), 0.01 * mu * result.normal_force_N)
+    relative = math.hypot(*error) / scale if scale > 0 else 0.0
+    tangential["relative_error"] = relative
+    tangential["wall_time_s"] = time.perf_counter() - t_series
+    extra["tangential"] = tangential
+    info = dict(extra.get("discretisation_error") or {})
+    info["relative_error"] = {
+        **(info.get("relative_error") or {}),
+        "creep_force_long": relative,
+        "creep_force_lat": relative,
+    }  # the creep force as a vector, against max(|F|, 0.01 mu N), as the BEM states it (comparisons.stated_errors)
+    info["creep_force_method"] = method
+    extra["discretisation_error"] = info
+    message = f"{result.message}; creep forces from the rolling series, stated error {relative:.2%}"
+    status = result.status
+    if opts.mesh_tolerance is not None and relative > opts.mesh_tolerance:
+        # as the normal problem's series: a solution with a larger error than asked (the levels are fixed options)
+        message += (
+            f" above mesh_tolerance = {opts.mesh_tolerance:g} at rolling_elements = "
+            f"{'/'.join(f'{n:g}' for n in opts.rolling_elements)} (finer levels, e.g. 6/9/13.5, state less)"
+        )
+        status = "mesh-tolerance-not-met" if status == "ok" else status
+    return dataclasses.replace(
+        result, creep_force_long_N=float(fx), creep_force_lat_N=float(fy), status=status, message=message,
+        extra=extra, wall_time_s=time.perf_counter() - t0,
+    )  # fmt: skip
 
 
 WINDOW_FRACTION = 0.6

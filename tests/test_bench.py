@@ -160,7 +160,7 @@ def test_fea_on_a_creep_case_has_a_creep_status_its_normal_error_and_a_checked_s
 
     monkeypatch.setattr(bench, "solve_contact_case", fake_solve)
     run = bench.run_one(named, "fea", "tol2%", {})
-    assert run.status == "ok" and run.creep_status == bench.FEA_CREEP_STATUS
+    assert run.status == "ok" and run.creep_status == f"{bench.FEA_CREEP_STATUS} (not-solved)"  # no reason given
     assert run.error is None  # it does not answer the case's creep-force question
     assert run.normal_error == pytest.approx(0.03)
     check = run.stated_check
@@ -174,3 +174,56 @@ def test_fea_on_a_creep_case_has_a_creep_status_its_normal_error_and_a_checked_s
     assert bench._plotted(run) and bench.pareto_front([run]) == []
     assert "(mesh-tolerance-not-met); creep forces error-not-stated" in bench._row_status(run)
     assert run.result_status == "mesh-tolerance-not-met" and "(mesh-tolerance-not-met)" in cell
+
+
+def _fea_creep_result(ref, creep_force_long_N, tangential, relative_creep=None):
+    """A synthetic FEA result on creep-long-mid: the reference's normal numbers, the given creep forces."""
+    from rigid_dynamics.contact.types import ContactResult
+
+    relative = {"normal_force": 0.0, "max_pressure": 0.01, "contact_area": 0.01}
+    if relative_creep is not None:
+        relative.update(creep_force_long=relative_creep, creep_force_lat=relative_creep)
+    return ContactResult(
+        method="fea", success=True, normal_force_N=ref["normal_force_N"], creep_force_long_N=creep_force_long_N,
+        creep_force_lat_N=None if creep_force_long_N is None else 0.0, max_pressure_Pa=ref["max_pressure_Pa"],
+        contact_area_m2=ref["contact_area_m2"], status="ok", message="",
+        extra={"discretisation_error": {"relative_error": relative}, "tangential": tangential},
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(("stated", "holds"), [(0.05, True), (0.01, False)])
+def test_fea_creep_forces_with_a_stated_error_are_judged_like_every_rung(monkeypatch, stated, holds):
+    """The FEA's creep forces from its rolling series (fea.model "Creep forces"): no creep status, the creep error
+    filled and in ``error``, the stated creep error in ``stated`` and checked (synthetic result, no solve)."""
+    named = load_named_case("creep-long-mid")
+    ref = named.reference
+    result = _fea_creep_result(ref, ref["creep_force_long_N"] * 1.03, {"status": "ok", "message": ""}, stated)
+    monkeypatch.setattr(bench, "solve_contact_case", lambda case, model, options: (
+        [("single", case.geometry, case.creepage, result)], True, ""))  # fmt: skip
+    run = bench.run_one(named, "fea", "tol5%", {})
+    assert run.creep_status is None
+    assert run.errors["err_creep_force"] == pytest.approx(0.03)
+    assert run.error == pytest.approx(0.03) and run.normal_error == pytest.approx(0.0, abs=1e-12)
+    assert run.stated_error == pytest.approx(max(stated, 0.01))
+    check = run.stated_check["creep_force"]
+    assert check["allowed"] == pytest.approx(stated + named.uncertainty["creep_force_long_N"])
+    assert check["holds"] is holds
+    assert ("UNDERSTATED (creep force)" in bench._check_word(run)) is not holds
+    assert bench.tolerance_table([run])["creep-long-mid"][0.05] is run  # it answers the case's question
+    cell = bench._fea_cell([run], "creep-long-mid", bench.fea_tolerance_table([run])["creep-long-mid"])
+    assert "creep forces 3 %" in cell and "error-not-stated" not in cell
+    assert "creep forces" not in bench._row_status(run)
+
+
+def test_fea_creep_status_names_the_series_reason(monkeypatch):
+    """An "unresolved" series (the slip zone narrower than a cell): creep forces None, the status with its reason."""
+    named = load_named_case("creep-long-small")
+    ref = named.reference
+    tangential = {"status": "unresolved", "message": "creep forces None: series unresolved: ..."}
+    result = _fea_creep_result(ref, None, tangential)
+    monkeypatch.setattr(bench, "solve_contact_case", lambda case, model, options: (
+        [("single", case.geometry, case.creepage, result)], True, ""))  # fmt: skip
+    run = bench.run_one(named, "fea", "tol5%", {})
+    assert run.creep_status == "error-not-stated (unresolved)" and run.error is None
+    assert run.errors["err_creep_force"] is None and "creep_force" not in (run.stated_check or {})
+    assert "creep forces error-not-stated (unresolved)" in bench._row_status(run)
