@@ -57,7 +57,7 @@ def run(
            "wall_s": wall}  # fmt: skip
     t = result.t
     late = t >= duration - window - 1e-12
-    if result.status != "ok" or not late.any():
+    if result.status not in ("ok", "warning") or not late.any():  # a warning's numbers stand with its message
         return out
     force = result.contact_force_N[late, 0, :]  # left wheel, main frame
     q, y = -force[:, 2], force[:, 1]
@@ -124,6 +124,8 @@ def formed() -> int:
             f"{r['y_over_q_mean']:.3f} | {r['y_over_q_max']:.2f} | {r['angle_range_rad'][0]:.2f}-"
             f"{r['angle_range_rad'][1]:.2f} rad | {r['wall_s']:.0f} s |"
         )
+    lines += ["", "Messages of the runs:", ""]
+    lines += [f"- {r['model']} ({r['patch_geometry']}), {1e3 * r['step_s']:.2f} ms: {r['message']}" for r in rows]
     write_text(OUT / "flange_aoa_formed.md", "\n".join(lines) + "\n")
     return 0
 
