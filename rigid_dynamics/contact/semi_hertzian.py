@@ -213,14 +213,15 @@ class KpecModel:
                 pen *= (normal_force_N / force) ** (1.0 / slope) if force > 0 else 2.0
                 x, y, h, p, contact, out = solve_at(pen)
         force = _force(p, x, y)
+        fn_kpec, p_max, curv_a, curv_b, y_mid, a_eq, b_eq, penetration = out
         if not contact.any():
-            if out[7] > 0.0:  # the gap overlaps (the kernel's penetration), yet no element carries pressure: a failure
+            if penetration > 0.0:  # the gap overlaps, yet no element carries pressure: a failure
                 return ContactResult(
                     method=self.name,
                     success=False,
                     status="no-pressure",
                     message=f"{self.name.upper()} put pressure on no element of a gap that overlaps by "
-                    f"{float(out[7]):.3g} m (its equivalent ellipse misses the deepest row)",
+                    f"{float(penetration):.3g} m (its equivalent ellipse misses the deepest row)",
                     normal_force_N=math.nan,
                     creepage=creepage,
                     wall_time_s=time.perf_counter() - start,
@@ -233,7 +234,6 @@ class KpecModel:
         elif friction_note is not None:
             message = f"{message}; {friction_note}"
         dx, dy = x[1] - x[0], y[1] - y[0]
-        fn_kpec, p_max, curv_a, curv_b, y_mid, a_eq, b_eq, penetration = out
         l1, l2, l3, a_fl, b_fl = simplified_flexibilities(
             contact, dx, dy, fn_kpec, g_mod, nu, mu, creepage.longitudinal, creepage.lateral, creepage.spin_1_per_m
         )
