@@ -324,10 +324,12 @@ is about twice the contact's extent, so about BEM_ELEMENTS^2 elements cover the 
 
 
 def _solves_gap(model) -> bool:
-    """Whether a contact model solves an undeformed distance (bem, fea, or declared ``solves_undeformed_distance``)."""
-    from rigid_dynamics.contact.wheelset_case import FIELD_MODELS
+    """Whether a contact model solves an undeformed distance (bem, fea, or declared ``solves_undeformed_distance``): the
+    static wheelset case's rule (wheelset_case._solves_undeformed_distance), so both form patches for the same models.
+    """
+    from rigid_dynamics.contact.wheelset_case import _solves_undeformed_distance
 
-    return bool(getattr(model, "solves_undeformed_distance", getattr(model, "name", "") in FIELD_MODELS))
+    return _solves_undeformed_distance(model)
 
 
 _FAILED = CallbackOutcome(0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan, np.nan, PATCH_ELLIPSE, np.nan, 1, NOT_FORMED)

@@ -161,13 +161,22 @@ def modal_cutoff_check(status: str, message: str, scene, tolerance: float) -> tu
     )
 
 
+def callback_grid_error(callback_stats, default_model: str = "the contact model") -> tuple[dict | None, str]:
+    """(the run's grid-error record, whose it is) from the callback's stats (callback.PatchCallback.stats): the
+    BEM's ``bem_grid_error`` ("BEM"), another model's ``grid_error`` (its name), or (None, ``default_model``).
+    """
+    stats = callback_stats or {}
+    if stats.get("bem_grid_error"):
+        return stats["bem_grid_error"], "BEM"
+    return stats.get("grid_error"), stats.get("model", default_model)
+
+
 def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, str]:
     """(status, message) with the BEM's grid judged: an "ok" run whose BEM patches were solved coarser than their
     ``grid_tolerance`` asks (the largest force estimate of a solve above it) ends "warning", naming the estimate; a
     run already warned names it too.
     """
-    stats = callback_stats or {}
-    grid = stats.get("bem_grid_error") or stats.get("grid_error")
+    grid, name = callback_grid_error(callback_stats)
     if (
         status not in ("ok", "warning")
         or not grid
@@ -175,9 +184,9 @@ def contact_grid_check(status: str, message: str, callback_stats) -> tuple[str, 
         or grid["largest_force"] <= grid["tolerance"]
     ):
         return status, message
-    if not stats.get("bem_grid_error"):
+    if name != "BEM":
         return "warning", (
-            f"{message}; {stats.get('model', 'the contact model')}'s grid-error estimate of the patch forces "
+            f"{message}; {name}'s grid-error estimate of the patch forces "
             f"{grid['largest_force']:.3g} (t = {grid['t_s']:.6g} s) exceeds its grid_tolerance = {grid['tolerance']:g}"
         )
     return "warning", (
@@ -272,11 +281,9 @@ def _contact_grid_error(result) -> dict:
     """The contact grid's statement: the BEM's own estimate of every solve in the loop (callback.PatchCallback
     keeps the largest), or "not estimated" for the other models.
     """
-    stats = result.callback_stats or {}
-    grid = stats.get("bem_grid_error") or stats.get("grid_error")
+    grid, name = callback_grid_error(result.callback_stats, result.contact_model)
     if not grid or not grid["estimated"]:
         return {"estimate": None, "method": f"not estimated ({result.contact_model})"}
-    name = "BEM" if stats.get("bem_grid_error") else stats.get("model", result.contact_model)
     return {
         "estimate": grid["largest_force"],
         "relative_to": f"each {name} patch's own normal and creep force (the creep force at least 0.01 mu F_N)",
